@@ -1,0 +1,172 @@
+//! Command-line options of `so3fft-bench`.
+//!
+//! Hand-written parser: the binary may only depend on std and the crate's own dependencies,
+//! so no argument-parsing crate is available.
+
+use so3fft::Rigor;
+use std::path::PathBuf;
+
+/// Runs per configuration when `--runs` is not given (smaller at large B, see [`Options::runs_for`]).
+pub const DEFAULT_RUNS: usize = 5;
+/// Runs per configuration under `--quick`.
+const QUICK_RUNS: usize = 3;
+/// Largest bandwidth `--quick` keeps: the smoke test must finish in seconds.
+const QUICK_MAX_BANDWIDTH: usize = 64;
+
+pub const USAGE: &str = "\
+usage: so3fft-bench [options]
+  --bandwidths LIST   comma-separated bandwidths B (default 16,32,64,128)
+  --threads LIST      comma-separated thread counts, 0 = all cores (default 1,2)
+  --runs N            timed runs per configuration (default 5; 3 at B = 256, 1 at B >= 512)
+  --csv PATH          CSV output file (default bench.csv)
+  --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default estimate)
+  --quick             CI smoke test: only B <= 64, 3 runs
+  -h, --help          print this help";
+
+/// Parsed benchmark options.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub bandwidths: Vec<usize>,
+    pub threads: Vec<usize>,
+    /// `Some` when the user chose the run count (then it is used at every B).
+    pub runs: Option<usize>,
+    pub csv: PathBuf,
+    pub rigor: Rigor,
+    pub quick: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            bandwidths: vec![16, 32, 64, 128],
+            threads: vec![1, 2],
+            runs: None,
+            csv: PathBuf::from("bench.csv"),
+            rigor: Rigor::Estimate,
+            quick: false,
+        }
+    }
+}
+
+impl Options {
+    /// Number of timed runs at bandwidth `b`.
+    ///
+    /// An explicit `--runs` wins. Otherwise the default shrinks with B because one transform
+    /// costs O(B^4): five runs at B = 512 would take minutes for little extra information.
+    pub fn runs_for(&self, b: usize) -> usize {
+        match self.runs {
+            Some(n) => n,
+            None if b <= 128 => DEFAULT_RUNS,
+            None if b <= 256 => 3,
+            None => 1,
+        }
+    }
+}
+
+/// What the command line asks for.
+pub enum Command {
+    Run(Options),
+    Help,
+}
+
+/// Parses the arguments after the program name. Accepts `--opt value` and `--opt=value`.
+pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String> {
+    let mut opts = Options::default();
+    let mut bandwidths_given = false;
+    let mut args = args.into_iter();
+    while let Some(arg) = args.next() {
+        let (name, inline) = match arg.split_once('=') {
+            Some((n, v)) if n.starts_with("--") => (n.to_string(), Some(v.to_string())),
+            _ => (arg.clone(), None),
+        };
+        let mut value = || {
+            inline
+                .clone()
+                .or_else(|| args.next())
+                .ok_or_else(|| format!("{name} needs a value"))
+        };
+        match name.as_str() {
+            "-h" | "--help" => return Ok(Command::Help),
+            "--quick" => opts.quick = true,
+            "--bandwidths" => {
+                opts.bandwidths = parse_list(&value()?, "--bandwidths")?;
+                bandwidths_given = true;
+            }
+            "--threads" => opts.threads = parse_list(&value()?, "--threads")?,
+            "--runs" => opts.runs = Some(parse_positive(&value()?, "--runs")?),
+            "--csv" => opts.csv = PathBuf::from(value()?),
+            "--rigor" => opts.rigor = parse_rigor(&value()?)?,
+            _ => return Err(format!("unknown option '{arg}'")),
+        }
+    }
+    if opts.quick {
+        apply_quick(&mut opts, bandwidths_given);
+    }
+    if opts.bandwidths.is_empty() {
+        return Err("no bandwidth left to run".into());
+    }
+    // Checked here because the memory estimate would overflow before the plan could refuse.
+    if let Some(&b) = opts
+        .bandwidths
+        .iter()
+        .find(|&&b| b == 0 || b > so3fft::MAX_BANDWIDTH)
+    {
+        return Err(format!(
+            "--bandwidths: {b} is not in 1..={}",
+            so3fft::MAX_BANDWIDTH
+        ));
+    }
+    Ok(Command::Run(opts))
+}
+
+/// `--quick` limits B to 64 (keeping a user list's small entries) and uses 3 runs unless
+/// `--runs` was given, so CI gets a smoke test of a few seconds.
+fn apply_quick(opts: &mut Options, bandwidths_given: bool) {
+    if bandwidths_given {
+        opts.bandwidths.retain(|&b| b <= QUICK_MAX_BANDWIDTH);
+    } else {
+        opts.bandwidths = vec![16, 32, 64];
+    }
+    opts.runs.get_or_insert(QUICK_RUNS);
+}
+
+fn parse_list(text: &str, what: &str) -> Result<Vec<usize>, String> {
+    text.split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| {
+            s.trim()
+                .parse::<usize>()
+                .map_err(|e| format!("{what}: '{s}': {e}"))
+        })
+        .collect()
+}
+
+fn parse_positive(text: &str, what: &str) -> Result<usize, String> {
+    match text.trim().parse::<usize>() {
+        Ok(0) => Err(format!("{what} must be at least 1")),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("{what}: '{text}': {e}")),
+    }
+}
+
+fn parse_rigor(text: &str) -> Result<Rigor, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "estimate" => Ok(Rigor::Estimate),
+        "measure" => Ok(Rigor::Measure),
+        "patient" => Ok(Rigor::Patient),
+        "exhaustive" => Ok(Rigor::Exhaustive),
+        _ => Err(format!(
+            "--rigor: '{text}' is not estimate, measure, patient or exhaustive"
+        )),
+    }
+}
+
+/// Lower-case name of a rigour, as accepted by `--rigor`.
+pub fn rigor_name(rigor: Rigor) -> &'static str {
+    match rigor {
+        Rigor::Estimate => "estimate",
+        Rigor::Measure => "measure",
+        Rigor::Patient => "patient",
+        Rigor::Exhaustive => "exhaustive",
+    }
+}

@@ -1,0 +1,40 @@
+//! # so3fft
+//!
+//! Fast Fourier transform on the rotation group SO(3) and its inverse, after Kostelec and
+//! Rockmore's FSOFT with the symmetry-clustered parallel discrete Wigner transform of
+//! Lux, Wülker and Chirikjian. Conventions, sample and coefficient layouts are SOFT 2.0's
+//! (see `SPEC.md`): samples `f(alpha_j1, beta_k, gamma_j2)` at index
+//! `k (2B)^2 + j1 (2B) + j2`, coefficients in `so3CoefLoc` order.
+//!
+//! ```
+//! use so3fft::{Plan, PlanOptions, Complex64};
+//! let b = 8;
+//! let plan = Plan::new(b, &PlanOptions::default()).unwrap();
+//! let mut coeffs = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
+//! coeffs[so3fft::coef_index(b, 3, -1, 2)] = Complex64::new(1.0, 0.5);
+//! let mut samples = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
+//! plan.inverse(&coeffs, &mut samples).unwrap();
+//! let mut back = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
+//! plan.forward(&samples, &mut back).unwrap();
+//! assert!((back[so3fft::coef_index(b, 3, -1, 2)] - coeffs[so3fft::coef_index(b, 3, -1, 2)]).norm() < 1e-13);
+//! ```
+
+#![warn(missing_docs)]
+
+mod dwt;
+mod error;
+mod fft;
+mod grid;
+mod plan;
+mod simd;
+mod symmetry;
+pub mod wigner;
+
+pub use error::{Error, Result};
+pub use fft::Rigor;
+pub use grid::{
+    alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
+};
+pub use num_complex::Complex64;
+pub use plan::{Direction, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
+pub use simd::Isa;

@@ -1,0 +1,561 @@
+//! Plans: everything that depends only on the bandwidth is computed once here, and
+//! executing a plan runs the two stages (FFTW over (alpha, gamma), DWT per cluster)
+//! chunk by chunk over mirrored pairs of beta slices.
+//!
+//! Beta slices are processed in chunks of `h` low slices `k` plus their mirrors
+//! `2B-1-k` (the Wigner-d symmetries pair `beta` with `pi - beta`), so the only large
+//! buffer is the chunk buffer of `2h` transformed slices, never a copy of the grid.
+
+use crate::dwt::{self, Lanes, Rec};
+use crate::error::{try_zeroed, Error, Result};
+use crate::fft::{AlignedBuf, ChunkFft, Rigor};
+use crate::grid::{block_start, num_coeffs, num_samples, weights};
+use crate::simd::Isa;
+use crate::symmetry::{clusters, Cluster};
+use crate::wigner::{rec_coeffs, start_norms, BetaTables, Ext};
+use num_complex::Complex64;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Largest bandwidth a plan accepts.
+pub const MAX_BANDWIDTH: usize = 2048;
+
+/// Which transforms a plan can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Direction {
+    /// Samples to coefficients only.
+    Forward,
+    /// Coefficients to samples only.
+    Inverse,
+    /// Both.
+    #[default]
+    Both,
+}
+
+/// Options for [`Plan::new`].
+#[derive(Clone, Debug, Default)]
+pub struct PlanOptions {
+    /// Which transforms the plan runs (default both).
+    pub direction: Direction,
+    /// Worker threads; 0 means all available cores.
+    pub threads: usize,
+    /// FFTW planner rigour.
+    pub rigor: Rigor,
+    /// Cap on the chunk buffer in bytes (`None`: the library default, see [`Plan::workspace_bytes`]).
+    pub max_workspace_bytes: Option<usize>,
+    /// Force an instruction set for the DWT kernels (`None`: the best this CPU has).
+    pub isa: Option<Isa>,
+}
+
+/// Wall time of each stage of one execution, in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    /// FFTW stage.
+    pub fft: f64,
+    /// Discrete Wigner transform stage (including gathers and scatters).
+    pub dwt: f64,
+    /// Whole call.
+    pub total: f64,
+}
+
+/// A precomputed SO(3) FFT of one bandwidth: weights, Wigner starting-value tables,
+/// cluster schedule, FFTW plans, worker pool and chunk buffer.
+///
+/// Execution methods take `&self`; a plan may be executed from several threads at once
+/// on different arrays (a concurrent call that finds the chunk buffer busy allocates its own).
+pub struct Plan {
+    b: usize,
+    direction: Direction,
+    threads: usize,
+    isa: Isa,
+    pool: rayon::ThreadPool,
+    clusters: Vec<Cluster>,
+    bt: BetaTables,
+    norms: Vec<Ext>,
+    /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight with the normalisation folded in.
+    wq: Vec<f64>,
+    /// FFTW plans per chunk size (the last chunk may be smaller): `(h, forward, inverse)`.
+    ffts: Vec<(usize, Option<ChunkFft>, Option<ChunkFft>)>,
+    /// Low beta slices per chunk.
+    chunk: usize,
+    buf: Mutex<Option<AlignedBuf>>,
+}
+
+/// Shared mutable pointer for disjoint parallel writes.
+#[derive(Clone, Copy)]
+struct SyncPtr<T>(*mut T);
+// SAFETY: used only for writes to disjoint index sets from different tasks.
+unsafe impl<T> Send for SyncPtr<T> {}
+unsafe impl<T> Sync for SyncPtr<T> {}
+
+impl<T> SyncPtr<T> {
+    /// The pointer (a method, so closures capture the whole `Sync` wrapper).
+    fn get(self) -> *mut T {
+        self.0
+    }
+}
+
+/// Per-task scratch, sized for the largest cluster and chunk.
+struct Scratch {
+    a: Vec<f64>,
+    c: Vec<f64>,
+    bb: Vec<f64>,
+    x: Vec<f64>,
+    p: Vec<f64>,
+    sc: Vec<f64>,
+    data: Vec<f64>,
+    out: Vec<f64>,
+}
+
+impl Scratch {
+    fn new(b: usize, nbp: usize) -> Scratch {
+        Scratch {
+            a: vec![0.0; b],
+            c: vec![0.0; b],
+            bb: vec![0.0; b],
+            x: vec![0.0; nbp],
+            p: vec![0.0; nbp],
+            sc: vec![0.0; nbp],
+            data: vec![0.0; nbp.max(b) * 16],
+            out: vec![0.0; nbp.max(b) * 16],
+        }
+    }
+}
+
+/// The beta slices of one chunk, in slot order: slots `0..h` hold betas `lo..lo+h`,
+/// slots `h..2h` the mirrored betas `2B-lo-h .. 2B-lo` (ascending), so slot `s` and
+/// slot `2h-1-s` hold `beta` and `pi - beta`.
+struct Chunk {
+    ks: Vec<usize>,
+    h: usize,
+}
+
+impl Chunk {
+    fn mirror(&self, s: usize) -> usize {
+        2 * self.h - 1 - s
+    }
+}
+
+fn default_workspace(b: usize) -> usize {
+    let grid_bytes = (num_samples(b) + num_coeffs(b)) * 16;
+    (512usize << 20).max(grid_bytes / 20)
+}
+
+impl Plan {
+    /// Make a plan for bandwidth `bandwidth` (1 ..= [`MAX_BANDWIDTH`]).
+    pub fn new(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+        let b = bandwidth;
+        if b == 0 || b > MAX_BANDWIDTH {
+            return Err(Error::InvalidBandwidth {
+                bandwidth: b,
+                max: MAX_BANDWIDTH,
+            });
+        }
+        let threads = if options.threads == 0 {
+            std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+        } else {
+            options.threads
+        };
+        if threads > 1024 {
+            return Err(Error::InvalidArgument(format!(
+                "{threads} threads requested (at most 1024)"
+            )));
+        }
+        let isa = options.isa.unwrap_or_else(Isa::detect);
+        if !isa.is_supported() {
+            return Err(Error::InvalidArgument(format!(
+                "instruction set {isa:?} not supported by this CPU"
+            )));
+        }
+        let n = 2 * b;
+        let slice_bytes = n * n * 16;
+        let budget = options
+            .max_workspace_bytes
+            .unwrap_or_else(|| default_workspace(b));
+        let chunk = (budget / (2 * slice_bytes)).clamp(1, b);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("so3fft-{i}"))
+            .build()
+            .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
+        let want_fwd = options.direction != Direction::Inverse;
+        let want_inv = options.direction != Direction::Forward;
+        let mut sizes = vec![chunk];
+        if b % chunk != 0 {
+            sizes.push(b % chunk);
+        }
+        let mut ffts = Vec::new();
+        for h in sizes {
+            let f = if want_fwd {
+                Some(ChunkFft::new(n, h, 2 * h, true, options.rigor)?)
+            } else {
+                None
+            };
+            let i = if want_inv {
+                Some(ChunkFft::new(n, h, 2 * h, false, options.rigor)?)
+            } else {
+                None
+            };
+            ffts.push((h, f, i));
+        }
+        let norm = PI / (2.0 * (b * b) as f64);
+        let wq = weights(b).iter().map(|w| w * norm).collect();
+        let buf = AlignedBuf::new(2 * chunk * n * n)?;
+        Ok(Plan {
+            b,
+            direction: options.direction,
+            threads,
+            isa,
+            pool,
+            clusters: clusters(b),
+            bt: BetaTables::grid(b),
+            norms: start_norms(b),
+            wq,
+            ffts,
+            chunk,
+            buf: Mutex::new(Some(buf)),
+        })
+    }
+
+    /// The bandwidth `B`.
+    pub fn bandwidth(&self) -> usize {
+        self.b
+    }
+
+    /// Number of worker threads.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Which transforms this plan runs.
+    pub fn direction(&self) -> Direction {
+        self.direction
+    }
+
+    /// Instruction set of the DWT kernels.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// `(2B)^3`.
+    pub fn num_samples(&self) -> usize {
+        num_samples(self.b)
+    }
+
+    /// `(4B^3 - B)/3`.
+    pub fn num_coeffs(&self) -> usize {
+        num_coeffs(self.b)
+    }
+
+    /// Bytes of the chunk buffer: `2 h (2B)^2 * 16` with `h` low beta slices per chunk,
+    /// `h = clamp(max_workspace_bytes / (2 (2B)^2 16), 1, B)`; by default the cap is
+    /// `max(512 MiB, 5% of the sample and coefficient arrays)`.
+    pub fn workspace_bytes(&self) -> usize {
+        2 * self.chunk * 4 * self.b * self.b * 16
+    }
+
+    fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
+        let ok = if fwd {
+            self.direction != Direction::Inverse
+        } else {
+            self.direction != Direction::Forward
+        };
+        if !ok {
+            return Err(Error::WrongDirection);
+        }
+        if samples != self.num_samples() {
+            return Err(Error::LengthMismatch {
+                what: "samples",
+                expected: self.num_samples(),
+                got: samples,
+            });
+        }
+        if coeffs != self.num_coeffs() {
+            return Err(Error::LengthMismatch {
+                what: "coefficients",
+                expected: self.num_coeffs(),
+                got: coeffs,
+            });
+        }
+        Ok(())
+    }
+
+    /// Forward transform: samples (`(2B)^3`, SPEC layout) to coefficients (`(4B^3-B)/3`).
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
+        self.forward_timed(samples, coeffs).map(|_| ())
+    }
+
+    /// Inverse transform: coefficients to samples.
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
+        self.inverse_timed(coeffs, samples).map(|_| ())
+    }
+
+    /// Run `f` with a chunk buffer: the plan's own if free, else a temporary one.
+    fn with_buf<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
+        match self.buf.try_lock() {
+            Ok(g) => f(g.as_ref().expect("plan buffer present")),
+            Err(_) => {
+                let n = 2 * self.b;
+                let tmp = AlignedBuf::new(2 * self.chunk * n * n)?;
+                f(&tmp)
+            }
+        }
+    }
+
+    fn chunks(&self) -> impl Iterator<Item = Chunk> + '_ {
+        let b = self.b;
+        (0..b).step_by(self.chunk).map(move |lo| {
+            let h = self.chunk.min(b - lo);
+            let mut ks: Vec<usize> = (lo..lo + h).collect();
+            ks.extend(2 * b - lo - h..2 * b - lo);
+            Chunk { ks, h }
+        })
+    }
+
+    /// Like [`Plan::forward`], also returning the time of each stage.
+    pub fn forward_timed(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        let t0 = Instant::now();
+        let nn = 4 * self.b * self.b;
+        let mut times = StageTimes::default();
+        let coef = SyncPtr(coeffs.as_mut_ptr());
+        self.with_buf(|buf| {
+            let bp = SyncPtr(buf.as_mut_ptr());
+            self.pool.install(|| {
+                for (ci, ch) in self.chunks().enumerate() {
+                    let t = Instant::now();
+                    let fft = self.chunk_fft(ch.h, true)?;
+                    let h = ch.h;
+                    // Low half and mirrored half: two batches, one per worker.
+                    rayon::join(
+                        || unsafe { fft.execute(samples.as_ptr().add(ch.ks[0] * nn), bp.get()) },
+                        || unsafe {
+                            fft.execute(samples.as_ptr().add(ch.ks[h] * nn), bp.get().add(h))
+                        },
+                    );
+                    times.fft += t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    let nbp = ch.ks.len().next_multiple_of(self.isa.lanes());
+                    self.clusters.par_iter().for_each_init(
+                        || Scratch::new(self.b, nbp),
+                        |sc, cl| unsafe {
+                            self.forward_cluster(sc, cl, &ch, bp.get(), coef, ci == 0);
+                        },
+                    );
+                    times.dwt += t.elapsed().as_secs_f64();
+                }
+                Ok::<(), Error>(())
+            })
+        })?;
+        times.total = t0.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    fn chunk_fft(&self, h: usize, fwd: bool) -> Result<&ChunkFft> {
+        let e = self
+            .ffts
+            .iter()
+            .find(|e| e.0 == h)
+            .expect("a plan exists for every chunk size");
+        if fwd { e.1.as_ref() } else { e.2.as_ref() }.ok_or(Error::WrongDirection)
+    }
+
+    /// Like [`Plan::inverse`], also returning the time of each stage.
+    pub fn inverse_timed(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(false, samples.len(), coeffs.len())?;
+        let t0 = Instant::now();
+        let n = 2 * self.b;
+        let nn = n * n;
+        let b = self.b;
+        let mut times = StageTimes::default();
+        let out = SyncPtr(samples.as_mut_ptr());
+        self.with_buf(|buf| {
+            let bp = SyncPtr(buf.as_mut_ptr());
+            self.pool.install(|| {
+                for ch in self.chunks() {
+                    let t = Instant::now();
+                    let nbp = ch.ks.len().next_multiple_of(self.isa.lanes());
+                    self.clusters.par_iter().for_each_init(
+                        || Scratch::new(self.b, nbp),
+                        |sc, cl| unsafe {
+                            self.inverse_cluster(sc, cl, &ch, bp.get(), coeffs);
+                        },
+                    );
+                    times.dwt += t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    let fft = self.chunk_fft(ch.h, false)?;
+                    let (h, nb) = (ch.h, ch.ks.len());
+                    // Frequency B (alpha or gamma) is outside the band limit.
+                    unsafe {
+                        for j in 0..n {
+                            for fi in [b * n + j, j * n + b] {
+                                std::ptr::write_bytes(bp.get().add(fi * nb), 0, nb);
+                            }
+                        }
+                    }
+                    rayon::join(
+                        || unsafe { fft.execute(bp.get(), out.get().add(ch.ks[0] * nn)) },
+                        || unsafe { fft.execute(bp.get().add(h), out.get().add(ch.ks[h] * nn)) },
+                    );
+                    times.fft += t.elapsed().as_secs_f64();
+                }
+                Ok::<(), Error>(())
+            })
+        })?;
+        times.total = t0.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// Recurrence coefficients and per-beta lane inputs of a cluster for one chunk.
+    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> (usize, usize) {
+        let n = self.b - cl.m;
+        rec_coeffs(cl.m, cl.mp, &mut sc.a[..n], &mut sc.c[..n], &mut sc.bb[..n]);
+        let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
+        let nb = ch.ks.len();
+        let nbp = nb.next_multiple_of(self.isa.lanes());
+        for (s, &k) in ch.ks.iter().enumerate() {
+            sc.x[s] = self.bt.cos_beta[k];
+            let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm);
+            sc.p[s] = p;
+            sc.sc[s] = scale;
+        }
+        for s in nb..nbp {
+            sc.x[s] = 0.0;
+            sc.p[s] = 0.0;
+            sc.sc[s] = 0.0;
+        }
+        (n, nbp)
+    }
+
+    /// Index of order pair `(m, mp)` inside a transformed slice.
+    fn freq_index(&self, m: isize, mp: isize) -> usize {
+        let n = 2 * self.b as isize;
+        (m.rem_euclid(n) * n + mp.rem_euclid(n)) as usize
+    }
+
+    /// Forward DWT of one cluster over one chunk, accumulated into `coef`.
+    ///
+    /// # Safety
+    /// `buf` holds the chunk's transformed slices; `coef` has `num_coeffs` entries and
+    /// no other task writes this cluster's blocks.
+    unsafe fn forward_cluster(
+        &self,
+        sc: &mut Scratch,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *const Complex64,
+        coef: SyncPtr<Complex64>,
+        first: bool,
+    ) {
+        let (n, nbp) = self.setup(sc, cl, ch);
+        let p = if cl.members.len() > 4 { 16 } else { 8 };
+        let nb = ch.ks.len();
+        let data = &mut sc.data[..nbp * p];
+        data.fill(0.0);
+        for (q, mem) in cl.members.iter().enumerate() {
+            let fi = self.freq_index(mem.m, mem.mp);
+            for s in 0..nb {
+                let slot = if mem.reversed { ch.mirror(s) } else { s };
+                let z = *buf.add(fi * nb + slot) * self.wq[ch.ks[slot]];
+                data[s * p + 2 * q] = z.re;
+                data[s * p + 2 * q + 1] = z.im;
+            }
+        }
+        let f = &mut sc.out[..n * p];
+        f.fill(0.0);
+        let rec = Rec {
+            a: &sc.a[..n],
+            c: &sc.c[..n],
+            bb: &sc.bb[..n],
+        };
+        let lanes = Lanes {
+            x: &sc.x[..nbp],
+            p: &sc.p[..nbp],
+            sc: &sc.sc[..nbp],
+        };
+        dwt::forward(self.isa, p, &rec, &lanes, data, f);
+        for (q, mem) in cl.members.iter().enumerate() {
+            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
+            for i in 0..n {
+                let g = mem.sign_at(cl.m + i);
+                let z = Complex64::new(f[i * p + 2 * q] * g, f[i * p + 2 * q + 1] * g);
+                if first {
+                    *dst.add(i) = z;
+                } else {
+                    *dst.add(i) += z;
+                }
+            }
+        }
+    }
+
+    /// Inverse DWT of one cluster over one chunk, written into the chunk buffer.
+    ///
+    /// # Safety
+    /// `buf` is the chunk buffer; no other task writes this cluster's order pairs.
+    unsafe fn inverse_cluster(
+        &self,
+        sc: &mut Scratch,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *mut Complex64,
+        coef: &[Complex64],
+    ) {
+        let (n, nbp) = self.setup(sc, cl, ch);
+        let p = if cl.members.len() > 4 { 16 } else { 8 };
+        let nb = ch.ks.len();
+        let fin = &mut sc.data[..n * p];
+        fin.fill(0.0);
+        let scale = 1.0 / (2.0 * PI);
+        for (q, mem) in cl.members.iter().enumerate() {
+            let src = &coef[block_start(self.b, mem.m, mem.mp)..];
+            for i in 0..n {
+                let g = mem.sign_at(cl.m + i) * scale;
+                fin[i * p + 2 * q] = src[i].re * g;
+                fin[i * p + 2 * q + 1] = src[i].im * g;
+            }
+        }
+        let y = &mut sc.out[..nbp * p];
+        let rec = Rec {
+            a: &sc.a[..n],
+            c: &sc.c[..n],
+            bb: &sc.bb[..n],
+        };
+        let lanes = Lanes {
+            x: &sc.x[..nbp],
+            p: &sc.p[..nbp],
+            sc: &sc.sc[..nbp],
+        };
+        dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
+        for (q, mem) in cl.members.iter().enumerate() {
+            let fi = self.freq_index(mem.m, mem.mp);
+            for s in 0..nb {
+                let slot = if mem.reversed { ch.mirror(s) } else { s };
+                *buf.add(fi * nb + slot) =
+                    Complex64::new(y[2 * q * nbp + s], y[(2 * q + 1) * nbp + s]);
+            }
+        }
+    }
+}
+
+#[allow(dead_code)]
+fn _assert_send_sync() {
+    fn is<T: Send + Sync>() {}
+    is::<Plan>();
+}
+
+#[allow(dead_code)]
+pub(crate) fn zeroed_complex(n: usize) -> Result<Vec<Complex64>> {
+    try_zeroed(n)
+}

@@ -1,0 +1,217 @@
+//! Minimal SIMD abstraction with run-time dispatch (AVX-512, AVX2+FMA, portable scalar).
+//!
+//! Kernels are written once, generic over [`Simd`], and instantiated inside
+//! `#[target_feature]` entry points (see `dwt.rs`): every method here is
+//! `#[inline(always)]`, so after inlining the intrinsics sit in a function that
+//! has the features enabled.
+
+/// Instruction set chosen for the DWT kernels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// AVX-512F, 8 doubles per vector.
+    Avx512,
+    /// AVX2 with FMA, 4 doubles per vector.
+    Avx2,
+    /// Portable scalar code (one double per "vector", no FMA).
+    Scalar,
+}
+
+impl Isa {
+    /// The best instruction set this CPU supports.
+    pub fn detect() -> Isa {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Isa::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                return Isa::Avx2;
+            }
+        }
+        Isa::Scalar
+    }
+
+    /// Whether this CPU can run kernels for `self`.
+    pub fn is_supported(self) -> bool {
+        match self {
+            Isa::Scalar => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => {
+                std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
+    /// Number of doubles per vector.
+    pub fn lanes(self) -> usize {
+        match self {
+            Isa::Avx512 => 8,
+            Isa::Avx2 => 4,
+            Isa::Scalar => 1,
+        }
+    }
+}
+
+/// Vector operations used by the kernels. All methods are unsafe: the caller
+/// guarantees the CPU supports the instruction set and pointers are valid for `W` doubles.
+pub(crate) trait Simd: Copy {
+    /// Lanes per vector.
+    const W: usize;
+    /// The vector type.
+    type V: Copy;
+    unsafe fn splat(x: f64) -> Self::V;
+    unsafe fn load(p: *const f64) -> Self::V;
+    unsafe fn store(p: *mut f64, v: Self::V);
+    unsafe fn add(a: Self::V, b: Self::V) -> Self::V;
+    unsafe fn mul(a: Self::V, b: Self::V) -> Self::V;
+    /// `a * b + c`
+    unsafe fn fma(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
+    /// `a * b - c`
+    unsafe fn fms(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
+    /// Whether any lane has `|v| >= t`.
+    unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
+    #[inline(always)]
+    unsafe fn zero() -> Self::V {
+        Self::splat(0.0)
+    }
+}
+
+/// Portable scalar implementation (also the reference the SIMD paths are tested against).
+#[derive(Clone, Copy)]
+pub(crate) struct Scalar;
+
+impl Simd for Scalar {
+    const W: usize = 1;
+    type V = f64;
+    #[inline(always)]
+    unsafe fn splat(x: f64) -> f64 {
+        x
+    }
+    #[inline(always)]
+    unsafe fn load(p: *const f64) -> f64 {
+        *p
+    }
+    #[inline(always)]
+    unsafe fn store(p: *mut f64, v: f64) {
+        *p = v
+    }
+    #[inline(always)]
+    unsafe fn add(a: f64, b: f64) -> f64 {
+        a + b
+    }
+    #[inline(always)]
+    unsafe fn mul(a: f64, b: f64) -> f64 {
+        a * b
+    }
+    #[inline(always)]
+    unsafe fn fma(a: f64, b: f64, c: f64) -> f64 {
+        a * b + c
+    }
+    #[inline(always)]
+    unsafe fn fms(a: f64, b: f64, c: f64) -> f64 {
+        a * b - c
+    }
+    #[inline(always)]
+    unsafe fn any_abs_ge(v: f64, t: f64) -> bool {
+        v.abs() >= t
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use x86::{Avx2, Avx512};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::Simd;
+    use std::arch::x86_64::*;
+
+    /// AVX-512F: 8 doubles.
+    #[derive(Clone, Copy)]
+    pub(crate) struct Avx512;
+
+    impl Simd for Avx512 {
+        const W: usize = 8;
+        type V = __m512d;
+        #[inline(always)]
+        unsafe fn splat(x: f64) -> __m512d {
+            _mm512_set1_pd(x)
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f64) -> __m512d {
+            _mm512_loadu_pd(p)
+        }
+        #[inline(always)]
+        unsafe fn store(p: *mut f64, v: __m512d) {
+            _mm512_storeu_pd(p, v)
+        }
+        #[inline(always)]
+        unsafe fn add(a: __m512d, b: __m512d) -> __m512d {
+            _mm512_add_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn mul(a: __m512d, b: __m512d) -> __m512d {
+            _mm512_mul_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn fma(a: __m512d, b: __m512d, c: __m512d) -> __m512d {
+            _mm512_fmadd_pd(a, b, c)
+        }
+        #[inline(always)]
+        unsafe fn fms(a: __m512d, b: __m512d, c: __m512d) -> __m512d {
+            _mm512_fmsub_pd(a, b, c)
+        }
+        #[inline(always)]
+        unsafe fn any_abs_ge(v: __m512d, t: f64) -> bool {
+            _mm512_cmp_pd_mask::<_CMP_GE_OQ>(_mm512_abs_pd(v), _mm512_set1_pd(t)) != 0
+        }
+    }
+
+    /// AVX2 + FMA: 4 doubles.
+    #[derive(Clone, Copy)]
+    pub(crate) struct Avx2;
+
+    impl Simd for Avx2 {
+        const W: usize = 4;
+        type V = __m256d;
+        #[inline(always)]
+        unsafe fn splat(x: f64) -> __m256d {
+            _mm256_set1_pd(x)
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f64) -> __m256d {
+            _mm256_loadu_pd(p)
+        }
+        #[inline(always)]
+        unsafe fn store(p: *mut f64, v: __m256d) {
+            _mm256_storeu_pd(p, v)
+        }
+        #[inline(always)]
+        unsafe fn add(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_add_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn mul(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_mul_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn fma(a: __m256d, b: __m256d, c: __m256d) -> __m256d {
+            _mm256_fmadd_pd(a, b, c)
+        }
+        #[inline(always)]
+        unsafe fn fms(a: __m256d, b: __m256d, c: __m256d) -> __m256d {
+            _mm256_fmsub_pd(a, b, c)
+        }
+        #[inline(always)]
+        unsafe fn any_abs_ge(v: __m256d, t: f64) -> bool {
+            let a = _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
+            _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(a, _mm256_set1_pd(t))) != 0
+        }
+    }
+}

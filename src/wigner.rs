@@ -1,0 +1,345 @@
+//! Wigner-d generation: recurrence coefficients and overflow/underflow-free starting values.
+//!
+//! The DWT kernels (`dwt.rs`) run the three-term recurrence in `l` for the normalised
+//! `dt^l = sqrt((2l+1)/2) d^l` of a base pair `(m, m')`, `m >= m' >= 0`:
+//!
+//! `dt^{l+1} = (A_l cos(beta) + C_l) dt^l - Bc_l dt^{l-1}`, starting at `l0 = m` with
+//! `dt^{m}_{m,m'} = (-1)^(m-m') sqrt((2m+1)/2) sqrt(binom(2m, m-m')) cos(beta/2)^(m+m') sin(beta/2)^(m-m')`.
+//!
+//! The starting value over- and underflows doubles for large orders, so it is built in an
+//! extended format (mantissa, integer power of two) and handed to the kernels as a scaled
+//! value `p` with a scale index `sc <= 0`: the true value is `p * 2^(SCALE_STEP * sc)`.
+//! A lane whose `sc < 0` is below `2^-ACTIVE_BITS` and contributes nothing; the kernels
+//! rescale it by `2^-SCALE_STEP` whenever it grows past `BIG` until it reaches `sc = 0`,
+//! after which the recurrence continues in plain doubles.
+
+use crate::simd::Isa;
+
+/// Exponent step of one rescaling.
+pub(crate) const SCALE_STEP: i64 = 600;
+/// Lanes whose true value is below `2^-ACTIVE_BITS` are treated as zero.
+pub(crate) const ACTIVE_BITS: i64 = 300;
+/// Rescale threshold for the scaled values: `2^(SCALE_STEP - ACTIVE_BITS)`.
+pub(crate) const BIG: f64 = f64::from_bits(((1023 + SCALE_STEP - ACTIVE_BITS) as u64) << 52);
+/// Rescaling factor `2^-SCALE_STEP`.
+pub(crate) const TINY: f64 = f64::from_bits(((1023 - SCALE_STEP) as u64) << 52);
+
+/// A number `mant * 2^exp` with `mant` in `[0.5, 1)` (or zero): no overflow, no underflow.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Ext {
+    pub mant: f64,
+    pub exp: i64,
+}
+
+/// `x = m * 2^e` with `m` in `[0.5, 1)`; `(0, 0)` for zero. `x` must be finite.
+fn frexp(x: f64) -> (f64, i64) {
+    if x == 0.0 {
+        return (0.0, 0);
+    }
+    let bits = x.to_bits();
+    let e = ((bits >> 52) & 0x7ff) as i64;
+    if e == 0 {
+        // Subnormal: scale up first.
+        let (m, e2) = frexp(x * f64::from_bits((1023 + 64) << 52));
+        return (m, e2 - 64);
+    }
+    let m = f64::from_bits((bits & !(0x7ffu64 << 52)) | (1022u64 << 52));
+    (m, e - 1022)
+}
+
+/// `x * 2^n` for any `n` (results outside the double range saturate as IEEE does).
+pub(crate) fn ldexp(mut x: f64, mut n: i64) -> f64 {
+    while n > 1000 {
+        x *= f64::from_bits((1023 + 1000) << 52);
+        n -= 1000;
+    }
+    while n < -1000 {
+        x *= f64::from_bits((1023 - 1000) << 52);
+        n += 1000;
+    }
+    x * f64::from_bits(((1023 + n) as u64) << 52)
+}
+
+impl Ext {
+    pub const ONE: Ext = Ext { mant: 0.5, exp: 1 };
+
+    pub fn new(x: f64) -> Ext {
+        let (mant, exp) = frexp(x);
+        Ext { mant, exp }
+    }
+
+    #[inline]
+    pub fn mul(self, o: Ext) -> Ext {
+        let (mant, e) = frexp(self.mant * o.mant);
+        Ext {
+            mant,
+            exp: self.exp + o.exp + e,
+        }
+    }
+
+    pub fn mul_f64(self, x: f64) -> Ext {
+        self.mul(Ext::new(x))
+    }
+
+    pub fn sqrt(self) -> Ext {
+        if self.exp % 2 == 0 {
+            Ext::new(self.mant.sqrt()).mul(Ext {
+                mant: 0.5,
+                exp: self.exp / 2 + 1,
+            })
+        } else {
+            Ext::new((2.0 * self.mant).sqrt()).mul(Ext {
+                mant: 0.5,
+                exp: (self.exp - 1) / 2 + 1,
+            })
+        }
+    }
+
+    /// The kernels' scaled form `(p, sc)`: true value `= p * 2^(SCALE_STEP * sc)`,
+    /// `sc = 0` if the value is at least `2^-ACTIVE_BITS`, else `p` in `[2^-ACTIVE_BITS-1, BIG)`.
+    pub fn to_scaled(self) -> (f64, f64) {
+        if self.mant == 0.0 {
+            return (0.0, 0.0);
+        }
+        let e = self.exp; // |value| in [2^(e-1), 2^e)
+        if e > -ACTIVE_BITS {
+            return (ldexp(self.mant, e), 0.0);
+        }
+        let j = (-ACTIVE_BITS - e + SCALE_STEP) / SCALE_STEP; // ceil((-T - e)/S) for -T-e >= 0, >= 1
+        (ldexp(self.mant, e + SCALE_STEP * j), -(j as f64))
+    }
+}
+
+/// `sqrt((2m+1)/2 * binom(2m, m-m'))` for every `0 <= m' <= m < b`, index `m(m+1)/2 + m'`.
+pub(crate) fn start_norms(b: usize) -> Vec<Ext> {
+    let mut out = vec![Ext::ONE; b * (b + 1) / 2];
+    for m in 0..b {
+        // binom(2m, j) for j = m - m' = 0..m, built up by the ratio (2m-j+1)/j.
+        let mut bin = Ext::ONE;
+        for j in 0..=m {
+            if j > 0 {
+                bin = bin.mul_f64((2 * m - j + 1) as f64 / j as f64);
+            }
+            let mp = m - j;
+            out[m * (m + 1) / 2 + mp] = bin.mul_f64((2 * m + 1) as f64 / 2.0).sqrt();
+        }
+    }
+    out
+}
+
+/// Powers `base^a`, `0 <= a <= maxpow`, for a list of bases, stored in two levels
+/// (`a mod 64` and `64 * (a div 64)`) so one power costs one multiplication.
+pub(crate) struct PowTable {
+    nb: usize,
+    lo: Vec<Ext>,
+    hi: Vec<Ext>,
+}
+
+impl PowTable {
+    fn new(bases: &[f64], maxpow: usize) -> PowTable {
+        let nb = bases.len();
+        let nhi = maxpow / 64 + 1;
+        let mut lo = vec![Ext::ONE; 64 * nb];
+        let mut hi = vec![Ext::ONE; nhi * nb];
+        for (k, &c) in bases.iter().enumerate() {
+            let ce = Ext::new(c);
+            for j in 1..64 {
+                lo[j * nb + k] = lo[(j - 1) * nb + k].mul(ce);
+            }
+            let c64 = lo[63 * nb + k].mul(ce);
+            for j in 1..nhi {
+                hi[j * nb + k] = hi[(j - 1) * nb + k].mul(c64);
+            }
+        }
+        PowTable { nb, lo, hi }
+    }
+
+    #[inline]
+    fn pow(&self, k: usize, a: usize) -> Ext {
+        self.lo[(a % 64) * self.nb + k].mul(self.hi[(a / 64) * self.nb + k])
+    }
+}
+
+/// Per-beta tables for starting values: `cos(beta)`, and powers of `cos(beta/2)`, `sin(beta/2)`.
+pub(crate) struct BetaTables {
+    pub cos_beta: Vec<f64>,
+    cpow: PowTable,
+    spow: PowTable,
+}
+
+impl BetaTables {
+    /// Tables for points given as `(cos beta, cos(beta/2), sin(beta/2))`, powers up to `maxpow`.
+    pub fn new(points: &[(f64, f64, f64)], maxpow: usize) -> BetaTables {
+        let c: Vec<f64> = points.iter().map(|p| p.1).collect();
+        let s: Vec<f64> = points.iter().map(|p| p.2).collect();
+        BetaTables {
+            cos_beta: points.iter().map(|p| p.0).collect(),
+            cpow: PowTable::new(&c, maxpow),
+            spow: PowTable::new(&s, maxpow),
+        }
+    }
+
+    /// Tables for the `2B` grid betas of bandwidth `b`.
+    pub fn grid(b: usize) -> BetaTables {
+        let pts: Vec<(f64, f64, f64)> = (0..2 * b)
+            .map(|k| {
+                let bk = crate::grid::beta(b, k);
+                (bk.cos(), (bk / 2.0).cos(), (bk / 2.0).sin())
+            })
+            .collect();
+        BetaTables::new(&pts, 2 * b)
+    }
+
+    /// Scaled starting value `dt^m_{m,m'}` at point `k`, given `norm` from [`start_norms`].
+    #[inline]
+    pub fn start(&self, k: usize, m: usize, mp: usize, norm: Ext) -> (f64, f64) {
+        let v = norm
+            .mul(self.cpow.pow(k, m + mp))
+            .mul(self.spow.pow(k, m - mp));
+        let (p, sc) = v.to_scaled();
+        if (m - mp) % 2 == 1 {
+            (-p, sc)
+        } else {
+            (p, sc)
+        }
+    }
+}
+
+/// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + a.len()`:
+/// `a[i] = A_l`, `c[i] = C_l`, `bb[i] = Bc_l` with `l = m + i`.
+pub(crate) fn rec_coeffs(m: usize, mp: usize, a: &mut [f64], c: &mut [f64], bb: &mut [f64]) {
+    let n = a.len();
+    debug_assert!(c.len() == n && bb.len() == n);
+    let (mf, mpf) = (m as f64, mp as f64);
+    let mm = mf * mpf;
+    // q(l) = sqrt((l^2 - m^2)(l^2 - m'^2)); the products are exact integers below 2^53.
+    let q = |l: f64| ((l * l - mf * mf) * (l * l - mpf * mpf)).sqrt();
+    let mut ql = q(m as f64);
+    for i in 0..n {
+        let l = (m + i) as f64;
+        let ql1 = q(l + 1.0);
+        let k1 = (l + 1.0) * ((2.0 * l + 3.0) * (2.0 * l + 1.0)).sqrt();
+        let ai = k1 / ql1;
+        a[i] = ai;
+        if l == 0.0 {
+            c[i] = 0.0;
+            bb[i] = 0.0;
+        } else {
+            c[i] = -ai * mm / (l * (l + 1.0));
+            bb[i] = ((2.0 * l + 3.0) / (2.0 * l - 1.0)).sqrt() * (l + 1.0) / l * ql / ql1;
+        }
+        ql = ql1;
+    }
+}
+
+/// `d^l_{m,mp}(beta)` (standard, not normalised) for `l = max(|m|,|mp|) ..= lmax`.
+///
+/// Computed by the same starting values, recurrence and forward DWT kernel as the
+/// transforms (with the best instruction set of this CPU), so it doubles as a test of them.
+pub fn wigner_d_column(m: isize, mp: isize, lmax: usize, beta: f64) -> Vec<f64> {
+    wigner_d_column_isa(Isa::detect(), m, mp, lmax, beta)
+}
+
+pub(crate) fn wigner_d_column_isa(
+    isa: Isa,
+    m: isize,
+    mp: isize,
+    lmax: usize,
+    beta: f64,
+) -> Vec<f64> {
+    let (bm, bmp, mem) = crate::symmetry::locate(m, mp);
+    if lmax < bm {
+        return Vec::new();
+    }
+    // pi - beta for reversed members, without rounding: swap half-angle cos/sin, negate cos.
+    let (x, c, s) = (beta.cos(), (beta / 2.0).cos(), (beta / 2.0).sin());
+    let pt = if mem.reversed { (-x, s, c) } else { (x, c, s) };
+    let bt = BetaTables::new(&[pt], 2 * bm);
+    let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
+    let col = crate::dwt::column(isa, &bt, 0, bm, bmp, norm, lmax + 1);
+    col.iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let l = bm + i;
+            mem.sign_at(l) * v / ((2 * l + 1) as f64 / 2.0).sqrt()
+        })
+        .collect()
+}
+
+/// Normalised `dt^l_{m,mp}(beta_k)` on the bandwidth-`b` grid: rows `l = max(|m|,|mp|)..b`,
+/// each of `2b` values (`k = 0..2b`), row-major. Same code path as the DWT.
+pub fn dt_on_grid(b: usize, m: isize, mp: isize) -> Vec<f64> {
+    let (bm, bmp, mem) = crate::symmetry::locate(m, mp);
+    assert!(bm < b, "order ({m},{mp}) out of range for bandwidth {b}");
+    let n = 2 * b;
+    let bt = BetaTables::grid(b);
+    let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
+    let isa = Isa::detect();
+    let rows = b - bm;
+    let mut out = vec![0.0; rows * n];
+    for k in 0..n {
+        let src = if mem.reversed { n - 1 - k } else { k };
+        let col = crate::dwt::column(isa, &bt, src, bm, bmp, norm, b);
+        for (i, v) in col.iter().enumerate() {
+            out[i * n + k] = mem.sign_at(bm + i) * v;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frexp_ldexp_roundtrip() {
+        for &x in &[1.0, 0.75, 3e-310, 1e300, -2.5, 5e-324] {
+            let (m, e) = frexp(x);
+            assert!(m.abs() >= 0.5 && m.abs() < 1.0);
+            assert_eq!(ldexp(m, e), x);
+        }
+    }
+
+    #[test]
+    fn ext_handles_huge_and_tiny() {
+        // 2^-3000 * 2^2000 = 2^-1000
+        let a = Ext {
+            mant: 0.5,
+            exp: -2999,
+        };
+        let b = Ext {
+            mant: 0.5,
+            exp: 2001,
+        };
+        let p = a.mul(b);
+        assert_eq!(ldexp(p.mant, p.exp), ldexp(1.0, -1000));
+        let s = Ext { mant: 0.5, exp: 3 }.sqrt(); // sqrt(4) = 2
+        assert_eq!(ldexp(s.mant, s.exp), 2.0);
+        let s = Ext { mant: 0.5, exp: 4 }.sqrt(); // sqrt(8)
+        assert!((ldexp(s.mant, s.exp) - 8f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn scaled_form_is_consistent() {
+        for &e in &[0i64, -100, -299, -300, -301, -899, -900, -901, -5000] {
+            let x = Ext { mant: 0.75, exp: e };
+            let (p, sc) = x.to_scaled();
+            assert!(sc <= 0.0);
+            if sc < 0.0 {
+                assert!(p.abs() < BIG && p.abs() >= ldexp(1.0, -ACTIVE_BITS - 1));
+            }
+            // reconstruct in extended form
+            let (pm, pe) = frexp(p);
+            assert_eq!(pm, 0.75);
+            assert_eq!(pe + SCALE_STEP * (sc as i64), e);
+        }
+    }
+
+    #[test]
+    fn start_norm_small() {
+        // m = 2, m' = 0: sqrt(5/2 * binom(4,2)) = sqrt(15)
+        let n = start_norms(3);
+        let v = n[3];
+        assert!((ldexp(v.mant, v.exp) - 15f64.sqrt()).abs() < 1e-14);
+    }
+}

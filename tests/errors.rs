@@ -1,0 +1,339 @@
+//! Error reporting and index helpers (SPEC.md section 3 closed-form values).
+
+mod common;
+
+use common::*;
+use so3fft::{Complex64, Direction, Error, Plan, PlanOptions, MAX_BANDWIDTH};
+
+fn opts() -> PlanOptions {
+    PlanOptions::default()
+}
+
+#[test]
+fn invalid_bandwidth() {
+    match Plan::new(0, &opts()) {
+        Err(Error::InvalidBandwidth { bandwidth, max }) => {
+            assert_eq!(bandwidth, 0);
+            assert_eq!(max, MAX_BANDWIDTH);
+        }
+        Err(e) => panic!("Plan::new(0): expected InvalidBandwidth, got {e:?}"),
+        Ok(_) => panic!("Plan::new(0) succeeded"),
+    }
+    match Plan::new(MAX_BANDWIDTH + 1, &opts()) {
+        Err(Error::InvalidBandwidth { bandwidth, max }) => {
+            assert_eq!(bandwidth, MAX_BANDWIDTH + 1);
+            assert_eq!(max, MAX_BANDWIDTH);
+        }
+        Err(e) => panic!("Plan::new(MAX+1): expected InvalidBandwidth, got {e:?}"),
+        Ok(_) => panic!("Plan::new(MAX_BANDWIDTH+1) succeeded"),
+    }
+    // the error must be displayable
+    let e = Plan::new(0, &opts()).err().unwrap();
+    assert!(!format!("{e}").is_empty());
+    let _: &dyn std::error::Error = &e;
+}
+
+#[test]
+fn length_mismatch_leaves_output_untouched() {
+    let b = 4;
+    let p = Plan::new(b, &opts()).unwrap();
+    let (ns, nc) = (n_samples(b), n_coeffs(b));
+    let sentinel = Complex64::new(12345.0, -678.0);
+    let good_s = vec![Complex64::new(0.5, 0.25); ns];
+    let good_c = vec![Complex64::new(0.5, 0.25); nc];
+    let is_mismatch = |r: so3fft::Result<()>| matches!(r, Err(Error::LengthMismatch { .. }));
+    // forward: wrong input length (short and long), wrong output length
+    for (sl, cl) in [
+        (ns - 1, nc),
+        (ns + 1, nc),
+        (ns, nc - 1),
+        (ns, nc + 1),
+        (0, nc),
+        (ns, 0),
+    ] {
+        let s = vec![Complex64::new(1.0, 0.0); sl];
+        let mut c = vec![sentinel; cl];
+        let r = p.forward(&s, &mut c);
+        assert!(
+            is_mismatch(r.clone()),
+            "forward with lengths ({sl},{cl}): expected LengthMismatch, got {r:?}"
+        );
+        assert!(
+            c.iter().all(|&x| x == sentinel),
+            "forward with lengths ({sl},{cl}) modified the output buffer"
+        );
+    }
+    for (cl, sl) in [
+        (nc - 1, ns),
+        (nc + 1, ns),
+        (nc, ns - 1),
+        (nc, ns + 1),
+        (0, ns),
+        (nc, 0),
+    ] {
+        let c = vec![Complex64::new(1.0, 0.0); cl];
+        let mut s = vec![sentinel; sl];
+        let r = p.inverse(&c, &mut s);
+        assert!(
+            is_mismatch(r.clone()),
+            "inverse with lengths ({cl},{sl}): expected LengthMismatch, got {r:?}"
+        );
+        assert!(
+            s.iter().all(|&x| x == sentinel),
+            "inverse with lengths ({cl},{sl}) modified the output buffer"
+        );
+    }
+    // the reported numbers
+    let mut c = vec![sentinel; nc];
+    match p.forward(&good_s[..ns - 3], &mut c) {
+        Err(Error::LengthMismatch { expected, got, .. }) => {
+            assert_eq!(expected, ns);
+            assert_eq!(got, ns - 3);
+        }
+        r => panic!("expected LengthMismatch, got {r:?}"),
+    }
+    // timed variants check as well
+    let mut s = vec![sentinel; ns + 2];
+    assert!(matches!(
+        p.inverse_timed(&good_c, &mut s),
+        Err(Error::LengthMismatch { .. })
+    ));
+    assert!(s.iter().all(|&x| x == sentinel));
+    let mut c = vec![sentinel; nc + 2];
+    assert!(matches!(
+        p.forward_timed(&good_s, &mut c),
+        Err(Error::LengthMismatch { .. })
+    ));
+    assert!(c.iter().all(|&x| x == sentinel));
+    // and a correct call still works after the errors
+    let mut c = vec![sentinel; nc];
+    p.forward(&good_s, &mut c).unwrap();
+    let t = p.forward_timed(&good_s, &mut c).unwrap();
+    assert!(t.total >= 0.0 && t.fft >= 0.0 && t.dwt >= 0.0);
+}
+
+#[test]
+fn wrong_direction() {
+    let b = 4;
+    let (ns, nc) = (n_samples(b), n_coeffs(b));
+    let sentinel = Complex64::new(-3.0, 7.0);
+    let pi = Plan::new(
+        b,
+        &PlanOptions {
+            direction: Direction::Inverse,
+            ..opts()
+        },
+    )
+    .unwrap();
+    let s = vec![Complex64::new(1.0, 0.0); ns];
+    let mut c = vec![sentinel; nc];
+    let r = pi.forward(&s, &mut c);
+    assert_eq!(r, Err(Error::WrongDirection), "forward on an Inverse plan");
+    assert!(
+        c.iter().all(|&x| x == sentinel),
+        "forward on an Inverse plan modified the output"
+    );
+    assert!(matches!(
+        pi.forward_timed(&s, &mut c),
+        Err(Error::WrongDirection)
+    ));
+    // inverse on the inverse plan works
+    pi.inverse(&c, &mut vec![Complex64::new(0.0, 0.0); ns])
+        .unwrap();
+
+    let pf = Plan::new(
+        b,
+        &PlanOptions {
+            direction: Direction::Forward,
+            ..opts()
+        },
+    )
+    .unwrap();
+    let c = vec![Complex64::new(1.0, 0.0); nc];
+    let mut s = vec![sentinel; ns];
+    let r = pf.inverse(&c, &mut s);
+    assert_eq!(r, Err(Error::WrongDirection), "inverse on a Forward plan");
+    assert!(
+        s.iter().all(|&x| x == sentinel),
+        "inverse on a Forward plan modified the output"
+    );
+    assert!(matches!(
+        pf.inverse_timed(&c, &mut s),
+        Err(Error::WrongDirection)
+    ));
+    pf.forward(&s, &mut vec![Complex64::new(0.0, 0.0); nc])
+        .unwrap();
+}
+
+#[test]
+fn try_coef_index_errors() {
+    let b = 8;
+    let bad: [(usize, isize, isize); 8] = [
+        (3, 4, 0),
+        (3, 0, -4),
+        (3, -4, -4),
+        (0, 1, 0),
+        (8, 0, 0),
+        (9, 1, 1),
+        (8, 8, 8),
+        (7, 8, 0),
+    ];
+    for (l, m, mp) in bad {
+        let r = so3fft::try_coef_index(b, l, m, mp);
+        assert!(
+            r.is_err(),
+            "try_coef_index({b},{l},{m},{mp}) = {r:?}, expected an error"
+        );
+        if let Err(e) = &r {
+            assert!(
+                matches!(e, Error::InvalidArgument(_)),
+                "try_coef_index({b},{l},{m},{mp}): unexpected error kind {e:?}"
+            );
+        }
+    }
+    assert!(
+        so3fft::try_coef_index(0, 0, 0, 0).is_err(),
+        "try_coef_index with B = 0"
+    );
+    assert_eq!(
+        so3fft::try_coef_index(b, 7, -7, 7),
+        Ok(so3fft::coef_index(b, 7, -7, 7))
+    );
+}
+
+#[test]
+fn max_bandwidth_plan_does_not_panic() {
+    // Must either succeed or report OutOfMemory (it must not allocate the (2B)^3 sample grid).
+    let t0 = std::time::Instant::now();
+    let r = std::panic::catch_unwind(|| {
+        Plan::new(MAX_BANDWIDTH, &PlanOptions::default())
+            .map(|p| (p.bandwidth(), p.num_samples(), p.num_coeffs()))
+    });
+    match r {
+        Err(_) => panic!("Plan::new(MAX_BANDWIDTH) panicked"),
+        Ok(Ok((bw, ns, nc))) => {
+            assert_eq!(bw, MAX_BANDWIDTH);
+            assert_eq!(ns, n_samples(MAX_BANDWIDTH));
+            assert_eq!(nc, n_coeffs(MAX_BANDWIDTH));
+            println!(
+                "Plan::new(MAX_BANDWIDTH={MAX_BANDWIDTH}) succeeded in {:.2}s",
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        Ok(Err(Error::OutOfMemory { bytes })) => {
+            println!("Plan::new(MAX_BANDWIDTH) -> OutOfMemory {{ bytes: {bytes} }}")
+        }
+        Ok(Err(e)) => panic!("Plan::new(MAX_BANDWIDTH) returned unexpected error {e:?}"),
+    }
+    // a small workspace cap must still give a working plan at a moderate size
+    let p = Plan::new(
+        16,
+        &PlanOptions {
+            max_workspace_bytes: Some(4096),
+            ..PlanOptions::default()
+        },
+    );
+    match p {
+        Ok(p) => {
+            let mut rng = Rng::new(5);
+            let c = rng.complex_vec(n_coeffs(16));
+            let mut f = vec![Complex64::new(0.0, 0.0); n_samples(16)];
+            p.inverse(&c, &mut f).unwrap();
+            let mut c2 = vec![Complex64::new(0.0, 0.0); n_coeffs(16)];
+            p.forward(&f, &mut c2).unwrap();
+            let (e, _) = max_abs_diff(&c, &c2);
+            println!("B=16 with max_workspace_bytes=4096: roundtrip err {e:.3e}");
+            assert!(e <= 1e-13, "roundtrip with tiny workspace cap: {e:e}");
+        }
+        Err(e) => println!("note: B=16 with max_workspace_bytes=4096 rejected: {e:?}"),
+    }
+}
+
+// ---- index helpers ----------------------------------------------------------------------------
+
+#[test]
+fn coef_index_spec_spot_values_b256() {
+    let b = 256;
+    // (M, M', l) -> index, from SPEC.md section 3
+    let cases: [(isize, isize, usize, usize); 7] = [
+        (0, 0, 0, 0),
+        (0, 0, 255, 255),
+        (0, 1, 1, 256),
+        (0, -1, 1, 65281),
+        (1, 0, 1, 65536),
+        (-1, 0, 1, 22304001),
+        (-1, -1, 255, 22369535),
+    ];
+    for (m, mp, l, want) in cases {
+        assert_eq!(
+            so3fft::coef_index(b, l, m, mp),
+            want,
+            "coef_index(B=256, l={l}, M={m}, M'={mp})"
+        );
+        assert_eq!(
+            so3fft::try_coef_index(b, l, m, mp),
+            Ok(want),
+            "try_coef_index(B=256, l={l}, M={m}, M'={mp})"
+        );
+    }
+    assert_eq!(so3fft::num_coeffs(b), 22369536);
+    assert_eq!(so3fft::num_coeffs(b), n_coeffs(b));
+}
+
+#[test]
+fn coef_index_bijection_and_layout() {
+    for b in 1..=12usize {
+        let n = so3fft::num_coeffs(b);
+        assert_eq!(n, n_coeffs(b), "num_coeffs({b})");
+        let lay = Layout::new(b);
+        let mut seen = vec![false; n];
+        for (l, m, mp) in triples(b) {
+            let i = so3fft::coef_index(b, l, m, mp);
+            assert!(i < n, "coef_index({b},{l},{m},{mp}) = {i} out of range {n}");
+            assert!(!seen[i], "coef_index({b},{l},{m},{mp}) = {i} duplicated");
+            seen[i] = true;
+            assert_eq!(
+                i,
+                lay.idx(l, m, mp),
+                "coef_index({b},{l},{m},{mp}) differs from SOFT block order"
+            );
+            assert_eq!(so3fft::try_coef_index(b, l, m, mp), Ok(i));
+        }
+        assert!(seen.iter().all(|&s| s), "B={b}: not onto");
+    }
+}
+
+#[test]
+fn sample_index_and_grid_helpers() {
+    for b in [1usize, 2, 5, 8] {
+        let n = 2 * b;
+        assert_eq!(so3fft::num_samples(b), n * n * n);
+        for k in 0..n {
+            for j1 in 0..n {
+                for j2 in 0..n {
+                    assert_eq!(
+                        so3fft::sample_index(b, j1, k, j2),
+                        k * n * n + j1 * n + j2,
+                        "sample_index({b}, j1={j1}, k={k}, j2={j2})"
+                    );
+                }
+            }
+        }
+        let pi = std::f64::consts::PI;
+        for j in 0..n {
+            let a = pi * j as f64 / b as f64;
+            assert!(
+                (so3fft::alpha(b, j) - a).abs() <= 4.0 * f64::EPSILON,
+                "alpha({b},{j})"
+            );
+            assert!(
+                (so3fft::gamma(b, j) - a).abs() <= 4.0 * f64::EPSILON,
+                "gamma({b},{j})"
+            );
+            assert!(
+                (so3fft::beta(b, j) - grid_beta(b, j)).abs() <= 4.0 * f64::EPSILON,
+                "beta({b},{j})"
+            );
+        }
+    }
+}
