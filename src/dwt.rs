@@ -12,7 +12,7 @@
 //! of a vector is active only the recurrence runs (the negligible prefix in `l` is skipped).
 
 use crate::simd::{Isa, Scalar, Simd};
-use crate::wigner::{BetaTables, Ext, BIG, TINY};
+use crate::wigner::{BetaTables, Ext, RecTables, BIG, TINY};
 
 /// Recurrence coefficients of one cluster, index `i = l - l0`.
 pub(crate) struct Rec<'a> {
@@ -129,7 +129,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
     let p = W * NV;
     let n = rec.a.len();
     let nb = lanes.x.len();
-    debug_assert!(nb % W == 0 && xin.len() >= nb * p && f.len() >= n * p);
+    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * p && f.len() >= n * p);
     let fp = f.as_mut_ptr();
     for s0 in (0..nb).step_by(W) {
         let mut st = State::<S, W>::new(lanes, s0);
@@ -183,7 +183,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
 ) {
     let n = rec.a.len();
     let nb = lanes.x.len();
-    debug_assert!(nb % W == 0 && fin.len() >= n * P && y.len() >= nb * P);
+    debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
     let fp = fin.as_ptr();
     for s0 in (0..nb).step_by(W) {
         let mut st = State::<S, W>::new(lanes, s0);
@@ -235,7 +235,7 @@ pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64],
     let n = rec.a.len();
     let nb = lanes.x.len();
     assert!(rec.c.len() == n && rec.bb.len() == n);
-    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb % isa.lanes() == 0);
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(xin.len() >= nb * p && f.len() >= n * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
     unsafe {
@@ -260,7 +260,7 @@ pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64],
     let n = rec.a.len();
     let nb = lanes.x.len();
     assert!(rec.c.len() == n && rec.bb.len() == n);
-    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb % isa.lanes() == 0);
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && y.len() >= nb * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
     unsafe {
@@ -282,9 +282,11 @@ pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64],
 
 /// `dt^l_{m,mp}` of the base pair at point `k` of `bt`, for `l = m..lend`, through the
 /// forward kernel (one beta, unit data in column 0).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn column(
     isa: Isa,
     bt: &BetaTables,
+    rt: &RecTables,
     k: usize,
     m: usize,
     mp: usize,
@@ -293,9 +295,9 @@ pub(crate) fn column(
 ) -> Vec<f64> {
     let n = lend - m;
     let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    crate::wigner::rec_coeffs(m, mp, &mut a, &mut c, &mut bb);
+    rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
     let w = isa.lanes();
-    let (p0, sc0) = bt.start(k, m, mp, norm);
+    let (p0, sc0) = bt.start(k, m, mp, norm, 1.0);
     let mut x = vec![0.0; w];
     let mut p = vec![0.0; w];
     let mut sc = vec![0.0; w];
@@ -342,10 +344,11 @@ mod tests {
         let b = 200;
         let bt = BetaTables::grid(b);
         let norms = crate::wigner::start_norms(b);
+        let rt = RecTables::new(b);
         for &(m, mp) in &[(0usize, 0usize), (5, 3), (150, 20), (199, 199), (120, 0)] {
             let n = b - m;
             let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            crate::wigner::rec_coeffs(m, mp, &mut a, &mut c, &mut bb);
+            rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
             let rec = Rec {
                 a: &a,
                 c: &c,
@@ -357,7 +360,7 @@ mod tests {
             let mut sc = vec![0.0; nb];
             for k in 0..nb {
                 x[k] = bt.cos_beta[k];
-                let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp]);
+                let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
                 p[k] = pp;
                 sc[k] = ss;
             }
@@ -398,6 +401,66 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod kernel_speed {
+    use super::*;
+
+    /// Kernel-only throughput (run with --ignored --nocapture): GFLOP/s of the fused
+    /// recurrence + accumulation for one generic cluster, all 2B grid betas.
+    #[test]
+    #[ignore]
+    fn kernel_gflops() {
+        for &(b, nbs) in &[(256usize, 512usize), (256, 128), (128, 256)] {
+            let bt = BetaTables::grid(b);
+            let norms = crate::wigner::start_norms(b);
+            let rt = RecTables::new(b);
+            let (m, mp) = (b / 8, b / 16);
+            let n = b - m;
+            let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
+            let rec = Rec {
+                a: &a,
+                c: &c,
+                bb: &bb,
+            };
+            let (mut x, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
+            for s in 0..nbs {
+                let k = s * (2 * b) / nbs;
+                x[s] = bt.cos_beta[k];
+                let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
+                p[s] = pp;
+                sc[s] = ss;
+            }
+            let lanes = Lanes {
+                x: &x,
+                p: &p,
+                sc: &sc,
+            };
+            let xin = vec![0.5; nbs * 16];
+            let mut f = vec![0.0; n * 16];
+            let mut y = vec![0.0; nbs * 16];
+            let isa = Isa::detect();
+            let reps = 200;
+            let t = std::time::Instant::now();
+            for _ in 0..reps {
+                forward(isa, 16, &rec, &lanes, &xin, &mut f);
+            }
+            let tf = t.elapsed().as_secs_f64() / reps as f64;
+            let t = std::time::Instant::now();
+            for _ in 0..reps {
+                inverse(isa, 16, &rec, &lanes, &f, &mut y);
+            }
+            let ti = t.elapsed().as_secs_f64() / reps as f64;
+            let flops = (n * nbs * 16 * 2) as f64;
+            println!(
+                "B={b} nb={nbs} L={n}: forward {:.1} GFLOP/s, inverse {:.1} GFLOP/s",
+                flops / tf / 1e9,
+                flops / ti / 1e9
+            );
         }
     }
 }

@@ -64,13 +64,3 @@ impl std::error::Error for Error {}
 
 /// Result type of this crate.
 pub type Result<T> = std::result::Result<T, Error>;
-
-/// Allocate a zeroed vector without aborting on failure.
-pub(crate) fn try_zeroed<T: Clone + Default>(n: usize) -> Result<Vec<T>> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n).map_err(|_| Error::OutOfMemory {
-        bytes: n.saturating_mul(std::mem::size_of::<T>()),
-    })?;
-    v.resize(n, T::default());
-    Ok(v)
-}

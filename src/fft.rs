@@ -10,7 +10,7 @@
 use crate::error::{Error, Result};
 use fftw_sys as ffi;
 use num_complex::Complex64;
-use std::sync::{Mutex, MutexGuard, Once};
+use std::sync::{Arc, Mutex, MutexGuard, Once};
 
 /// FFTW planner rigour (FFTW_ESTIMATE ... FFTW_EXHAUSTIVE).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -46,10 +46,12 @@ pub(crate) fn planner_lock() -> MutexGuard<'static, ()> {
     LOCK.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// An FFTW-allocated (SIMD-aligned) complex buffer.
+/// A page-aligned complex buffer, zero-filled. Large buffers are mapped directly and
+/// asked to use transparent huge pages: the chunk buffer is read and written with large
+/// strides, and 4 KiB pages would make nearly every access a TLB miss.
 pub(crate) struct AlignedBuf {
     ptr: *mut Complex64,
-    len: usize,
+    bytes: usize,
 }
 
 // SAFETY: the buffer is plain memory owned by this value.
@@ -57,31 +59,52 @@ unsafe impl Send for AlignedBuf {}
 unsafe impl Sync for AlignedBuf {}
 
 impl AlignedBuf {
-    /// Allocate `len` complex values (uninitialised memory is zeroed).
+    /// Allocate `len` complex values, zero-filled and touched (so page faults happen here).
     pub fn new(len: usize) -> Result<AlignedBuf> {
         let bytes = len
             .checked_mul(16)
-            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?;
-        let ptr = unsafe { ffi::fftw_malloc(bytes.max(16)) } as *mut Complex64;
-        if ptr.is_null() {
+            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?
+            .max(4096);
+        // SAFETY: anonymous private mapping; checked for failure below.
+        let ptr = unsafe {
+            libc::mmap(
+                std::ptr::null_mut(),
+                bytes,
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS | libc::MAP_NORESERVE,
+                -1,
+                0,
+            )
+        };
+        if ptr == libc::MAP_FAILED {
             return Err(Error::OutOfMemory { bytes });
         }
-        unsafe { std::ptr::write_bytes(ptr, 0, len) };
-        Ok(AlignedBuf { ptr, len })
+        unsafe {
+            if bytes >= 1 << 21 {
+                libc::madvise(ptr, bytes, libc::MADV_HUGEPAGE);
+            }
+            // Touch every page now rather than inside the first transform. With no swap
+            // and overcommit, a failure here would be the kernel's OOM killer, so callers
+            // check available memory for very large plans (see Plan::new).
+            std::ptr::write_bytes(ptr as *mut u8, 0, bytes);
+        }
+        Ok(AlignedBuf {
+            ptr: ptr as *mut Complex64,
+            bytes,
+        })
     }
 
     pub fn as_mut_ptr(&self) -> *mut Complex64 {
         self.ptr
     }
-
-    pub fn len(&self) -> usize {
-        self.len
-    }
 }
 
 impl Drop for AlignedBuf {
     fn drop(&mut self) {
-        unsafe { ffi::fftw_free(self.ptr as *mut _) }
+        // SAFETY: the mapping was created in `new` with this size.
+        unsafe {
+            libc::munmap(self.ptr as *mut libc::c_void, self.bytes);
+        }
     }
 }
 
@@ -98,12 +121,27 @@ impl Drop for RawPlan {
     }
 }
 
-/// A batch of `howmany` out-of-place `n x n` DFTs between slice-major arrays (one slice of
-/// `n*n` contiguous values after another) and the pair-major chunk buffer (value `(a, b)` of
-/// batch member `s` at `(a*n + b)*stride + s`), so that the DWT reads each order pair's
-/// betas contiguously. The transposition is folded into FFTW's strides.
-pub(crate) struct ChunkFft {
-    plan: RawPlan,
+fn make_plan(n: usize, sign: i32, flags: u32) -> Result<RawPlan> {
+    // Planning may write to both arrays (FFTW_MEASURE): plan on scratch memory.
+    let a = AlignedBuf::new(n * n)?;
+    let b = AlignedBuf::new(n * n)?;
+    let p = {
+        let _g = planner_lock();
+        unsafe {
+            ffi::fftw_plan_dft_2d(
+                n as i32,
+                n as i32,
+                a.as_mut_ptr(),
+                b.as_mut_ptr(),
+                sign,
+                flags | ffi::FFTW_PRESERVE_INPUT,
+            )
+        }
+    };
+    if p.is_null() {
+        return Err(Error::Fftw(format!("could not plan a {n}x{n} DFT")));
+    }
+    Ok(RawPlan(p))
 }
 
 /// Sign of the exponent: `+1` is FFTW_BACKWARD (used by the forward SO(3) transform).
@@ -111,47 +149,54 @@ pub(crate) const SIGN_PLUS: i32 = ffi::FFTW_BACKWARD as i32;
 /// `-1` is FFTW_FORWARD (used by the inverse SO(3) transform).
 pub(crate) const SIGN_MINUS: i32 = ffi::FFTW_FORWARD;
 
-impl ChunkFft {
-    /// `to_pairs`: slice-major input to pair-major output (forward SO(3) transform, sign +1);
-    /// otherwise pair-major input to slice-major output (inverse, sign -1).
-    pub fn new(n: usize, howmany: usize, stride: usize, to_pairs: bool, rigor: Rigor) -> Result<ChunkFft> {
-        let nn = n * n;
-        // Planning may write to both arrays (FFTW_MEASURE), so plan on scratch memory.
-        let slices = AlignedBuf::new(howmany * nn)?;
-        let pairs = AlignedBuf::new(stride * nn)?;
-        let dims = [n as i32, n as i32];
-        let flags = rigor.flags() | ffi::FFTW_UNALIGNED;
-        let p = {
-            let _g = planner_lock();
-            unsafe {
-                if to_pairs {
-                    ffi::fftw_plan_many_dft(
-                        2, dims.as_ptr(), howmany as i32,
-                        slices.as_mut_ptr(), std::ptr::null(), 1, nn as i32,
-                        pairs.as_mut_ptr(), std::ptr::null(), stride as i32, 1,
-                        SIGN_PLUS, flags | ffi::FFTW_PRESERVE_INPUT,
-                    )
-                } else {
-                    ffi::fftw_plan_many_dft(
-                        2, dims.as_ptr(), howmany as i32,
-                        pairs.as_mut_ptr(), std::ptr::null(), stride as i32, 1,
-                        slices.as_mut_ptr(), std::ptr::null(), 1, nn as i32,
-                        SIGN_MINUS, flags,
-                    )
+/// Out-of-place `n x n` complex DFT of one beta slice (contiguous), usable on any arrays.
+pub(crate) struct SliceFft {
+    n: usize,
+    sign: i32,
+    flags: u32,
+    aligned: RawPlan,
+    /// Plan for arrays whose alignment differs from FFTW's, made on first need.
+    unaligned: Mutex<Option<Arc<RawPlan>>>,
+}
+
+impl SliceFft {
+    pub fn new(n: usize, sign: i32, rigor: Rigor) -> Result<SliceFft> {
+        Ok(SliceFft {
+            n,
+            sign,
+            flags: rigor.flags(),
+            aligned: make_plan(n, sign, rigor.flags())?,
+            unaligned: Mutex::new(None),
+        })
+    }
+
+    /// Transform `n*n` values from `inp` to `out`.
+    ///
+    /// # Safety
+    /// `inp` must be valid for reading and `out` for writing `n*n` values; no overlap.
+    pub unsafe fn execute(&self, inp: *const Complex64, out: *mut Complex64) -> Result<()> {
+        let ia = ffi::fftw_alignment_of(inp as *mut f64);
+        let oa = ffi::fftw_alignment_of(out as *mut f64);
+        if ia == 0 && oa == 0 {
+            ffi::fftw_execute_dft(self.aligned.0, inp as *mut _, out);
+            return Ok(());
+        }
+        let plan = {
+            let mut g = self.unaligned.lock().unwrap_or_else(|e| e.into_inner());
+            match &*g {
+                Some(p) => p.clone(),
+                None => {
+                    let p = Arc::new(make_plan(
+                        self.n,
+                        self.sign,
+                        self.flags | ffi::FFTW_UNALIGNED,
+                    )?);
+                    *g = Some(p.clone());
+                    p
                 }
             }
         };
-        if p.is_null() {
-            return Err(Error::Fftw(format!("could not plan {howmany} DFTs of size {n}x{n}")));
-        }
-        Ok(ChunkFft { plan: RawPlan(p) })
-    }
-
-    /// Execute on new arrays.
-    ///
-    /// # Safety
-    /// `inp` and `out` must span the extents the plan was made for and not overlap.
-    pub unsafe fn execute(&self, inp: *const Complex64, out: *mut Complex64) {
-        ffi::fftw_execute_dft(self.plan.0, inp as *mut _, out);
+        ffi::fftw_execute_dft(plan.0, inp as *mut _, out);
+        Ok(())
     }
 }

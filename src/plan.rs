@@ -7,12 +7,12 @@
 //! buffer is the chunk buffer of `2h` transformed slices, never a copy of the grid.
 
 use crate::dwt::{self, Lanes, Rec};
-use crate::error::{try_zeroed, Error, Result};
-use crate::fft::{AlignedBuf, ChunkFft, Rigor};
+use crate::error::{Error, Result};
+use crate::fft::{AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
 use crate::symmetry::{clusters, Cluster};
-use crate::wigner::{rec_coeffs, start_norms, BetaTables, Ext};
+use crate::wigner::{start_norms, BetaTables, Ext, RecTables};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -76,8 +76,14 @@ pub struct Plan {
     norms: Vec<Ext>,
     /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight with the normalisation folded in.
     wq: Vec<f64>,
-    /// FFTW plans per chunk size (the last chunk may be smaller): `(h, forward, inverse)`.
-    ffts: Vec<(usize, Option<ChunkFft>, Option<ChunkFft>)>,
+    rt: RecTables,
+    fwd_fft: Option<SliceFft>,
+    inv_fft: Option<SliceFft>,
+    /// Per-worker buffers of `FFT_GROUP` slices, for transposing between the
+    /// slice-major sample arrays and the pair-major chunk buffer.
+    fft_scratch: Vec<Mutex<AlignedBuf>>,
+    /// Per-worker DWT scratch.
+    dwt_scratch: Vec<Mutex<Scratch>>,
     /// Low beta slices per chunk.
     chunk: usize,
     buf: Mutex<Option<AlignedBuf>>,
@@ -129,14 +135,10 @@ impl Scratch {
 /// slot `2h-1-s` hold `beta` and `pi - beta`.
 struct Chunk {
     ks: Vec<usize>,
-    h: usize,
 }
 
-impl Chunk {
-    fn mirror(&self, s: usize) -> usize {
-        2 * self.h - 1 - s
-    }
-}
+/// Slices transformed and transposed together (4 complex values fill a cache line).
+const FFT_GROUP: usize = 4;
 
 fn default_workspace(b: usize) -> usize {
     let grid_bytes = (num_samples(b) + num_coeffs(b)) * 16;
@@ -184,24 +186,23 @@ impl Plan {
             .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
         let want_fwd = options.direction != Direction::Inverse;
         let want_inv = options.direction != Direction::Forward;
-        let mut sizes = vec![chunk];
-        if b % chunk != 0 {
-            sizes.push(b % chunk);
-        }
-        let mut ffts = Vec::new();
-        for h in sizes {
-            let f = if want_fwd {
-                Some(ChunkFft::new(n, h, 2 * h, true, options.rigor)?)
-            } else {
-                None
-            };
-            let i = if want_inv {
-                Some(ChunkFft::new(n, h, 2 * h, false, options.rigor)?)
-            } else {
-                None
-            };
-            ffts.push((h, f, i));
-        }
+        let fwd_fft = if want_fwd {
+            Some(SliceFft::new(n, SIGN_PLUS, options.rigor)?)
+        } else {
+            None
+        };
+        let inv_fft = if want_inv {
+            Some(SliceFft::new(n, SIGN_MINUS, options.rigor)?)
+        } else {
+            None
+        };
+        let nbp = (2 * chunk).next_multiple_of(isa.lanes());
+        let dwt_scratch = (0..threads)
+            .map(|_| Mutex::new(Scratch::new(b, nbp)))
+            .collect();
+        let fft_scratch = (0..threads)
+            .map(|_| AlignedBuf::new(FFT_GROUP * n * n).map(Mutex::new))
+            .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
         let buf = AlignedBuf::new(2 * chunk * n * n)?;
@@ -215,7 +216,11 @@ impl Plan {
             bt: BetaTables::grid(b),
             norms: start_norms(b),
             wq,
-            ffts,
+            rt: RecTables::new(b),
+            fwd_fft,
+            inv_fft,
+            fft_scratch,
+            dwt_scratch,
             chunk,
             buf: Mutex::new(Some(buf)),
         })
@@ -312,7 +317,7 @@ impl Plan {
             let h = self.chunk.min(b - lo);
             let mut ks: Vec<usize> = (lo..lo + h).collect();
             ks.extend(2 * b - lo - h..2 * b - lo);
-            Chunk { ks, h }
+            Chunk { ks }
         })
     }
 
@@ -324,7 +329,6 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
         let t0 = Instant::now();
-        let nn = 4 * self.b * self.b;
         let mut times = StageTimes::default();
         let coef = SyncPtr(coeffs.as_mut_ptr());
         self.with_buf(|buf| {
@@ -332,24 +336,16 @@ impl Plan {
             self.pool.install(|| {
                 for (ci, ch) in self.chunks().enumerate() {
                     let t = Instant::now();
-                    let fft = self.chunk_fft(ch.h, true)?;
-                    let h = ch.h;
-                    // Low half and mirrored half: two batches, one per worker.
-                    rayon::join(
-                        || unsafe { fft.execute(samples.as_ptr().add(ch.ks[0] * nn), bp.get()) },
-                        || unsafe {
-                            fft.execute(samples.as_ptr().add(ch.ks[h] * nn), bp.get().add(h))
-                        },
-                    );
+                    self.fft_chunk(&ch, true, samples.as_ptr() as *mut Complex64, bp.get())?;
                     times.fft += t.elapsed().as_secs_f64();
                     let t = Instant::now();
-                    let nbp = ch.ks.len().next_multiple_of(self.isa.lanes());
-                    self.clusters.par_iter().for_each_init(
-                        || Scratch::new(self.b, nbp),
-                        |sc, cl| unsafe {
-                            self.forward_cluster(sc, cl, &ch, bp.get(), coef, ci == 0);
-                        },
-                    );
+                    self.clusters
+                        .par_iter()
+                        .with_min_len(4)
+                        .for_each(|cl| unsafe {
+                            let mut sc = self.scratch();
+                            self.forward_cluster(&mut sc, cl, &ch, bp.get(), coef, ci == 0);
+                        });
                     times.dwt += t.elapsed().as_secs_f64();
                 }
                 Ok::<(), Error>(())
@@ -359,13 +355,72 @@ impl Plan {
         Ok(times)
     }
 
-    fn chunk_fft(&self, h: usize, fwd: bool) -> Result<&ChunkFft> {
-        let e = self
-            .ffts
-            .iter()
-            .find(|e| e.0 == h)
-            .expect("a plan exists for every chunk size");
-        if fwd { e.1.as_ref() } else { e.2.as_ref() }.ok_or(Error::WrongDirection)
+    /// This worker's DWT scratch.
+    fn scratch(&self) -> std::sync::MutexGuard<'_, Scratch> {
+        let tid = rayon::current_thread_index().unwrap_or(0) % self.dwt_scratch.len();
+        self.dwt_scratch[tid]
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// FFT stage of one chunk. Forward: slices `ks[s]` of `grid` are transformed and
+    /// transposed into the pair-major chunk buffer (`buf[fi * nb + s]`). Inverse: the
+    /// reverse, into `grid`. Groups of `FFT_GROUP` slots are spread over the workers.
+    fn fft_chunk(
+        &self,
+        ch: &Chunk,
+        forward: bool,
+        grid: *mut Complex64,
+        buf: *mut Complex64,
+    ) -> Result<()> {
+        let fft = if forward {
+            self.fwd_fft.as_ref()
+        } else {
+            self.inv_fft.as_ref()
+        }
+        .ok_or(Error::WrongDirection)?;
+        let (b, n) = (self.b, 2 * self.b);
+        let nn = n * n;
+        let nb = ch.ks.len();
+        let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
+        (0..nb.div_ceil(FFT_GROUP))
+            .into_par_iter()
+            .try_for_each(|gi| unsafe {
+                let s0 = gi * FFT_GROUP;
+                let g = FFT_GROUP.min(nb - s0);
+                let tid = rayon::current_thread_index().unwrap_or(0) % self.fft_scratch.len();
+                let scratch = self.fft_scratch[tid]
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner());
+                let sp = scratch.as_mut_ptr();
+                let bp = buf.get();
+                if forward {
+                    for j in 0..g {
+                        fft.execute(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nn))?;
+                    }
+                    for fi in 0..nn {
+                        for j in 0..g {
+                            *bp.add(fi * nb + s0 + j) = *sp.add(j * nn + fi);
+                        }
+                    }
+                } else {
+                    for fi in 0..nn {
+                        for j in 0..g {
+                            *sp.add(j * nn + fi) = *bp.add(fi * nb + s0 + j);
+                        }
+                    }
+                    for j in 0..g {
+                        let slot = sp.add(j * nn);
+                        // Frequency B (alpha or gamma) is outside the band limit.
+                        for i in 0..n {
+                            *slot.add(b * n + i) = Complex64::new(0.0, 0.0);
+                            *slot.add(i * n + b) = Complex64::new(0.0, 0.0);
+                        }
+                        fft.execute(slot, grid.get().add(ch.ks[s0 + j] * nn))?;
+                    }
+                }
+                Ok(())
+            })
     }
 
     /// Like [`Plan::inverse`], also returning the time of each stage.
@@ -376,9 +431,6 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
         let t0 = Instant::now();
-        let n = 2 * self.b;
-        let nn = n * n;
-        let b = self.b;
         let mut times = StageTimes::default();
         let out = SyncPtr(samples.as_mut_ptr());
         self.with_buf(|buf| {
@@ -386,29 +438,16 @@ impl Plan {
             self.pool.install(|| {
                 for ch in self.chunks() {
                     let t = Instant::now();
-                    let nbp = ch.ks.len().next_multiple_of(self.isa.lanes());
-                    self.clusters.par_iter().for_each_init(
-                        || Scratch::new(self.b, nbp),
-                        |sc, cl| unsafe {
-                            self.inverse_cluster(sc, cl, &ch, bp.get(), coeffs);
-                        },
-                    );
+                    self.clusters
+                        .par_iter()
+                        .with_min_len(4)
+                        .for_each(|cl| unsafe {
+                            let mut sc = self.scratch();
+                            self.inverse_cluster(&mut sc, cl, &ch, bp.get(), coeffs);
+                        });
                     times.dwt += t.elapsed().as_secs_f64();
                     let t = Instant::now();
-                    let fft = self.chunk_fft(ch.h, false)?;
-                    let (h, nb) = (ch.h, ch.ks.len());
-                    // Frequency B (alpha or gamma) is outside the band limit.
-                    unsafe {
-                        for j in 0..n {
-                            for fi in [b * n + j, j * n + b] {
-                                std::ptr::write_bytes(bp.get().add(fi * nb), 0, nb);
-                            }
-                        }
-                    }
-                    rayon::join(
-                        || unsafe { fft.execute(bp.get(), out.get().add(ch.ks[0] * nn)) },
-                        || unsafe { fft.execute(bp.get().add(h), out.get().add(ch.ks[h] * nn)) },
-                    );
+                    self.fft_chunk(&ch, false, out.get(), bp.get())?;
                     times.fft += t.elapsed().as_secs_f64();
                 }
                 Ok::<(), Error>(())
@@ -419,15 +458,18 @@ impl Plan {
     }
 
     /// Recurrence coefficients and per-beta lane inputs of a cluster for one chunk.
-    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> (usize, usize) {
-        let n = self.b - cl.m;
-        rec_coeffs(cl.m, cl.mp, &mut sc.a[..n], &mut sc.c[..n], &mut sc.bb[..n]);
+    /// The forward transform folds the quadrature weights into the starting values.
+    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk, forward: bool) -> (usize, usize) {
+        let n = self.b - cl.l0();
+        self.rt
+            .coeffs(cl.m, cl.mp, &mut sc.a[..n], &mut sc.c[..n], &mut sc.bb[..n]);
         let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
         let nb = ch.ks.len();
         let nbp = nb.next_multiple_of(self.isa.lanes());
         for (s, &k) in ch.ks.iter().enumerate() {
             sc.x[s] = self.bt.cos_beta[k];
-            let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm);
+            let w = if forward { self.wq[k] } else { 1.0 };
+            let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, w);
             sc.p[s] = p;
             sc.sc[s] = scale;
         }
@@ -459,18 +501,28 @@ impl Plan {
         coef: SyncPtr<Complex64>,
         first: bool,
     ) {
-        let (n, nbp) = self.setup(sc, cl, ch);
+        let (n, nbp) = self.setup(sc, cl, ch, true);
         let p = if cl.members.len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let data = &mut sc.data[..nbp * p];
-        data.fill(0.0);
+        if cl.members.len() * 2 < p || nb < nbp {
+            data.fill(0.0);
+        }
         for (q, mem) in cl.members.iter().enumerate() {
-            let fi = self.freq_index(mem.m, mem.mp);
-            for s in 0..nb {
-                let slot = if mem.reversed { ch.mirror(s) } else { s };
-                let z = *buf.add(fi * nb + slot) * self.wq[ch.ks[slot]];
-                data[s * p + 2 * q] = z.re;
-                data[s * p + 2 * q + 1] = z.im;
+            let src = buf.add(self.freq_index(mem.m, mem.mp) * nb);
+            let col = data.chunks_exact_mut(p).map(|r| &mut r[2 * q..2 * q + 2]);
+            if mem.reversed {
+                for (s, d) in col.take(nb).enumerate() {
+                    let z = *src.add(nb - 1 - s);
+                    d[0] = z.re;
+                    d[1] = z.im;
+                }
+            } else {
+                for (s, d) in col.take(nb).enumerate() {
+                    let z = *src.add(s);
+                    d[0] = z.re;
+                    d[1] = z.im;
+                }
             }
         }
         let f = &mut sc.out[..n * p];
@@ -487,14 +539,21 @@ impl Plan {
         };
         dwt::forward(self.isa, p, &rec, &lanes, data, f);
         for (q, mem) in cl.members.iter().enumerate() {
-            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
-            for i in 0..n {
-                let g = mem.sign_at(cl.m + i);
-                let z = Complex64::new(f[i * p + 2 * q] * g, f[i * p + 2 * q + 1] * g);
-                if first {
-                    *dst.add(i) = z;
-                } else {
-                    *dst.add(i) += z;
+            let dst = std::slice::from_raw_parts_mut(
+                coef.get().add(block_start(self.b, mem.m, mem.mp)),
+                n,
+            );
+            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
+            let rows = f.chunks_exact(p).map(|r| (r[2 * q], r[2 * q + 1]));
+            if first {
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
+                    *d = Complex64::new(re * g, im * g);
+                }
+            } else {
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
+                    *d += Complex64::new(re * g, im * g);
                 }
             }
         }
@@ -512,18 +571,21 @@ impl Plan {
         buf: *mut Complex64,
         coef: &[Complex64],
     ) {
-        let (n, nbp) = self.setup(sc, cl, ch);
+        let (n, nbp) = self.setup(sc, cl, ch, false);
         let p = if cl.members.len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let fin = &mut sc.data[..n * p];
-        fin.fill(0.0);
+        if cl.members.len() * 2 < p {
+            fin.fill(0.0);
+        }
         let scale = 1.0 / (2.0 * PI);
         for (q, mem) in cl.members.iter().enumerate() {
-            let src = &coef[block_start(self.b, mem.m, mem.mp)..];
-            for i in 0..n {
-                let g = mem.sign_at(cl.m + i) * scale;
-                fin[i * p + 2 * q] = src[i].re * g;
-                fin[i * p + 2 * q + 1] = src[i].im * g;
+            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
+            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
+            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
+                let g = sg[i & 1];
+                row[2 * q] = z.re * g;
+                row[2 * q + 1] = z.im * g;
             }
         }
         let y = &mut sc.out[..nbp * p];
@@ -539,23 +601,26 @@ impl Plan {
         };
         dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
         for (q, mem) in cl.members.iter().enumerate() {
-            let fi = self.freq_index(mem.m, mem.mp);
-            for s in 0..nb {
-                let slot = if mem.reversed { ch.mirror(s) } else { s };
-                *buf.add(fi * nb + slot) =
-                    Complex64::new(y[2 * q * nbp + s], y[(2 * q + 1) * nbp + s]);
+            let dst = buf.add(self.freq_index(mem.m, mem.mp) * nb);
+            let (yr, yi) = (&y[2 * q * nbp..][..nb], &y[(2 * q + 1) * nbp..][..nb]);
+            if mem.reversed {
+                for s in 0..nb {
+                    *dst.add(nb - 1 - s) = Complex64::new(yr[s], yi[s]);
+                }
+            } else {
+                for s in 0..nb {
+                    *dst.add(s) = Complex64::new(yr[s], yi[s]);
+                }
             }
         }
     }
 }
 
-#[allow(dead_code)]
-fn _assert_send_sync() {
-    fn is<T: Send + Sync>() {}
-    is::<Plan>();
-}
-
-#[allow(dead_code)]
-pub(crate) fn zeroed_complex(n: usize) -> Result<Vec<Complex64>> {
-    try_zeroed(n)
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn plan_is_send_sync() {
+        fn is<T: Send + Sync>() {}
+        is::<super::Plan>();
+    }
 }

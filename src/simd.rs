@@ -62,8 +62,6 @@ impl Isa {
 /// Vector operations used by the kernels. All methods are unsafe: the caller
 /// guarantees the CPU supports the instruction set and pointers are valid for `W` doubles.
 pub(crate) trait Simd: Copy {
-    /// Lanes per vector.
-    const W: usize;
     /// The vector type.
     type V: Copy;
     unsafe fn splat(x: f64) -> Self::V;
@@ -88,7 +86,6 @@ pub(crate) trait Simd: Copy {
 pub(crate) struct Scalar;
 
 impl Simd for Scalar {
-    const W: usize = 1;
     type V = f64;
     #[inline(always)]
     unsafe fn splat(x: f64) -> f64 {
@@ -137,7 +134,6 @@ mod x86 {
     pub(crate) struct Avx512;
 
     impl Simd for Avx512 {
-        const W: usize = 8;
         type V = __m512d;
         #[inline(always)]
         unsafe fn splat(x: f64) -> __m512d {
@@ -178,7 +174,6 @@ mod x86 {
     pub(crate) struct Avx2;
 
     impl Simd for Avx2 {
-        const W: usize = 4;
         type V = __m256d;
         #[inline(always)]
         unsafe fn splat(x: f64) -> __m256d {

@@ -104,11 +104,6 @@ impl Cluster {
     pub fn l0(&self) -> usize {
         self.m
     }
-
-    /// Relative work: members times degrees.
-    pub fn cost(&self, b: usize) -> usize {
-        self.members.len() * (b - self.m)
-    }
 }
 
 /// Number of generic clusters (`m > m' > 0`): `(B-1)(B-2)/2`.

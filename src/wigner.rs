@@ -153,11 +153,6 @@ impl PowTable {
         }
         PowTable { nb, lo, hi }
     }
-
-    #[inline]
-    fn pow(&self, k: usize, a: usize) -> Ext {
-        self.lo[(a % 64) * self.nb + k].mul(self.hi[(a / 64) * self.nb + k])
-    }
 }
 
 /// Per-beta tables for starting values: `cos(beta)`, and powers of `cos(beta/2)`, `sin(beta/2)`.
@@ -190,45 +185,112 @@ impl BetaTables {
         BetaTables::new(&pts, 2 * b)
     }
 
-    /// Scaled starting value `dt^m_{m,m'}` at point `k`, given `norm` from [`start_norms`].
+    /// Scaled starting value `weight * dt^m_{m,m'}` at point `k`, given `norm` from
+    /// [`start_norms`]. (A per-lane weight scales every degree of the recurrence alike.)
     #[inline]
-    pub fn start(&self, k: usize, m: usize, mp: usize, norm: Ext) -> (f64, f64) {
-        let v = norm
-            .mul(self.cpow.pow(k, m + mp))
-            .mul(self.spow.pow(k, m - mp));
-        let (p, sc) = v.to_scaled();
-        if (m - mp) % 2 == 1 {
-            (-p, sc)
-        } else {
-            (p, sc)
-        }
+    pub fn start(&self, k: usize, m: usize, mp: usize, norm: Ext, weight: f64) -> (f64, f64) {
+        let (a, b) = (m + mp, m - mp);
+        let c1 = self.cpow.lo[(a % 64) * self.cpow.nb + k];
+        let c2 = self.cpow.hi[(a / 64) * self.cpow.nb + k];
+        let s1 = self.spow.lo[(b % 64) * self.spow.nb + k];
+        let s2 = self.spow.hi[(b / 64) * self.spow.nb + k];
+        // Five mantissas in [0.5, 1) and a weight: no intermediate renormalisation needed.
+        let (mant, e) = frexp(norm.mant * c1.mant * c2.mant * s1.mant * s2.mant * weight);
+        let v = Ext {
+            mant: if b % 2 == 1 { -mant } else { mant },
+            exp: e + norm.exp + c1.exp + c2.exp + s1.exp + s2.exp,
+        };
+        v.to_scaled()
     }
 }
 
-/// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + a.len()`:
-/// `a[i] = A_l`, `c[i] = C_l`, `bb[i] = Bc_l` with `l = m + i`.
-pub(crate) fn rec_coeffs(m: usize, mp: usize, a: &mut [f64], c: &mut [f64], bb: &mut [f64]) {
-    let n = a.len();
-    debug_assert!(c.len() == n && bb.len() == n);
-    let (mf, mpf) = (m as f64, mp as f64);
-    let mm = mf * mpf;
-    // q(l) = sqrt((l^2 - m^2)(l^2 - m'^2)); the products are exact integers below 2^53.
-    let q = |l: f64| ((l * l - mf * mf) * (l * l - mpf * mpf)).sqrt();
-    let mut ql = q(m as f64);
-    for i in 0..n {
-        let l = (m + i) as f64;
-        let ql1 = q(l + 1.0);
-        let k1 = (l + 1.0) * ((2.0 * l + 3.0) * (2.0 * l + 1.0)).sqrt();
-        let ai = k1 / ql1;
-        a[i] = ai;
-        if l == 0.0 {
-            c[i] = 0.0;
-            bb[i] = 0.0;
-        } else {
-            c[i] = -ai * mm / (l * (l + 1.0));
-            bb[i] = ((2.0 * l + 3.0) / (2.0 * l - 1.0)).sqrt() * (l + 1.0) / l * ql / ql1;
+/// Tables from which the recurrence coefficients of any base pair follow by a few
+/// multiplications (no square root or division per cluster).
+pub(crate) struct RecTables {
+    stride: usize,
+    /// `sqrt(l^2 - m^2)` at `[m * stride + l]` (`l >= m`).
+    s: Vec<f64>,
+    /// `1 / sqrt(l^2 - m^2)` (`l > m`, 0 at `l = m`).
+    r: Vec<f64>,
+    k1: Vec<f64>,
+    k2: Vec<f64>,
+    k3: Vec<f64>,
+}
+
+impl RecTables {
+    /// Tables for degrees up to `lmax` (coefficients for `l <= lmax`).
+    pub fn new(lmax: usize) -> RecTables {
+        let stride = lmax + 2;
+        let mut s = vec![0.0; (lmax + 1) * stride];
+        let mut r = vec![0.0; (lmax + 1) * stride];
+        for m in 0..=lmax {
+            for l in m..stride {
+                let v = (((l * l - m * m) as f64).max(0.0)).sqrt();
+                s[m * stride + l] = v;
+                r[m * stride + l] = if l > m { 1.0 / v } else { 0.0 };
+            }
         }
-        ql = ql1;
+        let k1 = (0..=lmax)
+            .map(|l| {
+                let l = l as f64;
+                (l + 1.0) * ((2.0 * l + 3.0) * (2.0 * l + 1.0)).sqrt()
+            })
+            .collect();
+        let k2 = (0..=lmax)
+            .map(|l| {
+                let l = l as f64;
+                if l == 0.0 {
+                    0.0
+                } else {
+                    ((2.0 * l + 3.0) / (2.0 * l - 1.0)).sqrt() * (l + 1.0) / l
+                }
+            })
+            .collect();
+        let k3 = (0..=lmax)
+            .map(|l| {
+                let l = l as f64;
+                if l == 0.0 {
+                    0.0
+                } else {
+                    1.0 / (l * (l + 1.0))
+                }
+            })
+            .collect();
+        RecTables {
+            stride,
+            s,
+            r,
+            k1,
+            k2,
+            k3,
+        }
+    }
+
+    /// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + a.len()`:
+    /// `dt^{l+1} = (a x + c) dt^l - bb dt^{l-1}` with `a[i] = A_l`, `c[i] = C_l`,
+    /// `bb[i] = Bc_l`, `l = m + i`, where (with `q(l) = sqrt((l^2-m^2)(l^2-m'^2))`)
+    /// `A_l = (l+1) sqrt((2l+3)(2l+1)) / q(l+1)`, `C_l = -A_l m m' / (l(l+1))`,
+    /// `Bc_l = sqrt((2l+3)/(2l-1)) (l+1)/l q(l)/q(l+1)`.
+    pub fn coeffs(&self, m: usize, mp: usize, a: &mut [f64], c: &mut [f64], bb: &mut [f64]) {
+        let n = a.len();
+        assert!(c.len() == n && bb.len() == n && m + n < self.stride && mp <= m);
+        let st = self.stride;
+        let mm = (m * mp) as f64;
+        let rng = m..m + n;
+        let (sm, smp) = (
+            &self.s[m * st..][rng.clone()],
+            &self.s[mp * st..][rng.clone()],
+        );
+        let rng1 = m + 1..m + n + 1;
+        let (rm, rmp) = (&self.r[m * st..][rng1.clone()], &self.r[mp * st..][rng1]);
+        let (k1, k2, k3) = (&self.k1[rng.clone()], &self.k2[rng.clone()], &self.k3[rng]);
+        for i in 0..n {
+            let inv = rm[i] * rmp[i];
+            let ai = k1[i] * inv;
+            a[i] = ai;
+            c[i] = -ai * mm * k3[i];
+            bb[i] = k2[i] * sm[i] * smp[i] * inv;
+        }
     }
 }
 
@@ -256,7 +318,8 @@ pub(crate) fn wigner_d_column_isa(
     let pt = if mem.reversed { (-x, s, c) } else { (x, c, s) };
     let bt = BetaTables::new(&[pt], 2 * bm);
     let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
-    let col = crate::dwt::column(isa, &bt, 0, bm, bmp, norm, lmax + 1);
+    let rt = RecTables::new(lmax + 1);
+    let col = crate::dwt::column(isa, &bt, &rt, 0, bm, bmp, norm, lmax + 1);
     col.iter()
         .enumerate()
         .map(|(i, v)| {
@@ -274,12 +337,13 @@ pub fn dt_on_grid(b: usize, m: isize, mp: isize) -> Vec<f64> {
     let n = 2 * b;
     let bt = BetaTables::grid(b);
     let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
+    let rt = RecTables::new(b);
     let isa = Isa::detect();
     let rows = b - bm;
     let mut out = vec![0.0; rows * n];
     for k in 0..n {
         let src = if mem.reversed { n - 1 - k } else { k };
-        let col = crate::dwt::column(isa, &bt, src, bm, bmp, norm, b);
+        let col = crate::dwt::column(isa, &bt, &rt, src, bm, bmp, norm, b);
         for (i, v) in col.iter().enumerate() {
             out[i * n + k] = mem.sign_at(bm + i) * v;
         }
