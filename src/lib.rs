@@ -21,6 +21,7 @@
 
 #![warn(missing_docs)]
 
+pub mod capi;
 mod dwt;
 mod error;
 mod fft;
