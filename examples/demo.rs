@@ -31,6 +31,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok()
             .and_then(|s| s.parse().ok())
             .unwrap_or(0),
+        max_workspace_bytes: std::env::var("SO3FFT_WORKSPACE_MB")
+            .ok()
+            .and_then(|s| s.parse::<usize>().ok())
+            .map(|mb| mb << 20),
         ..Default::default()
     };
     println!("so3fft demo: random coefficients -> inverse -> forward, all cores");

@@ -385,7 +385,7 @@ mod tests {
                     forward(isa, pw, &rec, &lanes, &xin, &mut f);
                     inverse(isa, pw, &rec, &lanes, &fin, &mut y);
                     // FMA and plain multiply-add round differently; the recurrence error
-                    // grows like l * eps, so compare relative to the largest value.
+                    // grows like l * eps (l <= 200 here), so compare relative to the largest value.
                     let rel = |u: &[f64], r: &[f64]| {
                         let scale = r.iter().fold(0.0f64, |s, x| s.max(x.abs()));
                         let e = u
@@ -396,7 +396,7 @@ mod tests {
                     };
                     let (ef, ey) = (rel(&f, &f_ref), rel(&y, &y_ref));
                     assert!(
-                        ef < 1e-13 && ey < 1e-13,
+                        ef < 1e-12 && ey < 1e-12,
                         "{isa:?} m={m} mp={mp} P={pw}: {ef} {ey}"
                     );
                 }

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
-use crate::symmetry::{clusters, Cluster};
+use crate::symmetry::{cluster_pairs, Cluster};
 use crate::wigner::{start_norms, BetaTables, Ext, RecTables};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -71,7 +71,8 @@ pub struct Plan {
     threads: usize,
     isa: Isa,
     pool: rayon::ThreadPool,
-    clusters: Vec<Cluster>,
+    /// Base pairs of the clusters, in scheduling order (kappa order first).
+    clusters: Vec<(u32, u32)>,
     bt: BetaTables,
     norms: Vec<Ext>,
     /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight with the normalisation folded in.
@@ -79,13 +80,17 @@ pub struct Plan {
     rt: RecTables,
     fwd_fft: Option<SliceFft>,
     inv_fft: Option<SliceFft>,
-    /// Per-worker buffers of `FFT_GROUP` slices, for transposing between the
+    /// Per-worker buffers of `group` slices, for transposing between the
     /// slice-major sample arrays and the pair-major chunk buffer.
     fft_scratch: Vec<Mutex<AlignedBuf>>,
     /// Per-worker DWT scratch.
     dwt_scratch: Vec<Mutex<Scratch>>,
     /// Low beta slices per chunk.
     chunk: usize,
+    /// Slices per FFT group.
+    group: usize,
+    /// Bytes this plan holds.
+    memory: usize,
     buf: Mutex<Option<AlignedBuf>>,
 }
 
@@ -137,12 +142,70 @@ struct Chunk {
     ks: Vec<usize>,
 }
 
-/// Slices transformed and transposed together (4 complex values fill a cache line).
-const FFT_GROUP: usize = 4;
+/// Slices transformed and transposed together: 4 complex values fill a cache line; fewer
+/// when slices are large (the per-worker buffer holds a whole group).
+fn fft_group(b: usize) -> usize {
+    let slice_bytes = 64 * b * b;
+    ((64usize << 20) / slice_bytes).clamp(1, 4)
+}
 
+/// A field of Linux's `/proc/meminfo` in bytes, if known.
+fn meminfo(field: &str) -> Option<usize> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = s.lines().find(|l| l.starts_with(field))?;
+    let kb: usize = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Bytes of memory the system can still give us (`MemAvailable`), if known.
+pub(crate) fn mem_available() -> Option<usize> {
+    meminfo("MemAvailable:")
+}
+
+/// Default cap on the chunk buffer: `max(512 MiB, 5%` of the sample plus coefficient
+/// arrays`)`, and at most a quarter of the available memory.
 fn default_workspace(b: usize) -> usize {
     let grid_bytes = (num_samples(b) + num_coeffs(b)) * 16;
-    (512usize << 20).max(grid_bytes / 20)
+    let d = (512usize << 20).max(grid_bytes / 20);
+    match mem_available() {
+        Some(avail) => d.min(avail / 4),
+        None => d,
+    }
+}
+
+/// How a plan's memory splits up (see [`Plan::memory_bytes`]).
+struct Layout {
+    chunk: usize,
+    group: usize,
+    chunk_bytes: usize,
+    fft_scratch_bytes: usize,
+    table_bytes: usize,
+}
+
+impl Layout {
+    fn new(b: usize, threads: usize, budget: usize) -> Layout {
+        let slice_bytes = 64 * b * b;
+        let chunk = (budget / (2 * slice_bytes)).clamp(1, b);
+        let group = fft_group(b);
+        // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
+        // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list, per-worker DWT scratch.
+        let table_bytes = 16 * (b + 1) * (b + 2)
+            + 8 * b * (b + 1)
+            + 64 * b * (66 + b / 32)
+            + 8 * b * b
+            + threads * 8 * (6 * b + 40 * (2 * chunk + 8));
+        Layout {
+            chunk,
+            group,
+            chunk_bytes: 2 * chunk * slice_bytes,
+            fft_scratch_bytes: threads * group * slice_bytes,
+            table_bytes,
+        }
+    }
+
+    fn total(&self) -> usize {
+        self.chunk_bytes + self.fft_scratch_bytes + self.table_bytes
+    }
 }
 
 impl Plan {
@@ -174,11 +237,25 @@ impl Plan {
             )));
         }
         let n = 2 * b;
-        let slice_bytes = n * n * 16;
         let budget = options
             .max_workspace_bytes
             .unwrap_or_else(|| default_workspace(b));
-        let chunk = (budget / (2 * slice_bytes)).clamp(1, b);
+        let layout = Layout::new(b, threads, budget);
+        // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
+        // available memory, and plan plus the caller's arrays in the machine.
+        let arrays = (num_samples(b) + num_coeffs(b)).saturating_mul(16);
+        let too_big = match (mem_available(), meminfo("MemTotal:")) {
+            (Some(avail), Some(total)) => {
+                layout.total() > avail || layout.total().saturating_add(arrays) > total
+            }
+            _ => false,
+        };
+        if too_big {
+            return Err(Error::OutOfMemory {
+                bytes: layout.total().saturating_add(arrays),
+            });
+        }
+        let chunk = layout.chunk;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("so3fft-{i}"))
@@ -201,7 +278,7 @@ impl Plan {
             .map(|_| Mutex::new(Scratch::new(b, nbp)))
             .collect();
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new(FFT_GROUP * n * n).map(Mutex::new))
+            .map(|_| AlignedBuf::new(layout.group * n * n).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -212,7 +289,7 @@ impl Plan {
             threads,
             isa,
             pool,
-            clusters: clusters(b),
+            clusters: cluster_pairs(b),
             bt: BetaTables::grid(b),
             norms: start_norms(b),
             wq,
@@ -222,6 +299,8 @@ impl Plan {
             fft_scratch,
             dwt_scratch,
             chunk,
+            group: layout.group,
+            memory: layout.total(),
             buf: Mutex::new(Some(buf)),
         })
     }
@@ -256,9 +335,20 @@ impl Plan {
         num_coeffs(self.b)
     }
 
+    /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
+    /// computed before allocating: `2h (2B)^2 16` for the chunk buffer (below) plus
+    /// `threads * g * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`)
+    /// plus `O(B^2)` tables. A transform needs the caller's arrays on top
+    /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
+    /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
+    pub fn memory_bytes(&self) -> usize {
+        self.memory
+    }
+
     /// Bytes of the chunk buffer: `2 h (2B)^2 * 16` with `h` low beta slices per chunk,
     /// `h = clamp(max_workspace_bytes / (2 (2B)^2 16), 1, B)`; by default the cap is
-    /// `max(512 MiB, 5% of the sample and coefficient arrays)`.
+    /// `max(512 MiB, 5% of the sample and coefficient arrays)`, at most a quarter of the
+    /// available memory.
     pub fn workspace_bytes(&self) -> usize {
         2 * self.chunk * 4 * self.b * self.b * 16
     }
@@ -342,7 +432,8 @@ impl Plan {
                     self.clusters
                         .par_iter()
                         .with_min_len(4)
-                        .for_each(|cl| unsafe {
+                        .for_each(|&(m, mp)| unsafe {
+                            let cl = &Cluster::new(m as usize, mp as usize);
                             let mut sc = self.scratch();
                             self.forward_cluster(&mut sc, cl, &ch, bp.get(), coef, ci == 0);
                         });
@@ -365,7 +456,7 @@ impl Plan {
 
     /// FFT stage of one chunk. Forward: slices `ks[s]` of `grid` are transformed and
     /// transposed into the pair-major chunk buffer (`buf[fi * nb + s]`). Inverse: the
-    /// reverse, into `grid`. Groups of `FFT_GROUP` slots are spread over the workers.
+    /// reverse, into `grid`. Groups of `self.group` slots are spread over the workers.
     fn fft_chunk(
         &self,
         ch: &Chunk,
@@ -383,11 +474,12 @@ impl Plan {
         let nn = n * n;
         let nb = ch.ks.len();
         let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        (0..nb.div_ceil(FFT_GROUP))
+        let group = self.group;
+        (0..nb.div_ceil(group))
             .into_par_iter()
             .try_for_each(|gi| unsafe {
-                let s0 = gi * FFT_GROUP;
-                let g = FFT_GROUP.min(nb - s0);
+                let s0 = gi * group;
+                let g = group.min(nb - s0);
                 let tid = rayon::current_thread_index().unwrap_or(0) % self.fft_scratch.len();
                 let scratch = self.fft_scratch[tid]
                     .lock()
@@ -441,7 +533,8 @@ impl Plan {
                     self.clusters
                         .par_iter()
                         .with_min_len(4)
-                        .for_each(|cl| unsafe {
+                        .for_each(|&(m, mp)| unsafe {
+                            let cl = &Cluster::new(m as usize, mp as usize);
                             let mut sc = self.scratch();
                             self.inverse_cluster(&mut sc, cl, &ch, bp.get(), coeffs);
                         });
@@ -502,13 +595,13 @@ impl Plan {
         first: bool,
     ) {
         let (n, nbp) = self.setup(sc, cl, ch, true);
-        let p = if cl.members.len() > 4 { 16 } else { 8 };
+        let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let data = &mut sc.data[..nbp * p];
-        if cl.members.len() * 2 < p || nb < nbp {
+        if cl.members().len() * 2 < p || nb < nbp {
             data.fill(0.0);
         }
-        for (q, mem) in cl.members.iter().enumerate() {
+        for (q, mem) in cl.members().iter().enumerate() {
             let src = buf.add(self.freq_index(mem.m, mem.mp) * nb);
             let col = data.chunks_exact_mut(p).map(|r| &mut r[2 * q..2 * q + 2]);
             if mem.reversed {
@@ -538,7 +631,7 @@ impl Plan {
             sc: &sc.sc[..nbp],
         };
         dwt::forward(self.isa, p, &rec, &lanes, data, f);
-        for (q, mem) in cl.members.iter().enumerate() {
+        for (q, mem) in cl.members().iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
                 coef.get().add(block_start(self.b, mem.m, mem.mp)),
                 n,
@@ -572,14 +665,14 @@ impl Plan {
         coef: &[Complex64],
     ) {
         let (n, nbp) = self.setup(sc, cl, ch, false);
-        let p = if cl.members.len() > 4 { 16 } else { 8 };
+        let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let fin = &mut sc.data[..n * p];
-        if cl.members.len() * 2 < p {
+        if cl.members().len() * 2 < p {
             fin.fill(0.0);
         }
         let scale = 1.0 / (2.0 * PI);
-        for (q, mem) in cl.members.iter().enumerate() {
+        for (q, mem) in cl.members().iter().enumerate() {
             let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
             let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
             for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
@@ -600,7 +693,7 @@ impl Plan {
             sc: &sc.sc[..nbp],
         };
         dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
-        for (q, mem) in cl.members.iter().enumerate() {
+        for (q, mem) in cl.members().iter().enumerate() {
             let dst = buf.add(self.freq_index(mem.m, mem.mp) * nb);
             let (yr, yi) = (&y[2 * q * nbp..][..nb], &y[(2 * q + 1) * nbp..][..nb]);
             if mem.reversed {

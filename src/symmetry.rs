@@ -50,15 +50,16 @@ impl Member {
     }
 }
 
-/// A group of order pairs sharing one Wigner-d recurrence.
+/// A group of order pairs sharing one Wigner-d recurrence (no heap: plans build
+/// them on the fly from the base pair).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct Cluster {
     /// Base order `m` (`m >= m' >= 0`); also the lowest degree `l0`.
     pub m: usize,
     /// Base order `m'`.
     pub mp: usize,
-    /// The distinct members (1, 4 or 8).
-    pub members: Vec<Member>,
+    slots: [Member; 8],
+    len: usize,
 }
 
 fn neg1(e: isize) -> i8 {
@@ -85,19 +86,37 @@ impl Cluster {
             (b, -a, neg1(a), true, true),
             (-b, a, neg1(b), true, true),
         ];
-        let mut members: Vec<Member> = Vec::with_capacity(8);
+        let first = Member {
+            m: a,
+            mp: b,
+            sign: 1,
+            parity: false,
+            reversed: false,
+        };
+        let mut c = Cluster {
+            m,
+            mp,
+            slots: [first; 8],
+            len: 0,
+        };
         for (m, mp, sign, parity, reversed) in all {
-            if !members.iter().any(|x| x.m == m && x.mp == mp) {
-                members.push(Member {
+            if !c.members().iter().any(|x| x.m == m && x.mp == mp) {
+                c.slots[c.len] = Member {
                     m,
                     mp,
                     sign,
                     parity,
                     reversed,
-                });
+                };
+                c.len += 1;
             }
         }
-        Cluster { m, mp, members }
+        c
+    }
+
+    /// The distinct members (1, 4 or 8).
+    pub fn members(&self) -> &[Member] {
+        &self.slots[..self.len]
     }
 
     /// Lowest degree present in the cluster.
@@ -127,21 +146,21 @@ pub(crate) fn kappa_to_pair(b: usize, kappa: usize) -> (usize, usize) {
     }
 }
 
-/// All clusters of bandwidth `b`: the generic ones in kappa order, then the
-/// `m' = 0` and `m = m'` groups, then `(0, 0)`. Together they cover every order
-/// pair `(M, M')`, `|M|, |M'| < B`, exactly once.
-pub(crate) fn clusters(b: usize) -> Vec<Cluster> {
-    let mut v: Vec<Cluster> = (0..num_generic(b))
+/// Base pairs of all clusters of bandwidth `b`: the generic ones in kappa order, then
+/// the `m' = 0` and `m = m'` groups, then `(0, 0)`. Together their clusters cover every
+/// order pair `(M, M')`, `|M|, |M'| < B`, exactly once.
+pub(crate) fn cluster_pairs(b: usize) -> Vec<(u32, u32)> {
+    let mut v: Vec<(u32, u32)> = (0..num_generic(b))
         .map(|k| {
             let (m, mp) = kappa_to_pair(b, k);
-            Cluster::new(m, mp)
+            (m as u32, mp as u32)
         })
         .collect();
-    for m in 1..b {
-        v.push(Cluster::new(m, 0));
-        v.push(Cluster::new(m, m));
+    for m in 1..b as u32 {
+        v.push((m, 0));
+        v.push((m, m));
     }
-    v.push(Cluster::new(0, 0));
+    v.push((0, 0));
     v
 }
 
@@ -152,7 +171,7 @@ pub(crate) fn locate(m: isize, mp: isize) -> (usize, usize, Member) {
     let (bm, bmp) = (a.max(b), a.min(b));
     let c = Cluster::new(bm, bmp);
     let mem = *c
-        .members
+        .members()
         .iter()
         .find(|x| x.m == m && x.mp == mp)
         .expect("every order pair is a member of its base cluster");
@@ -182,7 +201,8 @@ mod tests {
         for b in 1..30usize {
             let bi = b as isize;
             let mut seen = HashSet::new();
-            for c in clusters(b) {
+            for (m, mp) in cluster_pairs(b) {
+                let c = Cluster::new(m as usize, mp as usize);
                 let expect = if c.m == 0 {
                     1
                 } else if c.mp == 0 || c.mp == c.m {
@@ -190,8 +210,8 @@ mod tests {
                 } else {
                     8
                 };
-                assert_eq!(c.members.len(), expect);
-                for mem in &c.members {
+                assert_eq!(c.members().len(), expect);
+                for mem in c.members() {
                     assert!(mem.m.abs() < bi && mem.mp.abs() < bi);
                     assert_eq!(mem.m.unsigned_abs().max(mem.mp.unsigned_abs()), c.l0());
                     assert!(seen.insert((mem.m, mem.mp)));
@@ -221,7 +241,7 @@ mod tests {
             for bm in 0..7usize {
                 for bmp in 0..=bm {
                     let c = Cluster::new(bm, bmp);
-                    for mem in &c.members {
+                    for mem in c.members() {
                         for l in bm..9 {
                             let li = l as i64;
                             let base_b = if mem.reversed {
