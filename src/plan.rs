@@ -429,14 +429,9 @@ impl Plan {
                     self.fft_chunk(&ch, true, samples.as_ptr() as *mut Complex64, bp.get())?;
                     times.fft += t.elapsed().as_secs_f64();
                     let t = Instant::now();
-                    self.clusters
-                        .par_iter()
-                        .with_min_len(4)
-                        .for_each(|&(m, mp)| unsafe {
-                            let cl = &Cluster::new(m as usize, mp as usize);
-                            let mut sc = self.scratch();
-                            self.forward_cluster(&mut sc, cl, &ch, bp.get(), coef, ci == 0);
-                        });
+                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| unsafe {
+                        self.forward_cluster(sc, cl, &ch, bp.get(), coef, ci == 0);
+                    });
                     times.dwt += t.elapsed().as_secs_f64();
                 }
                 Ok::<(), Error>(())
@@ -444,6 +439,54 @@ impl Plan {
         })?;
         times.total = t0.elapsed().as_secs_f64();
         Ok(times)
+    }
+
+    /// Run `f` on every cluster in parallel (work stealing over runs of consecutive
+    /// clusters). Before a cluster is processed, the chunk-buffer rows and coefficient
+    /// rows of the next one are prefetched: they are short streams in arrays far larger
+    /// than the caches, so without it each cluster would start by waiting on memory.
+    fn for_each_cluster(
+        &self,
+        ch: &Chunk,
+        buf: *mut Complex64,
+        coef: *mut Complex64,
+        f: impl Fn(&mut Scratch, &Cluster) + Sync,
+    ) {
+        let (buf, coef) = (SyncPtr(buf), SyncPtr(coef));
+        self.clusters.par_chunks(8).for_each(|run| {
+            let mut sc = self.scratch();
+            let mut next = Cluster::new(run[0].0 as usize, run[0].1 as usize);
+            for i in 0..run.len() {
+                let cl = next;
+                if let Some(&(m, mp)) = run.get(i + 1) {
+                    next = Cluster::new(m as usize, mp as usize);
+                    self.prefetch(&next, ch.ks.len(), buf.get(), coef.get());
+                }
+                f(&mut sc, &cl);
+            }
+        });
+    }
+
+    /// Hint the cache about the rows a cluster will touch.
+    fn prefetch(&self, cl: &Cluster, nb: usize, buf: *mut Complex64, coef: *mut Complex64) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let n = self.b - cl.l0();
+            for mem in cl.members() {
+                // 4 complex values per 64-byte line; wrapping_add: hints never fault.
+                let row = buf.wrapping_add(self.freq_index(mem.m, mem.mp) * nb);
+                for s in (0..nb).step_by(4) {
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(s) as *const i8) };
+                }
+                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
+                for i in (0..n).step_by(4) {
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(i) as *const i8) };
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = (cl, nb, buf, coef);
     }
 
     /// This worker's DWT scratch.
@@ -530,14 +573,10 @@ impl Plan {
             self.pool.install(|| {
                 for ch in self.chunks() {
                     let t = Instant::now();
-                    self.clusters
-                        .par_iter()
-                        .with_min_len(4)
-                        .for_each(|&(m, mp)| unsafe {
-                            let cl = &Cluster::new(m as usize, mp as usize);
-                            let mut sc = self.scratch();
-                            self.inverse_cluster(&mut sc, cl, &ch, bp.get(), coeffs);
-                        });
+                    let cp = coeffs.as_ptr() as *mut Complex64;
+                    self.for_each_cluster(&ch, bp.get(), cp, |sc, cl| unsafe {
+                        self.inverse_cluster(sc, cl, &ch, bp.get(), coeffs);
+                    });
                     times.dwt += t.elapsed().as_secs_f64();
                     let t = Instant::now();
                     self.fft_chunk(&ch, false, out.get(), bp.get())?;

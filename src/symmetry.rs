@@ -52,7 +52,7 @@ impl Member {
 
 /// A group of order pairs sharing one Wigner-d recurrence (no heap: plans build
 /// them on the fly from the base pair).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Cluster {
     /// Base order `m` (`m >= m' >= 0`); also the lowest degree `l0`.
     pub m: usize,
