@@ -201,9 +201,60 @@ fn try_coef_index_errors() {
     );
 }
 
+/// Address-space limit for the child process that builds the MAX_BANDWIDTH plan. A plan must not
+/// allocate the (2B)^3 sample grid (1 TiB at B = 2048); a few GiB for tables, FFTW plans and the
+/// default beta-chunk workspace are plenty.
+const CHILD_AS_LIMIT_KIB: u64 = 8 * 1024 * 1024; // 8 GiB
+
+/// Plan::new(MAX_BANDWIDTH) must either succeed or return OutOfMemory, without panicking or
+/// aborting. It runs in a child process (this test binary, running the ignored test below) under
+/// `ulimit -v` so that a plan which over-allocates gets a failed allocation instead of eating the
+/// machine's memory. An over-allocating library that uses infallible allocation aborts the child;
+/// that is reported as a failure.
 #[test]
 fn max_bandwidth_plan_does_not_panic() {
-    // Must either succeed or report OutOfMemory (it must not allocate the (2B)^3 sample grid).
+    let exe = std::env::current_exe().expect("current_exe");
+    let t0 = std::time::Instant::now();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {CHILD_AS_LIMIT_KIB} && exec timeout 300 \"$0\" --exact child_max_bandwidth_plan --ignored --nocapture --test-threads=1"))
+        .arg(&exe)
+        .env("SO3FFT_LIMITED_CHILD", "1")
+        .output()
+        .expect("spawn child test process");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!(
+        "child ({:.1}s, status {:?}):\n{stdout}",
+        t0.elapsed().as_secs_f64(),
+        out.status
+    );
+    let tail: String = stderr
+        .lines()
+        .rev()
+        .take(15)
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(
+        out.status.success() && stdout.contains("CHILD-RESULT:"),
+        "Plan::new(MAX_BANDWIDTH = {}) under a {} GiB address-space limit did not return Ok/OutOfMemory cleanly \
+         (exit status {:?}; a signal means abort/kill, e.g. an infallible allocation failed).\nchild stdout:\n{stdout}\nchild stderr (tail):\n{tail}",
+        MAX_BANDWIDTH,
+        CHILD_AS_LIMIT_KIB / (1024 * 1024),
+        out.status
+    );
+}
+
+#[test]
+#[ignore = "run only as the memory-limited child of max_bandwidth_plan_does_not_panic"]
+fn child_max_bandwidth_plan() {
+    if std::env::var("SO3FFT_LIMITED_CHILD").ok().as_deref() != Some("1") {
+        println!("skipped: only runs under the address-space limit set by max_bandwidth_plan_does_not_panic");
+        return;
+    }
     let t0 = std::time::Instant::now();
     let r = std::panic::catch_unwind(|| {
         Plan::new(MAX_BANDWIDTH, &PlanOptions::default())
@@ -216,36 +267,40 @@ fn max_bandwidth_plan_does_not_panic() {
             assert_eq!(ns, n_samples(MAX_BANDWIDTH));
             assert_eq!(nc, n_coeffs(MAX_BANDWIDTH));
             println!(
-                "Plan::new(MAX_BANDWIDTH={MAX_BANDWIDTH}) succeeded in {:.2}s",
+                "CHILD-RESULT: Plan::new(MAX_BANDWIDTH={MAX_BANDWIDTH}) succeeded in {:.2}s",
                 t0.elapsed().as_secs_f64()
             );
         }
         Ok(Err(Error::OutOfMemory { bytes })) => {
-            println!("Plan::new(MAX_BANDWIDTH) -> OutOfMemory {{ bytes: {bytes} }}")
+            println!("CHILD-RESULT: Plan::new(MAX_BANDWIDTH) -> OutOfMemory {{ bytes: {bytes} }}")
         }
         Ok(Err(e)) => panic!("Plan::new(MAX_BANDWIDTH) returned unexpected error {e:?}"),
     }
-    // a small workspace cap must still give a working plan at a moderate size
-    let p = Plan::new(
-        16,
+}
+
+/// A small workspace cap must still give a correct plan (or be rejected with an error).
+#[test]
+fn tiny_workspace_cap() {
+    let b = 16;
+    match Plan::new(
+        b,
         &PlanOptions {
             max_workspace_bytes: Some(4096),
             ..PlanOptions::default()
         },
-    );
-    match p {
+    ) {
         Ok(p) => {
             let mut rng = Rng::new(5);
-            let c = rng.complex_vec(n_coeffs(16));
-            let mut f = vec![Complex64::new(0.0, 0.0); n_samples(16)];
+            let c = rng.complex_vec(n_coeffs(b));
+            let mut f = vec![Complex64::new(0.0, 0.0); n_samples(b)];
             p.inverse(&c, &mut f).unwrap();
-            let mut c2 = vec![Complex64::new(0.0, 0.0); n_coeffs(16)];
+            let mut c2 = vec![Complex64::new(0.0, 0.0); n_coeffs(b)];
             p.forward(&f, &mut c2).unwrap();
             let (e, _) = max_abs_diff(&c, &c2);
-            println!("B=16 with max_workspace_bytes=4096: roundtrip err {e:.3e}");
+            println!("B={b} with max_workspace_bytes=4096: roundtrip err {e:.3e}");
             assert!(e <= 1e-13, "roundtrip with tiny workspace cap: {e:e}");
         }
-        Err(e) => println!("note: B=16 with max_workspace_bytes=4096 rejected: {e:?}"),
+        Err(e) => println!("note: B={b} with max_workspace_bytes=4096 rejected: {e:?}"),
     }
 }
 

@@ -78,7 +78,7 @@ fn run(b: usize, pairs: &[(isize, isize)], row_step: usize) {
             "B={b} (m,m')=({m},{mp}): max |G-I| = {r:.3e} over {cnt} entries (worst at l={l}, l'={lp}) [{:.2}s]",
             t0.elapsed().as_secs_f64()
         );
-        if !(r <= TOL) {
+        if r.is_nan() || r > TOL {
             fails.push(format!(
                 "B={b} (m,m')=({m},{mp}): residual {r:.3e} at (l,l')=({l},{lp})"
             ));
@@ -149,7 +149,9 @@ fn dt_on_grid_vs_reference_csv() {
     use std::collections::BTreeMap;
     let rows = parse_wigner_csv();
     // (b, m, mp) -> list of (l, k, beta, d)
-    let mut want: BTreeMap<(usize, isize, isize), Vec<(usize, usize, f64, f64)>> = BTreeMap::new();
+    // (b, m, mp) -> [(l, k, beta, d)]
+    type Wanted = BTreeMap<(usize, isize, isize), Vec<(usize, usize, f64, f64)>>;
+    let mut want: Wanted = BTreeMap::new();
     for r in rows.iter().filter(|r| r.l >= 63) {
         for (b, ks) in [
             (512usize, &[0usize, 1][..]),
@@ -181,11 +183,11 @@ fn dt_on_grid_vs_reference_csv() {
         for &(l, k, beta_csv, d) in list {
             let norm = ((2 * l + 1) as f64 / 2.0).sqrt();
             let got = dt[(l - l0) * 2 * b + k] / norm;
-            // tolerance as in reference.rs (max(1e-14, 4e-16 l)) plus the effect of a possibly
+            // tolerance as in reference.rs (common::wigner_tol) plus the effect of a possibly
             // different rounding of beta_k (library's so3fft::beta vs the csv's exact double):
             // |d/dbeta d^l| <= l + 1.
             let dbeta = (so3fft::beta(b, k) - beta_csv).abs();
-            let tol = f64::max(1e-14, 4e-16 * l as f64) + (l + 1) as f64 * dbeta;
+            let tol = common::wigner_tol(l, beta_csv) + (l + 1) as f64 * dbeta;
             let err = if got.is_nan() {
                 f64::INFINITY
             } else {
@@ -193,7 +195,7 @@ fn dt_on_grid_vs_reference_csv() {
             };
             let e = maxerr.entry(l).or_insert(0.0);
             *e = e.max(err);
-            if !(err <= tol) {
+            if err.is_nan() || err > tol {
                 fails.push(format!("B={b} m={m} mp={mp} l={l} k={k}: d = {got:e}, want {d:e}, err {err:.3e} > {tol:.2e}"));
             }
         }

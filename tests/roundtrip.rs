@@ -19,8 +19,7 @@ fn plan(b: usize) -> Plan {
 /// forward(inverse(c)) == c for random band-limited coefficients (exact quadrature => identity).
 #[test]
 fn roundtrip_inverse_then_forward() {
-    // every B up to 32, then a spread (odd, even, powers of two and neighbours) up to 64
-    let bs: Vec<usize> = (1..=32).chain([33, 40, 47, 48, 63, 64]).collect();
+    let bs: Vec<usize> = (1..=64).collect();
     let mut fails = Vec::new();
     let mut worst = (0.0f64, 0usize);
     for &b in &bs {
@@ -39,13 +38,13 @@ fn roundtrip_inverse_then_forward() {
         if e > worst.0 {
             worst = (e, b);
         }
-        if b <= 4 || b % 8 == 0 || b == 63 || !(e <= TOL) {
+        if b <= 4 || b % 8 == 0 || b == 63 || (e.is_nan() || e > TOL) {
             println!(
                 "B={b:3}: roundtrip max abs err {e:.3e}  ({:.3}s)",
                 t0.elapsed().as_secs_f64()
             );
         }
-        if !(e <= TOL) {
+        if e.is_nan() || e > TOL {
             fails.push(format!(
                 "B={b}: err {e:.3e} at coef {i}: got {} want {}",
                 c2[i], c[i]
@@ -128,10 +127,10 @@ fn real_signal_symmetry() {
             maxsym = maxsym.max(d);
         }
         println!("B={b}: max |Im f| for symmetric coefs {maxim:.3e} (|f|max {:.2}); max symmetry defect of forward(real) {maxsym:.3e}", max_abs(&f));
-        if !(maxim <= TOL) {
+        if maxim.is_nan() || maxim > TOL {
             fails.push(format!("B={b}: imaginary part {maxim:e}"));
         }
-        if !(maxsym <= TOL) {
+        if maxsym.is_nan() || maxsym > TOL {
             fails.push(format!(
                 "B={b}: forward of real samples violates the symmetry by {maxsym:e}"
             ));
@@ -203,7 +202,7 @@ fn gamma_and_alpha_shift() {
                 if gamma_axis { "M'" } else { "M" }
             );
             println!("B={b} {what}: max abs err {e:.3e}");
-            if !(e <= TOL) {
+            if e.is_nan() || e > TOL {
                 fails.push(format!(
                     "{what}: err {e:.3e} at coef {i}: got {} want {}",
                     got[i], want[i]
