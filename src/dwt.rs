@@ -12,26 +12,59 @@
 //! of a vector is active only the recurrence runs (the negligible prefix in `l` is skipped).
 
 use crate::simd::{Isa, Scalar, Simd};
-use crate::wigner::{BetaTables, Ext, RecTables, BIG, TINY};
+use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, BIG, TINY};
 
-/// Recurrence coefficients of one cluster, index `i = l - l0`.
+/// Recurrence coefficients of one cluster, index `i = l - l0` (see `RecTables::coeffs`).
 pub(crate) struct Rec<'a> {
+    /// `A_l`
     pub a: &'a [f64],
-    pub c: &'a [f64],
+    /// `-A_l`
+    pub an: &'a [f64],
+    /// `A_l + C_l`
+    pub d: &'a [f64],
+    /// `C_l - A_l`
+    pub e: &'a [f64],
+    /// `Bc_l`
     pub bb: &'a [f64],
 }
 
-/// Per-lane inputs: `cos(beta)`, scaled starting value and scale index. Lengths are a
-/// multiple of the vector width (pad with zeros).
+impl<'a> Rec<'a> {
+    /// The first `n` degrees of `r`.
+    pub fn new(r: &'a RecCoeffs, n: usize) -> Rec<'a> {
+        Rec {
+            a: &r.a[..n],
+            an: &r.an[..n],
+            d: &r.d[..n],
+            e: &r.e[..n],
+            bb: &r.bb[..n],
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.a.len()
+    }
+}
+
+/// Per-lane inputs: recurrence argument `tau`, scaled starting value and scale index.
+/// Lengths are a multiple of the vector width (pad with zeros). Vectors starting before
+/// `upper_from` are in the lower half (`beta < pi/2`, `tau = 1 - cos beta`), the others in
+/// the upper half (`tau = 1 + cos beta`): the recurrence multiplier `A cos(beta) + C` is
+/// formed as `(A + C) - A tau` or `A tau + (C - A)`, never from a rounded `cos(beta)`,
+/// which near the poles would shift beta and move `d^l` by up to `l^2 eps`.
 pub(crate) struct Lanes<'a> {
-    pub x: &'a [f64],
+    pub tau: &'a [f64],
     pub p: &'a [f64],
     pub sc: &'a [f64],
+    pub upper_from: usize,
 }
 
 /// Recurrence state of one vector of betas.
-struct State<S: Simd, const W: usize> {
-    x: S::V,
+struct State<'r, S: Simd, const W: usize> {
+    tau: S::V,
+    /// `-A` (lower half) or `A` (upper half).
+    ka: &'r [f64],
+    /// `A + C` (lower half) or `C - A` (upper half).
+    kc: &'r [f64],
     p0: S::V,
     p1: S::V,
     sc: [f64; W],
@@ -39,9 +72,9 @@ struct State<S: Simd, const W: usize> {
     active: usize,
 }
 
-impl<S: Simd, const W: usize> State<S, W> {
+impl<'r, S: Simd, const W: usize> State<'r, S, W> {
     #[inline(always)]
-    unsafe fn new(lanes: &Lanes, s0: usize) -> Self {
+    unsafe fn new(rec: &Rec<'r>, lanes: &Lanes, s0: usize) -> Self {
         let mut sc = [0.0; W];
         sc.copy_from_slice(&lanes.sc[s0..s0 + W]);
         let mut mask = [0.0; W];
@@ -52,8 +85,15 @@ impl<S: Simd, const W: usize> State<S, W> {
                 active += 1;
             }
         }
+        let (ka, kc) = if s0 >= lanes.upper_from {
+            (rec.a, rec.e)
+        } else {
+            (rec.an, rec.d)
+        };
         State {
-            x: S::load(lanes.x.as_ptr().add(s0)),
+            tau: S::load(lanes.tau.as_ptr().add(s0)),
+            ka,
+            kc,
             p0: S::zero(),
             p1: S::load(lanes.p.as_ptr().add(s0)),
             sc,
@@ -65,7 +105,7 @@ impl<S: Simd, const W: usize> State<S, W> {
     /// Advance from degree `l0+i` to `l0+i+1`.
     #[inline(always)]
     unsafe fn step(&mut self, rec: &Rec, i: usize) {
-        let t = S::fma(S::splat(rec.a[i]), self.x, S::splat(rec.c[i]));
+        let t = S::fma(S::splat(self.ka[i]), self.tau, S::splat(self.kc[i]));
         let u = S::mul(S::splat(rec.bb[i]), self.p0);
         let p2 = S::fms(t, self.p1, u);
         self.p0 = self.p1;
@@ -127,12 +167,12 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
     f: &mut [f64],
 ) {
     let p = W * NV;
-    let n = rec.a.len();
-    let nb = lanes.x.len();
+    let n = rec.len();
+    let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * p && f.len() >= n * p);
     let fp = f.as_mut_ptr();
     for s0 in (0..nb).step_by(W) {
-        let mut st = State::<S, W>::new(lanes, s0);
+        let mut st = State::<S, W>::new(rec, lanes, s0);
         let mut xr = [[S::zero(); NV]; W];
         for (w, row) in xr.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
@@ -181,12 +221,12 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
     fin: &[f64],
     y: &mut [f64],
 ) {
-    let n = rec.a.len();
-    let nb = lanes.x.len();
+    let n = rec.len();
+    let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
     let fp = fin.as_ptr();
     for s0 in (0..nb).step_by(W) {
-        let mut st = State::<S, W>::new(lanes, s0);
+        let mut st = State::<S, W>::new(rec, lanes, s0);
         let mut acc = [S::zero(); P];
         st.run(
             rec,
@@ -232,9 +272,9 @@ entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
 pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], f: &mut [f64]) {
-    let n = rec.a.len();
-    let nb = lanes.x.len();
-    assert!(rec.c.len() == n && rec.bb.len() == n);
+    let n = rec.len();
+    let nb = lanes.tau.len();
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(xin.len() >= nb * p && f.len() >= n * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
@@ -257,9 +297,9 @@ pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64],
 
 /// Inverse kernel: `y[q*nb + s] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16.
 pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
-    let n = rec.a.len();
-    let nb = lanes.x.len();
-    assert!(rec.c.len() == n && rec.bb.len() == n);
+    let n = rec.len();
+    let nb = lanes.tau.len();
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && y.len() >= nb * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
@@ -294,28 +334,26 @@ pub(crate) fn column(
     lend: usize,
 ) -> Vec<f64> {
     let n = lend - m;
-    let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
+    let mut rc = RecCoeffs::new(n);
+    rt.coeffs(m, mp, &mut rc);
     let w = isa.lanes();
     let (p0, sc0) = bt.start(k, m, mp, norm, 1.0);
-    let mut x = vec![0.0; w];
+    let mut tau = vec![0.0; w];
     let mut p = vec![0.0; w];
     let mut sc = vec![0.0; w];
-    x[0] = bt.cos_beta[k];
+    let upper = bt.upper(k);
+    tau[0] = if upper { bt.tau_hi[k] } else { bt.tau_lo[k] };
     p[0] = p0;
     sc[0] = sc0;
     let mut xin = vec![0.0; w * 8];
     xin[0] = 1.0;
     let mut f = vec![0.0; n * 8];
-    let rec = Rec {
-        a: &a,
-        c: &c,
-        bb: &bb,
-    };
+    let rec = Rec::new(&rc, n);
     let lanes = Lanes {
-        x: &x,
+        tau: &tau,
         p: &p,
         sc: &sc,
+        upper_from: if upper { 0 } else { w },
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     (0..n).map(|i| f[i * 8]).collect()
@@ -347,27 +385,24 @@ mod tests {
         let rt = RecTables::new(b);
         for &(m, mp) in &[(0usize, 0usize), (5, 3), (150, 20), (199, 199), (120, 0)] {
             let n = b - m;
-            let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
-            let rec = Rec {
-                a: &a,
-                c: &c,
-                bb: &bb,
-            };
+            let mut rc = RecCoeffs::new(n);
+            rt.coeffs(m, mp, &mut rc);
+            let rec = Rec::new(&rc, n);
             let nb = 2 * b;
             let mut x = vec![0.0; nb];
             let mut p = vec![0.0; nb];
             let mut sc = vec![0.0; nb];
             for k in 0..nb {
-                x[k] = bt.cos_beta[k];
+                x[k] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
                 let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
                 p[k] = pp;
                 sc[k] = ss;
             }
             let lanes = Lanes {
-                x: &x,
+                tau: &x,
                 p: &p,
                 sc: &sc,
+                upper_from: b,
             };
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
@@ -420,25 +455,22 @@ mod kernel_speed {
             let rt = RecTables::new(b);
             let (m, mp) = (b / 8, b / 16);
             let n = b - m;
-            let (mut a, mut c, mut bb) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            rt.coeffs(m, mp, &mut a, &mut c, &mut bb);
-            let rec = Rec {
-                a: &a,
-                c: &c,
-                bb: &bb,
-            };
+            let mut rc = RecCoeffs::new(n);
+            rt.coeffs(m, mp, &mut rc);
+            let rec = Rec::new(&rc, n);
             let (mut x, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
             for s in 0..nbs {
                 let k = s * (2 * b) / nbs;
-                x[s] = bt.cos_beta[k];
+                x[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
                 let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
                 p[s] = pp;
                 sc[s] = ss;
             }
             let lanes = Lanes {
-                x: &x,
+                tau: &x,
                 p: &p,
                 sc: &sc,
+                upper_from: nbs / 2,
             };
             let xin = vec![0.5; nbs * 16];
             let mut f = vec![0.0; n * 16];

@@ -12,7 +12,7 @@ use crate::fft::{AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
 use crate::symmetry::{cluster_pairs, Cluster};
-use crate::wigner::{start_norms, BetaTables, Ext, RecTables};
+use crate::wigner::{start_norms, BetaTables, Ext, RecCoeffs, RecTables};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -110,10 +110,8 @@ impl<T> SyncPtr<T> {
 
 /// Per-task scratch, sized for the largest cluster and chunk.
 struct Scratch {
-    a: Vec<f64>,
-    c: Vec<f64>,
-    bb: Vec<f64>,
-    x: Vec<f64>,
+    rec: RecCoeffs,
+    tau: Vec<f64>,
     p: Vec<f64>,
     sc: Vec<f64>,
     data: Vec<f64>,
@@ -123,10 +121,8 @@ struct Scratch {
 impl Scratch {
     fn new(b: usize, nbp: usize) -> Scratch {
         Scratch {
-            a: vec![0.0; b],
-            c: vec![0.0; b],
-            bb: vec![0.0; b],
-            x: vec![0.0; nbp],
+            rec: RecCoeffs::new(b),
+            tau: vec![0.0; nbp],
             p: vec![0.0; nbp],
             sc: vec![0.0; nbp],
             data: vec![0.0; nbp.max(b) * 16],
@@ -138,8 +134,26 @@ impl Scratch {
 /// The beta slices of one chunk, in slot order: slots `0..h` hold betas `lo..lo+h`,
 /// slots `h..2h` the mirrored betas `2B-lo-h .. 2B-lo` (ascending), so slot `s` and
 /// slot `2h-1-s` hold `beta` and `pi - beta`.
+///
+/// The DWT kernels see the slots as lanes, each half padded to `hp` (a multiple of the
+/// vector width) so that no vector mixes the lower and upper half: lanes `0..h` are
+/// slots `0..h`, lanes `hp..hp+h` are slots `h..2h`.
 struct Chunk {
     ks: Vec<usize>,
+    h: usize,
+    hp: usize,
+}
+
+impl Chunk {
+    /// `(first lane, first slot)` of the lower and upper half; each holds `h` slots.
+    fn halves(&self) -> [(usize, usize); 2] {
+        [(0, 0), (self.hp, self.h)]
+    }
+
+    /// Number of lanes.
+    fn lanes(&self) -> usize {
+        2 * self.hp
+    }
 }
 
 /// Slices transformed and transposed together: 4 complex values fill a cache line; fewer
@@ -273,7 +287,7 @@ impl Plan {
         } else {
             None
         };
-        let nbp = (2 * chunk).next_multiple_of(isa.lanes());
+        let nbp = 2 * chunk.next_multiple_of(isa.lanes());
         let dwt_scratch = (0..threads)
             .map(|_| Mutex::new(Scratch::new(b, nbp)))
             .collect();
@@ -407,7 +421,8 @@ impl Plan {
             let h = self.chunk.min(b - lo);
             let mut ks: Vec<usize> = (lo..lo + h).collect();
             ks.extend(2 * b - lo - h..2 * b - lo);
-            Chunk { ks }
+            let hp = h.next_multiple_of(self.isa.lanes());
+            Chunk { ks, h, hp }
         })
     }
 
@@ -593,24 +608,29 @@ impl Plan {
     /// The forward transform folds the quadrature weights into the starting values.
     fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk, forward: bool) -> (usize, usize) {
         let n = self.b - cl.l0();
-        self.rt
-            .coeffs(cl.m, cl.mp, &mut sc.a[..n], &mut sc.c[..n], &mut sc.bb[..n]);
+        sc.rec.resize(n);
+        self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
         let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
-        let nb = ch.ks.len();
-        let nbp = nb.next_multiple_of(self.isa.lanes());
-        for (s, &k) in ch.ks.iter().enumerate() {
-            sc.x[s] = self.bt.cos_beta[k];
-            let w = if forward { self.wq[k] } else { 1.0 };
-            let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, w);
-            sc.p[s] = p;
-            sc.sc[s] = scale;
+        let nl = ch.lanes();
+        sc.tau[..nl].fill(0.0);
+        sc.p[..nl].fill(0.0);
+        sc.sc[..nl].fill(0.0);
+        for (half, (u0, s0)) in ch.halves().into_iter().enumerate() {
+            let tau = if half == 0 {
+                &self.bt.tau_lo
+            } else {
+                &self.bt.tau_hi
+            };
+            for j in 0..ch.h {
+                let k = ch.ks[s0 + j];
+                sc.tau[u0 + j] = tau[k];
+                let w = if forward { self.wq[k] } else { 1.0 };
+                let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, w);
+                sc.p[u0 + j] = p;
+                sc.sc[u0 + j] = scale;
+            }
         }
-        for s in nb..nbp {
-            sc.x[s] = 0.0;
-            sc.p[s] = 0.0;
-            sc.sc[s] = 0.0;
-        }
-        (n, nbp)
+        (n, nl)
     }
 
     /// Index of order pair `(m, mp)` inside a transformed slice.
@@ -633,41 +653,33 @@ impl Plan {
         coef: SyncPtr<Complex64>,
         first: bool,
     ) {
-        let (n, nbp) = self.setup(sc, cl, ch, true);
+        let (n, nl) = self.setup(sc, cl, ch, true);
         let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
-        let data = &mut sc.data[..nbp * p];
-        if cl.members().len() * 2 < p || nb < nbp {
+        let data = &mut sc.data[..nl * p];
+        if cl.members().len() * 2 < p || ch.h < ch.hp {
             data.fill(0.0);
         }
         for (q, mem) in cl.members().iter().enumerate() {
             let src = buf.add(self.freq_index(mem.m, mem.mp) * nb);
-            let col = data.chunks_exact_mut(p).map(|r| &mut r[2 * q..2 * q + 2]);
-            if mem.reversed {
-                for (s, d) in col.take(nb).enumerate() {
-                    let z = *src.add(nb - 1 - s);
-                    d[0] = z.re;
-                    d[1] = z.im;
-                }
-            } else {
-                for (s, d) in col.take(nb).enumerate() {
-                    let z = *src.add(s);
-                    d[0] = z.re;
-                    d[1] = z.im;
+            for (u0, s0) in ch.halves() {
+                let rows = data[u0 * p..].chunks_exact_mut(p).take(ch.h);
+                for (j, d) in rows.enumerate() {
+                    let s = s0 + j;
+                    let z = *src.add(if mem.reversed { nb - 1 - s } else { s });
+                    d[2 * q] = z.re;
+                    d[2 * q + 1] = z.im;
                 }
             }
         }
         let f = &mut sc.out[..n * p];
         f.fill(0.0);
-        let rec = Rec {
-            a: &sc.a[..n],
-            c: &sc.c[..n],
-            bb: &sc.bb[..n],
-        };
+        let rec = Rec::new(&sc.rec, n);
         let lanes = Lanes {
-            x: &sc.x[..nbp],
-            p: &sc.p[..nbp],
-            sc: &sc.sc[..nbp],
+            tau: &sc.tau[..nl],
+            p: &sc.p[..nl],
+            sc: &sc.sc[..nl],
+            upper_from: ch.hp,
         };
         dwt::forward(self.isa, p, &rec, &lanes, data, f);
         for (q, mem) in cl.members().iter().enumerate() {
@@ -703,7 +715,7 @@ impl Plan {
         buf: *mut Complex64,
         coef: &[Complex64],
     ) {
-        let (n, nbp) = self.setup(sc, cl, ch, false);
+        let (n, nl) = self.setup(sc, cl, ch, false);
         let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let fin = &mut sc.data[..n * p];
@@ -720,28 +732,23 @@ impl Plan {
                 row[2 * q + 1] = z.im * g;
             }
         }
-        let y = &mut sc.out[..nbp * p];
-        let rec = Rec {
-            a: &sc.a[..n],
-            c: &sc.c[..n],
-            bb: &sc.bb[..n],
-        };
+        let y = &mut sc.out[..nl * p];
+        let rec = Rec::new(&sc.rec, n);
         let lanes = Lanes {
-            x: &sc.x[..nbp],
-            p: &sc.p[..nbp],
-            sc: &sc.sc[..nbp],
+            tau: &sc.tau[..nl],
+            p: &sc.p[..nl],
+            sc: &sc.sc[..nl],
+            upper_from: ch.hp,
         };
         dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = buf.add(self.freq_index(mem.m, mem.mp) * nb);
-            let (yr, yi) = (&y[2 * q * nbp..][..nb], &y[(2 * q + 1) * nbp..][..nb]);
-            if mem.reversed {
-                for s in 0..nb {
-                    *dst.add(nb - 1 - s) = Complex64::new(yr[s], yi[s]);
-                }
-            } else {
-                for s in 0..nb {
-                    *dst.add(s) = Complex64::new(yr[s], yi[s]);
+            let (yr, yi) = (&y[2 * q * nl..][..nl], &y[(2 * q + 1) * nl..][..nl]);
+            for (u0, s0) in ch.halves() {
+                for j in 0..ch.h {
+                    let s = s0 + j;
+                    let z = Complex64::new(yr[u0 + j], yi[u0 + j]);
+                    *dst.add(if mem.reversed { nb - 1 - s } else { s }) = z;
                 }
             }
         }

@@ -155,20 +155,29 @@ impl PowTable {
     }
 }
 
-/// Per-beta tables for starting values: `cos(beta)`, and powers of `cos(beta/2)`, `sin(beta/2)`.
+/// Per-beta tables: the recurrence argument and powers of `cos(beta/2)`, `sin(beta/2)`.
+///
+/// The recurrence never sees `cos(beta)` itself: near the poles a rounded `cos(beta)` is a
+/// systematic shift of beta, which moves `d^l` by up to `l^2 eps`. Instead each point keeps
+/// `tau_lo = 1 - cos(beta) = 2 sin^2(beta/2)` and `tau_hi = 1 + cos(beta) = 2 cos^2(beta/2)`,
+/// both accurate to a few ulps, and the kernels use the one that is small (see `dwt.rs`).
 pub(crate) struct BetaTables {
-    pub cos_beta: Vec<f64>,
+    /// `2 sin^2(beta/2)`
+    pub tau_lo: Vec<f64>,
+    /// `2 cos^2(beta/2)`
+    pub tau_hi: Vec<f64>,
     cpow: PowTable,
     spow: PowTable,
 }
 
 impl BetaTables {
-    /// Tables for points given as `(cos beta, cos(beta/2), sin(beta/2))`, powers up to `maxpow`.
-    pub fn new(points: &[(f64, f64, f64)], maxpow: usize) -> BetaTables {
-        let c: Vec<f64> = points.iter().map(|p| p.1).collect();
-        let s: Vec<f64> = points.iter().map(|p| p.2).collect();
+    /// Tables for points given as `(cos(beta/2), sin(beta/2))`, powers up to `maxpow`.
+    pub fn new(points: &[(f64, f64)], maxpow: usize) -> BetaTables {
+        let c: Vec<f64> = points.iter().map(|p| p.0).collect();
+        let s: Vec<f64> = points.iter().map(|p| p.1).collect();
         BetaTables {
-            cos_beta: points.iter().map(|p| p.0).collect(),
+            tau_lo: s.iter().map(|s| 2.0 * s * s).collect(),
+            tau_hi: c.iter().map(|c| 2.0 * c * c).collect(),
             cpow: PowTable::new(&c, maxpow),
             spow: PowTable::new(&s, maxpow),
         }
@@ -176,13 +185,18 @@ impl BetaTables {
 
     /// Tables for the `2B` grid betas of bandwidth `b`.
     pub fn grid(b: usize) -> BetaTables {
-        let pts: Vec<(f64, f64, f64)> = (0..2 * b)
+        let pts: Vec<(f64, f64)> = (0..2 * b)
             .map(|k| {
                 let bk = crate::grid::beta(b, k);
-                (bk.cos(), (bk / 2.0).cos(), (bk / 2.0).sin())
+                ((bk / 2.0).cos(), (bk / 2.0).sin())
             })
             .collect();
         BetaTables::new(&pts, 2 * b)
+    }
+
+    /// Whether point `k` lies in the upper half (`beta > pi/2`), where the kernels use `tau_hi`.
+    pub fn upper(&self, k: usize) -> bool {
+        self.tau_hi[k] < self.tau_lo[k]
     }
 
     /// Scaled starting value `weight * dt^m_{m,m'}` at point `k`, given `norm` from
@@ -266,14 +280,20 @@ impl RecTables {
         }
     }
 
-    /// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + a.len()`:
-    /// `dt^{l+1} = (a x + c) dt^l - bb dt^{l-1}` with `a[i] = A_l`, `c[i] = C_l`,
-    /// `bb[i] = Bc_l`, `l = m + i`, where (with `q(l) = sqrt((l^2-m^2)(l^2-m'^2))`)
+    /// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + n`, `l = m + i`:
+    /// `dt^{l+1} = (A_l x + C_l) dt^l - Bc_l dt^{l-1}` with (`q(l) = sqrt((l^2-m^2)(l^2-m'^2))`)
     /// `A_l = (l+1) sqrt((2l+3)(2l+1)) / q(l+1)`, `C_l = -A_l m m' / (l(l+1))`,
     /// `Bc_l = sqrt((2l+3)/(2l-1)) (l+1)/l q(l)/q(l+1)`.
-    pub fn coeffs(&self, m: usize, mp: usize, a: &mut [f64], c: &mut [f64], bb: &mut [f64]) {
-        let n = a.len();
-        assert!(c.len() == n && bb.len() == n && m + n < self.stride && mp <= m);
+    ///
+    /// Stored for the two argument forms the kernels use: with `x = 1 - tau`,
+    /// `A x + C = (A + C) - A tau`, and with `x = tau - 1`, `A x + C = A tau + (C - A)`.
+    pub fn coeffs(&self, m: usize, mp: usize, r: &mut RecCoeffs) {
+        let n = r.a.len();
+        assert!(
+            r.an.len() == n && r.d.len() == n && r.e.len() == n && r.bb.len() == n,
+            "coefficient arrays of unequal length"
+        );
+        assert!(m + n < self.stride && mp <= m);
         let st = self.stride;
         let mm = (m * mp) as f64;
         let rng = m..m + n;
@@ -287,9 +307,48 @@ impl RecTables {
         for i in 0..n {
             let inv = rm[i] * rmp[i];
             let ai = k1[i] * inv;
-            a[i] = ai;
-            c[i] = -ai * mm * k3[i];
-            bb[i] = k2[i] * sm[i] * smp[i] * inv;
+            let ci = -ai * mm * k3[i];
+            r.a[i] = ai;
+            r.an[i] = -ai;
+            r.d[i] = ai + ci;
+            r.e[i] = ci - ai;
+            r.bb[i] = k2[i] * sm[i] * smp[i] * inv;
+        }
+    }
+}
+
+/// Recurrence coefficients of one cluster (see [`RecTables::coeffs`]), index `i = l - l0`.
+#[derive(Default)]
+pub(crate) struct RecCoeffs {
+    pub a: Vec<f64>,
+    pub an: Vec<f64>,
+    pub d: Vec<f64>,
+    pub e: Vec<f64>,
+    pub bb: Vec<f64>,
+}
+
+impl RecCoeffs {
+    /// Arrays for `n` degrees.
+    pub fn new(n: usize) -> RecCoeffs {
+        RecCoeffs {
+            a: vec![0.0; n],
+            an: vec![0.0; n],
+            d: vec![0.0; n],
+            e: vec![0.0; n],
+            bb: vec![0.0; n],
+        }
+    }
+
+    /// Shorten (or lengthen) every array to `n` degrees.
+    pub fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.a,
+            &mut self.an,
+            &mut self.d,
+            &mut self.e,
+            &mut self.bb,
+        ] {
+            v.resize(n, 0.0);
         }
     }
 }
@@ -313,9 +372,9 @@ pub(crate) fn wigner_d_column_isa(
     if lmax < bm {
         return Vec::new();
     }
-    // pi - beta for reversed members, without rounding: swap half-angle cos/sin, negate cos.
-    let (x, c, s) = (beta.cos(), (beta / 2.0).cos(), (beta / 2.0).sin());
-    let pt = if mem.reversed { (-x, s, c) } else { (x, c, s) };
+    // pi - beta for reversed members, without rounding: swap the half-angle cos and sin.
+    let (c, s) = ((beta / 2.0).cos(), (beta / 2.0).sin());
+    let pt = if mem.reversed { (s, c) } else { (c, s) };
     let bt = BetaTables::new(&[pt], 2 * bm);
     let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
     let rt = RecTables::new(lmax + 1);

@@ -1,0 +1,41 @@
+/* A minimal downstream program: inverse and forward transform of one coefficient. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <so3fft.h>
+
+int main(void) {
+    const int B = 8;
+    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B), i;
+    so3fft_complex *coeffs = malloc(nc * sizeof *coeffs);
+    so3fft_complex *samples = malloc(ns * sizeof *samples);
+    so3fft_complex *back = malloc(nc * sizeof *back);
+    so3fft_plan plan;
+    double err = 0.0;
+    ptrdiff_t k = so3fft_coef_index(B, 3, -1, 2);
+
+    if (!coeffs || !samples || !back || k < 0) return EXIT_FAILURE;
+    for (i = 0; i < nc; i++) coeffs[i][0] = coeffs[i][1] = 0.0;
+    coeffs[k][0] = 1.0;
+    coeffs[k][1] = 0.5;
+
+    plan = so3fft_plan_both(B, SO3FFT_ESTIMATE);
+    if (!plan) {
+        fprintf(stderr, "so3fft: %s\n", so3fft_last_error());
+        return EXIT_FAILURE;
+    }
+    if (so3fft_execute_inverse(plan, coeffs, samples) != SO3FFT_OK ||
+        so3fft_execute_forward(plan, samples, back) != SO3FFT_OK) {
+        fprintf(stderr, "so3fft: %s\n", so3fft_last_error());
+        so3fft_destroy_plan(plan);
+        return EXIT_FAILURE;
+    }
+    so3fft_destroy_plan(plan);
+    for (i = 0; i < nc; i++) err = fmax(err, hypot(back[i][0] - coeffs[i][0], back[i][1] - coeffs[i][1]));
+    printf("so3fft %s: B=%d round trip error %.3g\n", so3fft_version(), B, err);
+    free(coeffs);
+    free(samples);
+    free(back);
+    return err < 1e-12 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
