@@ -190,8 +190,8 @@ extern "C" {
  * `nthreads`: 0 = all available cores (the initial setting), n > 0 = n threads.
  * The setting is **process-wide** (not thread-local): it applies to plans created
  * afterwards by any thread; existing plans keep their thread count. Each plan owns its
- * own pool of worker threads, started by the planner; `so3fft_destroy_plan` tells them to
- * exit (they finish asynchronously, shortly after it returns). `so3fft_plan_general`
+ * own pool of worker threads, started by the planner; `so3fft_destroy_plan` stops them
+ * and waits until they have finished. `so3fft_plan_general`
  * takes its thread count as an argument instead. so3fft never changes FFTW's own thread
  * settings.
  *
@@ -272,9 +272,10 @@ so3fft_plan so3fft_plan_both(int B, unsigned int flags);
 so3fft_plan so3fft_plan_general(int B, int direction, so3fft_complex *in, so3fft_complex *out, unsigned int flags, int nthreads);
 
 /**
- * Destroys a plan and releases everything it owns (tables, FFTW plans, buffers) and
- * tells its worker threads to exit (they finish asynchronously, shortly after this
- * returns). The arrays given at planning are not touched (they belong to the caller).
+ * Destroys a plan and releases everything it owns (tables, FFTW plans, buffers), and
+ * stops its worker threads, returning once they have finished their work (only the
+ * threads' final exit from the C library may trail the return). The arrays given at
+ * planning are not touched (they belong to the caller).
  * `p = NULL` is a no-op.
  *
  * Must not run while another thread executes the same plan; destroying different

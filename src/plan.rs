@@ -70,7 +70,10 @@ pub struct Plan {
     direction: Direction,
     threads: usize,
     isa: Isa,
-    pool: rayon::ThreadPool,
+    /// Worker pool (an `Option` so `Drop` can release it before waiting for the workers).
+    pool: Option<rayon::ThreadPool>,
+    /// Number of pool threads still running; `Drop` waits for zero.
+    live: std::sync::Arc<(Mutex<usize>, std::sync::Condvar)>,
     /// Base pairs of the clusters, in scheduling order (kappa order first).
     clusters: Vec<(u32, u32)>,
     bt: BetaTables,
@@ -270,9 +273,16 @@ impl Plan {
             });
         }
         let chunk = layout.chunk;
+        let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
+        let on_exit = live.clone();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("so3fft-{i}"))
+            .exit_handler(move |_| {
+                let (n, cv) = &*on_exit;
+                *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;
+                cv.notify_all();
+            })
             .build()
             .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
         let want_fwd = options.direction != Direction::Inverse;
@@ -302,7 +312,8 @@ impl Plan {
             direction: options.direction,
             threads,
             isa,
-            pool,
+            pool: Some(pool),
+            live,
             clusters: cluster_pairs(b),
             bt: BetaTables::grid(b),
             norms: start_norms(b),
@@ -317,6 +328,10 @@ impl Plan {
             memory: layout.total(),
             buf: Mutex::new(Some(buf)),
         })
+    }
+
+    fn pool(&self) -> &rayon::ThreadPool {
+        self.pool.as_ref().expect("pool lives until drop")
     }
 
     /// The bandwidth `B`.
@@ -438,7 +453,7 @@ impl Plan {
         let coef = SyncPtr(coeffs.as_mut_ptr());
         self.with_buf(|buf| {
             let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool.install(|| {
+            self.pool().install(|| {
                 for (ci, ch) in self.chunks().enumerate() {
                     let t = Instant::now();
                     self.fft_chunk(&ch, true, samples.as_ptr() as *mut Complex64, bp.get())?;
@@ -585,7 +600,7 @@ impl Plan {
         let out = SyncPtr(samples.as_mut_ptr());
         self.with_buf(|buf| {
             let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool.install(|| {
+            self.pool().install(|| {
                 for ch in self.chunks() {
                     let t = Instant::now();
                     let cp = coeffs.as_ptr() as *mut Complex64;
@@ -755,8 +770,40 @@ impl Plan {
     }
 }
 
+impl Drop for Plan {
+    /// Release the worker pool and wait until its threads have finished, so that nothing
+    /// of the plan runs after it is gone (a C host may unload the library right after).
+    fn drop(&mut self) {
+        drop(self.pool.take());
+        let (n, cv) = &*self.live;
+        let mut g = n.lock().unwrap_or_else(|e| e.into_inner());
+        while *g > 0 {
+            g = cv.wait(g).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    /// After a plan is dropped none of its worker threads is still doing work: every one
+    /// has run its exit handler (counted in `live`), which the drop waits for.
+    #[test]
+    fn drop_waits_for_workers() {
+        for _ in 0..5 {
+            let plan = super::Plan::new(
+                4,
+                &super::PlanOptions {
+                    threads: 3,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let live = plan.live.clone();
+            drop(plan);
+            assert_eq!(*live.0.lock().unwrap(), 0);
+        }
+    }
+
     #[test]
     fn plan_is_send_sync() {
         fn is<T: Send + Sync>() {}
