@@ -35,6 +35,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok()
             .and_then(|s| s.parse::<usize>().ok())
             .map(|mb| mb << 20),
+        fft_threading: match std::env::var("SO3FFT_FFT_THREADING").as_deref() {
+            Ok("workers") => so3fft::FftThreading::SlicesAcrossWorkers,
+            Ok("fftw") => so3fft::FftThreading::FftwThreads,
+            _ => so3fft::FftThreading::Auto,
+        },
         ..Default::default()
     };
     println!("so3fft demo: random coefficients -> inverse -> forward, all cores");

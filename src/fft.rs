@@ -121,21 +121,52 @@ impl Drop for RawPlan {
     }
 }
 
-fn make_plan(n: usize, sign: i32, flags: u32) -> Result<RawPlan> {
+extern "C" {
+    // FFTW >= 3.3.9; not declared by fftw-sys (bindings of 3.3.8).
+    fn fftw_planner_nthreads() -> std::os::raw::c_int;
+}
+
+static THREADS_INIT: Once = Once::new();
+static THREADS_OK: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Plan one `n x n` DFT; with `nthreads > 1` the plan runs on FFTW's own threads.
+///
+/// FFTW's thread count for new plans is process-wide: it is set only while this plan is
+/// made, under the planner lock, and the host's value is restored before the lock is
+/// released, so the host's FFTW settings are unchanged when we return.
+fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawPlan> {
     // Planning may write to both arrays (FFTW_MEASURE): plan on scratch memory.
     let a = AlignedBuf::new(n * n)?;
     let b = AlignedBuf::new(n * n)?;
     let p = {
         let _g = planner_lock();
         unsafe {
-            ffi::fftw_plan_dft_2d(
+            let threaded = nthreads > 1 && {
+                THREADS_INIT.call_once(|| {
+                    let ok = ffi::fftw_init_threads() != 0;
+                    THREADS_OK.store(ok, std::sync::atomic::Ordering::Relaxed);
+                });
+                THREADS_OK.load(std::sync::atomic::Ordering::Relaxed)
+            };
+            let host = if threaded {
+                let host = fftw_planner_nthreads();
+                ffi::fftw_plan_with_nthreads(nthreads as i32);
+                Some(host)
+            } else {
+                None
+            };
+            let p = ffi::fftw_plan_dft_2d(
                 n as i32,
                 n as i32,
                 a.as_mut_ptr(),
                 b.as_mut_ptr(),
                 sign,
                 flags | ffi::FFTW_PRESERVE_INPUT,
-            )
+            );
+            if let Some(host) = host {
+                ffi::fftw_plan_with_nthreads(host);
+            }
+            p
         }
     };
     if p.is_null() {
@@ -154,18 +185,21 @@ pub(crate) struct SliceFft {
     n: usize,
     sign: i32,
     flags: u32,
+    nthreads: usize,
     aligned: RawPlan,
     /// Plan for arrays whose alignment differs from FFTW's, made on first need.
     unaligned: Mutex<Option<Arc<RawPlan>>>,
 }
 
 impl SliceFft {
-    pub fn new(n: usize, sign: i32, rigor: Rigor) -> Result<SliceFft> {
+    /// A plan for one slice; `nthreads > 1` makes it run on FFTW's own threads.
+    pub fn new(n: usize, sign: i32, rigor: Rigor, nthreads: usize) -> Result<SliceFft> {
         Ok(SliceFft {
             n,
             sign,
             flags: rigor.flags(),
-            aligned: make_plan(n, sign, rigor.flags())?,
+            nthreads,
+            aligned: make_plan(n, sign, rigor.flags(), nthreads)?,
             unaligned: Mutex::new(None),
         })
     }
@@ -190,6 +224,7 @@ impl SliceFft {
                         self.n,
                         self.sign,
                         self.flags | ffi::FFTW_UNALIGNED,
+                        self.nthreads,
                     )?);
                     *g = Some(p.clone());
                     p

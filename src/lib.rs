@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod capi;
+pub mod soft;
 mod dwt;
 mod error;
 mod fft;
@@ -37,5 +38,5 @@ pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
 pub use num_complex::Complex64;
-pub use plan::{Direction, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
+pub use plan::{Direction, FftThreading, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
 pub use simd::Isa;

@@ -1,0 +1,35 @@
+/*
+ * so3fft SOFT 2.0 compatibility layer: wrap_fftw.h, the self-contained (wrapped) transforms.
+ *
+ * Written for so3fft from the specification of SOFT 2.0's interface (SPEC.md sections 3-5);
+ * no SOFT source or header text is used. Copyright (C) the so3fft authors.
+ * SPDX-License-Identifier: GPL-2.0-or-later
+ *
+ * Include <fftw3.h> before this header, as with SOFT (it is included here if it was not).
+ * Link with so3fft (pkg-config so3fft-soft, or CMake target so3fft::soft).
+ */
+#ifndef SO3FFT_SOFT_WRAP_FFTW_H
+#define SO3FFT_SOFT_WRAP_FFTW_H
+
+#ifndef FFTW3_H
+#include <fftw3.h>
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/*
+ * Forward and inverse SO(3) transforms at bandwidth bw without caller-provided workspaces,
+ * weights or plans: signal holds (2bw)^3 samples, coeffs (4bw^3-bw)/3 coefficients;
+ * flag = 1 for real data (as in soft_fftw.h). Inputs are not modified.
+ * (softFFTWCor2 and s2RotateFFTW of SOFT's wrap_fftw.h are not provided by so3fft.)
+ */
+void Forward_SO3_Naive_fftw_W(int bw, fftw_complex *signal, fftw_complex *coeffs, int flag);
+void Inverse_SO3_Naive_fftw_W(int bw, fftw_complex *coeffs, fftw_complex *signal, int flag);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SO3FFT_SOFT_WRAP_FFTW_H */
