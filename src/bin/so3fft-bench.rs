@@ -13,6 +13,8 @@ mod cli;
 mod peak;
 #[path = "so3fft_bench/report.rs"]
 mod report;
+#[path = "so3fft_bench/soft_cmp.rs"]
+mod soft_cmp;
 #[path = "so3fft_bench/workload.rs"]
 mod workload;
 
@@ -55,6 +57,16 @@ fn run(opts: &Options) -> ExitCode {
     let speedups = report::speedups(&rows);
     if !speedups.is_empty() {
         println!("\nSpeed-up (median wall time, 1 thread / N threads):\n{speedups}");
+    }
+    if opts.soft {
+        let mut soft_rows = Vec::new();
+        for &b in &opts.bandwidths {
+            match soft_cmp::compare(b, opts.runs_for(b)) {
+                Ok(r) => soft_rows.extend(r),
+                Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
+            }
+        }
+        print!("{}", soft_cmp::table(&soft_rows));
     }
     if let Err(e) = report::write_csv(&opts.csv, &rows) {
         eprintln!("so3fft-bench: cannot write {}: {e}", opts.csv.display());

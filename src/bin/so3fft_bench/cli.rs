@@ -21,6 +21,7 @@ usage: so3fft-bench [options]
   --csv PATH          CSV output file (default bench.csv)
   --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default estimate)
   --quick             CI smoke test: only B <= 64, 3 runs
+  --soft              also time the SOFT 2.0 entry points against the native plan (each B)
   -h, --help          print this help";
 
 /// Parsed benchmark options.
@@ -33,6 +34,8 @@ pub struct Options {
     pub csv: PathBuf,
     pub rigor: Rigor,
     pub quick: bool,
+    /// Compare the SOFT compatibility layer with the native plan.
+    pub soft: bool,
 }
 
 impl Default for Options {
@@ -44,6 +47,7 @@ impl Default for Options {
             csv: PathBuf::from("bench.csv"),
             rigor: Rigor::Estimate,
             quick: false,
+            soft: false,
         }
     }
 }
@@ -88,6 +92,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         match name.as_str() {
             "-h" | "--help" => return Ok(Command::Help),
             "--quick" => opts.quick = true,
+            "--soft" => opts.soft = true,
             "--bandwidths" => {
                 opts.bandwidths = parse_list(&value()?, "--bandwidths")?;
                 bandwidths_given = true;
