@@ -304,6 +304,16 @@ impl Plan {
             });
         }
         let chunk = layout.chunk;
+        // The tables below are ordinary (aborting) allocations of O(B^2) bytes; reserving their
+        // total once, fallibly, first turns a shortage (e.g. an address-space limit) into an
+        // error. The large buffers are mapped fallibly in `AlignedBuf::new`.
+        let mut probe: Vec<u8> = Vec::new();
+        probe
+            .try_reserve_exact(layout.table_bytes)
+            .map_err(|_| Error::OutOfMemory {
+                bytes: layout.table_bytes,
+            })?;
+        drop(probe);
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
         let on_exit = live.clone();
         let pool = rayon::ThreadPoolBuilder::new()
