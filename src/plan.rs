@@ -785,13 +785,19 @@ impl Plan {
         if cl.members().len() * 2 < p || ch.h < ch.hp {
             data.fill(0.0);
         }
+        // All members' rows are read together (betas outer): several memory streams in
+        // flight instead of one short stream at a time.
+        let mut src = [(std::ptr::null::<Complex64>(), false); 8];
         for (q, mem) in cl.members().iter().enumerate() {
-            let src = buf.add(self.freq_index(mem.m, mem.mp) * nb);
-            for (u0, s0) in ch.halves() {
-                let rows = data[u0 * p..].chunks_exact_mut(p).take(ch.h);
-                for (j, d) in rows.enumerate() {
-                    let s = s0 + j;
-                    let z = *src.add(if mem.reversed { nb - 1 - s } else { s });
+            src[q] = (buf.add(self.freq_index(mem.m, mem.mp) * nb), mem.reversed);
+        }
+        let src = &src[..cl.members().len()];
+        for (u0, s0) in ch.halves() {
+            let rows = data[u0 * p..].chunks_exact_mut(p).take(ch.h);
+            for (j, d) in rows.enumerate() {
+                let s = s0 + j;
+                for (q, &(row, reversed)) in src.iter().enumerate() {
+                    let z = *row.add(if reversed { nb - 1 - s } else { s });
                     d[2 * q] = z.re;
                     d[2 * q + 1] = z.im;
                 }
