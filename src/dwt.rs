@@ -59,6 +59,7 @@ pub(crate) struct Lanes<'a> {
 }
 
 /// Recurrence state of one vector of betas.
+#[derive(Clone, Copy)]
 struct State<'r, S: Simd, const W: usize> {
     tau: S::V,
     /// `-A` (lower half) or `A` (upper half).
@@ -70,6 +71,8 @@ struct State<'r, S: Simd, const W: usize> {
     sc: [f64; W],
     mask: [f64; W],
     active: usize,
+    /// Next degree index (`l - l0`).
+    i: usize,
 }
 
 impl<'r, S: Simd, const W: usize> State<'r, S, W> {
@@ -99,6 +102,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             sc,
             mask,
             active,
+            i: 0,
         }
     }
 
@@ -134,11 +138,11 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
         self.p1 = S::load(a1.as_ptr());
     }
 
-    /// Run degrees `0..n`, calling `acc(v, i)` with the value vector at each degree from
-    /// the first one where some lane is active.
+    /// Run the remaining degrees up to `n`, calling `acc(v, i)` with the value vector at
+    /// each degree from the first one where some lane is active.
     #[inline(always)]
     unsafe fn run(&mut self, rec: &Rec, n: usize, mut acc: impl FnMut(S::V, usize)) {
-        let mut i = 0;
+        let mut i = self.i;
         // Slow phase: some lanes still scaled down.
         while i < n && self.active < W {
             if self.active > 0 {
@@ -156,7 +160,60 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             self.step(rec, i);
             i += 1;
         }
+        self.i = i;
     }
+}
+
+/// Vectors whose recurrences are advanced together through their negligible prefix.
+const GROUP: usize = 4;
+
+/// Advance every state of `st` through the degrees where none of its lanes is active yet.
+///
+/// That prefix needs only the recurrence, whose one-FMA-per-degree dependency chain would
+/// leave a lone vector latency-bound; interleaving `GROUP` independent chains keeps the
+/// floating-point pipes busy.
+#[inline(always)]
+unsafe fn skip_inactive<S: Simd, const W: usize>(
+    st: &mut [State<'_, S, W>; GROUP],
+    rec: &Rec,
+    n: usize,
+) {
+    loop {
+        let mut any = false;
+        for s in st.iter_mut() {
+            if s.active == 0 && s.i < n {
+                s.step(rec, s.i);
+                s.i += 1;
+                if S::any_abs_ge(s.p1, BIG) {
+                    s.rescale();
+                }
+                any = true;
+            }
+        }
+        if !any {
+            break;
+        }
+    }
+}
+
+/// Lane offsets of the vectors processed together, starting at `s0` (unused entries
+/// repeat the last vector and are marked done).
+#[inline(always)]
+unsafe fn group_states<'r, S: Simd, const W: usize>(
+    rec: &Rec<'r>,
+    lanes: &Lanes,
+    s0: usize,
+    nb: usize,
+    n: usize,
+) -> (usize, [State<'r, S, W>; GROUP]) {
+    let g = ((nb - s0) / W).min(GROUP);
+    let mut st: [State<'r, S, W>; GROUP] =
+        std::array::from_fn(|j| State::new(rec, lanes, s0 + j.min(g - 1) * W));
+    for s in st.iter_mut().skip(g) {
+        s.i = n;
+    }
+    skip_inactive(&mut st, rec, n);
+    (g, st)
 }
 
 #[inline(always)]
@@ -171,46 +228,53 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
     let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * p && f.len() >= n * p);
     let fp = f.as_mut_ptr();
-    for s0 in (0..nb).step_by(W) {
-        let mut st = State::<S, W>::new(rec, lanes, s0);
-        let mut xr = [[S::zero(); NV]; W];
-        for (w, row) in xr.iter_mut().enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = S::load(xin.as_ptr().add((s0 + w) * p + j * W));
+    let mut g0 = 0;
+    while g0 < nb {
+        let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
+        for (gi, st) in group.iter().enumerate().take(g) {
+            // A local copy, so the state lives in registers during the run.
+            let mut st = *st;
+            let s0 = g0 + gi * W;
+            let mut xr = [[S::zero(); NV]; W];
+            for (w, row) in xr.iter_mut().enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = S::load(xin.as_ptr().add((s0 + w) * p + j * W));
+                }
             }
-        }
-        st.run(
-            rec,
-            n,
-            #[inline(always)]
-            |v, i| {
-                let mut tmp = [0.0; W];
-                S::store(tmp.as_mut_ptr(), v);
-                let row = fp.add(i * p);
-                let mut acc0 = [S::zero(); NV];
-                let mut acc1 = [S::zero(); NV];
-                for (j, a) in acc0.iter_mut().enumerate() {
-                    *a = S::load(row.add(j * W));
-                }
-                let mut w = 0;
-                while w < W {
-                    let t = S::splat(tmp[w]);
-                    for j in 0..NV {
-                        acc0[j] = S::fma(t, xr[w][j], acc0[j]);
+            st.run(
+                rec,
+                n,
+                #[inline(always)]
+                |v, i| {
+                    let mut tmp = [0.0; W];
+                    S::store(tmp.as_mut_ptr(), v);
+                    let row = fp.add(i * p);
+                    let mut acc0 = [S::zero(); NV];
+                    let mut acc1 = [S::zero(); NV];
+                    for (j, a) in acc0.iter_mut().enumerate() {
+                        *a = S::load(row.add(j * W));
                     }
-                    if w + 1 < W {
-                        let t = S::splat(tmp[w + 1]);
+                    let mut w = 0;
+                    while w < W {
+                        let t = S::splat(tmp[w]);
                         for j in 0..NV {
-                            acc1[j] = S::fma(t, xr[w + 1][j], acc1[j]);
+                            acc0[j] = S::fma(t, xr[w][j], acc0[j]);
                         }
+                        if w + 1 < W {
+                            let t = S::splat(tmp[w + 1]);
+                            for j in 0..NV {
+                                acc1[j] = S::fma(t, xr[w + 1][j], acc1[j]);
+                            }
+                        }
+                        w += 2;
                     }
-                    w += 2;
-                }
-                for j in 0..NV {
-                    S::store(row.add(j * W), S::add(acc0[j], acc1[j]));
-                }
-            },
-        );
+                    for j in 0..NV {
+                        S::store(row.add(j * W), S::add(acc0[j], acc1[j]));
+                    }
+                },
+            );
+        }
+        g0 += g * W;
     }
 }
 
@@ -225,23 +289,30 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
     let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
     let fp = fin.as_ptr();
-    for s0 in (0..nb).step_by(W) {
-        let mut st = State::<S, W>::new(rec, lanes, s0);
-        let mut acc = [S::zero(); P];
-        st.run(
-            rec,
-            n,
-            #[inline(always)]
-            |v, i| {
-                let row = fp.add(i * P);
-                for (q, a) in acc.iter_mut().enumerate() {
-                    *a = S::fma(v, S::splat(*row.add(q)), *a);
-                }
-            },
-        );
-        for (q, a) in acc.iter().enumerate() {
-            S::store(y.as_mut_ptr().add(q * nb + s0), *a);
+    let mut g0 = 0;
+    while g0 < nb {
+        let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
+        for (gi, st) in group.iter().enumerate().take(g) {
+            // A local copy, so the state lives in registers during the run.
+            let mut st = *st;
+            let s0 = g0 + gi * W;
+            let mut acc = [S::zero(); P];
+            st.run(
+                rec,
+                n,
+                #[inline(always)]
+                |v, i| {
+                    let row = fp.add(i * P);
+                    for (q, a) in acc.iter_mut().enumerate() {
+                        *a = S::fma(v, S::splat(*row.add(q)), *a);
+                    }
+                },
+            );
+            for (q, a) in acc.iter().enumerate() {
+                S::store(y.as_mut_ptr().add(q * nb + s0), *a);
+            }
         }
+        g0 += g * W;
     }
 }
 
