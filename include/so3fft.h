@@ -406,7 +406,8 @@ double so3fft_gamma(int B, int j);
  * SOFT's `makeweights2`). Writes exactly `2B` doubles; no alignment beyond that of
  * `double` is required.
  *
- * Returns `SO3FFT_OK`, `SO3FFT_EBANDWIDTH` or `SO3FFT_ENULL` (nothing written then).
+ * Returns `SO3FFT_OK`, or `SO3FFT_EBANDWIDTH`, `SO3FFT_ENULL` or `SO3FFT_EINVAL` (`w` not
+ * aligned like `double`); nothing is written then.
  *
  * Requirements: `w` is NULL or points to at least `2B` writable doubles.
  */

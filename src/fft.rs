@@ -10,7 +10,7 @@
 use crate::error::{Error, Result};
 use fftw_sys as ffi;
 use num_complex::Complex64;
-use std::sync::{Arc, Mutex, MutexGuard, Once};
+use std::sync::{Mutex, MutexGuard, Once};
 
 /// FFTW planner rigour (FFTW_ESTIMATE ... FFTW_EXHAUSTIVE).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -121,9 +121,20 @@ impl Drop for RawPlan {
     }
 }
 
-extern "C" {
-    // FFTW >= 3.3.9; not declared by fftw-sys (bindings of 3.3.8).
-    fn fftw_planner_nthreads() -> std::os::raw::c_int;
+/// FFTW's current thread count for new plans. `fftw_planner_nthreads` exists from FFTW
+/// 3.3.9 on and is looked up at run time, so the library still loads with 3.3.8 (where the
+/// host's setting cannot be read and is taken to be FFTW's default, 1).
+fn fftw_planner_nthreads() -> std::os::raw::c_int {
+    type F = unsafe extern "C" fn() -> std::os::raw::c_int;
+    // SAFETY: dlsym with a NUL-terminated name; the symbol, when present, has this type.
+    unsafe {
+        let sym = libc::dlsym(libc::RTLD_DEFAULT, c"fftw_planner_nthreads".as_ptr());
+        if sym.is_null() {
+            1
+        } else {
+            std::mem::transmute::<*mut libc::c_void, F>(sym)()
+        }
+    }
 }
 
 static THREADS_INIT: Once = Once::new();
@@ -182,25 +193,18 @@ pub(crate) const SIGN_MINUS: i32 = ffi::FFTW_FORWARD;
 
 /// Out-of-place `n x n` complex DFT of one beta slice (contiguous), usable on any arrays.
 pub(crate) struct SliceFft {
-    n: usize,
-    sign: i32,
-    flags: u32,
-    nthreads: usize,
     aligned: RawPlan,
-    /// Plan for arrays whose alignment differs from FFTW's, made on first need.
-    unaligned: Mutex<Option<Arc<RawPlan>>>,
+    /// Plan for arrays not aligned as FFTW's SIMD code wants (FFTW_UNALIGNED, planned
+    /// with FFTW_ESTIMATE: such arrays are rare, as any 16-byte aligned array qualifies).
+    unaligned: RawPlan,
 }
 
 impl SliceFft {
     /// A plan for one slice; `nthreads > 1` makes it run on FFTW's own threads.
     pub fn new(n: usize, sign: i32, rigor: Rigor, nthreads: usize) -> Result<SliceFft> {
         Ok(SliceFft {
-            n,
-            sign,
-            flags: rigor.flags(),
-            nthreads,
             aligned: make_plan(n, sign, rigor.flags(), nthreads)?,
-            unaligned: Mutex::new(None),
+            unaligned: make_plan(n, sign, ffi::FFTW_ESTIMATE | ffi::FFTW_UNALIGNED, nthreads)?,
         })
     }
 
@@ -208,30 +212,14 @@ impl SliceFft {
     ///
     /// # Safety
     /// `inp` must be valid for reading and `out` for writing `n*n` values; no overlap.
-    pub unsafe fn execute(&self, inp: *const Complex64, out: *mut Complex64) -> Result<()> {
+    pub unsafe fn execute(&self, inp: *const Complex64, out: *mut Complex64) {
         let ia = ffi::fftw_alignment_of(inp as *mut f64);
         let oa = ffi::fftw_alignment_of(out as *mut f64);
-        if ia == 0 && oa == 0 {
-            ffi::fftw_execute_dft(self.aligned.0, inp as *mut _, out);
-            return Ok(());
-        }
-        let plan = {
-            let mut g = self.unaligned.lock().unwrap_or_else(|e| e.into_inner());
-            match &*g {
-                Some(p) => p.clone(),
-                None => {
-                    let p = Arc::new(make_plan(
-                        self.n,
-                        self.sign,
-                        self.flags | ffi::FFTW_UNALIGNED,
-                        self.nthreads,
-                    )?);
-                    *g = Some(p.clone());
-                    p
-                }
-            }
+        let plan = if ia == 0 && oa == 0 {
+            &self.aligned
+        } else {
+            &self.unaligned
         };
         ffi::fftw_execute_dft(plan.0, inp as *mut _, out);
-        Ok(())
     }
 }

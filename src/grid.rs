@@ -103,10 +103,11 @@ pub fn coef_index(b: usize, l: usize, m: isize, mp: isize) -> usize {
 }
 
 fn valid_lmm(b: usize, l: usize, m: isize, mp: isize) -> bool {
-    l < b && m.unsigned_abs() <= l && mp.unsigned_abs() <= l
+    // Beyond 2^20 the layout's indices would overflow 64-bit arithmetic.
+    b <= 1 << 20 && l < b && m.unsigned_abs() <= l && mp.unsigned_abs() <= l
 }
 
-/// Checked [`coef_index`]: an error if `l >= b` or `|m| > l` or `|m'| > l`.
+/// Checked [`coef_index`]: an error if `l >= b` or `|m| > l` or `|m'| > l` (or `b > 2^20`).
 pub fn try_coef_index(b: usize, l: usize, m: isize, mp: isize) -> Result<usize> {
     if !valid_lmm(b, l, m, mp) {
         return Err(Error::InvalidArgument(format!(

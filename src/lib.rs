@@ -22,13 +22,13 @@
 #![warn(missing_docs)]
 
 pub mod capi;
-pub mod soft;
 mod dwt;
 mod error;
 mod fft;
 mod grid;
 mod plan;
 mod simd;
+pub mod soft;
 mod symmetry;
 pub mod wigner;
 

@@ -62,7 +62,11 @@ pub enum FftThreading {
     Auto,
     /// Each worker transforms whole beta slices with a single-threaded FFTW plan.
     SlicesAcrossWorkers,
-    /// Slices one after another, each on FFTW's own threads (`fftw3_threads`).
+    /// Slices one after another, each on FFTW's own threads (`fftw3_threads`). Making such a
+    /// plan calls `fftw_init_threads` once and sets FFTW's process-wide thread count for new
+    /// plans, restoring the previous value before returning. Our own planner calls are
+    /// serialised, but a host thread that plans an FFTW transform at that same moment may
+    /// pick up this thread count. The default (`Auto`) never does any of this.
     FftwThreads,
 }
 
@@ -241,7 +245,7 @@ impl Layout {
             + 8 * b * (b + 1)
             + 64 * b * (66 + b / 32)
             + 8 * b * b
-            + threads * 8 * (6 * b + 40 * (2 * chunk + 8));
+            + threads * 8 * (6 * b + 3 * (2 * chunk + 8) + 32 * (2 * chunk + 8).max(b));
         Layout {
             chunk,
             group,
@@ -314,18 +318,6 @@ impl Plan {
                 bytes: layout.table_bytes,
             })?;
         drop(probe);
-        let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
-        let on_exit = live.clone();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .thread_name(|i| format!("so3fft-{i}"))
-            .exit_handler(move |_| {
-                let (n, cv) = &*on_exit;
-                *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;
-                cv.notify_all();
-            })
-            .build()
-            .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
         let want_fwd = options.direction != Direction::Inverse;
         let want_inv = options.direction != Direction::Forward;
         let fftw_threaded = threads > 1
@@ -354,6 +346,19 @@ impl Plan {
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
         let buf = AlignedBuf::new(2 * chunk * n * n)?;
+        // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
+        let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
+        let on_exit = live.clone();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("so3fft-{i}"))
+            .exit_handler(move |_| {
+                let (n, cv) = &*on_exit;
+                *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;
+                cv.notify_all();
+            })
+            .build()
+            .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
         Ok(Plan {
             b,
             direction: options.direction,
@@ -467,15 +472,28 @@ impl Plan {
     }
 
     /// Run `f` with a chunk buffer: the plan's own if free, else a temporary one.
+    ///
+    /// A concurrent execution gets a private chunk buffer only while the memory it needs is
+    /// available (twice over); otherwise a plain thread waits for the plan's buffer, and a
+    /// worker of some rayon pool (which must not block: the holder may be further down its
+    /// own stack) gets `Error::OutOfMemory`.
     fn with_buf<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
-        match self.buf.try_lock() {
-            Ok(g) => f(g.as_ref().expect("plan buffer present")),
-            Err(_) => {
-                let n = 2 * self.b;
-                let tmp = AlignedBuf::new(2 * self.chunk * n * n)?;
-                f(&tmp)
+        let g = match self.buf.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => {
+                let bytes = self.workspace_bytes();
+                if mem_available().is_none_or(|a| a / 2 >= bytes) {
+                    let tmp = AlignedBuf::new(bytes / 16)?;
+                    return f(&tmp);
+                }
+                if rayon::current_thread_index().is_some() {
+                    return Err(Error::OutOfMemory { bytes });
+                }
+                self.buf.lock().unwrap_or_else(|e| e.into_inner())
             }
-        }
+        };
+        f(g.as_ref().expect("plan buffer present"))
     }
 
     fn chunks(&self) -> impl Iterator<Item = Chunk> + '_ {
@@ -680,7 +698,7 @@ impl Plan {
         };
         if forward {
             for j in 0..g {
-                fft.execute(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nn))?;
+                fft.execute(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nn));
             }
             copy_all(&to_pairs);
         } else {
@@ -692,7 +710,7 @@ impl Plan {
                     *slot.add(b * n + i) = Complex64::new(0.0, 0.0);
                     *slot.add(i * n + b) = Complex64::new(0.0, 0.0);
                 }
-                fft.execute(slot, grid.get().add(ch.ks[s0 + j] * nn))?;
+                fft.execute(slot, grid.get().add(ch.ks[s0 + j] * nn));
             }
         }
         Ok(())
@@ -890,6 +908,12 @@ impl Drop for Plan {
     /// Release the worker pool and wait until its threads have finished, so that nothing
     /// of the plan runs after it is gone (a C host may unload the library right after).
     fn drop(&mut self) {
+        // Dropping a plan on one of its own workers would wait for itself. No code outside
+        // the library runs on these workers, so this cannot happen through the public API.
+        debug_assert!(self
+            .pool
+            .as_ref()
+            .is_none_or(|p| p.current_thread_index().is_none()));
         drop(self.pool.take());
         let (n, cv) = &*self.live;
         let mut g = n.lock().unwrap_or_else(|e| e.into_inner());

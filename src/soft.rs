@@ -106,8 +106,8 @@ fn check_disjoint<A, B>(a: *const A, na: usize, b: *const B, nb: usize) -> SoftR
 }
 
 /// Convert an index or size to the C `int` SOFT returns.
-fn to_int(v: i64) -> SoftResult<c_int> {
-    c_int::try_from(v).map_err(|_| format!("result {v} does not fit in a C int"))
+fn to_int(v: impl Into<i128> + Copy + std::fmt::Display) -> SoftResult<c_int> {
+    c_int::try_from(v.into()).map_err(|_| format!("result {v} does not fit in a C int"))
 }
 
 // ----------------------------------------------------------------------------------------
@@ -573,7 +573,7 @@ pub extern "C" fn totalCoeffs_so3(bw: c_int) -> c_int {
         if bw < 1 {
             return Err(format!("invalid bandwidth {bw}"));
         }
-        let b = bw as i64;
+        let b = bw as i128;
         to_int((4 * b * b * b - b) / 3)
     })
 }
@@ -614,8 +614,8 @@ pub extern "C" fn sampLoc_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
         if bw < 1 {
             return Err(format!("invalid bandwidth {bw}"));
         }
-        let n = 2 * bw as i64;
-        let (m1, m2) = (m1 as i64, m2 as i64);
+        let n = 2 * bw as i128;
+        let (m1, m2) = (m1 as i128, m2 as i128);
         if m1.abs() >= n || m2.abs() >= n {
             return Err(format!(
                 "orders ({m1}, {m2}) out of range for bandwidth {bw}"
