@@ -446,29 +446,37 @@ mod tests {
             .collect()
     }
 
+    /// Recurrence coefficients of base pair `(m, mp)` at bandwidth `b` and lane inputs for
+    /// `nbs` points spread evenly over the grid (lower half first, as in a chunk).
+    pub(super) fn cluster_setup(
+        b: usize,
+        m: usize,
+        mp: usize,
+        nbs: usize,
+    ) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let bt = BetaTables::grid(b);
+        let norm = crate::wigner::start_norms(b)[m * (m + 1) / 2 + mp];
+        let mut rc = RecCoeffs::new(b - m);
+        RecTables::new(b).coeffs(m, mp, &mut rc);
+        let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
+        for s in 0..nbs {
+            let k = s * (2 * b) / nbs;
+            tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
+            (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0);
+        }
+        (rc, tau, p, sc)
+    }
+
     /// Every SIMD path agrees with the portable scalar one, forward and inverse,
     /// including lanes that start scaled down (large m at betas near the poles).
     #[test]
     fn simd_paths_match_scalar() {
         let b = 200;
-        let bt = BetaTables::grid(b);
-        let norms = crate::wigner::start_norms(b);
-        let rt = RecTables::new(b);
         for &(m, mp) in &[(0usize, 0usize), (5, 3), (150, 20), (199, 199), (120, 0)] {
             let n = b - m;
-            let mut rc = RecCoeffs::new(n);
-            rt.coeffs(m, mp, &mut rc);
-            let rec = Rec::new(&rc, n);
             let nb = 2 * b;
-            let mut x = vec![0.0; nb];
-            let mut p = vec![0.0; nb];
-            let mut sc = vec![0.0; nb];
-            for k in 0..nb {
-                x[k] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
-                let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
-                p[k] = pp;
-                sc[k] = ss;
-            }
+            let (rc, x, p, sc) = cluster_setup(b, m, mp, nb);
+            let rec = Rec::new(&rc, n);
             let lanes = Lanes {
                 tau: &x,
                 p: &p,
@@ -513,6 +521,7 @@ mod tests {
 
 #[cfg(test)]
 mod kernel_speed {
+    use super::tests::cluster_setup;
     use super::*;
 
     /// Kernel-only throughput (run with --ignored --nocapture): GFLOP/s of the fused
@@ -521,22 +530,10 @@ mod kernel_speed {
     #[ignore]
     fn kernel_gflops() {
         for &(b, nbs) in &[(256usize, 512usize), (256, 128), (128, 256)] {
-            let bt = BetaTables::grid(b);
-            let norms = crate::wigner::start_norms(b);
-            let rt = RecTables::new(b);
             let (m, mp) = (b / 8, b / 16);
             let n = b - m;
-            let mut rc = RecCoeffs::new(n);
-            rt.coeffs(m, mp, &mut rc);
+            let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
             let rec = Rec::new(&rc, n);
-            let (mut x, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
-            for s in 0..nbs {
-                let k = s * (2 * b) / nbs;
-                x[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
-                let (pp, ss) = bt.start(k, m, mp, norms[m * (m + 1) / 2 + mp], 1.0);
-                p[s] = pp;
-                sc[s] = ss;
-            }
             let lanes = Lanes {
                 tau: &x,
                 p: &p,
