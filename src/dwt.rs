@@ -108,9 +108,17 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
 
     /// Advance from degree `l0+i` to `l0+i+1`.
     #[inline(always)]
+    ///
+    /// # Safety
+    /// `i < rec.len()` (all coefficient slices have that length, checked by the entry points).
     unsafe fn step(&mut self, rec: &Rec, i: usize) {
-        let t = S::fma(S::splat(self.ka[i]), self.tau, S::splat(self.kc[i]));
-        let u = S::mul(S::splat(rec.bb[i]), self.p0);
+        debug_assert!(i < self.ka.len() && i < self.kc.len() && i < rec.bb.len());
+        let t = S::fma(
+            S::splat(*self.ka.get_unchecked(i)),
+            self.tau,
+            S::splat(*self.kc.get_unchecked(i)),
+        );
+        let u = S::mul(S::splat(*rec.bb.get_unchecked(i)), self.p0);
         let p2 = S::fms(t, self.p1, u);
         self.p0 = self.p1;
         self.p1 = p2;
