@@ -35,6 +35,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok()
             .and_then(|s| s.parse::<usize>().ok())
             .map(|mb| mb << 20),
+        skip_bits: std::env::var("SO3FFT_SKIP_BITS")
+            .ok()
+            .and_then(|s| s.parse().ok()),
         fft_threading: match std::env::var("SO3FFT_FFT_THREADING").as_deref() {
             Ok("workers") => so3fft::FftThreading::SlicesAcrossWorkers,
             Ok("fftw") => so3fft::FftThreading::FftwThreads,

@@ -8,11 +8,11 @@
 //! * inverse: `y[q][s] = sum_i dt_{l0+i}(beta_s) * fin[i][q]`
 //!
 //! `P` is 16 (8 complex order pairs) or 8 (4 pairs). Each beta lane starts in the scaled
-//! form of `wigner.rs`; lanes below `2^-ACTIVE_BITS` contribute nothing, and while no lane
+//! form of `wigner.rs`; lanes below the skip threshold contribute nothing, and while no lane
 //! of a vector is active only the recurrence runs (the negligible prefix in `l` is skipped).
 
 use crate::simd::{Isa, Scalar, Simd};
-use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, BIG, TINY};
+use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, TINY};
 
 /// Recurrence coefficients of one cluster, index `i = l - l0` (see `RecTables::coeffs`).
 pub(crate) struct Rec<'a> {
@@ -56,6 +56,8 @@ pub(crate) struct Lanes<'a> {
     pub p: &'a [f64],
     pub sc: &'a [f64],
     pub upper_from: usize,
+    /// Rescale threshold of the scaled values, `wigner::big(skip bits)`.
+    pub big: f64,
 }
 
 /// Recurrence state of one vector of betas.
@@ -73,6 +75,8 @@ struct State<'r, S: Simd, const W: usize> {
     active: usize,
     /// Next degree index (`l - l0`).
     i: usize,
+    /// Rescale threshold (see [`Lanes::big`]).
+    big: f64,
 }
 
 impl<'r, S: Simd, const W: usize> State<'r, S, W> {
@@ -103,6 +107,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             mask,
             active,
             i: 0,
+            big: lanes.big,
         }
     }
 
@@ -124,7 +129,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
         self.p1 = p2;
     }
 
-    /// Rescale lanes that grew past `BIG` (rare: at most once per `2^600` of growth).
+    /// Rescale lanes that grew past `big` (rare: at most once per `2^600` of growth).
     #[inline(never)]
     unsafe fn rescale(&mut self) {
         let mut a0 = [0.0; W];
@@ -132,7 +137,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
         S::store(a0.as_mut_ptr(), self.p0);
         S::store(a1.as_mut_ptr(), self.p1);
         for w in 0..W {
-            if self.sc[w] < 0.0 && a1[w].abs() >= BIG {
+            if self.sc[w] < 0.0 && a1[w].abs() >= self.big {
                 a0[w] *= TINY;
                 a1[w] *= TINY;
                 self.sc[w] += 1.0;
@@ -158,7 +163,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             }
             self.step(rec, i);
             i += 1;
-            if S::any_abs_ge(self.p1, BIG) {
+            if S::any_abs_ge(self.p1, self.big) {
                 self.rescale();
             }
         }
@@ -192,7 +197,7 @@ unsafe fn skip_inactive<S: Simd, const W: usize>(
             if s.active == 0 && s.i < n {
                 s.step(rec, s.i);
                 s.i += 1;
-                if S::any_abs_ge(s.p1, BIG) {
+                if S::any_abs_ge(s.p1, s.big) {
                     s.rescale();
                 }
                 any = true;
@@ -416,7 +421,7 @@ pub(crate) fn column(
     let mut rc = RecCoeffs::new(n);
     rt.coeffs(m, mp, &mut rc);
     let w = isa.lanes();
-    let (p0, sc0) = bt.start(k, m, mp, norm, 1.0);
+    let (p0, sc0) = bt.start(k, m, mp, norm, 1.0, DEFAULT_SKIP_BITS);
     let mut tau = vec![0.0; w];
     let mut p = vec![0.0; w];
     let mut sc = vec![0.0; w];
@@ -433,6 +438,7 @@ pub(crate) fn column(
         p: &p,
         sc: &sc,
         upper_from: if upper { 0 } else { w },
+        big: crate::wigner::big(DEFAULT_SKIP_BITS),
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     (0..n).map(|i| f[i * 8]).collect()
@@ -470,7 +476,7 @@ mod tests {
         for s in 0..nbs {
             let k = s * (2 * b) / nbs;
             tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
-            (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0);
+            (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0, DEFAULT_SKIP_BITS);
         }
         (rc, tau, p, sc)
     }
@@ -490,6 +496,7 @@ mod tests {
                 p: &p,
                 sc: &sc,
                 upper_from: b,
+                big: crate::wigner::big(DEFAULT_SKIP_BITS),
             };
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
@@ -547,6 +554,7 @@ mod kernel_speed {
                 p: &p,
                 sc: &sc,
                 upper_from: nbs / 2,
+                big: crate::wigner::big(DEFAULT_SKIP_BITS),
             };
             let xin = vec![0.5; nbs * 16];
             let mut f = vec![0.0; n * 16];

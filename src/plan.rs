@@ -12,7 +12,9 @@ use crate::fft::{AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
 use crate::symmetry::{cluster_pairs, Cluster};
-use crate::wigner::{start_norms, BetaTables, Ext, RecCoeffs, RecTables};
+use crate::wigner::{
+    big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
+};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -49,6 +51,12 @@ pub struct PlanOptions {
     pub isa: Option<Isa>,
     /// How the FFT stage uses the threads.
     pub fft_threading: FftThreading,
+    /// Skip threshold `2^-skip_bits` (`None`: 300, i.e. about 5e-91). For each cluster and beta,
+    /// Wigner-d values below it are treated as zero, so the leading degrees where they are
+    /// negligible cost only the recurrence. A contribution skipped this way is at most
+    /// `2^-skip_bits` times the data it multiplies, so with `skip_bits >= 64` the total
+    /// change is below `B 2^-64`, under the rounding error of the transform. Accepted: 24..=560.
+    pub skip_bits: Option<u32>,
 }
 
 /// How the FFT stage is parallelised.
@@ -117,6 +125,8 @@ pub struct Plan {
     group: usize,
     /// Bytes this plan holds.
     memory: usize,
+    /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
+    skip_bits: u32,
     buf: Mutex<Option<AlignedBuf>>,
 }
 
@@ -282,6 +292,12 @@ impl Plan {
                 "{threads} threads requested (at most 1024)"
             )));
         }
+        let skip_bits = options.skip_bits.unwrap_or(DEFAULT_SKIP_BITS);
+        if !SKIP_BITS_RANGE.contains(&skip_bits) {
+            return Err(Error::InvalidArgument(format!(
+                "skip_bits {skip_bits} outside {SKIP_BITS_RANGE:?}"
+            )));
+        }
         let isa = options.isa.unwrap_or_else(Isa::detect);
         if !isa.is_supported() {
             return Err(Error::InvalidArgument(format!(
@@ -379,6 +395,7 @@ impl Plan {
             chunk,
             group: layout.group,
             memory: layout.total(),
+            skip_bits,
             buf: Mutex::new(Some(buf)),
         })
     }
@@ -748,8 +765,8 @@ impl Plan {
     }
 
     /// Recurrence coefficients and per-beta lane inputs of a cluster for one chunk.
-    /// The forward transform folds the quadrature weights into the starting values.
-    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk, forward: bool) -> (usize, usize) {
+    /// (The forward transform applies the quadrature weights to the gathered data.)
+    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> (usize, usize) {
         let n = self.b - cl.l0();
         sc.rec.resize(n);
         self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
@@ -767,8 +784,7 @@ impl Plan {
             for j in 0..ch.h {
                 let k = ch.ks[s0 + j];
                 sc.tau[u0 + j] = tau[k];
-                let w = if forward { self.wq[k] } else { 1.0 };
-                let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, w);
+                let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, 1.0, self.skip_bits);
                 sc.p[u0 + j] = p;
                 sc.sc[u0 + j] = scale;
             }
@@ -796,7 +812,7 @@ impl Plan {
         coef: SyncPtr<Complex64>,
         first: bool,
     ) {
-        let (n, nl) = self.setup(sc, cl, ch, true);
+        let (n, nl) = self.setup(sc, cl, ch);
         let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let data = &mut sc.data[..nl * p];
@@ -814,10 +830,13 @@ impl Plan {
             let rows = data[u0 * p..].chunks_exact_mut(p).take(ch.h);
             for (j, d) in rows.enumerate() {
                 let s = s0 + j;
+                // Quadrature weight (w_k = w_{2B-1-k}); applied to the data, not folded into
+                // the starting values, so the skip threshold bounds the Wigner-d values.
+                let w = self.wq[ch.ks[s]];
                 for (q, &(row, reversed)) in src.iter().enumerate() {
                     let z = *row.add(if reversed { nb - 1 - s } else { s });
-                    d[2 * q] = z.re;
-                    d[2 * q + 1] = z.im;
+                    d[2 * q] = z.re * w;
+                    d[2 * q + 1] = z.im * w;
                 }
             }
         }
@@ -829,6 +848,7 @@ impl Plan {
             p: &sc.p[..nl],
             sc: &sc.sc[..nl],
             upper_from: ch.hp,
+            big: big(self.skip_bits),
         };
         dwt::forward(self.isa, p, &rec, &lanes, data, f);
         for (q, mem) in cl.members().iter().enumerate() {
@@ -864,7 +884,7 @@ impl Plan {
         buf: *mut Complex64,
         coef: &[Complex64],
     ) {
-        let (n, nl) = self.setup(sc, cl, ch, false);
+        let (n, nl) = self.setup(sc, cl, ch);
         let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
         let fin = &mut sc.data[..n * p];
@@ -888,6 +908,7 @@ impl Plan {
             p: &sc.p[..nl],
             sc: &sc.sc[..nl],
             upper_from: ch.hp,
+            big: big(self.skip_bits),
         };
         dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
         for (q, mem) in cl.members().iter().enumerate() {

@@ -9,18 +9,24 @@
 //! The starting value over- and underflows doubles for large orders, so it is built in an
 //! extended format (mantissa, integer power of two) and handed to the kernels as a scaled
 //! value `p` with a scale index `sc <= 0`: the true value is `p * 2^(SCALE_STEP * sc)`.
-//! A lane whose `sc < 0` is below `2^-ACTIVE_BITS` and contributes nothing; the kernels
-//! rescale it by `2^-SCALE_STEP` whenever it grows past `BIG` until it reaches `sc = 0`,
+//! A lane whose `sc < 0` is below the skip threshold `2^-bits` and contributes nothing; the
+//! kernels rescale it by `2^-SCALE_STEP` whenever it grows past `big(bits)` until it reaches `sc = 0`,
 //! after which the recurrence continues in plain doubles.
 
 use crate::simd::Isa;
 
 /// Exponent step of one rescaling.
 pub(crate) const SCALE_STEP: i64 = 600;
-/// Lanes whose true value is below `2^-ACTIVE_BITS` are treated as zero.
-pub(crate) const ACTIVE_BITS: i64 = 300;
-/// Rescale threshold for the scaled values: `2^(SCALE_STEP - ACTIVE_BITS)`.
-pub(crate) const BIG: f64 = f64::from_bits(((1023 + SCALE_STEP - ACTIVE_BITS) as u64) << 52);
+/// Default skip threshold: lanes whose true value is below `2^-DEFAULT_SKIP_BITS` are
+/// treated as zero (see `PlanOptions::skip_bits`).
+pub(crate) const DEFAULT_SKIP_BITS: u32 = 300;
+/// Accepted range of skip thresholds (`2^-bits`): the scaled values stay normal doubles.
+pub(crate) const SKIP_BITS_RANGE: std::ops::RangeInclusive<u32> = 24..=560;
+
+/// Rescale threshold of the scaled values for skip threshold `2^-bits`: `2^(SCALE_STEP - bits)`.
+pub(crate) fn big(bits: u32) -> f64 {
+    ldexp(1.0, SCALE_STEP - bits as i64)
+}
 /// Rescaling factor `2^-SCALE_STEP`.
 pub(crate) const TINY: f64 = f64::from_bits(((1023 - SCALE_STEP) as u64) << 52);
 
@@ -95,17 +101,19 @@ impl Ext {
         }
     }
 
-    /// The kernels' scaled form `(p, sc)`: true value `= p * 2^(SCALE_STEP * sc)`,
-    /// `sc = 0` if the value is at least `2^-ACTIVE_BITS`, else `p` in `[2^-ACTIVE_BITS-1, BIG)`.
-    pub fn to_scaled(self) -> (f64, f64) {
+    /// The kernels' scaled form `(p, sc)` for skip threshold `2^-bits`: true value
+    /// `= p * 2^(SCALE_STEP * sc)`, `sc = 0` if the value is at least `2^-bits`, else `p` in
+    /// `[2^(-bits-1), big(bits))`.
+    pub fn to_scaled(self, bits: u32) -> (f64, f64) {
+        let active_bits = bits as i64;
         if self.mant == 0.0 {
             return (0.0, 0.0);
         }
         let e = self.exp; // |value| in [2^(e-1), 2^e)
-        if e > -ACTIVE_BITS {
+        if e > -active_bits {
             return (ldexp(self.mant, e), 0.0);
         }
-        let j = (-ACTIVE_BITS - e + SCALE_STEP) / SCALE_STEP; // ceil((-T - e)/S) for -T-e >= 0, >= 1
+        let j = (-active_bits - e + SCALE_STEP) / SCALE_STEP; // ceil((-T - e)/S) for -T-e >= 0, >= 1
         (ldexp(self.mant, e + SCALE_STEP * j), -(j as f64))
     }
 }
@@ -202,7 +210,15 @@ impl BetaTables {
     /// Scaled starting value `weight * dt^m_{m,m'}` at point `k`, given `norm` from
     /// [`start_norms`]. (A per-lane weight scales every degree of the recurrence alike.)
     #[inline]
-    pub fn start(&self, k: usize, m: usize, mp: usize, norm: Ext, weight: f64) -> (f64, f64) {
+    pub fn start(
+        &self,
+        k: usize,
+        m: usize,
+        mp: usize,
+        norm: Ext,
+        weight: f64,
+        bits: u32,
+    ) -> (f64, f64) {
         let (a, b) = (m + mp, m - mp);
         let c1 = self.cpow.lo[(a % 64) * self.cpow.nb + k];
         let c2 = self.cpow.hi[(a / 64) * self.cpow.nb + k];
@@ -214,7 +230,7 @@ impl BetaTables {
             mant: if b % 2 == 1 { -mant } else { mant },
             exp: e + norm.exp + c1.exp + c2.exp + s1.exp + s2.exp,
         };
-        v.to_scaled()
+        v.to_scaled(bits)
     }
 }
 
@@ -446,10 +462,11 @@ mod tests {
     fn scaled_form_is_consistent() {
         for &e in &[0i64, -100, -299, -300, -301, -899, -900, -901, -5000] {
             let x = Ext { mant: 0.75, exp: e };
-            let (p, sc) = x.to_scaled();
+            let bits = DEFAULT_SKIP_BITS;
+            let (p, sc) = x.to_scaled(bits);
             assert!(sc <= 0.0);
             if sc < 0.0 {
-                assert!(p.abs() < BIG && p.abs() >= ldexp(1.0, -ACTIVE_BITS - 1));
+                assert!(p.abs() < big(bits) && p.abs() >= ldexp(1.0, -(bits as i64) - 1));
             }
             // reconstruct in extended form
             let (pm, pe) = frexp(p);

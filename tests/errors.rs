@@ -392,3 +392,21 @@ fn sample_index_and_grid_helpers() {
         }
     }
 }
+
+/// Skip thresholds outside the documented range are rejected.
+#[test]
+fn invalid_skip_bits() {
+    for bits in [0u32, 23, 561, 10_000] {
+        let r = Plan::new(
+            4,
+            &PlanOptions {
+                skip_bits: Some(bits),
+                ..Default::default()
+            },
+        );
+        assert!(
+            matches!(r, Err(Error::InvalidArgument(_))),
+            "skip_bits {bits}"
+        );
+    }
+}
