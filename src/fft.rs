@@ -223,3 +223,88 @@ impl SliceFft {
         ffi::fftw_execute_dft(plan.0, inp as *mut _, out);
     }
 }
+
+/// Plan one `n x n` real-to-complex (`r2c`) or complex-to-real (`c2r`) DFT, single-threaded.
+fn make_real_plan(n: usize, r2c: bool, flags: u32) -> Result<RawPlan> {
+    // Scratch for planning (FFTW_MEASURE writes): room for n^2 reals or n(n/2+1) complex.
+    let a = AlignedBuf::new(n * n)?;
+    let b = AlignedBuf::new(n * n)?;
+    let p = {
+        let _g = planner_lock();
+        unsafe {
+            if r2c {
+                ffi::fftw_plan_dft_r2c_2d(
+                    n as i32,
+                    n as i32,
+                    a.as_mut_ptr() as *mut f64,
+                    b.as_mut_ptr(),
+                    flags | ffi::FFTW_PRESERVE_INPUT,
+                )
+            } else {
+                // A multi-dimensional c2r cannot preserve its input; ours is scratch.
+                ffi::fftw_plan_dft_c2r_2d(
+                    n as i32,
+                    n as i32,
+                    a.as_mut_ptr(),
+                    b.as_mut_ptr() as *mut f64,
+                    flags,
+                )
+            }
+        }
+    };
+    if p.is_null() {
+        return Err(Error::Fftw(format!("could not plan a real {n}x{n} DFT")));
+    }
+    Ok(RawPlan(p))
+}
+
+/// Real-data slice transforms: `r2c` (FFTW sign -1, output `n x (n/2+1)`) and its
+/// inverse-direction `c2r` (sign +1), each with an aligned and an unaligned variant.
+pub(crate) struct SliceFftReal {
+    r2c: RawPlan,
+    r2c_unaligned: RawPlan,
+    c2r: RawPlan,
+    c2r_unaligned: RawPlan,
+}
+
+impl SliceFftReal {
+    pub fn new(n: usize, rigor: Rigor) -> Result<SliceFftReal> {
+        let u = ffi::FFTW_ESTIMATE | ffi::FFTW_UNALIGNED;
+        Ok(SliceFftReal {
+            r2c: make_real_plan(n, true, rigor.flags())?,
+            r2c_unaligned: make_real_plan(n, true, u)?,
+            c2r: make_real_plan(n, false, rigor.flags())?,
+            c2r_unaligned: make_real_plan(n, false, u)?,
+        })
+    }
+
+    /// `n*n` reals at `inp` to `n*(n/2+1)` complex values at `out`.
+    ///
+    /// # Safety
+    /// Both pointers valid for those extents, no overlap.
+    pub unsafe fn r2c(&self, inp: *const f64, out: *mut Complex64) {
+        let aligned = ffi::fftw_alignment_of(inp as *mut f64) == 0
+            && ffi::fftw_alignment_of(out as *mut f64) == 0;
+        let p = if aligned {
+            &self.r2c
+        } else {
+            &self.r2c_unaligned
+        };
+        ffi::fftw_execute_dft_r2c(p.0, inp as *mut f64, out);
+    }
+
+    /// `n*(n/2+1)` complex values at `inp` (destroyed) to `n*n` reals at `out`.
+    ///
+    /// # Safety
+    /// Both pointers valid for those extents, no overlap.
+    pub unsafe fn c2r(&self, inp: *mut Complex64, out: *mut f64) {
+        let aligned =
+            ffi::fftw_alignment_of(inp as *mut f64) == 0 && ffi::fftw_alignment_of(out) == 0;
+        let p = if aligned {
+            &self.c2r
+        } else {
+            &self.c2r_unaligned
+        };
+        ffi::fftw_execute_dft_c2r(p.0, inp, out);
+    }
+}

@@ -8,7 +8,9 @@
 
 use crate::dwt::{self, Lanes, Rec};
 use crate::error::{Error, Result};
-use crate::fft::{AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
+use crate::fft::{AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
+
+mod real;
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
 use crate::symmetry::{cluster_pairs, Cluster};
@@ -57,6 +59,9 @@ pub struct PlanOptions {
     /// `2^-skip_bits` times the data it multiplies, so with `skip_bits >= 64` the total
     /// change is below `B 2^-64`, under the rounding error of the transform. Accepted: 24..=560.
     pub skip_bits: Option<u32>,
+    /// Also prepare the real-signal transforms [`Plan::forward_real`] and
+    /// [`Plan::inverse_real`] (real-to-complex FFTW plans; planning takes longer).
+    pub real: bool,
 }
 
 /// How the FFT stage is parallelised.
@@ -112,6 +117,8 @@ pub struct Plan {
     rt: RecTables,
     fwd_fft: Option<SliceFft>,
     inv_fft: Option<SliceFft>,
+    /// Real-data slice FFTs (with `PlanOptions::real`).
+    real_fft: Option<SliceFftReal>,
     /// Per-worker buffers of `group` slices, for transposing between the
     /// slice-major sample arrays and the pair-major chunk buffer.
     fft_scratch: Vec<Mutex<AlignedBuf>>,
@@ -356,6 +363,11 @@ impl Plan {
         let dwt_scratch = (0..threads)
             .map(|_| Mutex::new(Scratch::new(b, nbp)))
             .collect();
+        let real_fft = if options.real {
+            Some(SliceFftReal::new(n, options.rigor)?)
+        } else {
+            None
+        };
         let fft_scratch = (0..threads)
             .map(|_| AlignedBuf::new(layout.group * n * n).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
@@ -389,6 +401,7 @@ impl Plan {
             rt: RecTables::new(b),
             fwd_fft,
             inv_fft,
+            real_fft,
             fft_scratch,
             dwt_scratch,
             fftw_threaded,

@@ -1,0 +1,321 @@
+//! Real-valued signals: real samples, r2c/c2r slice FFTs, and half the order pairs.
+//!
+//! For real `f`, `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`: the members of a
+//! cluster come in negation pairs `(M,M') <-> (-M,-M')`, and only one of each pair (the
+//! representative: `M' > 0`, or `M' = 0` and `M >= 0`) is transformed, which halves the
+//! DWT work. The r2c FFT of a slice gives `R[a][b']` for `b' <= B` (sign -1); with `f` real,
+//! `S(M,M') = conj(R[M mod 2B][M'])` for `M' >= 0`. The chunk buffer holds these
+//! `2B (B+1)` half-spectrum rows per slot. The inverse fills the c2r input
+//! `Y[M mod 2B][M'] = conj(G(M,M'))` for `M' >= 0`, which makes `f = c2r(Y)` the samples.
+
+use super::*;
+use crate::symmetry::Member;
+
+/// Whether `mem` is the representative of its negation pair.
+fn representative(mem: &Member) -> bool {
+    mem.mp > 0 || (mem.mp == 0 && mem.m >= 0)
+}
+
+/// `(-1)^(M - M')`.
+fn neg_sign(m: isize, mp: isize) -> f64 {
+    if (m - mp).rem_euclid(2) == 0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+impl Plan {
+    /// Forward transform of a real signal: `(2B)^3` real samples (SPEC layout) to all
+    /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
+    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`].
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
+        self.forward_real_timed(samples, coeffs).map(|_| ())
+    }
+
+    /// Inverse transform to a real signal: coefficients (only one of each pair
+    /// `(M,M')`, `(-M,-M')` is read: those with `M' > 0`, or `M' = 0` and `M >= 0`) to
+    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`].
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
+        self.inverse_real_timed(coeffs, samples).map(|_| ())
+    }
+
+    fn real_fft(&self) -> Result<&SliceFftReal> {
+        self.real_fft.as_ref().ok_or_else(|| {
+            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
+        })
+    }
+
+    /// Like [`Plan::forward_real`], also returning the time of each stage.
+    pub fn forward_real_timed(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        self.real_fft()?;
+        let t0 = Instant::now();
+        let mut times = StageTimes::default();
+        let coef = SyncPtr(coeffs.as_mut_ptr());
+        self.with_buf(|buf| {
+            let bp = SyncPtr(buf.as_mut_ptr());
+            self.pool().install(|| {
+                for (ci, ch) in self.chunks().enumerate() {
+                    let t = Instant::now();
+                    self.fft_chunk_real(&ch, true, samples.as_ptr() as *mut f64, bp.get())?;
+                    times.fft += t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| unsafe {
+                        self.forward_cluster_real(sc, cl, &ch, bp.get(), coef, ci == 0);
+                    });
+                    times.dwt += t.elapsed().as_secs_f64();
+                }
+                Ok::<(), Error>(())
+            })
+        })?;
+        times.total = t0.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// Like [`Plan::inverse_real`], also returning the time of each stage.
+    pub fn inverse_real_timed(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+    ) -> Result<StageTimes> {
+        self.check(false, samples.len(), coeffs.len())?;
+        self.real_fft()?;
+        let t0 = Instant::now();
+        let mut times = StageTimes::default();
+        let out = SyncPtr(samples.as_mut_ptr());
+        self.with_buf(|buf| {
+            let bp = SyncPtr(buf.as_mut_ptr());
+            self.pool().install(|| {
+                for ch in self.chunks() {
+                    let t = Instant::now();
+                    let cp = coeffs.as_ptr() as *mut Complex64;
+                    self.for_each_cluster(&ch, bp.get(), cp, |sc, cl| unsafe {
+                        self.inverse_cluster_real(sc, cl, &ch, bp.get(), coeffs);
+                    });
+                    times.dwt += t.elapsed().as_secs_f64();
+                    let t = Instant::now();
+                    self.fft_chunk_real(&ch, false, out.get(), bp.get())?;
+                    times.fft += t.elapsed().as_secs_f64();
+                }
+                Ok::<(), Error>(())
+            })
+        })?;
+        times.total = t0.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// Row of the half-spectrum chunk buffer holding frequency `(a, b')`, `b' <= B`.
+    fn half_index(&self, a: isize, bp: isize) -> usize {
+        let n = 2 * self.b as isize;
+        (a.rem_euclid(n) * (self.b as isize + 1) + bp) as usize
+    }
+
+    /// FFT stage of one chunk for real data (see the module documentation).
+    fn fft_chunk_real(
+        &self,
+        ch: &Chunk,
+        forward: bool,
+        grid: *mut f64,
+        buf: *mut Complex64,
+    ) -> Result<()> {
+        let fft = self.real_fft()?;
+        let (b, n) = (self.b, 2 * self.b);
+        let (nn, nh) = (n * n, n * (b + 1));
+        let nb = ch.ks.len();
+        let group = self.group;
+        let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
+        (0..nb.div_ceil(group))
+            .into_par_iter()
+            .try_for_each(|gi| -> Result<()> {
+                let s0 = gi * group;
+                let g = group.min(nb - s0);
+                let guard = lock_free(&self.fft_scratch);
+                let own;
+                let scratch = match &guard {
+                    Some(x) => &**x,
+                    None => {
+                        own = AlignedBuf::new(group * nn)?;
+                        &own
+                    }
+                };
+                let (sp, bp) = (scratch.as_mut_ptr(), buf.get());
+                // SAFETY: the scratch holds `group` slices of n^2 >= nh values; group `gi`
+                // owns slots s0..s0+g of the buffer; grid slices are (2B)^2 reals each.
+                unsafe {
+                    if forward {
+                        for j in 0..g {
+                            fft.r2c(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nh));
+                        }
+                        for fi in 0..nh {
+                            for j in 0..g {
+                                *bp.add(fi * nb + s0 + j) = *sp.add(j * nh + fi);
+                            }
+                        }
+                    } else {
+                        for fi in 0..nh {
+                            for j in 0..g {
+                                *sp.add(j * nh + fi) = *bp.add(fi * nb + s0 + j);
+                            }
+                        }
+                        for j in 0..g {
+                            let slot = sp.add(j * nh);
+                            // Frequency B (alpha or gamma) is outside the band limit.
+                            for i in 0..=b {
+                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
+                            }
+                            for a in 0..n {
+                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
+                            }
+                            fft.c2r(slot, grid.get().add(ch.ks[s0 + j] * nn));
+                        }
+                    }
+                }
+                Ok(())
+            })
+    }
+
+    /// Forward DWT of one cluster's representatives for real data; partners by symmetry.
+    ///
+    /// # Safety
+    /// As for `forward_cluster`, with the half-spectrum chunk buffer.
+    unsafe fn forward_cluster_real(
+        &self,
+        sc: &mut Scratch,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *const Complex64,
+        coef: SyncPtr<Complex64>,
+        first: bool,
+    ) {
+        let (n, nl) = self.setup(sc, cl, ch);
+        let p = 8;
+        let nb = ch.ks.len();
+        let mut reps = [cl.members()[0]; 4];
+        let mut nr = 0;
+        for mem in cl.members().iter().filter(|m| representative(m)) {
+            reps[nr] = *mem;
+            nr += 1;
+        }
+        let reps = &reps[..nr];
+        let data = &mut sc.data[..nl * p];
+        data.fill(0.0);
+        for (q, mem) in reps.iter().enumerate() {
+            // S(M,M') = conj(R[M][M']) for M' >= 0 (representatives have M' >= 0).
+            let row = buf.add(self.half_index(mem.m, mem.mp) * nb);
+            for (u0, s0) in ch.halves() {
+                for j in 0..ch.h {
+                    let s = s0 + j;
+                    let w = self.wq[ch.ks[s]];
+                    let z = *row.add(if mem.reversed { nb - 1 - s } else { s });
+                    let d = &mut data[(u0 + j) * p..];
+                    d[2 * q] = z.re * w;
+                    d[2 * q + 1] = -z.im * w;
+                }
+            }
+        }
+        let f = &mut sc.out[..n * p];
+        f.fill(0.0);
+        let rec = Rec::new(&sc.rec, n);
+        let lanes = Lanes {
+            tau: &sc.tau[..nl],
+            p: &sc.p[..nl],
+            sc: &sc.sc[..nl],
+            upper_from: ch.hp,
+            big: big(self.skip_bits),
+        };
+        dwt::forward(self.isa, p, &rec, &lanes, data, f);
+        for (q, mem) in reps.iter().enumerate() {
+            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
+            let partner = (mem.m != 0 || mem.mp != 0)
+                .then(|| coef.get().add(block_start(self.b, -mem.m, -mem.mp)));
+            let ps = neg_sign(mem.m, mem.mp);
+            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
+            for i in 0..n {
+                let g = sg[i & 1];
+                let z = Complex64::new(f[i * p + 2 * q] * g, f[i * p + 2 * q + 1] * g);
+                let zp = z.conj() * ps;
+                if first {
+                    *dst.add(i) = z;
+                    if let Some(pp) = partner {
+                        *pp.add(i) = zp;
+                    }
+                } else {
+                    *dst.add(i) += z;
+                    if let Some(pp) = partner {
+                        *pp.add(i) += zp;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Inverse DWT of one cluster's representatives for real data, into the half-spectrum
+    /// chunk buffer as the c2r input.
+    ///
+    /// # Safety
+    /// As for `inverse_cluster`, with the half-spectrum chunk buffer.
+    unsafe fn inverse_cluster_real(
+        &self,
+        sc: &mut Scratch,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *mut Complex64,
+        coef: &[Complex64],
+    ) {
+        let (n, nl) = self.setup(sc, cl, ch);
+        let p = 8;
+        let nb = ch.ks.len();
+        let mut reps = [cl.members()[0]; 4];
+        let mut nr = 0;
+        for mem in cl.members().iter().filter(|m| representative(m)) {
+            reps[nr] = *mem;
+            nr += 1;
+        }
+        let reps = &reps[..nr];
+        let fin = &mut sc.data[..n * p];
+        fin.fill(0.0);
+        let scale = 1.0 / (2.0 * PI);
+        for (q, mem) in reps.iter().enumerate() {
+            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
+            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
+            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
+                let g = sg[i & 1];
+                row[2 * q] = z.re * g;
+                row[2 * q + 1] = z.im * g;
+            }
+        }
+        let y = &mut sc.out[..nl * p];
+        let rec = Rec::new(&sc.rec, n);
+        let lanes = Lanes {
+            tau: &sc.tau[..nl],
+            p: &sc.p[..nl],
+            sc: &sc.sc[..nl],
+            upper_from: ch.hp,
+            big: big(self.skip_bits),
+        };
+        dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
+        for (q, mem) in reps.iter().enumerate() {
+            let own = buf.add(self.half_index(mem.m, mem.mp) * nb);
+            // For M' = 0 the mirrored frequency (-M, 0) is also in the half spectrum.
+            let mirror =
+                (mem.mp == 0 && mem.m != 0).then(|| buf.add(self.half_index(-mem.m, 0) * nb));
+            let (yr, yi) = (&y[2 * q * nl..][..nl], &y[(2 * q + 1) * nl..][..nl]);
+            for (u0, s0) in ch.halves() {
+                for j in 0..ch.h {
+                    let s = s0 + j;
+                    let slot = if mem.reversed { nb - 1 - s } else { s };
+                    let g = Complex64::new(yr[u0 + j], yi[u0 + j]);
+                    *own.add(slot) = g.conj();
+                    if let Some(mp) = mirror {
+                        *mp.add(slot) = g;
+                    }
+                }
+            }
+        }
+    }
+}
