@@ -267,7 +267,8 @@ impl Layout {
             chunk,
             group,
             chunk_bytes: 2 * chunk * slice_bytes,
-            fft_scratch_bytes: threads * group * slice_bytes,
+            // One slice more than a group: room for packing real samples (real path).
+            fft_scratch_bytes: threads * (group + 1) * slice_bytes,
             table_bytes,
         }
     }
@@ -369,7 +370,7 @@ impl Plan {
             None
         };
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new(layout.group * n * n).map(Mutex::new))
+            .map(|_| AlignedBuf::new((layout.group + 1) * n * n).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -449,7 +450,7 @@ impl Plan {
 
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: `2h (2B)^2 16` for the chunk buffer (below) plus
-    /// `threads * g * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`)
+    /// `threads * (g + 1) * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`)
     /// plus `O(B^2)` tables. A transform needs the caller's arrays on top
     /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.

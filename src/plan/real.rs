@@ -25,6 +25,22 @@ fn neg_sign(m: isize, mp: isize) -> f64 {
     }
 }
 
+/// Where the real samples of a forward transform come from.
+#[derive(Clone, Copy)]
+enum RealInput {
+    /// `(2B)^3` doubles.
+    Real(*const f64),
+    /// The real parts of `(2B)^3` complex values.
+    RealParts(*const Complex64),
+}
+
+/// `RealInput` shared by the FFT workers (read only).
+#[derive(Clone, Copy)]
+struct SyncInput(RealInput);
+// SAFETY: the pointed-to samples are only read, by all workers, during one execution.
+unsafe impl Send for SyncInput {}
+unsafe impl Sync for SyncInput {}
+
 impl Plan {
     /// Forward transform of a real signal: `(2B)^3` real samples (SPEC layout) to all
     /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
@@ -53,7 +69,23 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
+        self.forward_real_impl(RealInput::Real(samples.as_ptr()), coeffs)
+    }
+
+    /// Forward transform of the real parts of complex samples (the imaginary parts are not
+    /// read): the real path for callers whose real data sit in a complex array.
+    pub(crate) fn forward_real_parts(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        self.forward_real_impl(RealInput::RealParts(samples.as_ptr()), coeffs)
+    }
+
+    fn forward_real_impl(&self, input: RealInput, coeffs: &mut [Complex64]) -> Result<StageTimes> {
         self.real_fft()?;
+        let input = SyncInput(input);
         let t0 = Instant::now();
         let mut times = StageTimes::default();
         let coef = SyncPtr(coeffs.as_mut_ptr());
@@ -62,7 +94,7 @@ impl Plan {
             self.pool().install(|| {
                 for (ci, ch) in self.chunks().enumerate() {
                     let t = Instant::now();
-                    self.fft_chunk_real(&ch, true, samples.as_ptr() as *mut f64, bp.get())?;
+                    self.fft_chunk_real(&ch, Some(input), std::ptr::null_mut(), bp.get())?;
                     times.fft += t.elapsed().as_secs_f64();
                     let t = Instant::now();
                     self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| unsafe {
@@ -99,7 +131,7 @@ impl Plan {
                     });
                     times.dwt += t.elapsed().as_secs_f64();
                     let t = Instant::now();
-                    self.fft_chunk_real(&ch, false, out.get(), bp.get())?;
+                    self.fft_chunk_real(&ch, None, out.get(), bp.get())?;
                     times.fft += t.elapsed().as_secs_f64();
                 }
                 Ok::<(), Error>(())
@@ -115,11 +147,12 @@ impl Plan {
         (a.rem_euclid(n) * (self.b as isize + 1) + bp) as usize
     }
 
-    /// FFT stage of one chunk for real data (see the module documentation).
+    /// FFT stage of one chunk for real data (see the module documentation): forward from
+    /// `input`, or (with `input = None`) inverse into `grid`.
     fn fft_chunk_real(
         &self,
         ch: &Chunk,
-        forward: bool,
+        input: Option<SyncInput>,
         grid: *mut f64,
         buf: *mut Complex64,
     ) -> Result<()> {
@@ -139,17 +172,31 @@ impl Plan {
                 let scratch = match &guard {
                     Some(x) => &**x,
                     None => {
-                        own = AlignedBuf::new(group * nn)?;
+                        own = AlignedBuf::new((group + 1) * nn)?;
                         &own
                     }
                 };
                 let (sp, bp) = (scratch.as_mut_ptr(), buf.get());
-                // SAFETY: the scratch holds `group` slices of n^2 >= nh values; group `gi`
+                // SAFETY: the scratch holds `group + 1` slices of n^2 complex values: g half
+                // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; group `gi`
                 // owns slots s0..s0+g of the buffer; grid slices are (2B)^2 reals each.
                 unsafe {
-                    if forward {
+                    if let Some(SyncInput(input)) = input {
+                        // Real parts of complex samples are first packed into the free
+                        // part of the scratch (after the g half spectra), one slice each.
+                        let packed = sp.add(g * nh) as *mut f64;
                         for j in 0..g {
-                            fft.r2c(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nh));
+                            let src = match input {
+                                RealInput::Real(p) => p.add(ch.ks[s0 + j] * nn),
+                                RealInput::RealParts(p) => {
+                                    let slice = p.add(ch.ks[s0 + j] * nn);
+                                    for i in 0..nn {
+                                        *packed.add(i) = (*slice.add(i)).re;
+                                    }
+                                    packed as *const f64
+                                }
+                            };
+                            fft.r2c(src, sp.add(j * nh));
                         }
                         for fi in 0..nh {
                             for j in 0..g {
