@@ -94,11 +94,12 @@
 #define SO3FFT_DESTROY_INPUT 16
 
 /**
- * Planner flag: the signal is real-valued (samples have zero imaginary parts; for the
- * inverse, coefficients satisfy `fhat(l,-m,-m') = (-1)^(m-m') conj(fhat(l,m,m'))`).
- * Accepted; the current implementation computes the full complex transform, whose
- * result for such data is the same, and reads and writes the full arrays (the
- * layouts do not change with this flag).
+ * Planner flag: the signal is real-valued. The array layouts do not change, and about
+ * half the work is done (r2c/c2r FFTs, one order pair of each `(m,m')`, `(-m,-m')`).
+ * Forward: only the real parts of the samples are read; all coefficients are written
+ * and satisfy `fhat(l,-m,-m') = (-1)^(m-m') conj(fhat(l,m,m'))` exactly. Inverse: the
+ * coefficients must satisfy that symmetry, and only the blocks with `m' > 0`, or `m' = 0`
+ * and `m >= 0`, are read; the samples' imaginary parts are written as exactly 0.
  */
 #define SO3FFT_REAL 32
 

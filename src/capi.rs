@@ -33,6 +33,8 @@ pub struct so3fft_plan_s {
     input: *mut so3fft_complex,
     /// Output array given at planning, or NULL.
     output: *mut so3fft_complex,
+    /// Made with `SO3FFT_REAL`: transforms take the real-signal path.
+    real: bool,
 }
 
 /// A plan: a pointer to an opaque object (like `fftw_plan`).
@@ -62,11 +64,12 @@ pub const SO3FFT_EXHAUSTIVE: c_uint = 4;
 /// `FFTW_DESTROY_INPUT`). Accepted; the current implementation never modifies its input
 /// arrays, with or without this flag.
 pub const SO3FFT_DESTROY_INPUT: c_uint = 16;
-/// Planner flag: the signal is real-valued (samples have zero imaginary parts; for the
-/// inverse, coefficients satisfy `fhat(l,-m,-m') = (-1)^(m-m') conj(fhat(l,m,m'))`).
-/// Accepted; the current implementation computes the full complex transform, whose
-/// result for such data is the same, and reads and writes the full arrays (the
-/// layouts do not change with this flag).
+/// Planner flag: the signal is real-valued. The array layouts do not change, and about
+/// half the work is done (r2c/c2r FFTs, one order pair of each `(m,m')`, `(-m,-m')`).
+/// Forward: only the real parts of the samples are read; all coefficients are written
+/// and satisfy `fhat(l,-m,-m') = (-1)^(m-m') conj(fhat(l,m,m'))` exactly. Inverse: the
+/// coefficients must satisfy that symmetry, and only the blocks with `m' > 0`, or `m' = 0`
+/// and `m >= 0`, are read; the samples' imaginary parts are written as exactly 0.
 pub const SO3FFT_REAL: c_uint = 32;
 
 const KNOWN_FLAGS: c_uint =
@@ -346,6 +349,13 @@ unsafe fn run_forward(
     // Complex64 is #[repr(C)] { re: f64, im: f64 }, the layout of double[2].
     let s = std::slice::from_raw_parts(samples as *const Complex64, ns);
     let c = std::slice::from_raw_parts_mut(coeffs as *mut Complex64, nc);
+    if ps.real {
+        return ps
+            .plan
+            .forward_real_parts(s, c)
+            .map(|_| ())
+            .map_err(CErr::from);
+    }
     ps.plan.forward(s, c).map_err(CErr::from)
 }
 
@@ -368,6 +378,9 @@ unsafe fn run_inverse(
     // SAFETY: as in run_forward.
     let c = std::slice::from_raw_parts(coeffs as *const Complex64, nc);
     let s = std::slice::from_raw_parts_mut(samples as *mut Complex64, ns);
+    if ps.real {
+        return ps.plan.inverse_real_to_complex(c, s).map_err(CErr::from);
+    }
     ps.plan.inverse(c, s).map_err(CErr::from)
 }
 
@@ -448,10 +461,12 @@ fn make_plan(
                 ))
             }
         }
+        let real = flags & SO3FFT_REAL != 0;
         let options = PlanOptions {
             direction,
             threads,
             rigor,
+            real,
             ..PlanOptions::default()
         };
         let plan = Plan::new(b, &options)?;
@@ -459,6 +474,7 @@ fn make_plan(
             plan,
             input,
             output,
+            real,
         })))
     })
 }

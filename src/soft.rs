@@ -364,54 +364,9 @@ unsafe fn inverse_core(
         return plan.inverse(input, out).map_err(|e| e.to_string());
     }
     let expanded = expand_real(b, input)?;
-    // The real samples go to the first half of the output's memory (ns doubles), then are
-    // spread in place, from the end, to complex values with imaginary part 0: entry i
-    // occupies doubles 2i and 2i+1 >= i, so nothing is overwritten before it is read.
-    let res = {
-        // SAFETY: `out` spans 2 ns doubles; the f64 view is dropped before `out` is used again.
-        let re = std::slice::from_raw_parts_mut(out.as_mut_ptr() as *mut f64, ns);
-        plan.inverse_real(&expanded, re)
-    };
+    let res = plan.inverse_real_to_complex(&expanded, out);
     release_real_buf(b, expanded);
-    res.map_err(|e| e.to_string())?;
-    spread_real_in_place(out.as_mut_ptr() as *mut f64, ns, plan.threads());
-    Ok(())
-}
-
-/// Turn `n` reals at `base[0..n]` into `n` complex values `(x, 0)` at `base[0..2n]`, in
-/// place. Entry `i` goes to doubles `2i, 2i+1`; the range `[n/2, n)` lands in `[n, 2n)`,
-/// clear of every real still to be read, so it can be done by several threads; then
-/// `[n/4, n/2)` and so on, halving down to the first few entries, done from the top down.
-///
-/// # Safety
-/// `base` is valid for `2n` doubles.
-unsafe fn spread_real_in_place(base: *mut f64, n: usize, threads: usize) {
-    #[derive(Clone, Copy)]
-    struct P(*mut f64);
-    // SAFETY: threads write disjoint ranges and read ranges nobody writes in that round.
-    unsafe impl Send for P {}
-    unsafe impl Sync for P {}
-    let spread = |p: P, lo: usize, hi: usize| {
-        for i in (lo..hi).rev() {
-            let v = *p.0.add(i);
-            *p.0.add(2 * i + 1) = 0.0;
-            *p.0.add(2 * i) = v;
-        }
-    };
-    let mut hi = n;
-    while hi > 1 << 16 {
-        let lo = hi / 2;
-        let per = (hi - lo).div_ceil(threads.max(1));
-        std::thread::scope(|s| {
-            for a in (lo..hi).step_by(per) {
-                let b = (a + per).min(hi);
-                let p = P(base);
-                s.spawn(move || spread(p, a, b));
-            }
-        });
-        hi = lo;
-    }
-    spread(P(base), 0, hi);
+    res.map_err(|e| e.to_string())
 }
 
 // ----------------------------------------------------------------------------------------

@@ -56,6 +56,25 @@ impl Plan {
         self.inverse_real_timed(coeffs, samples).map(|_| ())
     }
 
+    /// [`Plan::inverse_real`] into a complex sample array: real parts are the samples,
+    /// imaginary parts exactly 0 (for callers whose interface is complex, such as the C API
+    /// with `SO3FFT_REAL` and SOFT's `flag = 1`). No extra memory: the reals are written to
+    /// the first half of `samples` and spread in place.
+    pub(crate) fn inverse_real_to_complex(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+    ) -> Result<()> {
+        self.check(false, samples.len(), coeffs.len())?;
+        let ns = samples.len();
+        // SAFETY: `samples` spans 2 ns doubles; the f64 view ends before `samples` is used.
+        let re = unsafe { std::slice::from_raw_parts_mut(samples.as_mut_ptr() as *mut f64, ns) };
+        self.inverse_real(coeffs, re)?;
+        // SAFETY: `samples` is valid for 2 ns doubles.
+        unsafe { spread_real_in_place(samples.as_mut_ptr() as *mut f64, ns, self.threads) };
+        Ok(())
+    }
+
     fn real_fft(&self) -> Result<&SliceFftReal> {
         self.real_fft.as_ref().ok_or_else(|| {
             Error::InvalidArgument("the plan was made without PlanOptions::real".into())
@@ -365,4 +384,40 @@ impl Plan {
             }
         }
     }
+}
+
+/// Turn `n` reals at `base[0..n]` into `n` complex values `(x, 0)` at `base[0..2n]`, in
+/// place. Entry `i` goes to doubles `2i, 2i+1`; the range `[n/2, n)` lands in `[n, 2n)`,
+/// clear of every real still to be read, so it can be done by several threads; then
+/// `[n/4, n/2)` and so on, halving down to the first few entries, done from the top down.
+///
+/// # Safety
+/// `base` is valid for `2n` doubles.
+unsafe fn spread_real_in_place(base: *mut f64, n: usize, threads: usize) {
+    #[derive(Clone, Copy)]
+    struct P(*mut f64);
+    // SAFETY: threads write disjoint ranges and read ranges nobody writes in that round.
+    unsafe impl Send for P {}
+    unsafe impl Sync for P {}
+    let spread = |p: P, lo: usize, hi: usize| {
+        for i in (lo..hi).rev() {
+            let v = *p.0.add(i);
+            *p.0.add(2 * i + 1) = 0.0;
+            *p.0.add(2 * i) = v;
+        }
+    };
+    let mut hi = n;
+    while hi > 1 << 16 {
+        let lo = hi / 2;
+        let per = (hi - lo).div_ceil(threads.max(1));
+        std::thread::scope(|s| {
+            for a in (lo..hi).step_by(per) {
+                let b = (a + per).min(hi);
+                let p = P(base);
+                s.spawn(move || spread(p, a, b));
+            }
+        });
+        hi = lo;
+    }
+    spread(P(base), 0, hi);
 }
