@@ -13,7 +13,7 @@ use crate::fft::{AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLU
 mod real;
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
-use crate::symmetry::{cluster_pairs, Cluster};
+use crate::symmetry::{cluster_pairs, Cluster, Member};
 use crate::wigner::{
     big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
 };
@@ -170,6 +170,37 @@ impl Scratch {
             sc: vec![0.0; nbp],
             data: vec![0.0; nbp.max(b) * 16],
             out: vec![0.0; nbp.max(b) * 16],
+        }
+    }
+}
+
+impl Scratch {
+    /// Run the DWT kernel on this scratch after [`Plan::setup`]: forward from `data` (`nl`
+    /// lanes of `p` values) into `out` (`n` degrees, zeroed first), inverse from `data`
+    /// (`n` degrees) into `out` (`p` rows of `nl` lanes).
+    fn kernel(&mut self, plan: &Plan, forward: bool, p: usize, n: usize, ch: &Chunk) {
+        let nl = ch.lanes();
+        let rec = Rec::new(&self.rec, n);
+        let lanes = Lanes {
+            tau: &self.tau[..nl],
+            p: &self.p[..nl],
+            sc: &self.sc[..nl],
+            upper_from: ch.hp,
+            big: big(plan.skip_bits),
+        };
+        if forward {
+            let f = &mut self.out[..n * p];
+            f.fill(0.0);
+            dwt::forward(plan.isa, p, &rec, &lanes, &self.data[..nl * p], f);
+        } else {
+            dwt::inverse(
+                plan.isa,
+                p,
+                &rec,
+                &lanes,
+                &self.data[..n * p],
+                &mut self.out[..nl * p],
+            );
         }
     }
 }
@@ -545,21 +576,51 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
+        let coef = SyncPtr(coeffs.as_mut_ptr());
+        self.run_chunks(
+            true,
+            coef,
+            |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
+            |sc, cl, ch, buf, first| unsafe {
+                self.forward_cluster(sc, cl, ch, buf, coef, first);
+            },
+        )
+    }
+
+    /// The chunk loop shared by every transform: for each chunk, the FFT stage and the DWT
+    /// of every cluster, in the order of the direction (forward: FFT then DWT), timed.
+    /// `coef` is the coefficient array (for prefetching); `first` tells the cluster stage
+    /// whether this is the first chunk (the forward assigns rather than accumulates then).
+    fn run_chunks(
+        &self,
+        forward: bool,
+        coef: SyncPtr<Complex64>,
+        fft: impl Fn(&Chunk, *mut Complex64) -> Result<()> + Sync,
+        cluster: impl Fn(&mut Scratch, &Cluster, &Chunk, *mut Complex64, bool) + Sync,
+    ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
-        let coef = SyncPtr(coeffs.as_mut_ptr());
         self.with_buf(|buf| {
             let bp = SyncPtr(buf.as_mut_ptr());
             self.pool().install(|| {
                 for (ci, ch) in self.chunks().enumerate() {
+                    let mut fft_stage = || -> Result<()> {
+                        let t = Instant::now();
+                        fft(&ch, bp.get())?;
+                        times.fft += t.elapsed().as_secs_f64();
+                        Ok(())
+                    };
+                    if forward {
+                        fft_stage()?;
+                    }
                     let t = Instant::now();
-                    self.fft_chunk(&ch, true, samples.as_ptr() as *mut Complex64, bp.get())?;
-                    times.fft += t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| unsafe {
-                        self.forward_cluster(sc, cl, &ch, bp.get(), coef, ci == 0);
+                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| {
+                        cluster(sc, cl, &ch, bp.get(), ci == 0)
                     });
                     times.dwt += t.elapsed().as_secs_f64();
+                    if !forward {
+                        fft_stage()?;
+                    }
                 }
                 Ok::<(), Error>(())
             })
@@ -754,28 +815,13 @@ impl Plan {
         samples: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        let t0 = Instant::now();
-        let mut times = StageTimes::default();
         let out = SyncPtr(samples.as_mut_ptr());
-        self.with_buf(|buf| {
-            let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool().install(|| {
-                for ch in self.chunks() {
-                    let t = Instant::now();
-                    let cp = coeffs.as_ptr() as *mut Complex64;
-                    self.for_each_cluster(&ch, bp.get(), cp, |sc, cl| unsafe {
-                        self.inverse_cluster(sc, cl, &ch, bp.get(), coeffs);
-                    });
-                    times.dwt += t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    self.fft_chunk(&ch, false, out.get(), bp.get())?;
-                    times.fft += t.elapsed().as_secs_f64();
-                }
-                Ok::<(), Error>(())
-            })
-        })?;
-        times.total = t0.elapsed().as_secs_f64();
-        Ok(times)
+        self.run_chunks(
+            false,
+            SyncPtr(coeffs.as_ptr() as *mut Complex64),
+            |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
+            |sc, cl, ch, buf, _| unsafe { self.inverse_cluster(sc, cl, ch, buf, coeffs) },
+        )
     }
 
     /// Recurrence coefficients and per-beta lane inputs of a cluster for one chunk.
@@ -804,6 +850,26 @@ impl Plan {
             }
         }
         (n, nl)
+    }
+
+    /// Inverse DWT input: `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree
+    /// `l0 + i`, times the member's sign and `1/(2 pi)`; unused columns zero.
+    fn gather_coeffs(&self, fin: &mut [f64], cl: &Cluster, members: &[Member], coef: &[Complex64]) {
+        let p = fin.len() / (self.b - cl.l0());
+        if members.len() * 2 < p {
+            fin.fill(0.0);
+        }
+        let n = self.b - cl.l0();
+        let scale = 1.0 / (2.0 * PI);
+        for (q, mem) in members.iter().enumerate() {
+            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
+            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
+            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
+                let g = sg[i & 1];
+                row[2 * q] = z.re * g;
+                row[2 * q + 1] = z.im * g;
+            }
+        }
     }
 
     /// Index of order pair `(m, mp)` inside a transformed slice.
@@ -854,17 +920,8 @@ impl Plan {
                 }
             }
         }
-        let f = &mut sc.out[..n * p];
-        f.fill(0.0);
-        let rec = Rec::new(&sc.rec, n);
-        let lanes = Lanes {
-            tau: &sc.tau[..nl],
-            p: &sc.p[..nl],
-            sc: &sc.sc[..nl],
-            upper_from: ch.hp,
-            big: big(self.skip_bits),
-        };
-        dwt::forward(self.isa, p, &rec, &lanes, data, f);
+        sc.kernel(self, true, p, n, ch);
+        let f = &sc.out[..n * p];
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
                 coef.get().add(block_start(self.b, mem.m, mem.mp)),
@@ -901,30 +958,9 @@ impl Plan {
         let (n, nl) = self.setup(sc, cl, ch);
         let p = if cl.members().len() > 4 { 16 } else { 8 };
         let nb = ch.ks.len();
-        let fin = &mut sc.data[..n * p];
-        if cl.members().len() * 2 < p {
-            fin.fill(0.0);
-        }
-        let scale = 1.0 / (2.0 * PI);
-        for (q, mem) in cl.members().iter().enumerate() {
-            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
-            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
-            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
-                let g = sg[i & 1];
-                row[2 * q] = z.re * g;
-                row[2 * q + 1] = z.im * g;
-            }
-        }
-        let y = &mut sc.out[..nl * p];
-        let rec = Rec::new(&sc.rec, n);
-        let lanes = Lanes {
-            tau: &sc.tau[..nl],
-            p: &sc.p[..nl],
-            sc: &sc.sc[..nl],
-            upper_from: ch.hp,
-            big: big(self.skip_bits),
-        };
-        dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
+        self.gather_coeffs(&mut sc.data[..n * p], cl, cl.members(), coef);
+        sc.kernel(self, false, p, n, ch);
+        let y = &sc.out[..nl * p];
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = buf.add(self.freq_index(mem.m, mem.mp) * nb);
             let (yr, yi) = (&y[2 * q * nl..][..nl], &y[(2 * q + 1) * nl..][..nl]);

@@ -16,6 +16,17 @@ fn representative(mem: &Member) -> bool {
     mem.mp > 0 || (mem.mp == 0 && mem.m >= 0)
 }
 
+/// The representatives of a cluster (1, 2 or 4 members) and their number.
+fn representatives(cl: &Cluster) -> ([Member; 4], usize) {
+    let mut reps = [cl.members()[0]; 4];
+    let mut nr = 0;
+    for mem in cl.members().iter().filter(|m| representative(m)) {
+        reps[nr] = *mem;
+        nr += 1;
+    }
+    (reps, nr)
+}
+
 /// `(-1)^(M - M')`.
 fn neg_sign(m: isize, mp: isize) -> f64 {
     if (m - mp).rem_euclid(2) == 0 {
@@ -105,27 +116,15 @@ impl Plan {
     fn forward_real_impl(&self, input: RealInput, coeffs: &mut [Complex64]) -> Result<StageTimes> {
         self.real_fft()?;
         let input = SyncInput(input);
-        let t0 = Instant::now();
-        let mut times = StageTimes::default();
         let coef = SyncPtr(coeffs.as_mut_ptr());
-        self.with_buf(|buf| {
-            let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool().install(|| {
-                for (ci, ch) in self.chunks().enumerate() {
-                    let t = Instant::now();
-                    self.fft_chunk_real(&ch, Some(input), std::ptr::null_mut(), bp.get())?;
-                    times.fft += t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| unsafe {
-                        self.forward_cluster_real(sc, cl, &ch, bp.get(), coef, ci == 0);
-                    });
-                    times.dwt += t.elapsed().as_secs_f64();
-                }
-                Ok::<(), Error>(())
-            })
-        })?;
-        times.total = t0.elapsed().as_secs_f64();
-        Ok(times)
+        self.run_chunks(
+            true,
+            coef,
+            |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
+            |sc, cl, ch, buf, first| unsafe {
+                self.forward_cluster_real(sc, cl, ch, buf, coef, first);
+            },
+        )
     }
 
     /// Like [`Plan::inverse_real`], also returning the time of each stage.
@@ -136,28 +135,13 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
         self.real_fft()?;
-        let t0 = Instant::now();
-        let mut times = StageTimes::default();
         let out = SyncPtr(samples.as_mut_ptr());
-        self.with_buf(|buf| {
-            let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool().install(|| {
-                for ch in self.chunks() {
-                    let t = Instant::now();
-                    let cp = coeffs.as_ptr() as *mut Complex64;
-                    self.for_each_cluster(&ch, bp.get(), cp, |sc, cl| unsafe {
-                        self.inverse_cluster_real(sc, cl, &ch, bp.get(), coeffs);
-                    });
-                    times.dwt += t.elapsed().as_secs_f64();
-                    let t = Instant::now();
-                    self.fft_chunk_real(&ch, None, out.get(), bp.get())?;
-                    times.fft += t.elapsed().as_secs_f64();
-                }
-                Ok::<(), Error>(())
-            })
-        })?;
-        times.total = t0.elapsed().as_secs_f64();
-        Ok(times)
+        self.run_chunks(
+            false,
+            SyncPtr(coeffs.as_ptr() as *mut Complex64),
+            |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
+            |sc, cl, ch, buf, _| unsafe { self.inverse_cluster_real(sc, cl, ch, buf, coeffs) },
+        )
     }
 
     /// Row of the half-spectrum chunk buffer holding frequency `(a, b')`, `b' <= B`.
@@ -261,12 +245,7 @@ impl Plan {
         let (n, nl) = self.setup(sc, cl, ch);
         let p = 8;
         let nb = ch.ks.len();
-        let mut reps = [cl.members()[0]; 4];
-        let mut nr = 0;
-        for mem in cl.members().iter().filter(|m| representative(m)) {
-            reps[nr] = *mem;
-            nr += 1;
-        }
+        let (reps, nr) = representatives(cl);
         let reps = &reps[..nr];
         let data = &mut sc.data[..nl * p];
         data.fill(0.0);
@@ -284,17 +263,8 @@ impl Plan {
                 }
             }
         }
-        let f = &mut sc.out[..n * p];
-        f.fill(0.0);
-        let rec = Rec::new(&sc.rec, n);
-        let lanes = Lanes {
-            tau: &sc.tau[..nl],
-            p: &sc.p[..nl],
-            sc: &sc.sc[..nl],
-            upper_from: ch.hp,
-            big: big(self.skip_bits),
-        };
-        dwt::forward(self.isa, p, &rec, &lanes, data, f);
+        sc.kernel(self, true, p, n, ch);
+        let f = &sc.out[..n * p];
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let partner = (mem.m != 0 || mem.mp != 0)
@@ -336,35 +306,11 @@ impl Plan {
         let (n, nl) = self.setup(sc, cl, ch);
         let p = 8;
         let nb = ch.ks.len();
-        let mut reps = [cl.members()[0]; 4];
-        let mut nr = 0;
-        for mem in cl.members().iter().filter(|m| representative(m)) {
-            reps[nr] = *mem;
-            nr += 1;
-        }
+        let (reps, nr) = representatives(cl);
         let reps = &reps[..nr];
-        let fin = &mut sc.data[..n * p];
-        fin.fill(0.0);
-        let scale = 1.0 / (2.0 * PI);
-        for (q, mem) in reps.iter().enumerate() {
-            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
-            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
-            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
-                let g = sg[i & 1];
-                row[2 * q] = z.re * g;
-                row[2 * q + 1] = z.im * g;
-            }
-        }
-        let y = &mut sc.out[..nl * p];
-        let rec = Rec::new(&sc.rec, n);
-        let lanes = Lanes {
-            tau: &sc.tau[..nl],
-            p: &sc.p[..nl],
-            sc: &sc.sc[..nl],
-            upper_from: ch.hp,
-            big: big(self.skip_bits),
-        };
-        dwt::inverse(self.isa, p, &rec, &lanes, fin, y);
+        self.gather_coeffs(&mut sc.data[..n * p], cl, reps, coef);
+        sc.kernel(self, false, p, n, ch);
+        let y = &sc.out[..nl * p];
         for (q, mem) in reps.iter().enumerate() {
             let own = buf.add(self.half_index(mem.m, mem.mp) * nb);
             // For M' = 0 the mirrored frequency (-M, 0) is also in the half spectrum.
