@@ -683,6 +683,16 @@ impl Plan {
         let _ = (cl, nb, buf, coef);
     }
 
+    /// Run `f` with a per-worker FFT scratch buffer (`group + 1` slices). A worker may take
+    /// on another execution's group while it waits inside a parallel copy, so buffers are
+    /// taken by try_lock, never by blocking; when all are busy a private one is allocated.
+    fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
+        match lock_free(&self.fft_scratch) {
+            Some(g) => f(&g),
+            None => f(&AlignedBuf::new((self.group + 1) * 4 * self.b * self.b)?),
+        }
+    }
+
     /// FFT stage of one chunk. Forward: slices `ks[s]` of `grid` are transformed and
     /// transposed into the pair-major chunk buffer (`buf[fi * nb + s]`). Inverse: the
     /// reverse, into `grid`. Groups of `self.group` slots are spread over the workers.
@@ -706,19 +716,8 @@ impl Plan {
         let run = |gi: usize, parallel_copy: bool| -> Result<()> {
             let s0 = gi * group;
             let g = group.min(nb - s0);
-            // A worker may take on another execution's group while it waits inside a
-            // parallel copy, so buffers are taken by try_lock, never by blocking.
-            let guard = lock_free(&self.fft_scratch);
-            let own;
-            let scratch = match &guard {
-                Some(g) => &**g,
-                None => {
-                    own = AlignedBuf::new(group * 4 * self.b * self.b)?;
-                    &own
-                }
-            };
-            // SAFETY: the scratch holds `group` slices; group `gi` owns slots s0..s0+g.
-            unsafe {
+            self.with_fft_scratch(|scratch| unsafe {
+                // SAFETY: the scratch holds `group` slices; group `gi` owns slots s0..s0+g.
                 self.fft_group(
                     ch,
                     fft,
@@ -730,7 +729,7 @@ impl Plan {
                     g,
                     parallel_copy,
                 )
-            }
+            })
         };
         if self.fftw_threaded {
             // FFTW parallelises each slice; the copies are spread over the workers.

@@ -170,62 +170,55 @@ impl Plan {
             .try_for_each(|gi| -> Result<()> {
                 let s0 = gi * group;
                 let g = group.min(nb - s0);
-                let guard = lock_free(&self.fft_scratch);
-                let own;
-                let scratch = match &guard {
-                    Some(x) => &**x,
-                    None => {
-                        own = AlignedBuf::new((group + 1) * nn)?;
-                        &own
-                    }
-                };
-                let (sp, bp) = (scratch.as_mut_ptr(), buf.get());
-                // SAFETY: the scratch holds `group + 1` slices of n^2 complex values: g half
-                // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; group `gi`
-                // owns slots s0..s0+g of the buffer; grid slices are (2B)^2 reals each.
-                unsafe {
-                    if let Some(SyncInput(input)) = input {
-                        // Real parts of complex samples are first packed into the free
-                        // part of the scratch (after the g half spectra), one slice each.
-                        let packed = sp.add(g * nh) as *mut f64;
-                        for j in 0..g {
-                            let src = match input {
-                                RealInput::Real(p) => p.add(ch.ks[s0 + j] * nn),
-                                RealInput::RealParts(p) => {
-                                    let slice = p.add(ch.ks[s0 + j] * nn);
-                                    for i in 0..nn {
-                                        *packed.add(i) = (*slice.add(i)).re;
+                self.with_fft_scratch(|scratch| {
+                    let (sp, bp) = (scratch.as_mut_ptr(), buf.get());
+                    // SAFETY: the scratch holds `group + 1` slices of n^2 complex values: g half
+                    // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; group `gi`
+                    // owns slots s0..s0+g of the buffer; grid slices are (2B)^2 reals each.
+                    unsafe {
+                        if let Some(SyncInput(input)) = input {
+                            // Real parts of complex samples are first packed into the free
+                            // part of the scratch (after the g half spectra), one slice each.
+                            let packed = sp.add(g * nh) as *mut f64;
+                            for j in 0..g {
+                                let src = match input {
+                                    RealInput::Real(p) => p.add(ch.ks[s0 + j] * nn),
+                                    RealInput::RealParts(p) => {
+                                        let slice = p.add(ch.ks[s0 + j] * nn);
+                                        for i in 0..nn {
+                                            *packed.add(i) = (*slice.add(i)).re;
+                                        }
+                                        packed as *const f64
                                     }
-                                    packed as *const f64
+                                };
+                                fft.r2c(src, sp.add(j * nh));
+                            }
+                            for fi in 0..nh {
+                                for j in 0..g {
+                                    *bp.add(fi * nb + s0 + j) = *sp.add(j * nh + fi);
                                 }
-                            };
-                            fft.r2c(src, sp.add(j * nh));
-                        }
-                        for fi in 0..nh {
+                            }
+                        } else {
+                            for fi in 0..nh {
+                                for j in 0..g {
+                                    *sp.add(j * nh + fi) = *bp.add(fi * nb + s0 + j);
+                                }
+                            }
                             for j in 0..g {
-                                *bp.add(fi * nb + s0 + j) = *sp.add(j * nh + fi);
+                                let slot = sp.add(j * nh);
+                                // Frequency B (alpha or gamma) is outside the band limit.
+                                for i in 0..=b {
+                                    *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
+                                }
+                                for a in 0..n {
+                                    *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
+                                }
+                                fft.c2r(slot, grid.get().add(ch.ks[s0 + j] * nn));
                             }
-                        }
-                    } else {
-                        for fi in 0..nh {
-                            for j in 0..g {
-                                *sp.add(j * nh + fi) = *bp.add(fi * nb + s0 + j);
-                            }
-                        }
-                        for j in 0..g {
-                            let slot = sp.add(j * nh);
-                            // Frequency B (alpha or gamma) is outside the band limit.
-                            for i in 0..=b {
-                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
-                            }
-                            for a in 0..n {
-                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
-                            }
-                            fft.c2r(slot, grid.get().add(ch.ks[s0 + j] * nn));
                         }
                     }
-                }
-                Ok(())
+                    Ok(())
+                })
             })
     }
 
