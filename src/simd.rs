@@ -80,6 +80,12 @@ pub(crate) trait Simd: Copy {
     unsafe fn fms(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
     /// Whether any lane has `|v| >= t`.
     unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
+    /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
+    /// pins the program order of what is computed before and after it.
+    #[inline(always)]
+    unsafe fn fence(v: Self::V) -> Self::V {
+        v
+    }
     #[inline(always)]
     unsafe fn zero() -> Self::V {
         Self::splat(0.0)
@@ -168,6 +174,15 @@ mod x86 {
         unsafe fn fms(a: __m512d, b: __m512d, c: __m512d) -> __m512d {
             _mm512_fmsub_pd(a, b, c)
         }
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        unsafe fn fence(mut v: __m512d) -> __m512d {
+            // SAFETY: an empty instruction sequence on a register operand.
+            unsafe {
+                std::arch::asm!("/* {0} */", inout(zmm_reg) v, options(nomem, nostack, preserves_flags))
+            };
+            v
+        }
         #[inline(always)]
         unsafe fn any_abs_ge(v: __m512d, t: f64) -> bool {
             _mm512_cmp_pd_mask::<_CMP_GE_OQ>(_mm512_abs_pd(v), _mm512_set1_pd(t)) != 0
@@ -207,6 +222,15 @@ mod x86 {
         #[inline(always)]
         unsafe fn fms(a: __m256d, b: __m256d, c: __m256d) -> __m256d {
             _mm256_fmsub_pd(a, b, c)
+        }
+        #[inline]
+        #[target_feature(enable = "avx")]
+        unsafe fn fence(mut v: __m256d) -> __m256d {
+            // SAFETY: an empty instruction sequence on a register operand.
+            unsafe {
+                std::arch::asm!("/* {0} */", inout(ymm_reg) v, options(nomem, nostack, preserves_flags))
+            };
+            v
         }
         #[inline(always)]
         unsafe fn any_abs_ge(v: __m256d, t: f64) -> bool {
