@@ -268,8 +268,9 @@ pub(crate) fn mem_available() -> Option<usize> {
     meminfo("MemAvailable:")
 }
 
-/// Default cap on the chunk buffer: `max(512 MiB, 5%` of the sample plus coefficient
-/// arrays`)`, and at most a quarter of the available memory.
+/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 5%` of the
+/// sample plus coefficient arrays`)`, and at most a quarter of the available memory. The
+/// chunk buffer gets what the FFT buffers and tables leave of it (at least one slice pair).
 fn default_workspace(b: usize) -> usize {
     let grid_bytes = (num_samples(b) + num_coeffs(b)) * 16;
     let d = (512usize << 20).max(grid_bytes / 20);
@@ -355,10 +356,19 @@ impl Plan {
             )));
         }
         let n = 2 * b;
-        let budget = options
-            .max_workspace_bytes
-            .unwrap_or_else(|| default_workspace(b));
-        let layout = Layout::new(b, threads, budget);
+        let layout = match options.max_workspace_bytes {
+            Some(cap) => Layout::new(b, threads, cap),
+            None => {
+                // The default caps the plan's whole memory, not only the chunk buffer, so
+                // that at large B a transform needs at most 5% beyond the caller's arrays.
+                let target = default_workspace(b);
+                let rest = {
+                    let probe = Layout::new(b, threads, target);
+                    probe.total() - probe.chunk_bytes
+                };
+                Layout::new(b, threads, target.saturating_sub(rest))
+            }
+        };
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
         // available memory, and plan plus the caller's arrays in the machine.
         let arrays = (num_samples(b) + num_coeffs(b)).saturating_mul(16);
@@ -502,9 +512,11 @@ impl Plan {
     }
 
     /// Bytes of the chunk buffer: `2 h (2B)^2 * 16` with `h` low beta slices per chunk,
-    /// `h = clamp(max_workspace_bytes / (2 (2B)^2 16), 1, B)`; by default the cap is
-    /// `max(512 MiB, 5% of the sample and coefficient arrays)`, at most a quarter of the
-    /// available memory.
+    /// `h = clamp(cap / (2 (2B)^2 16), 1, B)`. With `max_workspace_bytes` the cap is that
+    /// value. By default the whole plan ([`Plan::memory_bytes`]) is held to
+    /// `max(512 MiB, 5% of the sample and coefficient arrays)` (at most a quarter of the
+    /// available memory), and the cap is what the FFT buffers and tables leave of it. At
+    /// B = 512 that keeps a complex transform within the caller's arrays plus 5%.
     pub fn workspace_bytes(&self) -> usize {
         2 * self.chunk * 4 * self.b * self.b * 16
     }

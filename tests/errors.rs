@@ -410,3 +410,36 @@ fn invalid_skip_bits() {
         );
     }
 }
+
+/// With the default workspace a plan needs at most 5% beyond the caller's arrays at
+/// B = 512 (issue 5: a complex forward at B = 512 must run in input + output + 5%), and
+/// `memory_bytes` covers the chunk buffer. Planning only: nothing of grid size is touched.
+#[test]
+fn default_plan_memory_within_five_percent_at_512() {
+    let b = 512;
+    let options = PlanOptions {
+        direction: Direction::Forward,
+        ..Default::default()
+    };
+    match Plan::new(b, &options) {
+        Ok(plan) => {
+            let arrays = (plan.num_samples() + plan.num_coeffs()) * 16;
+            let ratio = plan.memory_bytes() as f64 / arrays as f64;
+            println!(
+                "B = 512: plan {} MiB (workspace {} MiB), {:.2}% of the arrays",
+                plan.memory_bytes() >> 20,
+                plan.workspace_bytes() >> 20,
+                100.0 * ratio
+            );
+            assert!(
+                ratio <= 0.05,
+                "plan memory {:.2}% of the arrays",
+                100.0 * ratio
+            );
+            assert!(plan.workspace_bytes() < plan.memory_bytes());
+        }
+        // A machine with little memory: the plan refuses cleanly, which is also correct.
+        Err(Error::OutOfMemory { .. }) => println!("B = 512 plan refused: out of memory"),
+        Err(e) => panic!("unexpected error {e:?}"),
+    }
+}
