@@ -275,8 +275,6 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
                 n,
                 #[inline(always)]
                 |v, i| {
-                    let mut tmp = [0.0; W];
-                    S::store(tmp.as_mut_ptr(), v);
                     let row = fp.add(i * p);
                     let mut acc0 = [S::zero(); NV];
                     let mut acc1 = [S::zero(); NV];
@@ -285,12 +283,12 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
                     }
                     let mut w = 0;
                     while w < W {
-                        let t = S::splat(tmp[w]);
+                        let t = S::lane(v, w);
                         for j in 0..NV {
                             acc0[j] = S::fma(t, xr[w][j], acc0[j]);
                         }
                         if w + 1 < W {
-                            let t = S::splat(tmp[w + 1]);
+                            let t = S::lane(v, w + 1);
                             for j in 0..NV {
                                 acc1[j] = S::fma(t, xr[w + 1][j], acc1[j]);
                             }

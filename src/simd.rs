@@ -80,6 +80,9 @@ pub(crate) trait Simd: Copy {
     unsafe fn fms(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
     /// Whether any lane has `|v| >= t`.
     unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
+    /// Lane `w` of `v` in every lane.
+    #[inline(always)]
+    unsafe fn lane(v: Self::V, w: usize) -> Self::V;
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
     /// pins the program order of what is computed before and after it.
     #[inline(always)]
@@ -125,6 +128,10 @@ impl Simd for Scalar {
     #[inline(always)]
     unsafe fn fms(a: f64, b: f64, c: f64) -> f64 {
         a * b - c
+    }
+    #[inline(always)]
+    unsafe fn lane(v: f64, _w: usize) -> f64 {
+        v
     }
     #[inline(always)]
     unsafe fn any_abs_ge(v: f64, t: f64) -> bool {
@@ -174,6 +181,11 @@ mod x86 {
         unsafe fn fms(a: __m512d, b: __m512d, c: __m512d) -> __m512d {
             _mm512_fmsub_pd(a, b, c)
         }
+        #[inline(always)]
+        unsafe fn lane(v: __m512d, w: usize) -> __m512d {
+            // One full-width permute per lane (no extract + broadcast pairs).
+            _mm512_permutexvar_pd(_mm512_set1_epi64(w as i64), v)
+        }
         #[inline]
         #[target_feature(enable = "avx512f")]
         unsafe fn fence(mut v: __m512d) -> __m512d {
@@ -222,6 +234,12 @@ mod x86 {
         #[inline(always)]
         unsafe fn fms(a: __m256d, b: __m256d, c: __m256d) -> __m256d {
             _mm256_fmsub_pd(a, b, c)
+        }
+        #[inline(always)]
+        unsafe fn lane(v: __m256d, w: usize) -> __m256d {
+            let mut t = [0.0; 4];
+            _mm256_storeu_pd(t.as_mut_ptr(), v);
+            _mm256_set1_pd(t[w])
         }
         #[inline]
         #[target_feature(enable = "avx")]
