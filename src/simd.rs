@@ -81,7 +81,6 @@ pub(crate) trait Simd: Copy {
     /// Whether any lane has `|v| >= t`.
     unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
     /// Lane `w` of `v` in every lane.
-    #[inline(always)]
     unsafe fn lane(v: Self::V, w: usize) -> Self::V;
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
     /// pins the program order of what is computed before and after it.
