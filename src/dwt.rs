@@ -234,8 +234,15 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     n: usize,
 ) -> (usize, [State<'r, S, W>; GROUP]) {
     let g = ((nb - s0) / W).min(GROUP);
-    let mut st: [State<'r, S, W>; GROUP] =
-        std::array::from_fn(|j| State::new(rec, lanes, s0 + j.min(g - 1) * W));
+    // Written out rather than `std::array::from_fn`, which is not inlined into the
+    // `target_feature` entry points and so would call the SIMD loads out of line.
+    let at = |j: usize| s0 + j.min(g - 1) * W;
+    let mut st: [State<'r, S, W>; GROUP] = [
+        State::new(rec, lanes, at(0)),
+        State::new(rec, lanes, at(1)),
+        State::new(rec, lanes, at(2)),
+        State::new(rec, lanes, at(3)),
+    ];
     for s in st.iter_mut().skip(g) {
         s.i = n;
     }
