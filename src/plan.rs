@@ -268,12 +268,15 @@ pub(crate) fn mem_available() -> Option<usize> {
     meminfo("MemAvailable:")
 }
 
-/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 5%` of the
-/// sample plus coefficient arrays`)`, and at most a quarter of the available memory. The
+/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.5%` of the
+/// sample plus coefficient arrays`)` (real samples for a real plan), and at most a quarter of the available memory. The
 /// chunk buffer gets what the FFT buffers and tables leave of it (at least one slice pair).
-fn default_workspace(b: usize) -> usize {
-    let grid_bytes = (num_samples(b) + num_coeffs(b)) * 16;
-    let d = (512usize << 20).max(grid_bytes / 20);
+fn default_workspace(b: usize, real: bool) -> usize {
+    // Real plans: real samples (8 bytes each). A margin of 0.5% is left for the rest of
+    // the process.
+    let sample_bytes = if real { 8 } else { 16 };
+    let grid_bytes = num_samples(b) * sample_bytes + num_coeffs(b) * 16;
+    let d = (512usize << 20).max(grid_bytes / 1000 * 45);
     match mem_available() {
         Some(avail) => d.min(avail / 4),
         None => d,
@@ -361,7 +364,7 @@ impl Plan {
             None => {
                 // The default caps the plan's whole memory, not only the chunk buffer, so
                 // that at large B a transform needs at most 5% beyond the caller's arrays.
-                let target = default_workspace(b);
+                let target = default_workspace(b, options.real);
                 let rest = {
                     let probe = Layout::new(b, threads, target);
                     probe.total() - probe.chunk_bytes
@@ -514,7 +517,7 @@ impl Plan {
     /// Bytes of the chunk buffer: `2 h (2B)^2 * 16` with `h` low beta slices per chunk,
     /// `h = clamp(cap / (2 (2B)^2 16), 1, B)`. With `max_workspace_bytes` the cap is that
     /// value. By default the whole plan ([`Plan::memory_bytes`]) is held to
-    /// `max(512 MiB, 5% of the sample and coefficient arrays)` (at most a quarter of the
+    /// `max(512 MiB, 4.5% of the sample and coefficient arrays)` (at most a quarter of the
     /// available memory), and the cap is what the FFT buffers and tables leave of it. At
     /// B = 512 that keeps a complex transform within the caller's arrays plus 5%.
     pub fn workspace_bytes(&self) -> usize {
