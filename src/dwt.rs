@@ -58,6 +58,9 @@ pub(crate) struct Lanes<'a> {
     pub upper_from: usize,
     /// Rescale threshold of the scaled values, `wigner::big(skip bits)`.
     pub big: f64,
+    /// Skip the degrees where no lane of a vector is active yet (`false` only to measure
+    /// what skipping saves: inactive lanes then accumulate exact zeros).
+    pub skip: bool,
 }
 
 /// Recurrence state of one vector of betas.
@@ -77,6 +80,8 @@ struct State<'r, S: Simd, const W: usize> {
     i: usize,
     /// Rescale threshold (see [`Lanes::big`]).
     big: f64,
+    /// See [`Lanes::skip`].
+    skip: bool,
 }
 
 impl<'r, S: Simd, const W: usize> State<'r, S, W> {
@@ -108,6 +113,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             active,
             i: 0,
             big: lanes.big,
+            skip: lanes.skip,
         }
     }
 
@@ -158,7 +164,7 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
         let mut i = self.i;
         // Slow phase: some lanes still scaled down.
         while i < n && self.active < W {
-            if self.active > 0 {
+            if self.active > 0 || !self.skip {
                 acc(S::mul(self.p1, S::load(self.mask.as_ptr())), i);
             }
             self.step(rec, i);
@@ -225,7 +231,9 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     for s in st.iter_mut().skip(g) {
         s.i = n;
     }
-    skip_inactive(&mut st, rec, n);
+    if lanes.skip {
+        skip_inactive(&mut st, rec, n);
+    }
     (g, st)
 }
 
@@ -439,6 +447,7 @@ pub(crate) fn column(
         sc: &sc,
         upper_from: if upper { 0 } else { w },
         big: crate::wigner::big(DEFAULT_SKIP_BITS),
+        skip: true,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     (0..n).map(|i| f[i * 8]).collect()
@@ -497,6 +506,7 @@ mod tests {
                 sc: &sc,
                 upper_from: b,
                 big: crate::wigner::big(DEFAULT_SKIP_BITS),
+                skip: true,
             };
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
@@ -555,6 +565,7 @@ mod kernel_speed {
                 sc: &sc,
                 upper_from: nbs / 2,
                 big: crate::wigner::big(DEFAULT_SKIP_BITS),
+                skip: true,
             };
             let xin = vec![0.5; nbs * 16];
             let mut f = vec![0.0; n * 16];

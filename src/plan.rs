@@ -57,7 +57,10 @@ pub struct PlanOptions {
     /// Wigner-d values below it are treated as zero, so the leading degrees where they are
     /// negligible cost only the recurrence. A contribution skipped this way is at most
     /// `2^-skip_bits` times the data it multiplies, so with `skip_bits >= 64` the total
-    /// change is below `B 2^-64`, under the rounding error of the transform. Accepted: 24..=560.
+    /// change is below `B 2^-64`, under the rounding error of the transform. Accepted: 24..=560,
+    /// and `Some(0)`, which turns skipping off: every degree of every beta runs the full
+    /// recurrence and accumulation (values below `2^-560` still enter as exact zeros). That
+    /// mode exists to measure what skipping saves; it gives the same results, only slower.
     pub skip_bits: Option<u32>,
     /// Also prepare the real-signal transforms [`Plan::forward_real`] and
     /// [`Plan::inverse_real`] (real-to-complex FFTW plans; planning takes longer).
@@ -134,6 +137,8 @@ pub struct Plan {
     memory: usize,
     /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
     skip_bits: u32,
+    /// Whether degrees below the threshold are skipped (`PlanOptions::skip_bits` not `Some(0)`).
+    skip: bool,
     buf: Mutex<Option<AlignedBuf>>,
 }
 
@@ -187,6 +192,7 @@ impl Scratch {
             sc: &self.sc[..nl],
             upper_from: ch.hp,
             big: big(plan.skip_bits),
+            skip: plan.skip,
         };
         if forward {
             let f = &mut self.out[..n * p];
@@ -331,7 +337,12 @@ impl Plan {
                 "{threads} threads requested (at most 1024)"
             )));
         }
-        let skip_bits = options.skip_bits.unwrap_or(DEFAULT_SKIP_BITS);
+        let skip = options.skip_bits != Some(0);
+        let skip_bits = match options.skip_bits {
+            None => DEFAULT_SKIP_BITS,
+            Some(0) => *SKIP_BITS_RANGE.end(),
+            Some(bits) => bits,
+        };
         if !SKIP_BITS_RANGE.contains(&skip_bits) {
             return Err(Error::InvalidArgument(format!(
                 "skip_bits {skip_bits} outside {SKIP_BITS_RANGE:?}"
@@ -441,6 +452,7 @@ impl Plan {
             group: layout.group,
             memory: layout.total(),
             skip_bits,
+            skip,
             buf: Mutex::new(Some(buf)),
         })
     }

@@ -393,10 +393,10 @@ fn sample_index_and_grid_helpers() {
     }
 }
 
-/// Skip thresholds outside the documented range are rejected.
+/// Skip thresholds outside the documented range are rejected (0 means "no skipping").
 #[test]
 fn invalid_skip_bits() {
-    for bits in [0u32, 23, 561, 10_000] {
+    for bits in [1u32, 23, 561, 10_000] {
         let r = Plan::new(
             4,
             &PlanOptions {

@@ -247,4 +247,15 @@ fn skip_threshold_leaves_results_unchanged() {
     let scale_i = max_abs(&f2);
     println!("skip 2^-64 vs 2^-560: forward {ef:.2e} (of {scale_f:.2e}), inverse {ei:.2e} (of {scale_i:.2e})");
     assert!(ef <= 1e-14 * scale_f && ei <= 1e-14 * scale_i);
+
+    // No skipping at all (`Some(0)`): the skipped terms are exact zeros, so the results
+    // agree with the skipping plan up to the sign of zero.
+    let none = make(0);
+    let (mut c3, mut f3) = (zeros(n_coeffs(b)), zeros(n_samples(b)));
+    none.forward(&f, &mut c3).unwrap();
+    none.inverse(&c, &mut f3).unwrap();
+    let (ef0, _) = max_abs_diff(&c3, &c2);
+    let (ei0, _) = max_abs_diff(&f3, &f2);
+    println!("no skipping vs skip 2^-560: forward {ef0:.2e}, inverse {ei0:.2e}");
+    assert!(ef0 == 0.0 && ei0 == 0.0);
 }
