@@ -378,3 +378,27 @@ fn gb(bytes: usize) -> f64 {
 fn phase_gb(p: Option<memory::Phase>) -> String {
     p.map_or("n/a".into(), |p| format!("{:.3} GB", p.peak as f64 / 1e9))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The whole lean procedure at a small bandwidth: three rows, exact round trips.
+    #[test]
+    fn lean_run_at_small_bandwidth() {
+        let opts = crate::cli::Options {
+            rigor: so3fft::Rigor::Estimate,
+            ..Default::default()
+        };
+        let out = run(24, 2, &opts, 100.0);
+        assert!(out.noskip_missing.is_none(), "{:?}", out.noskip_missing);
+        let variants: Vec<Variant> = out.rows.iter().map(|r| r.variant).collect();
+        assert_eq!(variants, [Variant::Complex, Variant::NoSkip, Variant::Real]);
+        for r in &out.rows {
+            assert!(r.max_abs_err < 1e-13 && r.rel_l2_err < 1e-14, "{r:?}");
+            assert!(r.fwd.dwt > 0.0 && r.inv.fft > 0.0 && r.fwd_median > 0.0, "{r:?}");
+            assert!(r.ratio.is_some() || r.variant == Variant::Complex, "{r:?}");
+        }
+        assert!(out.rows[0].memory.is_some());
+    }
+}

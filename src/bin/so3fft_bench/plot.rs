@@ -197,7 +197,7 @@ fn error_panel(rows: &[Row]) -> Panel {
         series.extend([rel, max]);
     }
     Panel {
-        title: "Round-trip error (inverse then forward, random coefficients)",
+        title: "Round-trip error (inverse then forward)",
         y_label: "error",
         series,
     }
