@@ -396,7 +396,10 @@ mod tests {
         assert_eq!(variants, [Variant::Complex, Variant::NoSkip, Variant::Real]);
         for r in &out.rows {
             assert!(r.max_abs_err < 1e-13 && r.rel_l2_err < 1e-14, "{r:?}");
-            assert!(r.fwd.dwt > 0.0 && r.inv.fft > 0.0 && r.fwd_median > 0.0, "{r:?}");
+            assert!(
+                r.fwd.dwt > 0.0 && r.inv.fft > 0.0 && r.fwd_median > 0.0,
+                "{r:?}"
+            );
             assert!(r.ratio.is_some() || r.variant == Variant::Complex, "{r:?}");
         }
         assert!(out.rows[0].memory.is_some());

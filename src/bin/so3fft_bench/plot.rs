@@ -259,7 +259,9 @@ fn draw_panel(out: &mut String, left: f64, p: &Panel, x_values: &[f64]) {
         ly,
     };
     draw_axes(out, &ax, x_values, p.y_label);
-    for s in &series {
+    // Reverse order: the first legend entries end up on top where lines coincide (the
+    // errors with and without skipping are usually identical).
+    for s in series.iter().rev() {
         draw_series(out, &ax, s);
     }
     draw_legend(out, left, &series);
@@ -362,16 +364,17 @@ fn marker(out: &mut String, m: Marker, x: f64, y: f64, color: &str) {
             x + 4.0,
             y + 3.0
         ),
+        // Larger than the others and hollow, so a marker drawn on top stays visible inside.
         Marker::Diamond => writeln!(
             out,
             r#"<polygon points="{:.1},{:.1} {:.1},{:.1} {:.1},{:.1} {:.1},{:.1}" fill="white" stroke="{color}" stroke-width="1.5"/>"#,
             x,
-            y - 4.5,
-            x + 4.5,
+            y - 6.5,
+            x + 6.5,
             y,
             x,
-            y + 4.5,
-            x - 4.5,
+            y + 6.5,
+            x - 6.5,
             y
         ),
     };
