@@ -110,7 +110,12 @@ fn run(opts: &Options) -> ExitCode {
     }
     if opts.soft {
         let mut soft_rows = Vec::new();
-        for &b in &opts.bandwidths {
+        // Not above 256: the SOFT entry points need several grid-sized workspaces.
+        for &b in opts
+            .bandwidths
+            .iter()
+            .filter(|&&b| b <= cli::MAX_REGULAR_BANDWIDTH)
+        {
             match soft_cmp::compare(b, opts.runs_for(b)) {
                 Ok(r) => soft_rows.extend(r),
                 Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),

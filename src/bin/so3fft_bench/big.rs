@@ -80,7 +80,14 @@ impl Lean<'_> {
         0x5EED_1000 + self.b as u64
     }
 
-    fn plan(&self, skip_bits: Option<u32>, real: bool) -> Result<Plan, so3fft::Error> {
+    /// A plan with default options except those given. `workspace`: cap on the chunk buffer
+    /// (`None`: the library's default, which depends on `MemAvailable` at planning time).
+    fn plan(
+        &self,
+        skip_bits: Option<u32>,
+        real: bool,
+        workspace: Option<usize>,
+    ) -> Result<Plan, so3fft::Error> {
         Plan::new(
             self.b,
             &PlanOptions {
@@ -89,6 +96,7 @@ impl Lean<'_> {
                 rigor: self.opts.rigor,
                 skip_bits,
                 real,
+                max_workspace_bytes: workspace,
                 ..PlanOptions::default()
             },
         )
@@ -134,7 +142,7 @@ impl Lean<'_> {
     /// Steps 1 and 2; returns why the no-skip step was not run, if it was not.
     fn complex_steps(&mut self) -> Option<String> {
         let b = self.b;
-        let plan = match self.plan(None, false) {
+        let plan = match self.plan(None, false, None) {
             Ok(p) => p,
             Err(e) => {
                 eprintln!("so3fft-bench: B = {b}: complex plan failed: {e}");
@@ -153,8 +161,11 @@ impl Lean<'_> {
         );
 
         let skip = self.complex_round_trip(&plan, Variant::Complex, &mut coeffs, &mut grid);
+        // The no-skip plan gets the same chunk buffer: the default depends on MemAvailable,
+        // which the grid has just used up, and a smaller chunk makes the DWT stage slower.
+        let workspace = plan.workspace_bytes();
         drop(plan);
-        let missing = match (&skip, self.plan(Some(0), false)) {
+        let missing = match (&skip, self.plan(Some(0), false, Some(workspace))) {
             (Err(e), _) => Some(format!("complex round trip failed: {e}")),
             (Ok(_), Err(e)) => Some(format!("Plan::new with skip_bits Some(0): {e}")),
             (Ok(_), Ok(plan)) => {
@@ -219,18 +230,10 @@ impl Lean<'_> {
             workload::dwt_flops_exact(b),
         );
         eprintln!(
-            "  ({}: compared in {:.1} s; peak RSS during the inverse {}, during the forward {} \
-             = {} x (input + output = {:.3} GB), plan memory_bytes {:.3} GB; issue limit 1.05)",
+            "  ({}: compared in {:.1} s; {}; issue limit 1.05)",
             variant.name(),
             t.elapsed().as_secs_f64(),
-            phase_gb(inv_mem),
-            phase_gb(fwd_mem),
-            fwd_mem.map_or("n/a".into(), |p| format!(
-                "{:.4}",
-                p.peak as f64 / arrays as f64
-            )),
-            arrays as f64 / 1e9,
-            gb(plan.memory_bytes()),
+            memory_summary(inv_mem, fwd_mem, arrays, plan),
         );
         if variant == Variant::Complex {
             println!("{}", crate::report::table_line(&row));
@@ -248,7 +251,7 @@ impl Lean<'_> {
             ),
             Err(e) => eprintln!("so3fft-bench: real symmetry check failed: {e}"),
         }
-        let plan = match self.plan(None, true) {
+        let plan = match self.plan(None, true, None) {
             Ok(p) => p,
             Err(e) => {
                 eprintln!("so3fft-bench: B = {b}: real plan failed: {e}");
@@ -259,7 +262,12 @@ impl Lean<'_> {
             return;
         }
         let mut coeffs = self.take_coeffs();
+        let t = Instant::now();
         let mut grid = filled(so3fft::num_samples(b), 0.0f64);
+        eprintln!(
+            "  (real grid allocated and faulted in: {:.1} s)",
+            t.elapsed().as_secs_f64()
+        );
         match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
             Ok(row) => self.rows.push(row),
             Err(e) => eprintln!("so3fft-bench: B = {b}: real round trip failed: {e}"),
@@ -300,15 +308,8 @@ impl Lean<'_> {
             .find(|r| r.variant == Variant::Complex)
             .map(|c| (row.fwd_median / c.fwd_median, row.inv_median / c.inv_median));
         eprintln!(
-            "  (real: peak RSS during the inverse {}, during the forward {} = {} x (input + \
-             output = {:.3} GB))",
-            phase_gb(inv_mem),
-            phase_gb(fwd_mem),
-            fwd_mem.map_or("n/a".into(), |p| format!(
-                "{:.4}",
-                p.peak as f64 / arrays as f64
-            )),
-            arrays as f64 / 1e9,
+            "  (real: {})",
+            memory_summary(inv_mem, fwd_mem, arrays, plan)
         );
         Ok(row)
     }
@@ -373,6 +374,25 @@ pub fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
 
 fn gb(bytes: usize) -> f64 {
     bytes as f64 / 1e9
+}
+
+/// Peaks of both phases, the forward's against `arrays` bytes, and the plan's memory.
+fn memory_summary(
+    inv: Option<memory::Phase>,
+    fwd: Option<memory::Phase>,
+    arrays: u64,
+    plan: &Plan,
+) -> String {
+    format!(
+        "peak RSS during the inverse {}, during the forward {} = {} x (input + output = {:.3} GB); \
+         plan memory_bytes {:.3} GB, of which chunk buffer {:.3} GB",
+        phase_gb(inv),
+        phase_gb(fwd),
+        fwd.map_or("n/a".into(), |p| format!("{:.4}", p.peak as f64 / arrays as f64)),
+        arrays as f64 / 1e9,
+        gb(plan.memory_bytes()),
+        gb(plan.workspace_bytes()),
+    )
 }
 
 fn phase_gb(p: Option<memory::Phase>) -> String {
