@@ -199,7 +199,7 @@ fn bench_bandwidth(
     }
     let coeffs = workload::random_coeffs(so3fft::num_coeffs(b), 0x5EED_0000 + b as u64);
     for &threads in &opts.threads {
-        match bench_config(b, threads, Variant::Complex, opts, &coeffs, peak.one_core) {
+        match bench_config(b, threads, opts, &coeffs, peak.one_core) {
             Ok(row) => {
                 println!("{}", report::table_line(&row));
                 rows.push(row);
@@ -208,14 +208,8 @@ fn bench_bandwidth(
         }
     }
 
-    let threads = opts.threads[0];
-    match bench_config(b, threads, Variant::NoSkip, opts, &coeffs, peak.one_core) {
-        Ok(mut row) => {
-            if let Some(sk) = report::find(rows, Variant::Complex, b, row.threads) {
-                row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
-            }
-            rows.push(row);
-        }
+    match bench_noskip(b, opts.threads[0], opts, &coeffs, peak.one_core) {
+        Ok(row) => rows.push(row),
         Err(e) => {
             eprintln!("  (B = {b}: no-skip run n/a: {e})");
             noskip_missing.push((b, e.to_string()));
@@ -228,7 +222,7 @@ fn bench_bandwidth(
             Some(r) => Ok(r.clone()),
             None => {
                 eprintln!("  (B = {b}: library one-thread DWT measured for the plain-DWT ratio)");
-                bench_config(b, 1, Variant::Complex, opts, &coeffs, peak.one_core)
+                bench_config(b, 1, opts, &coeffs, peak.one_core)
             }
         };
         match lib {
@@ -247,21 +241,24 @@ fn bench_naive(b: usize, opts: &Options, coeffs: &[Complex64], peak_1core: f64) 
     let betas = naive::Betas::new(b);
     let mut g = vec![Complex64::default(); n * n * n];
     let mut result = vec![Complex64::default(); coeffs.len()];
-    let (mut fwd, mut inv) = (Vec::new(), Vec::new());
+    let mut times = RunTimes::default();
     let (error, phase) = memory::measure(|| {
         let mut error = RoundTripError::default();
         for _ in 0..runs {
-            let t = Instant::now();
+            let (cpu, t) = (cpu_seconds(), Instant::now());
             naive::inverse(b, &betas, coeffs, &mut g);
-            inv.push(t.elapsed().as_secs_f64());
-            let t = Instant::now();
+            times.inv_wall.push(t.elapsed().as_secs_f64());
+            times.inv_cpu.push(cpu_seconds() - cpu);
+            let (cpu, t) = (cpu_seconds(), Instant::now());
             naive::forward(b, &betas, &g, &mut result);
-            fwd.push(t.elapsed().as_secs_f64());
+            times.fwd_wall.push(t.elapsed().as_secs_f64());
+            times.fwd_cpu.push(cpu_seconds() - cpu);
             error = error.worst(workload::roundtrip_error(coeffs, &result));
         }
         error
     });
-    let (fwd, inv) = (workload::median(&fwd), workload::median(&inv));
+    let median = workload::median;
+    let (fwd, inv) = (median(&times.fwd_wall), median(&times.inv_wall));
     eprintln!("  (B = {b}: plain DWT, {runs} run(s): forward {fwd:.3e} s, inverse {inv:.3e} s)");
     let na = Stages {
         fft: f64::NAN,
@@ -287,6 +284,7 @@ fn bench_naive(b: usize, opts: &Options, coeffs: &[Complex64], peak_1core: f64) 
             arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
         }),
         ratio: None,
+        cpu: Some((median(&times.fwd_cpu), median(&times.inv_cpu))),
     }
 }
 
@@ -319,92 +317,174 @@ fn gib(bytes: usize) -> f64 {
 struct RunTimes {
     fwd_wall: Vec<f64>,
     inv_wall: Vec<f64>,
+    fwd_cpu: Vec<f64>,
+    inv_cpu: Vec<f64>,
     fwd: Vec<StageTimes>,
     inv: Vec<StageTimes>,
 }
 
-/// Plans and measures one (bandwidth, threads) configuration of the library: `Complex`
-/// (default options) or `NoSkip` (`skip_bits: Some(0)`, every degree computed).
+/// A plan being measured: its times and worst error so far.
+struct Config {
+    plan: Plan,
+    variant: Variant,
+    times: RunTimes,
+    error: RoundTripError,
+}
+
+impl Config {
+    /// Plans one (bandwidth, threads) configuration of the library: `Complex` (default
+    /// options) or `NoSkip` (`skip_bits: Some(0)`, every degree computed).
+    fn new(
+        b: usize,
+        threads: usize,
+        variant: Variant,
+        opts: &Options,
+    ) -> Result<Config, so3fft::Error> {
+        let plan_start = Instant::now();
+        let plan = Plan::new(
+            b,
+            &PlanOptions {
+                direction: Direction::Both,
+                threads,
+                rigor: opts.rigor,
+                skip_bits: (variant == Variant::NoSkip).then_some(0),
+                ..PlanOptions::default()
+            },
+        )?;
+        eprintln!(
+            "  (B = {b}, threads = {}{}: plan created in {:.3} s)",
+            plan.threads(),
+            if variant == Variant::NoSkip {
+                ", no skipping"
+            } else {
+                ""
+            },
+            plan_start.elapsed().as_secs_f64()
+        );
+        Ok(Config {
+            plan,
+            variant,
+            times: RunTimes::default(),
+            error: RoundTripError::default(),
+        })
+    }
+
+    /// One untimed round trip: faults in the output pages, warms caches and the thread pool.
+    fn warm_up(&self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
+        self.plan.inverse(coeffs, &mut arrays.samples)?;
+        self.plan.forward(&arrays.samples, &mut arrays.result)
+    }
+
+    /// One timed inverse-then-forward round trip, checked against `coeffs`.
+    fn run(&mut self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
+        let t = &mut self.times;
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        t.inv
+            .push(self.plan.inverse_timed(coeffs, &mut arrays.samples)?);
+        t.inv_wall.push(start.elapsed().as_secs_f64());
+        t.inv_cpu.push(cpu_seconds() - cpu);
+
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        t.fwd.push(
+            self.plan
+                .forward_timed(&arrays.samples, &mut arrays.result)?,
+        );
+        t.fwd_wall.push(start.elapsed().as_secs_f64());
+        t.fwd_cpu.push(cpu_seconds() - cpu);
+        let error = workload::roundtrip_error(coeffs, &arrays.result);
+        self.error = self.error.worst(error);
+        Ok(())
+    }
+
+    fn row(&self, b: usize, peak_1core: f64) -> Row {
+        let mut row = summarise(b, self.plan.threads(), &self.times, self.error, peak_1core);
+        row.variant = self.variant;
+        row
+    }
+}
+
+/// The sample and result arrays of the library's round trips at one bandwidth.
+struct Arrays {
+    samples: Vec<Complex64>,
+    result: Vec<Complex64>,
+}
+
+impl Arrays {
+    fn new(b: usize) -> Arrays {
+        Arrays {
+            samples: vec![Complex64::default(); so3fft::num_samples(b)],
+            result: vec![Complex64::default(); so3fft::num_coeffs(b)],
+        }
+    }
+}
+
+/// CPU time of the whole process (all threads) in seconds; NaN where unavailable. Against
+/// the wall time it shows whether the run had its cores (the machine is shared).
+pub fn cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec.
+    if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) } != 0 {
+        return f64::NAN;
+    }
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Measures one configuration: warm-up, then the timed runs with the peak memory of the runs.
 fn bench_config(
     b: usize,
     threads: usize,
-    variant: Variant,
     opts: &Options,
     coeffs: &[Complex64],
     peak_1core: f64,
 ) -> Result<Row, so3fft::Error> {
-    let plan_start = Instant::now();
-    let plan = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Both,
-            threads,
-            rigor: opts.rigor,
-            skip_bits: (variant == Variant::NoSkip).then_some(0),
-            ..PlanOptions::default()
-        },
-    )?;
-    eprintln!(
-        "  (B = {b}, threads = {}{}: plan created in {:.3} s)",
-        plan.threads(),
-        if variant == Variant::NoSkip {
-            ", no skipping"
-        } else {
-            ""
-        },
-        plan_start.elapsed().as_secs_f64()
-    );
-    let mut samples = vec![Complex64::default(); plan.num_samples()];
-    let mut result = vec![Complex64::default(); plan.num_coeffs()];
-    let runs = opts.runs_for(b);
-
-    // One untimed round trip faults in the output pages and warms caches and the thread pool,
-    // except at B >= 512 where it would cost as much as the measurement itself.
-    if b < 512 {
-        plan.inverse(coeffs, &mut samples)?;
-        plan.forward(&samples, &mut result)?;
-    }
-    let mut times = RunTimes::default();
-    let (error, phase) = memory::measure(|| {
-        let mut error = RoundTripError::default();
-        for _ in 0..runs {
-            error = error.worst(round_trip(
-                &plan,
-                coeffs,
-                &mut samples,
-                &mut result,
-                &mut times,
-            )?);
-        }
-        Ok::<_, so3fft::Error>(error)
-    });
-    let mut row = summarise(b, plan.threads(), runs, &times, error?, peak_1core);
-    row.variant = variant;
+    let mut config = Config::new(b, threads, Variant::Complex, opts)?;
+    let mut arrays = Arrays::new(b);
+    config.warm_up(coeffs, &mut arrays)?;
+    let (result, phase) =
+        memory::measure(|| (0..opts.runs_for(b)).try_for_each(|_| config.run(coeffs, &mut arrays)));
+    result?;
+    let mut row = config.row(b, peak_1core);
     row.memory = phase.map(|p| Memory {
         peak: p.peak,
         start: p.start,
-        plan: plan.memory_bytes() as u64,
+        plan: config.plan.memory_bytes() as u64,
         arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
     });
     Ok(row)
 }
 
-/// One timed inverse-then-forward round trip; returns its error against `coeffs`.
-fn round_trip(
-    plan: &Plan,
+/// Skipping against no skipping, interleaved run by run (alternating which goes first) so
+/// that the load of the shared machine hits both alike; returns the no-skip row with
+/// `ratio` = (no-skip / skip) DWT stage medians of these runs. No memory figure: two plans
+/// are held (and skipping does not change the allocation).
+fn bench_noskip(
+    b: usize,
+    threads: usize,
+    opts: &Options,
     coeffs: &[Complex64],
-    samples: &mut [Complex64],
-    result: &mut [Complex64],
-    times: &mut RunTimes,
-) -> Result<RoundTripError, so3fft::Error> {
-    let start = Instant::now();
-    times.inv.push(plan.inverse_timed(coeffs, samples)?);
-    times.inv_wall.push(start.elapsed().as_secs_f64());
-
-    let start = Instant::now();
-    times.fwd.push(plan.forward_timed(samples, result)?);
-    times.fwd_wall.push(start.elapsed().as_secs_f64());
-    Ok(workload::roundtrip_error(coeffs, result))
+    peak_1core: f64,
+) -> Result<Row, so3fft::Error> {
+    let mut noskip = Config::new(b, threads, Variant::NoSkip, opts)?;
+    let mut skip = Config::new(b, threads, Variant::Complex, opts)?;
+    let mut arrays = Arrays::new(b);
+    noskip.warm_up(coeffs, &mut arrays)?;
+    skip.warm_up(coeffs, &mut arrays)?;
+    for run in 0..opts.runs_for(b) {
+        if run % 2 == 0 {
+            skip.run(coeffs, &mut arrays)?;
+            noskip.run(coeffs, &mut arrays)?;
+        } else {
+            noskip.run(coeffs, &mut arrays)?;
+            skip.run(coeffs, &mut arrays)?;
+        }
+    }
+    let sk = skip.row(b, peak_1core);
+    let mut row = noskip.row(b, peak_1core);
+    row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
+    Ok(row)
 }
 
 /// Medians of the runs, as a table row. The whole-transform times are the bench's own wall
@@ -412,7 +492,6 @@ fn round_trip(
 fn summarise(
     b: usize,
     threads: usize,
-    runs: usize,
     times: &RunTimes,
     error: RoundTripError,
     peak_1core: f64,
@@ -425,7 +504,7 @@ fn summarise(
         variant: Variant::Complex,
         bandwidth: b,
         threads,
-        runs,
+        runs: times.fwd_wall.len(),
         fwd_median: workload::median(&times.fwd_wall),
         inv_median: workload::median(&times.inv_wall),
         fwd: stages(&times.fwd),
@@ -436,5 +515,9 @@ fn summarise(
         rel_l2_err: error.rel_l2,
         memory: None,
         ratio: None,
+        cpu: Some((
+            workload::median(&times.fwd_cpu),
+            workload::median(&times.inv_cpu),
+        )),
     }
 }

@@ -210,16 +210,16 @@ impl Lean<'_> {
             t.elapsed().as_secs_f64()
         );
         let (inv, inv_mem) = timed_phase(|| plan.inverse_timed(coeffs, grid));
-        let (inv_wall, inv) = (inv.0, inv.1?);
+        let inv: Timed = (inv.0, inv.1, inv.2?);
         let (fwd, fwd_mem) = timed_phase(|| plan.forward_timed(grid, coeffs));
-        let (fwd_wall, fwd) = (fwd.0, fwd.1?);
+        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
         let t = Instant::now();
         let error = seeded::compare_complex(self.seed(), coeffs);
         let arrays = 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64;
         let row = self.row(
             variant,
-            (inv_wall, inv),
-            (fwd_wall, fwd),
+            inv,
+            fwd,
             error,
             fwd_mem.map(|p| Memory {
                 peak: p.peak,
@@ -284,15 +284,15 @@ impl Lean<'_> {
         let b = self.b;
         seeded::fill_real(self.real_seed(), b, coeffs);
         let (inv, inv_mem) = timed_phase(|| plan.inverse_real_timed(coeffs, grid));
-        let (inv_wall, inv) = (inv.0, inv.1?);
+        let inv: Timed = (inv.0, inv.1, inv.2?);
         let (fwd, fwd_mem) = timed_phase(|| plan.forward_real_timed(grid, coeffs));
-        let (fwd_wall, fwd) = (fwd.0, fwd.1?);
+        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
         let error = seeded::compare_real(self.real_seed(), b, coeffs);
         let arrays = (8 * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64;
         let mut row = self.row(
             Variant::Real,
-            (inv_wall, inv),
-            (fwd_wall, fwd),
+            inv,
+            fwd,
             error,
             fwd_mem.map(|p| Memory {
                 peak: p.peak,
@@ -317,8 +317,8 @@ impl Lean<'_> {
     fn row(
         &self,
         variant: Variant,
-        inv: (f64, StageTimes),
-        fwd: (f64, StageTimes),
+        inv: Timed,
+        fwd: Timed,
         error: RoundTripError,
         memory: Option<Memory>,
         dwt_flops: u64,
@@ -334,25 +334,29 @@ impl Lean<'_> {
             runs: 1,
             fwd_median: fwd.0,
             inv_median: inv.0,
-            fwd: stages(fwd.1),
-            inv: stages(inv.1),
+            fwd: stages(fwd.2),
+            inv: stages(inv.2),
             dwt_flops,
             peak_1core: self.peak_1core,
             max_abs_err: error.max_abs,
             rel_l2_err: error.rel_l2,
             memory,
             ratio: None,
+            cpu: Some((fwd.1, inv.1)),
         }
     }
 }
 
-/// Runs `f` with the peak-memory counter reset first; returns its wall time and result, and
-/// the peak of the phase.
-fn timed_phase<R>(f: impl FnOnce() -> R) -> ((f64, R), Option<memory::Phase>) {
+/// Wall and process CPU time of one transform, and the library's stage times.
+type Timed = (f64, f64, StageTimes);
+
+/// Runs `f` with the peak-memory counter reset first; returns its wall and CPU time and
+/// result, and the peak of the phase.
+fn timed_phase<R>(f: impl FnOnce() -> R) -> ((f64, f64, R), Option<memory::Phase>) {
     memory::measure(|| {
-        let t = Instant::now();
+        let (cpu, t) = (crate::cpu_seconds(), Instant::now());
         let r = f();
-        (t.elapsed().as_secs_f64(), r)
+        (t.elapsed().as_secs_f64(), crate::cpu_seconds() - cpu, r)
     })
 }
 

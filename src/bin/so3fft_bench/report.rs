@@ -85,6 +85,8 @@ pub struct Row {
     /// one-thread DWT stage time / plain DWT time; `NoSkip`: DWT stage time without / with
     /// skipping; `Real`: whole-transform time real / complex at the same B and threads.
     pub ratio: Option<(f64, f64)>,
+    /// (forward, inverse) process CPU time, all threads, medians (`None`: not measured).
+    pub cpu: Option<(f64, f64)>,
 }
 
 impl Row {
@@ -109,19 +111,32 @@ impl Row {
     pub fn inv_frac_peak(&self) -> f64 {
         self.inv_dwt_gflops() / self.peak()
     }
+
+    /// Share of its threads' time the run got: CPU time / (wall time x threads), forward and
+    /// inverse together. Well below 1: other processes had the cores (or threads idled).
+    pub fn utilisation(&self) -> f64 {
+        let (wf, wi) = if self.variant == Variant::Naive {
+            (self.fwd.dwt, self.inv.dwt)
+        } else {
+            (self.fwd_median, self.inv_median)
+        };
+        self.cpu.map_or(f64::NAN, |(f, i)| {
+            (f + i) / ((wf + wi) * self.threads as f64)
+        })
+    }
 }
 
 /// Column header of the printed table.
 pub fn table_header() -> String {
     format!(
-        "{:>5} {:>3} {:>4} | {:>9} {:>9} | {:>9} {:>9} {:>9} {:>9} | {:>7} {:>7} {:>5} {:>5} | {:>8} {:>8} | {:>8}\n{}",
+        "{:>5} {:>3} {:>4} | {:>9} {:>9} | {:>9} {:>9} {:>9} {:>9} | {:>7} {:>7} {:>5} {:>5} | {:>8} {:>8} | {:>8} {:>4}\n{}",
         "B", "thr", "runs",
         "fwd s", "inv s",
         "fwd fft", "fwd dwt", "inv fft", "inv dwt",
         "fwd GF", "inv GF", "fwd%", "inv%",
         "max err", "rel L2",
-        "peak MiB",
-        "-".repeat(145),
+        "peak MiB", "util",
+        "-".repeat(150),
     )
 }
 
@@ -149,7 +164,7 @@ fn peak_mib(r: &Row) -> String {
 /// One line of the printed table.
 pub fn table_line(r: &Row) -> String {
     format!(
-        "{:>5} {:>3} {:>4} | {:>9} {:>9} | {:>9} {:>9} {:>9} {:>9} | {:>7.2} {:>7.2} {:>5.1} {:>5.1} | {:>8.2e} {:>8.2e} | {:>8}",
+        "{:>5} {:>3} {:>4} | {:>9} {:>9} | {:>9} {:>9} {:>9} {:>9} | {:>7.2} {:>7.2} {:>5.1} {:>5.1} | {:>8.2e} {:>8.2e} | {:>8} {:>4}",
         r.bandwidth, r.threads, r.runs,
         or_na!(r.fwd_median, "{:.4e}"), or_na!(r.inv_median, "{:.4e}"),
         or_na!(r.fwd.fft, "{:.3e}"), or_na!(r.fwd.dwt, "{:.3e}"),
@@ -157,7 +172,7 @@ pub fn table_line(r: &Row) -> String {
         r.fwd_dwt_gflops(), r.inv_dwt_gflops(),
         100.0 * r.fwd_frac_peak(), 100.0 * r.inv_frac_peak(),
         r.max_abs_err, r.rel_l2_err,
-        peak_mib(r),
+        peak_mib(r), or_na!(r.utilisation(), "{:.2}"),
     )
 }
 
@@ -191,19 +206,21 @@ pub fn find(rows: &[Row], variant: Variant, b: usize, threads: usize) -> Option<
         .find(|r| r.variant == variant && r.bandwidth == b && r.threads == threads)
 }
 
-/// With against without skipping of negligible Wigner-d prefixes, per bandwidth (rows of
-/// the no-skip run, paired with the complex row of the same threads); `missing` lists the
-/// bandwidths where the no-skip plan could not be made, with the reason.
+/// With against without skipping of negligible Wigner-d prefixes, per bandwidth: the no-skip
+/// rows, whose `ratio` (no-skip / skip DWT stage) comes from runs paired with a skipping
+/// plan (interleaved at B <= 256; see the callers), and the complex row of the same threads
+/// for the errors with skipping. `missing` lists the bandwidths where the no-skip plan could
+/// not be made, with the reason.
 pub fn skip_table(rows: &[Row], missing: &[(usize, String)]) -> String {
     let mut out = format!(
-        "{:>5} {:>3} | {:>9} {:>9} {:>6} | {:>9} {:>9} {:>6} | {:>9} {:>9} | {:>8} {:>8} | {:>8} {:>8}\n{}\n",
+        "{:>5} {:>3} | {:>9} {:>9} {:>6} | {:>9} {:>9} {:>6} | {:>8} {:>8} | {:>8} {:>8} | {:>4}\n{}\n",
         "B", "thr",
         "fwd dwt", "no-skip", "ratio",
         "inv dwt", "no-skip", "ratio",
-        "fwd s", "no-skip",
         "max err", "no-skip",
         "rel L2", "no-skip",
-        "-".repeat(128),
+        "util",
+        "-".repeat(111),
     );
     let mut bandwidths: Vec<usize> = rows
         .iter()
@@ -218,18 +235,18 @@ pub fn skip_table(rows: &[Row], missing: &[(usize, String)]) -> String {
             .iter()
             .find(|r| r.variant == Variant::NoSkip && r.bandwidth == b)
         {
-            let Some(sk) = find(rows, Variant::Complex, b, ns.threads) else {
-                continue;
-            };
+            let (rf, ri) = ns.ratio.unwrap_or((f64::NAN, f64::NAN));
+            let sk = find(rows, Variant::Complex, b, ns.threads);
+            let err = |f: fn(&Row) -> f64| sk.map_or(f64::NAN, f);
             let _ = writeln!(
                 out,
-                "{:>5} {:>3} | {:>9.3e} {:>9.3e} {:>6.3} | {:>9.3e} {:>9.3e} {:>6.3} | {:>9} {:>9} | {:>8.2e} {:>8.2e} | {:>8.2e} {:>8.2e}",
+                "{:>5} {:>3} | {:>9} {:>9.3e} {:>6} | {:>9} {:>9.3e} {:>6} | {:>8.2e} {:>8.2e} | {:>8.2e} {:>8.2e} | {:>4}",
                 b, ns.threads,
-                sk.fwd.dwt, ns.fwd.dwt, ns.fwd.dwt / sk.fwd.dwt,
-                sk.inv.dwt, ns.inv.dwt, ns.inv.dwt / sk.inv.dwt,
-                or_na!(sk.fwd_median, "{:.3e}"), or_na!(ns.fwd_median, "{:.3e}"),
-                sk.max_abs_err, ns.max_abs_err,
-                sk.rel_l2_err, ns.rel_l2_err,
+                or_na!(ns.fwd.dwt / rf, "{:.3e}"), ns.fwd.dwt, or_na!(rf, "{:.3}"),
+                or_na!(ns.inv.dwt / ri, "{:.3e}"), ns.inv.dwt, or_na!(ri, "{:.3}"),
+                err(|r| r.max_abs_err), ns.max_abs_err,
+                err(|r| r.rel_l2_err), ns.rel_l2_err,
+                or_na!(ns.utilisation(), "{:.2}"),
             );
         } else if let Some((_, why)) = missing.iter().find(|m| m.0 == b) {
             let _ = writeln!(out, "{b:>5}     | no-skip run n/a: {why}");
@@ -342,7 +359,7 @@ inv_fft_s,inv_dwt_s,dwt_flops,fwd_dwt_gflops,inv_dwt_gflops,peak_gflops_1core,fw
 inv_dwt_frac_peak,roundtrip_max_abs_err,roundtrip_rel_l2_err,variant,peak_rss_bytes,\
 rss_growth_bytes,plan_memory_bytes,arrays_bytes,peak_over_arrays,lib_over_naive_fwd_dwt,\
 lib_over_naive_inv_dwt,noskip_over_skip_fwd_dwt,noskip_over_skip_inv_dwt,real_over_complex_fwd,\
-real_over_complex_inv";
+real_over_complex_inv,fwd_cpu_s,inv_cpu_s,utilisation";
 
 /// A float field: Rust's shortest round-trip formatting in exponent form (`{:e}`), so nothing
 /// is lost and tiny errors stay readable; empty when NaN (does not apply).
@@ -395,6 +412,9 @@ pub fn csv(rows: &[Row]) -> String {
             ratio(Variant::NoSkip, false),
             ratio(Variant::Real, true),
             ratio(Variant::Real, false),
+            r.cpu.map_or(String::new(), |c| num(c.0)),
+            r.cpu.map_or(String::new(), |c| num(c.1)),
+            num(r.utilisation()),
         ];
         out.push_str(&fields.join(","));
         out.push('\n');
