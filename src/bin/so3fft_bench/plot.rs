@@ -299,6 +299,15 @@ fn draw_axes(out: &mut String, ax: &Axes, x_values: &[f64], y_label: &str) {
                     ax.x0 - 3.0,
                     ax.x0
                 );
+                // With few decades, label 2 and 5 too (else a panel may show two labels).
+                if decades <= 2 && (k == 2 || k == 5) {
+                    let _ = writeln!(
+                        out,
+                        r##"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="#555555">{k}e{e}</text>"##,
+                        ax.x0 - 9.0,
+                        y + 4.0
+                    );
+                }
             }
         }
     }
