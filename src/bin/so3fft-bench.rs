@@ -2,24 +2,38 @@
 //!
 //! For each bandwidth B and thread count it times the inverse and forward transforms (median of
 //! several runs, with the FFT and DWT stages separately), checks the round trip on random
-//! coefficients, and relates the DWT stage's flop rate to the machine's FMA peak measured in the
-//! same run. Prints a table and writes a CSV file.
+//! coefficients, relates the DWT stage's flop rate to the machine's FMA peak measured in the
+//! same run, and records the peak resident memory. Per bandwidth it also runs the transforms
+//! without skipping negligible Wigner-d prefixes and, at small B, a plain one-thread DWT
+//! (`naive.rs`) as a yardstick. `--big` adds B = 512 in a memory-lean procedure (`big.rs`).
+//! Prints tables, writes a CSV file and an SVG plot.
 //!
-//! `cargo run --release --bin so3fft-bench -- --help` lists the options.
+//! `cargo run --release --bin so3fft-bench -- --help` lists the options; `notes/bench.md`
+//! describes the columns and how each number is measured.
 
+#[path = "so3fft_bench/big.rs"]
+mod big;
 #[path = "so3fft_bench/cli.rs"]
 mod cli;
+#[path = "so3fft_bench/memory.rs"]
+mod memory;
+#[path = "so3fft_bench/naive.rs"]
+mod naive;
 #[path = "so3fft_bench/peak.rs"]
 mod peak;
+#[path = "so3fft_bench/plot.rs"]
+mod plot;
 #[path = "so3fft_bench/report.rs"]
 mod report;
+#[path = "so3fft_bench/seeded.rs"]
+mod seeded;
 #[path = "so3fft_bench/soft_cmp.rs"]
 mod soft_cmp;
 #[path = "so3fft_bench/workload.rs"]
 mod workload;
 
 use cli::{Command, Options};
-use report::{Row, Stages};
+use report::{Memory, Row, Stages, Variant};
 use so3fft::{Complex64, Direction, Plan, PlanOptions, StageTimes};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -50,17 +64,58 @@ fn run(opts: &Options) -> ExitCode {
     print_header(opts, &peak);
 
     let mut rows = Vec::new();
+    let mut noskip_missing = Vec::new();
     for &b in &opts.bandwidths {
-        rows.extend(bench_bandwidth(b, opts, &peak));
+        if b > cli::MAX_REGULAR_BANDWIDTH {
+            let threads = big_threads(opts, cores);
+            let out = big::run(b, threads, opts, peak.one_core);
+            rows.extend(out.rows);
+            noskip_missing.extend(out.noskip_missing.map(|why| (b, why)));
+        } else {
+            bench_bandwidth(b, opts, &peak, &mut rows, &mut noskip_missing);
+        }
     }
 
     let speedups = report::speedups(&rows);
     if !speedups.is_empty() {
         println!("\nSpeed-up (median wall time, 1 thread / N threads):\n{speedups}");
     }
+    if rows.iter().any(|r| r.variant == Variant::NoSkip) || !noskip_missing.is_empty() {
+        println!(
+            "Skipping of negligible Wigner-d prefixes: default (skip below 2^-300) against \
+             skip_bits = Some(0) (every degree of every beta); DWT stage times, ratio = no-skip / skip:\n{}",
+            report::skip_table(&rows, &noskip_missing)
+        );
+    }
+    if rows.iter().any(|r| r.variant == Variant::Naive) {
+        println!(
+            "Plain DWT (naive.rs: one thread, scalar loops, textbook recurrence) against the \
+             library's one-thread DWT stage; round trip errors of the plain DWT:\n{}",
+            report::naive_table(&rows)
+        );
+    }
+    if rows.iter().any(|r| r.variant == Variant::Real) {
+        println!(
+            "Real-signal transforms against the complex ones (same B, threads):\n{}",
+            report::real_table(&rows)
+        );
+    }
+    if rows.iter().any(|r| r.memory.is_some()) {
+        println!(
+            "Peak resident memory of the timed phase (VmHWM after a reset; B > 256: the forward \
+             alone); growth = peak - resident at the start of the phase; in+out = samples + \
+             coefficients:\n{}",
+            report::memory_table(&rows)
+        );
+    }
     if opts.soft {
         let mut soft_rows = Vec::new();
-        for &b in &opts.bandwidths {
+        // Not above 256: the SOFT entry points need several grid-sized workspaces.
+        for &b in opts
+            .bandwidths
+            .iter()
+            .filter(|&&b| b <= cli::MAX_REGULAR_BANDWIDTH)
+        {
             match soft_cmp::compare(b, opts.runs_for(b)) {
                 Ok(r) => soft_rows.extend(r),
                 Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
@@ -73,11 +128,26 @@ fn run(opts: &Options) -> ExitCode {
         return ExitCode::FAILURE;
     }
     println!("CSV written to {}", opts.csv.display());
+    if !rows.is_empty() {
+        match std::fs::write(&opts.plot, plot::svg(&rows)) {
+            Ok(()) => println!("Plot written to {}", opts.plot.display()),
+            Err(e) => eprintln!("so3fft-bench: cannot write {}: {e}", opts.plot.display()),
+        }
+    }
     if rows.is_empty() {
         eprintln!("so3fft-bench: no configuration was measured");
         return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
+}
+
+/// Threads of the one run at B > 256: the largest requested count (0 = all cores).
+fn big_threads(opts: &Options, cores: usize) -> usize {
+    opts.threads
+        .iter()
+        .map(|&t| if t == 0 { cores } else { t })
+        .max()
+        .unwrap_or(1)
 }
 
 /// Prints the measured peak, the flop-count convention and the table header.
@@ -115,13 +185,19 @@ fn print_header(opts: &Options, peak: &peak::Peak) {
     println!("{}", report::table_header());
 }
 
-/// All thread counts at one bandwidth. The random coefficients are shared between them.
-fn bench_bandwidth(b: usize, opts: &Options, peak: &peak::Peak) -> Vec<Row> {
+/// All measurements at one bandwidth B <= 256: every thread count, the no-skip run (first
+/// thread count) and the plain DWT. The random coefficients are shared between them.
+fn bench_bandwidth(
+    b: usize,
+    opts: &Options,
+    peak: &peak::Peak,
+    rows: &mut Vec<Row>,
+    noskip_missing: &mut Vec<(usize, String)>,
+) {
     if !fits_in_memory(b) {
-        return Vec::new();
+        return;
     }
     let coeffs = workload::random_coeffs(so3fft::num_coeffs(b), 0x5EED_0000 + b as u64);
-    let mut rows = Vec::new();
     for &threads in &opts.threads {
         match bench_config(b, threads, opts, &coeffs, peak.one_core) {
             Ok(row) => {
@@ -131,7 +207,85 @@ fn bench_bandwidth(b: usize, opts: &Options, peak: &peak::Peak) -> Vec<Row> {
             Err(e) => eprintln!("so3fft-bench: B = {b}, threads = {threads}: skipped: {e}"),
         }
     }
-    rows
+
+    match bench_noskip(b, opts.threads[0], opts, &coeffs, peak.one_core) {
+        Ok(row) => rows.push(row),
+        Err(e) => {
+            eprintln!("  (B = {b}: no-skip run n/a: {e})");
+            noskip_missing.push((b, e.to_string()));
+        }
+    }
+
+    if b <= opts.naive_max {
+        let mut row = bench_naive(b, opts, &coeffs, peak.one_core);
+        let lib = match report::find(rows, Variant::Complex, b, 1) {
+            Some(r) => Ok(r.clone()),
+            None => {
+                eprintln!("  (B = {b}: library one-thread DWT measured for the plain-DWT ratio)");
+                bench_config(b, 1, opts, &coeffs, peak.one_core)
+            }
+        };
+        match lib {
+            Ok(lib) => row.ratio = Some((lib.fwd.dwt / row.fwd.dwt, lib.inv.dwt / row.inv.dwt)),
+            Err(e) => eprintln!("so3fft-bench: B = {b}: one-thread plan failed: {e}"),
+        }
+        rows.push(row);
+    }
+}
+
+/// Timed runs of the plain DWT at bandwidth `b` (inverse of `coeffs` to the slice spectra,
+/// forward back): one run from B = 128 on (about 1 s per direction), else up to 3.
+fn bench_naive(b: usize, opts: &Options, coeffs: &[Complex64], peak_1core: f64) -> Row {
+    let runs = if b >= 128 { 1 } else { opts.runs_for(b).min(3) };
+    let n = 2 * b;
+    let betas = naive::Betas::new(b);
+    let mut g = vec![Complex64::default(); n * n * n];
+    let mut result = vec![Complex64::default(); coeffs.len()];
+    let mut times = RunTimes::default();
+    let (error, phase) = memory::measure(|| {
+        let mut error = RoundTripError::default();
+        for _ in 0..runs {
+            let (cpu, t) = (cpu_seconds(), Instant::now());
+            naive::inverse(b, &betas, coeffs, &mut g);
+            times.inv_wall.push(t.elapsed().as_secs_f64());
+            times.inv_cpu.push(cpu_seconds() - cpu);
+            let (cpu, t) = (cpu_seconds(), Instant::now());
+            naive::forward(b, &betas, &g, &mut result);
+            times.fwd_wall.push(t.elapsed().as_secs_f64());
+            times.fwd_cpu.push(cpu_seconds() - cpu);
+            error = error.worst(workload::roundtrip_error(coeffs, &result));
+        }
+        error
+    });
+    let median = workload::median;
+    let (fwd, inv) = (median(&times.fwd_wall), median(&times.inv_wall));
+    eprintln!("  (B = {b}: plain DWT, {runs} run(s): forward {fwd:.3e} s, inverse {inv:.3e} s)");
+    let na = Stages {
+        fft: f64::NAN,
+        dwt: f64::NAN,
+    };
+    Row {
+        variant: Variant::Naive,
+        bandwidth: b,
+        threads: 1,
+        runs,
+        fwd_median: f64::NAN,
+        inv_median: f64::NAN,
+        fwd: Stages { dwt: fwd, ..na },
+        inv: Stages { dwt: inv, ..na },
+        dwt_flops: workload::dwt_flops_exact(b),
+        peak_1core,
+        max_abs_err: error.max_abs,
+        rel_l2_err: error.rel_l2,
+        memory: phase.map(|p| Memory {
+            peak: p.peak,
+            start: p.start,
+            plan: 0,
+            arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
+        }),
+        ratio: None,
+        cpu: Some((median(&times.fwd_cpu), median(&times.inv_cpu))),
+    }
 }
 
 /// Whether bandwidth `b` fits in [`MEMORY_FRACTION`] of the available memory (warns if not).
@@ -163,11 +317,122 @@ fn gib(bytes: usize) -> f64 {
 struct RunTimes {
     fwd_wall: Vec<f64>,
     inv_wall: Vec<f64>,
+    fwd_cpu: Vec<f64>,
+    inv_cpu: Vec<f64>,
     fwd: Vec<StageTimes>,
     inv: Vec<StageTimes>,
 }
 
-/// Plans and measures one (bandwidth, threads) configuration.
+/// A plan being measured: its times and worst error so far.
+struct Config {
+    plan: Plan,
+    variant: Variant,
+    times: RunTimes,
+    error: RoundTripError,
+}
+
+impl Config {
+    /// Plans one (bandwidth, threads) configuration of the library: `Complex` (default
+    /// options) or `NoSkip` (`skip_bits: Some(0)`, every degree computed).
+    fn new(
+        b: usize,
+        threads: usize,
+        variant: Variant,
+        opts: &Options,
+    ) -> Result<Config, so3fft::Error> {
+        let plan_start = Instant::now();
+        let plan = Plan::new(
+            b,
+            &PlanOptions {
+                direction: Direction::Both,
+                threads,
+                rigor: opts.rigor,
+                skip_bits: (variant == Variant::NoSkip).then_some(0),
+                ..PlanOptions::default()
+            },
+        )?;
+        eprintln!(
+            "  (B = {b}, threads = {}{}: plan created in {:.3} s)",
+            plan.threads(),
+            if variant == Variant::NoSkip {
+                ", no skipping"
+            } else {
+                ""
+            },
+            plan_start.elapsed().as_secs_f64()
+        );
+        Ok(Config {
+            plan,
+            variant,
+            times: RunTimes::default(),
+            error: RoundTripError::default(),
+        })
+    }
+
+    /// One untimed round trip: faults in the output pages, warms caches and the thread pool.
+    fn warm_up(&self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
+        self.plan.inverse(coeffs, &mut arrays.samples)?;
+        self.plan.forward(&arrays.samples, &mut arrays.result)
+    }
+
+    /// One timed inverse-then-forward round trip, checked against `coeffs`.
+    fn run(&mut self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
+        let t = &mut self.times;
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        t.inv
+            .push(self.plan.inverse_timed(coeffs, &mut arrays.samples)?);
+        t.inv_wall.push(start.elapsed().as_secs_f64());
+        t.inv_cpu.push(cpu_seconds() - cpu);
+
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        t.fwd.push(
+            self.plan
+                .forward_timed(&arrays.samples, &mut arrays.result)?,
+        );
+        t.fwd_wall.push(start.elapsed().as_secs_f64());
+        t.fwd_cpu.push(cpu_seconds() - cpu);
+        let error = workload::roundtrip_error(coeffs, &arrays.result);
+        self.error = self.error.worst(error);
+        Ok(())
+    }
+
+    fn row(&self, b: usize, peak_1core: f64) -> Row {
+        let mut row = summarise(b, self.plan.threads(), &self.times, self.error, peak_1core);
+        row.variant = self.variant;
+        row
+    }
+}
+
+/// The sample and result arrays of the library's round trips at one bandwidth.
+struct Arrays {
+    samples: Vec<Complex64>,
+    result: Vec<Complex64>,
+}
+
+impl Arrays {
+    fn new(b: usize) -> Arrays {
+        Arrays {
+            samples: vec![Complex64::default(); so3fft::num_samples(b)],
+            result: vec![Complex64::default(); so3fft::num_coeffs(b)],
+        }
+    }
+}
+
+/// CPU time of the whole process (all threads) in seconds; NaN where unavailable. Against
+/// the wall time it shows whether the run had its cores (the machine is shared).
+pub fn cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec.
+    if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) } != 0 {
+        return f64::NAN;
+    }
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Measures one configuration: warm-up, then the timed runs with the peak memory of the runs.
 fn bench_config(
     b: usize,
     threads: usize,
@@ -175,68 +440,51 @@ fn bench_config(
     coeffs: &[Complex64],
     peak_1core: f64,
 ) -> Result<Row, so3fft::Error> {
-    let plan_start = Instant::now();
-    let plan = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Both,
-            threads,
-            rigor: opts.rigor,
-            ..PlanOptions::default()
-        },
-    )?;
-    eprintln!(
-        "  (B = {b}, threads = {}: plan created in {:.3} s)",
-        plan.threads(),
-        plan_start.elapsed().as_secs_f64()
-    );
-    let mut samples = vec![Complex64::default(); plan.num_samples()];
-    let mut result = vec![Complex64::default(); plan.num_coeffs()];
-    let runs = opts.runs_for(b);
-
-    // One untimed round trip faults in the output pages and warms caches and the thread pool,
-    // except at B >= 512 where it would cost as much as the measurement itself.
-    if b < 512 {
-        plan.inverse(coeffs, &mut samples)?;
-        plan.forward(&samples, &mut result)?;
-    }
-    let mut times = RunTimes::default();
-    let mut error = RoundTripError::default();
-    for _ in 0..runs {
-        error = error.worst(round_trip(
-            &plan,
-            coeffs,
-            &mut samples,
-            &mut result,
-            &mut times,
-        )?);
-    }
-    Ok(summarise(
-        b,
-        plan.threads(),
-        runs,
-        &times,
-        error,
-        peak_1core,
-    ))
+    let mut config = Config::new(b, threads, Variant::Complex, opts)?;
+    let mut arrays = Arrays::new(b);
+    config.warm_up(coeffs, &mut arrays)?;
+    let (result, phase) =
+        memory::measure(|| (0..opts.runs_for(b)).try_for_each(|_| config.run(coeffs, &mut arrays)));
+    result?;
+    let mut row = config.row(b, peak_1core);
+    row.memory = phase.map(|p| Memory {
+        peak: p.peak,
+        start: p.start,
+        plan: config.plan.memory_bytes() as u64,
+        arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
+    });
+    Ok(row)
 }
 
-/// One timed inverse-then-forward round trip; returns its error against `coeffs`.
-fn round_trip(
-    plan: &Plan,
+/// Skipping against no skipping, interleaved run by run (alternating which goes first) so
+/// that the load of the shared machine hits both alike; returns the no-skip row with
+/// `ratio` = (no-skip / skip) DWT stage medians of these runs. No memory figure: two plans
+/// are held (and skipping does not change the allocation).
+fn bench_noskip(
+    b: usize,
+    threads: usize,
+    opts: &Options,
     coeffs: &[Complex64],
-    samples: &mut [Complex64],
-    result: &mut [Complex64],
-    times: &mut RunTimes,
-) -> Result<RoundTripError, so3fft::Error> {
-    let start = Instant::now();
-    times.inv.push(plan.inverse_timed(coeffs, samples)?);
-    times.inv_wall.push(start.elapsed().as_secs_f64());
-
-    let start = Instant::now();
-    times.fwd.push(plan.forward_timed(samples, result)?);
-    times.fwd_wall.push(start.elapsed().as_secs_f64());
-    Ok(workload::roundtrip_error(coeffs, result))
+    peak_1core: f64,
+) -> Result<Row, so3fft::Error> {
+    let mut noskip = Config::new(b, threads, Variant::NoSkip, opts)?;
+    let mut skip = Config::new(b, threads, Variant::Complex, opts)?;
+    let mut arrays = Arrays::new(b);
+    noskip.warm_up(coeffs, &mut arrays)?;
+    skip.warm_up(coeffs, &mut arrays)?;
+    for run in 0..opts.runs_for(b) {
+        if run % 2 == 0 {
+            skip.run(coeffs, &mut arrays)?;
+            noskip.run(coeffs, &mut arrays)?;
+        } else {
+            noskip.run(coeffs, &mut arrays)?;
+            skip.run(coeffs, &mut arrays)?;
+        }
+    }
+    let sk = skip.row(b, peak_1core);
+    let mut row = noskip.row(b, peak_1core);
+    row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
+    Ok(row)
 }
 
 /// Medians of the runs, as a table row. The whole-transform times are the bench's own wall
@@ -244,7 +492,6 @@ fn round_trip(
 fn summarise(
     b: usize,
     threads: usize,
-    runs: usize,
     times: &RunTimes,
     error: RoundTripError,
     peak_1core: f64,
@@ -254,9 +501,10 @@ fn summarise(
         dwt: workload::median(&t.iter().map(|s| s.dwt).collect::<Vec<_>>()),
     };
     Row {
+        variant: Variant::Complex,
         bandwidth: b,
         threads,
-        runs,
+        runs: times.fwd_wall.len(),
         fwd_median: workload::median(&times.fwd_wall),
         inv_median: workload::median(&times.inv_wall),
         fwd: stages(&times.fwd),
@@ -265,5 +513,11 @@ fn summarise(
         peak_1core,
         max_abs_err: error.max_abs,
         rel_l2_err: error.rel_l2,
+        memory: None,
+        ratio: None,
+        cpu: Some((
+            workload::median(&times.fwd_cpu),
+            workload::median(&times.inv_cpu),
+        )),
     }
 }

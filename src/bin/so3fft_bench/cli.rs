@@ -12,17 +12,43 @@ pub const DEFAULT_RUNS: usize = 5;
 const QUICK_RUNS: usize = 3;
 /// Largest bandwidth `--quick` keeps: the smoke test must finish in seconds.
 const QUICK_MAX_BANDWIDTH: usize = 64;
+/// Largest bandwidth allowed without `--big`. Above it a round trip needs minutes and most of
+/// the memory, and the bench runs the memory-lean procedure (`big.rs`).
+pub const MAX_REGULAR_BANDWIDTH: usize = 256;
+/// Bandwidth `--big` adds.
+pub const BIG_BANDWIDTH: usize = 512;
+/// Largest bandwidth of the plain DWT by default (about 1 s per direction at 128 here).
+const DEFAULT_NAIVE_MAX: usize = 128;
+/// ... and under `--quick`.
+const QUICK_NAIVE_MAX: usize = 16;
 
 pub const USAGE: &str = "\
 usage: so3fft-bench [options]
-  --bandwidths LIST   comma-separated bandwidths B (default 16,32,64,128)
+  --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
+                      (default 16,32,64,128,256)
   --threads LIST      comma-separated thread counts, 0 = all cores (default 1,2)
-  --runs N            timed runs per configuration (default 5; 3 at B = 256, 1 at B >= 512)
+  --runs N            timed runs per configuration (default 5; 3 at B = 256; B > 256: always 1)
   --csv PATH          CSV output file (default bench.csv)
-  --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default estimate)
-  --quick             CI smoke test: only B <= 64, 3 runs
+  --plot PATH         SVG plot of time and error against B (default: the CSV path with
+                      extension .svg, i.e. bench.svg)
+  --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default
+                      measure: with estimate the FFT stage is about 6x slower at B = 256)
+  --naive-max B       largest B of the plain one-thread DWT timed for comparison (default 128,
+                      0 = none; about 1 s per direction at 128)
+  --big               also run B = 512 (added unless the list has a B above 256): needs minutes
+                      and about 22 GB. B > 256 runs once, with the largest thread count only:
+                      complex inverse then forward (peak memory of the forward against input +
+                      output), the same without skipping, and a real-signal round trip; random
+                      coefficients are regenerated from a seed instead of being stored. Skipped
+                      with a message when MemAvailable is too small.
+  --quick             CI smoke test: only B <= 64, 3 runs, plain DWT at B = 16 only
   --soft              also time the SOFT 2.0 entry points against the native plan (each B)
-  -h, --help          print this help";
+  -h, --help          print this help
+
+Each B <= 256 and thread count: inverse then forward on random coefficients, stage times
+(medians), DWT GFLOP/s against the FMA peak measured in the same run, round-trip errors, peak
+memory. Per B also: the transforms without skipping of negligible Wigner-d prefixes (first
+thread count) and the plain DWT. Columns and formulas: notes/bench.md.";
 
 /// Parsed benchmark options.
 #[derive(Debug, Clone)]
@@ -36,18 +62,30 @@ pub struct Options {
     pub quick: bool,
     /// Compare the SOFT compatibility layer with the native plan.
     pub soft: bool,
+    /// Allow bandwidths above [`MAX_REGULAR_BANDWIDTH`] (and add [`BIG_BANDWIDTH`]).
+    pub big: bool,
+    /// SVG plot file.
+    pub plot: PathBuf,
+    /// Largest bandwidth of the plain DWT (0: none).
+    pub naive_max: usize,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Options {
-            bandwidths: vec![16, 32, 64, 128],
+            bandwidths: vec![16, 32, 64, 128, 256],
             threads: vec![1, 2],
             runs: None,
             csv: PathBuf::from("bench.csv"),
-            rigor: Rigor::Estimate,
+            // Not the library's default (Estimate): FFTW_ESTIMATE plans made the FFT stage
+            // 6.3x slower at B = 256 on the development machine (6.9 s against 1.1 s, one
+            // thread), which would hide the DWT. Planning time is not part of any timing.
+            rigor: Rigor::Measure,
             quick: false,
             soft: false,
+            big: false,
+            plot: PathBuf::from("bench.svg"),
+            naive_max: DEFAULT_NAIVE_MAX,
         }
     }
 }
@@ -55,10 +93,12 @@ impl Default for Options {
 impl Options {
     /// Number of timed runs at bandwidth `b`.
     ///
-    /// An explicit `--runs` wins. Otherwise the default shrinks with B because one transform
-    /// costs O(B^4): five runs at B = 512 would take minutes for little extra information.
+    /// An explicit `--runs` wins (except above [`MAX_REGULAR_BANDWIDTH`], always one run).
+    /// Otherwise the default shrinks with B because one transform costs O(B^4): five runs at
+    /// B = 512 would take minutes for little extra information.
     pub fn runs_for(&self, b: usize) -> usize {
         match self.runs {
+            _ if b > MAX_REGULAR_BANDWIDTH => 1,
             Some(n) => n,
             None if b <= 128 => DEFAULT_RUNS,
             None if b <= 256 => 3,
@@ -77,6 +117,8 @@ pub enum Command {
 pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String> {
     let mut opts = Options::default();
     let mut bandwidths_given = false;
+    let mut plot_given = false;
+    let mut naive_given = false;
     let mut args = args.into_iter();
     while let Some(arg) = args.next() {
         let (name, inline) = match arg.split_once('=') {
@@ -93,6 +135,19 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
             "-h" | "--help" => return Ok(Command::Help),
             "--quick" => opts.quick = true,
             "--soft" => opts.soft = true,
+            "--big" => opts.big = true,
+            "--plot" => {
+                opts.plot = PathBuf::from(value()?);
+                plot_given = true;
+            }
+            "--naive-max" => {
+                let text = value()?;
+                opts.naive_max = text
+                    .trim()
+                    .parse()
+                    .map_err(|e| format!("--naive-max: '{text}': {e}"))?;
+                naive_given = true;
+            }
             "--bandwidths" => {
                 opts.bandwidths = parse_list(&value()?, "--bandwidths")?;
                 bandwidths_given = true;
@@ -104,8 +159,14 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
             _ => return Err(format!("unknown option '{arg}'")),
         }
     }
+    if !plot_given {
+        opts.plot = opts.csv.with_extension("svg");
+    }
+    if opts.big && !opts.bandwidths.iter().any(|&b| b > MAX_REGULAR_BANDWIDTH) {
+        opts.bandwidths.push(BIG_BANDWIDTH);
+    }
     if opts.quick {
-        apply_quick(&mut opts, bandwidths_given);
+        apply_quick(&mut opts, bandwidths_given, naive_given);
     }
     if opts.bandwidths.is_empty() {
         return Err("no bandwidth left to run".into());
@@ -121,18 +182,34 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
             so3fft::MAX_BANDWIDTH
         ));
     }
+    if !opts.big {
+        if let Some(&b) = opts.bandwidths.iter().find(|&&b| b > MAX_REGULAR_BANDWIDTH) {
+            return Err(format!(
+                "--bandwidths: B = {b} needs --big (minutes of run time, most of the memory)"
+            ));
+        }
+    }
+    if opts.threads.is_empty() {
+        return Err("--threads: no thread count given".into());
+    }
     Ok(Command::Run(opts))
 }
 
-/// `--quick` limits B to 64 (keeping a user list's small entries) and uses 3 runs unless
-/// `--runs` was given, so CI gets a smoke test of a few seconds.
-fn apply_quick(opts: &mut Options, bandwidths_given: bool) {
+/// `--quick` limits B to 64 (keeping a user list's small entries), uses 3 runs unless
+/// `--runs` was given and runs the plain DWT at B = 16 only (unless `--naive-max` was given,
+/// still at most 64), so CI gets a smoke test of a few seconds.
+fn apply_quick(opts: &mut Options, bandwidths_given: bool, naive_given: bool) {
     if bandwidths_given {
         opts.bandwidths.retain(|&b| b <= QUICK_MAX_BANDWIDTH);
     } else {
         opts.bandwidths = vec![16, 32, 64];
     }
     opts.runs.get_or_insert(QUICK_RUNS);
+    opts.naive_max = if naive_given {
+        opts.naive_max.min(QUICK_MAX_BANDWIDTH)
+    } else {
+        QUICK_NAIVE_MAX
+    };
 }
 
 fn parse_list(text: &str, what: &str) -> Result<Vec<usize>, String> {

@@ -101,6 +101,14 @@ pub fn dwt_flops_exact(b: usize) -> u64 {
     8 * b * (4 * b * b * b - b) / 3
 }
 
+/// DWT flops per direction of the real-signal transforms: only one order pair of each
+/// `(M, M') <-> (-M, -M')` pair is transformed, `(T + B)/2` of the `T = (4B^3 - B)/3`
+/// coefficients (the pair (0, 0) is its own partner), so `8B (T + B)/2 = 4B (T + B)`.
+pub fn dwt_flops_real(b: usize) -> u64 {
+    let b = b as u64;
+    4 * b * ((4 * b * b * b - b) / 3 + b)
+}
+
 /// Leading-order DWT flop count 32 B^4 / 3 (shown next to the exact one for comparison).
 pub fn dwt_flops_approx(b: usize) -> f64 {
     32.0 * (b as f64).powi(4) / 3.0

@@ -1,0 +1,431 @@
+//! Bandwidths above 256 (`--big`, B = 512): one memory-lean run of each transform.
+//!
+//! At B = 512 the sample grid alone is `(2B)^3` complex values, 17.2 GB, and the
+//! coefficients 2.9 GB, on a machine with 24 GiB and no swap. So no array is ever held twice:
+//!
+//! 1. Complex round trip. Coefficients are a hash of (seed, index) (`seeded.rs`); the inverse
+//!    writes the grid, the forward writes its result over the coefficient array, and the
+//!    result is compared with coefficients generated again. The peak resident memory of the
+//!    forward (reset just before it) is compared with input + output = grid + coefficients:
+//!    the issue asks for at most 5% more.
+//! 2. The same without skipping negligible Wigner-d prefixes (`skip_bits: Some(0)`), on the
+//!    same arrays (n/a while the library refuses that option).
+//! 3. Real-signal round trip (`forward_real` / `inverse_real`, real grid of 8.6 GB) on
+//!    coefficients with the real-signal symmetry, also regenerated for the comparison; its
+//!    times are related to the complex ones of step 1.
+//!
+//! Each plan is dropped before the next is made (a plan holds a chunk buffer of about 1 GB
+//! here). Before each step the memory it needs is checked against `MemAvailable`; a step
+//! that does not fit is skipped with a message. Everything runs once (a run takes minutes).
+
+use crate::memory;
+use crate::report::{Memory, Row, Stages, Variant};
+use crate::seeded;
+use crate::workload::{self, RoundTripError};
+use rayon::prelude::*;
+use so3fft::{Complex64, Direction, Plan, PlanOptions, StageTimes};
+use std::time::Instant;
+
+/// Memory left over for everything else when a step is admitted.
+const MARGIN_BYTES: usize = 512 << 20;
+/// Bandwidth of the check of the real-signal symmetry with the complex inverse.
+const SYMMETRY_CHECK_B: usize = 16;
+
+/// What one lean run produced: its rows, and the reason the no-skip step was not run.
+pub struct Outcome {
+    pub rows: Vec<Row>,
+    pub noskip_missing: Option<String>,
+}
+
+/// Runs the three steps at bandwidth `b` with `threads` workers.
+pub fn run(b: usize, threads: usize, opts: &crate::cli::Options, peak_1core: f64) -> Outcome {
+    eprintln!(
+        "  (B = {b}: memory-lean run, {threads} threads, each transform once; grid {:.2} GB, \
+         coefficients {:.2} GB)",
+        gb(16 * so3fft::num_samples(b)),
+        gb(16 * so3fft::num_coeffs(b))
+    );
+    let mut lean = Lean {
+        b,
+        threads,
+        opts,
+        peak_1core,
+        coeffs: None,
+        rows: Vec::new(),
+    };
+    let noskip_missing = lean.complex_steps();
+    lean.real_step();
+    Outcome {
+        rows: lean.rows,
+        noskip_missing,
+    }
+}
+
+struct Lean<'a> {
+    b: usize,
+    threads: usize,
+    opts: &'a crate::cli::Options,
+    peak_1core: f64,
+    /// The coefficient array, shared by all steps once allocated.
+    coeffs: Option<Vec<Complex64>>,
+    rows: Vec<Row>,
+}
+
+impl Lean<'_> {
+    fn seed(&self) -> u64 {
+        0x5EED_0000 + self.b as u64
+    }
+
+    fn real_seed(&self) -> u64 {
+        0x5EED_1000 + self.b as u64
+    }
+
+    /// A plan with default options except those given. `workspace`: cap on the chunk buffer
+    /// (`None`: the library's default, which depends on `MemAvailable` at planning time).
+    fn plan(
+        &self,
+        skip_bits: Option<u32>,
+        real: bool,
+        workspace: Option<usize>,
+    ) -> Result<Plan, so3fft::Error> {
+        Plan::new(
+            self.b,
+            &PlanOptions {
+                direction: Direction::Both,
+                threads: self.threads,
+                rigor: self.opts.rigor,
+                skip_bits,
+                real,
+                max_workspace_bytes: workspace,
+                ..PlanOptions::default()
+            },
+        )
+    }
+
+    /// Bytes still to allocate for a grid of `grid_bytes` plus the coefficients (if not held).
+    fn fits(&self, what: &str, grid_bytes: usize, plan: &Plan) -> bool {
+        let coef_bytes = if self.coeffs.is_some() {
+            0
+        } else {
+            16 * so3fft::num_coeffs(self.b)
+        };
+        let need = grid_bytes + coef_bytes + plan.memory_bytes();
+        match workload::mem_available_bytes() {
+            Some(avail) if need + MARGIN_BYTES > avail => {
+                eprintln!(
+                    "so3fft-bench: B = {}: skipping the {what}: it needs {:.2} GB more \
+                     (arrays and plan) plus {:.1} GB margin, MemAvailable is {:.2} GB",
+                    self.b,
+                    gb(need),
+                    gb(MARGIN_BYTES),
+                    gb(avail)
+                );
+                false
+            }
+            Some(_) => true,
+            None => {
+                eprintln!(
+                    "so3fft-bench: cannot read MemAvailable; running B = {} unchecked",
+                    self.b
+                );
+                true
+            }
+        }
+    }
+
+    fn take_coeffs(&mut self) -> Vec<Complex64> {
+        self.coeffs
+            .take()
+            .unwrap_or_else(|| filled(so3fft::num_coeffs(self.b), Complex64::new(0.0, 0.0)))
+    }
+
+    /// Steps 1 and 2; returns why the no-skip step was not run, if it was not.
+    fn complex_steps(&mut self) -> Option<String> {
+        let b = self.b;
+        let plan = match self.plan(None, false, None) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("so3fft-bench: B = {b}: complex plan failed: {e}");
+                return Some(format!("complex plan failed: {e}"));
+            }
+        };
+        if !self.fits("complex round trip", 16 * so3fft::num_samples(b), &plan) {
+            return Some("complex round trip skipped (memory)".into());
+        }
+        let mut coeffs = self.take_coeffs();
+        let t = Instant::now();
+        let mut grid = filled(so3fft::num_samples(b), Complex64::new(0.0, 0.0));
+        eprintln!(
+            "  (grid allocated and faulted in: {:.1} s)",
+            t.elapsed().as_secs_f64()
+        );
+
+        let skip = self.complex_round_trip(&plan, Variant::Complex, &mut coeffs, &mut grid);
+        // The no-skip plan gets the same chunk buffer: the default depends on MemAvailable,
+        // which the grid has just used up, and a smaller chunk makes the DWT stage slower.
+        let workspace = plan.workspace_bytes();
+        drop(plan);
+        let missing = match (&skip, self.plan(Some(0), false, Some(workspace))) {
+            (Err(e), _) => Some(format!("complex round trip failed: {e}")),
+            (Ok(_), Err(e)) => Some(format!("Plan::new with skip_bits Some(0): {e}")),
+            (Ok(_), Ok(plan)) => {
+                match self.complex_round_trip(&plan, Variant::NoSkip, &mut coeffs, &mut grid) {
+                    Ok(mut row) => {
+                        let sk = skip.as_ref().expect("checked above");
+                        row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
+                        self.rows.push(row);
+                        None
+                    }
+                    Err(e) => Some(format!("no-skip round trip failed: {e}")),
+                }
+            }
+        };
+        match skip {
+            Ok(row) => self.rows.insert(0, row),
+            Err(e) => eprintln!("so3fft-bench: B = {b}: complex round trip failed: {e}"),
+        }
+        if let Some(why) = &missing {
+            eprintln!("  (B = {b}: no-skip step n/a: {why})");
+        }
+        drop(grid);
+        self.coeffs = Some(coeffs);
+        missing
+    }
+
+    /// Inverse of seeded coefficients into `grid`, forward back into `coeffs`, comparison
+    /// with the regenerated coefficients.
+    fn complex_round_trip(
+        &self,
+        plan: &Plan,
+        variant: Variant,
+        coeffs: &mut [Complex64],
+        grid: &mut [Complex64],
+    ) -> Result<Row, so3fft::Error> {
+        let b = self.b;
+        let t = Instant::now();
+        seeded::fill_complex(self.seed(), coeffs);
+        eprintln!(
+            "  ({}: coefficients generated in {:.1} s)",
+            variant.name(),
+            t.elapsed().as_secs_f64()
+        );
+        let (inv, inv_mem) = timed_phase(|| plan.inverse_timed(coeffs, grid));
+        let inv: Timed = (inv.0, inv.1, inv.2?);
+        let (fwd, fwd_mem) = timed_phase(|| plan.forward_timed(grid, coeffs));
+        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
+        let t = Instant::now();
+        let error = seeded::compare_complex(self.seed(), coeffs);
+        let arrays = 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64;
+        let row = self.row(
+            variant,
+            inv,
+            fwd,
+            error,
+            fwd_mem.map(|p| Memory {
+                peak: p.peak,
+                start: p.start,
+                plan: plan.memory_bytes() as u64,
+                arrays,
+            }),
+            workload::dwt_flops_exact(b),
+        );
+        eprintln!(
+            "  ({}: compared in {:.1} s; {}; issue limit 1.05)",
+            variant.name(),
+            t.elapsed().as_secs_f64(),
+            memory_summary(inv_mem, fwd_mem, arrays, plan),
+        );
+        if variant == Variant::Complex {
+            println!("{}", crate::report::table_line(&row));
+        }
+        Ok(row)
+    }
+
+    /// Step 3.
+    fn real_step(&mut self) {
+        let b = self.b;
+        match seeded::real_symmetry_check(SYMMETRY_CHECK_B, self.real_seed()) {
+            Ok((im, abs)) => eprintln!(
+                "  (real-signal coefficients fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M')): \
+                 complex inverse at B = {SYMMETRY_CHECK_B} gives max |Im f| = {im:.2e}, max |f| = {abs:.2e})"
+            ),
+            Err(e) => eprintln!("so3fft-bench: real symmetry check failed: {e}"),
+        }
+        let plan = match self.plan(None, true, None) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("so3fft-bench: B = {b}: real plan failed: {e}");
+                return;
+            }
+        };
+        if !self.fits("real round trip", 8 * so3fft::num_samples(b), &plan) {
+            return;
+        }
+        let mut coeffs = self.take_coeffs();
+        let t = Instant::now();
+        let mut grid = filled(so3fft::num_samples(b), 0.0f64);
+        eprintln!(
+            "  (real grid allocated and faulted in: {:.1} s)",
+            t.elapsed().as_secs_f64()
+        );
+        match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
+            Ok(row) => self.rows.push(row),
+            Err(e) => eprintln!("so3fft-bench: B = {b}: real round trip failed: {e}"),
+        }
+        self.coeffs = Some(coeffs);
+    }
+
+    fn real_round_trip(
+        &self,
+        plan: &Plan,
+        coeffs: &mut [Complex64],
+        grid: &mut [f64],
+    ) -> Result<Row, so3fft::Error> {
+        let b = self.b;
+        seeded::fill_real(self.real_seed(), b, coeffs);
+        let (inv, inv_mem) = timed_phase(|| plan.inverse_real_timed(coeffs, grid));
+        let inv: Timed = (inv.0, inv.1, inv.2?);
+        let (fwd, fwd_mem) = timed_phase(|| plan.forward_real_timed(grid, coeffs));
+        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
+        let error = seeded::compare_real(self.real_seed(), b, coeffs);
+        let arrays = (8 * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64;
+        let mut row = self.row(
+            Variant::Real,
+            inv,
+            fwd,
+            error,
+            fwd_mem.map(|p| Memory {
+                peak: p.peak,
+                start: p.start,
+                plan: plan.memory_bytes() as u64,
+                arrays,
+            }),
+            workload::dwt_flops_real(b),
+        );
+        row.ratio = self
+            .rows
+            .iter()
+            .find(|r| r.variant == Variant::Complex)
+            .map(|c| (row.fwd_median / c.fwd_median, row.inv_median / c.inv_median));
+        eprintln!(
+            "  (real: {})",
+            memory_summary(inv_mem, fwd_mem, arrays, plan)
+        );
+        Ok(row)
+    }
+
+    fn row(
+        &self,
+        variant: Variant,
+        inv: Timed,
+        fwd: Timed,
+        error: RoundTripError,
+        memory: Option<Memory>,
+        dwt_flops: u64,
+    ) -> Row {
+        let stages = |t: StageTimes| Stages {
+            fft: t.fft,
+            dwt: t.dwt,
+        };
+        Row {
+            variant,
+            bandwidth: self.b,
+            threads: self.threads,
+            runs: 1,
+            fwd_median: fwd.0,
+            inv_median: inv.0,
+            fwd: stages(fwd.2),
+            inv: stages(inv.2),
+            dwt_flops,
+            peak_1core: self.peak_1core,
+            max_abs_err: error.max_abs,
+            rel_l2_err: error.rel_l2,
+            memory,
+            ratio: None,
+            cpu: Some((fwd.1, inv.1)),
+        }
+    }
+}
+
+/// Wall and process CPU time of one transform, and the library's stage times.
+type Timed = (f64, f64, StageTimes);
+
+/// Runs `f` with the peak-memory counter reset first; returns its wall and CPU time and
+/// result, and the peak of the phase.
+fn timed_phase<R>(f: impl FnOnce() -> R) -> ((f64, f64, R), Option<memory::Phase>) {
+    memory::measure(|| {
+        let (cpu, t) = (crate::cpu_seconds(), Instant::now());
+        let r = f();
+        (t.elapsed().as_secs_f64(), crate::cpu_seconds() - cpu, r)
+    })
+}
+
+/// A vector of `n` copies of `value`, written in parallel (which also faults the pages in, so
+/// the first transform's time does not include that).
+pub fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
+    let mut v: Vec<T> = Vec::with_capacity(n);
+    v.spare_capacity_mut()
+        .par_chunks_mut(1 << 16)
+        .for_each(|c| {
+            c.iter_mut().for_each(|x| {
+                x.write(value);
+            })
+        });
+    // SAFETY: the first `n` elements were initialised just above.
+    unsafe { v.set_len(n) };
+    v
+}
+
+fn gb(bytes: usize) -> f64 {
+    bytes as f64 / 1e9
+}
+
+/// Peaks of both phases, the forward's against `arrays` bytes, and the plan's memory.
+fn memory_summary(
+    inv: Option<memory::Phase>,
+    fwd: Option<memory::Phase>,
+    arrays: u64,
+    plan: &Plan,
+) -> String {
+    format!(
+        "peak RSS during the inverse {}, during the forward {} = {} x (input + output = {:.3} GB); \
+         plan memory_bytes {:.3} GB, of which chunk buffer {:.3} GB",
+        phase_gb(inv),
+        phase_gb(fwd),
+        fwd.map_or("n/a".into(), |p| format!("{:.4}", p.peak as f64 / arrays as f64)),
+        arrays as f64 / 1e9,
+        gb(plan.memory_bytes()),
+        gb(plan.workspace_bytes()),
+    )
+}
+
+fn phase_gb(p: Option<memory::Phase>) -> String {
+    p.map_or("n/a".into(), |p| format!("{:.3} GB", p.peak as f64 / 1e9))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The whole lean procedure at a small bandwidth: three rows, exact round trips.
+    #[test]
+    fn lean_run_at_small_bandwidth() {
+        let opts = crate::cli::Options {
+            rigor: so3fft::Rigor::Estimate,
+            ..Default::default()
+        };
+        let out = run(24, 2, &opts, 100.0);
+        assert!(out.noskip_missing.is_none(), "{:?}", out.noskip_missing);
+        let variants: Vec<Variant> = out.rows.iter().map(|r| r.variant).collect();
+        assert_eq!(variants, [Variant::Complex, Variant::NoSkip, Variant::Real]);
+        for r in &out.rows {
+            assert!(r.max_abs_err < 1e-13 && r.rel_l2_err < 1e-14, "{r:?}");
+            assert!(
+                r.fwd.dwt > 0.0 && r.inv.fft > 0.0 && r.fwd_median > 0.0,
+                "{r:?}"
+            );
+            assert!(r.ratio.is_some() || r.variant == Variant::Complex, "{r:?}");
+        }
+        assert!(out.rows[0].memory.is_some());
+    }
+}
