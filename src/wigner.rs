@@ -38,6 +38,7 @@ pub(crate) struct Ext {
 }
 
 /// `x = m * 2^e` with `m` in `[0.5, 1)`; `(0, 0)` for zero. `x` must be finite.
+#[inline]
 fn frexp(x: f64) -> (f64, i64) {
     if x == 0.0 {
         return (0.0, 0);
@@ -54,6 +55,7 @@ fn frexp(x: f64) -> (f64, i64) {
 }
 
 /// `x * 2^n` for any `n` (results outside the double range saturate as IEEE does).
+#[inline]
 pub(crate) fn ldexp(mut x: f64, mut n: i64) -> f64 {
     while n > 1000 {
         x *= f64::from_bits((1023 + 1000) << 52);
@@ -104,6 +106,7 @@ impl Ext {
     /// The kernels' scaled form `(p, sc)` for skip threshold `2^-bits`: true value
     /// `= p * 2^(SCALE_STEP * sc)`, `sc = 0` if the value is at least `2^-bits`, else `p` in
     /// `[2^(-bits-1), big(bits))`.
+    #[inline]
     pub fn to_scaled(self, bits: u32) -> (f64, f64) {
         let active_bits = bits as i64;
         if self.mant == 0.0 {
