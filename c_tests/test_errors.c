@@ -159,6 +159,8 @@ static void bad_arrays(void) {
     CHECK_ERR(SO3FFT_ENULL);
     CHECK(so3fft_get_nthreads(NULL) == SO3FFT_ENULL);
     CHECK_ERR(SO3FFT_ENULL);
+    CHECK(so3fft_get_fft_threading(NULL) == SO3FFT_ENULL);
+    CHECK_ERR(SO3FFT_ENULL);
     so3fft_destroy_plan(NULL); /* no-op, not an error */
     CHECK_NO_ERR();
 

@@ -20,6 +20,12 @@ static void roundtrip(int B, unsigned flags, int nthreads) {
         CHECK(so3fft_get_bandwidth(p) == B);
         if (nthreads > 0) CHECK(so3fft_get_nthreads(p) == nthreads);
         CHECK(so3fft_get_nthreads(p) >= 1);
+        /* One thread or no measuring: slices across workers; else either variant. */
+        if (nthreads == 1 || !(flags & (SO3FFT_MEASURE | SO3FFT_PATIENT | SO3FFT_EXHAUSTIVE)))
+            CHECK(so3fft_get_fft_threading(p) == SO3FFT_FFT_SLICES_ACROSS_WORKERS);
+        else
+            CHECK(so3fft_get_fft_threading(p) == SO3FFT_FFT_SLICES_ACROSS_WORKERS ||
+                  so3fft_get_fft_threading(p) == SO3FFT_FFT_FFTW_THREADS);
         CHECK(so3fft_execute_inverse(p, c, s) == SO3FFT_OK);
         CHECK(memcmp(c, c0, nc * sizeof *c) == 0); /* input untouched */
         CHECK(so3fft_execute_forward(p, s, back) == SO3FFT_OK);

@@ -119,6 +119,18 @@
 #define SO3FFT_BOTH 3
 
 /**
+ * Returned by `so3fft_get_fft_threading`: each worker thread of the plan transforms whole
+ * beta slices with a single-threaded FFTW plan.
+ */
+#define SO3FFT_FFT_SLICES_ACROSS_WORKERS 1
+
+/**
+ * Returned by `so3fft_get_fft_threading`: the beta slices are transformed one after
+ * another, each on FFTW's own threads.
+ */
+#define SO3FFT_FFT_FFTW_THREADS 2
+
+/**
  * Success.
  */
 #define SO3FFT_OK 0
@@ -354,6 +366,19 @@ int so3fft_get_bandwidth(so3fft_plan p);
  * Requirements: `p` is NULL or a live plan.
  */
 int so3fft_get_nthreads(so3fft_plan p);
+
+/**
+ * How the FFT stage of a plan uses its threads: `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or
+ * `SO3FFT_FFT_FFTW_THREADS`; `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
+ *
+ * The planner chooses: with `SO3FFT_ESTIMATE` or one thread, slices across workers; with
+ * `SO3FFT_MEASURE`, `SO3FFT_PATIENT` or `SO3FFT_EXHAUSTIVE` and more than one thread, it
+ * plans both variants, times them on a sample of the FFT stage and keeps the faster.
+ * Real-signal transforms (`SO3FFT_REAL`) always spread slices across the workers.
+ *
+ * Requirements: `p` is NULL or a live plan.
+ */
+int so3fft_get_fft_threading(so3fft_plan p);
 
 /**
  * Number of samples `(2B)^3` at bandwidth `B`: the length of a sample array.

@@ -82,6 +82,13 @@ pub const SO3FFT_INVERSE: c_int = 2;
 /// Direction for `so3fft_plan_general`: both (no arrays; new-array execute only).
 pub const SO3FFT_BOTH: c_int = 3;
 
+/// Returned by `so3fft_get_fft_threading`: each worker thread of the plan transforms whole
+/// beta slices with a single-threaded FFTW plan.
+pub const SO3FFT_FFT_SLICES_ACROSS_WORKERS: c_int = 1;
+/// Returned by `so3fft_get_fft_threading`: the beta slices are transformed one after
+/// another, each on FFTW's own threads.
+pub const SO3FFT_FFT_FFTW_THREADS: c_int = 2;
+
 /// Success.
 pub const SO3FFT_OK: c_int = 0;
 /// Invalid argument: unknown flag bits, index or thread count out of range, direction
@@ -718,6 +725,25 @@ pub unsafe extern "C" fn so3fft_get_bandwidth(p: so3fft_plan) -> c_int {
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_nthreads(p: so3fft_plan) -> c_int {
     boundary(SO3FFT_ENULL, || Ok(plan_ref(p)?.plan.threads() as c_int))
+}
+
+/// How the FFT stage of a plan uses its threads: `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or
+/// `SO3FFT_FFT_FFTW_THREADS`; `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
+///
+/// The planner chooses: with `SO3FFT_ESTIMATE` or one thread, slices across workers; with
+/// `SO3FFT_MEASURE`, `SO3FFT_PATIENT` or `SO3FFT_EXHAUSTIVE` and more than one thread, it
+/// plans both variants, times them on a sample of the FFT stage and keeps the faster.
+/// Real-signal transforms (`SO3FFT_REAL`) always spread slices across the workers.
+///
+/// Requirements: `p` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_fft_threading(p: so3fft_plan) -> c_int {
+    boundary(SO3FFT_ENULL, || {
+        Ok(match plan_ref(p)?.plan.fft_threading() {
+            crate::FftThreading::FftwThreads => SO3FFT_FFT_FFTW_THREADS,
+            _ => SO3FFT_FFT_SLICES_ACROSS_WORKERS,
+        })
+    })
 }
 
 // ---------------------------------------------------------------------------------------

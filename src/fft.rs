@@ -145,10 +145,20 @@ static THREADS_OK: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool
 /// FFTW's thread count for new plans is process-wide: it is set only while this plan is
 /// made, under the planner lock, and the host's value is restored before the lock is
 /// released, so the host's FFTW settings are unchanged when we return.
-fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawPlan> {
+fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize, in_place: bool) -> Result<RawPlan> {
     // Planning may write to both arrays (FFTW_MEASURE): plan on scratch memory.
     let a = AlignedBuf::new(n * n)?;
-    let b = AlignedBuf::new(n * n)?;
+    let b = AlignedBuf::new(if in_place { 1 } else { n * n })?;
+    let out = if in_place {
+        a.as_mut_ptr()
+    } else {
+        b.as_mut_ptr()
+    };
+    let flags = if in_place {
+        flags
+    } else {
+        flags | ffi::FFTW_PRESERVE_INPUT
+    };
     let p = {
         let _g = planner_lock();
         unsafe {
@@ -166,14 +176,7 @@ fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawPlan
             } else {
                 None
             };
-            let p = ffi::fftw_plan_dft_2d(
-                n as i32,
-                n as i32,
-                a.as_mut_ptr(),
-                b.as_mut_ptr(),
-                sign,
-                flags | ffi::FFTW_PRESERVE_INPUT,
-            );
+            let p = ffi::fftw_plan_dft_2d(n as i32, n as i32, a.as_mut_ptr(), out, sign, flags);
             if let Some(host) = host {
                 ffi::fftw_plan_with_nthreads(host);
             }
@@ -191,21 +194,59 @@ pub(crate) const SIGN_PLUS: i32 = ffi::FFTW_BACKWARD as i32;
 /// `-1` is FFTW_FORWARD (used by the inverse SO(3) transform).
 pub(crate) const SIGN_MINUS: i32 = ffi::FFTW_FORWARD;
 
-/// Out-of-place `n x n` complex DFT of one beta slice (contiguous), usable on any arrays.
+/// Out-of-place `n x n` complex DFT of one beta slice (contiguous), usable on any arrays,
+/// optionally with an in-place plan as well.
 pub(crate) struct SliceFft {
     aligned: RawPlan,
     /// Plan for arrays not aligned as FFTW's SIMD code wants (FFTW_UNALIGNED, planned
     /// with FFTW_ESTIMATE: such arrays are rare, as any 16-byte aligned array qualifies).
     unaligned: RawPlan,
+    /// In-place plan for aligned arrays (see [`SliceFft::with_in_place`]).
+    in_place: Option<RawPlan>,
 }
 
 impl SliceFft {
     /// A plan for one slice; `nthreads > 1` makes it run on FFTW's own threads.
     pub fn new(n: usize, sign: i32, rigor: Rigor, nthreads: usize) -> Result<SliceFft> {
         Ok(SliceFft {
-            aligned: make_plan(n, sign, rigor.flags(), nthreads)?,
-            unaligned: make_plan(n, sign, ffi::FFTW_ESTIMATE | ffi::FFTW_UNALIGNED, nthreads)?,
+            aligned: make_plan(n, sign, rigor.flags(), nthreads, false)?,
+            unaligned: make_plan(
+                n,
+                sign,
+                ffi::FFTW_ESTIMATE | ffi::FFTW_UNALIGNED,
+                nthreads,
+                false,
+            )?,
+            in_place: None,
         })
+    }
+
+    /// Also plan the in-place transform (single-threaded), for [`SliceFft::in_place`].
+    pub fn with_in_place(mut self, n: usize, sign: i32, rigor: Rigor) -> Result<SliceFft> {
+        self.in_place = Some(make_plan(n, sign, rigor.flags(), 1, true)?);
+        Ok(self)
+    }
+
+    /// Whether [`SliceFft::with_in_place`] was used.
+    pub fn has_in_place(&self) -> bool {
+        self.in_place.is_some()
+    }
+
+    /// Transform `n*n` values in place at `data`; falls back on the out-of-place plan
+    /// through `tmp` when there is no in-place plan or `data` is not aligned.
+    ///
+    /// # Safety
+    /// `data` and `tmp` valid for `n*n` values, no overlap.
+    pub unsafe fn in_place(&self, data: *mut Complex64, tmp: *mut Complex64, n: usize) {
+        match &self.in_place {
+            Some(p) if ffi::fftw_alignment_of(data as *mut f64) == 0 => {
+                ffi::fftw_execute_dft(p.0, data, data)
+            }
+            _ => {
+                std::ptr::copy_nonoverlapping(data, tmp, n * n);
+                self.execute(tmp, data);
+            }
+        }
     }
 
     /// Transform `n*n` values from `inp` to `out`.
@@ -308,3 +349,119 @@ impl SliceFftReal {
         ffi::fftw_execute_dft_c2r(p.0, inp, out);
     }
 }
+
+/// Copy frequencies `fi0..fi1` of `4 * q` slices (slice `j` at `sp + j * nn`) into the
+/// pair-major rows `bp[fi * nb .. fi * nb + 4 * q]` with non-temporal stores: each row is
+/// `q` whole 64-byte cache lines, written without first being read from memory.
+///
+/// # Safety
+/// Every `bp + fi * nb` is 64-byte aligned, the extents are valid, no overlap. The stores are
+/// weakly ordered: this function ends with a store fence.
+#[cfg(target_arch = "x86_64")]
+pub(crate) unsafe fn to_pairs_stream4(
+    sp: *const Complex64,
+    nn: usize,
+    q: usize,
+    bp: *mut Complex64,
+    nb: usize,
+    fi0: usize,
+    fi1: usize,
+) {
+    use std::arch::x86_64::{_mm_loadu_pd, _mm_sfence, _mm_stream_pd};
+    for fi in fi0..fi1 {
+        for k in 0..q {
+            let s = sp.add(4 * k * nn + fi) as *const f64;
+            let d = bp.add(fi * nb + 4 * k) as *mut f64;
+            _mm_stream_pd(d, _mm_loadu_pd(s));
+            _mm_stream_pd(d.add(2), _mm_loadu_pd(s.add(2 * nn)));
+            _mm_stream_pd(d.add(4), _mm_loadu_pd(s.add(4 * nn)));
+            _mm_stream_pd(d.add(6), _mm_loadu_pd(s.add(6 * nn)));
+        }
+    }
+    _mm_sfence();
+}
+
+/// Portable stand-in for the x86-64 version (ordinary stores).
+///
+/// # Safety
+/// As for the x86-64 version.
+#[cfg(not(target_arch = "x86_64"))]
+pub(crate) unsafe fn to_pairs_stream4(
+    sp: *const Complex64,
+    nn: usize,
+    q: usize,
+    bp: *mut Complex64,
+    nb: usize,
+    fi0: usize,
+    fi1: usize,
+) {
+    for fi in fi0..fi1 {
+        for j in 0..4 * q {
+            *bp.add(fi * nb + j) = *sp.add(j * nn + fi);
+        }
+    }
+}
+
+/// Portable stand-in for the x86-64 version (an ordinary copy).
+///
+/// # Safety
+/// As for the x86-64 version.
+#[cfg(not(target_arch = "x86_64"))]
+pub(crate) unsafe fn stream_copy(src: *const Complex64, dst: *mut Complex64, len: usize) {
+    std::ptr::copy_nonoverlapping(src, dst, len);
+}
+
+/// Copy `len` complex values from `src` to `dst` with non-temporal stores.
+///
+/// # Safety
+/// `dst` is 16-byte aligned, both valid for `len` values, no overlap. Ends with a store fence.
+#[cfg(target_arch = "x86_64")]
+pub(crate) unsafe fn stream_copy(src: *const Complex64, dst: *mut Complex64, len: usize) {
+    use std::arch::x86_64::{_mm_loadu_pd, _mm_sfence, _mm_stream_pd};
+    let (s, d) = (src as *const f64, dst as *mut f64);
+    for i in 0..len {
+        _mm_stream_pd(d.add(2 * i), _mm_loadu_pd(s.add(2 * i)));
+    }
+    _mm_sfence();
+}
+
+/// The reverse of [`to_pairs_stream4`]: rows `bp[fi * nb .. fi * nb + 4 * q]` for `fi0..fi1`
+/// into `4 * q` slices at `sp + j * nn`. The rows are `nb` values apart, so consecutive rows
+/// lie on different pages and the hardware prefetchers do not follow them: each row is
+/// prefetched `PREFETCH_ROWS` rows ahead.
+///
+/// # Safety
+/// The extents are valid, no overlap.
+pub(crate) unsafe fn from_pairs4(
+    sp: *mut Complex64,
+    nn: usize,
+    q: usize,
+    bp: *const Complex64,
+    nb: usize,
+    fi0: usize,
+    fi1: usize,
+) {
+    for fi in fi0..fi1 {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            // wrapping_add: a hint past the end never faults.
+            let ahead = bp.wrapping_add((fi + PREFETCH_ROWS) * nb) as *const i8;
+            for k in 0..q {
+                _mm_prefetch::<_MM_HINT_T0>(ahead.wrapping_add(64 * k));
+                _mm_prefetch::<_MM_HINT_T0>(ahead.wrapping_add(64 * k + 63));
+            }
+        }
+        for k in 0..q {
+            let r = bp.add(fi * nb + 4 * k);
+            let s = sp.add(4 * k * nn + fi);
+            *s = *r;
+            *s.add(nn) = *r.add(1);
+            *s.add(2 * nn) = *r.add(2);
+            *s.add(3 * nn) = *r.add(3);
+        }
+    }
+}
+
+/// Rows prefetched ahead by [`from_pairs4`].
+pub(crate) const PREFETCH_ROWS: usize = 16;

@@ -8,8 +8,9 @@
 
 use crate::dwt::{self, Lanes, Rec};
 use crate::error::{Error, Result};
-use crate::fft::{AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
+use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
 
+mod fft_tune;
 mod real;
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
 use crate::simd::Isa;
@@ -70,19 +71,42 @@ pub struct PlanOptions {
 /// How the FFT stage is parallelised.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FftThreading {
-    /// Library's choice. Currently slices across workers: with the pair-major copy that
-    /// follows each slice FFT it was faster than FFTW's threads at every bandwidth measured
-    /// on the development machine (B = 256, two threads: inverse FFT stage 0.53 s against
-    /// 0.92 s).
+    /// Library's choice, made when the plan is created.
+    ///
+    /// - With [`Rigor::Estimate`] (no measuring), or with one thread: slices across workers.
+    ///   With the pair-major copy that follows each slice FFT this was faster than FFTW's
+    ///   threads at every bandwidth measured on the development machine.
+    /// - With [`Rigor::Measure`], [`Rigor::Patient`] or [`Rigor::Exhaustive`] and more than
+    ///   one thread: both variants are planned and timed, and the faster one is kept
+    ///   ([`Plan::fft_threading`] tells which). The timed work is the FFT stage, for every
+    ///   direction the plan has, of the first `2 * threads` slice groups of a chunk (up to
+    ///   4 or 8 slices per group), on a scratch array standing in for the samples and on
+    ///   the plan's own chunk buffer, so the transposition into the chunk runs with its
+    ///   real stride. The variants alternate over three rounds and each is judged by its
+    ///   fastest round (interference from other processes only adds time); FFTW's threads
+    ///   are kept only when at least 3% faster, as slices across workers balance their
+    ///   load dynamically and suffer less from other processes on the machine. This costs a few
+    ///   percent of one transform on top of FFTW's own planning of the second variant; the
+    ///   scratch array is freed before [`Plan::new`] returns. When the other variant cannot
+    ///   be planned, or the scratch array would take more than a quarter of the available
+    ///   memory, the plan keeps slices across workers.
+    ///
+    ///   Measuring plans the FFTW-threaded variant, with the effects on FFTW's global state
+    ///   described under [`FftThreading::FftwThreads`], even when it is not kept.
+    ///
+    /// The real-signal transforms ([`PlanOptions::real`]) always spread slices across the
+    /// workers.
     #[default]
     Auto,
     /// Each worker transforms whole beta slices with a single-threaded FFTW plan.
     SlicesAcrossWorkers,
-    /// Slices one after another, each on FFTW's own threads (`fftw3_threads`). Making such a
-    /// plan calls `fftw_init_threads` once and sets FFTW's process-wide thread count for new
+    /// Slices one after another, each on FFTW's own threads (`fftw3_threads`); the copies
+    /// into and out of the chunk buffer are spread over the workers. Making such a plan
+    /// calls `fftw_init_threads` once and sets FFTW's process-wide thread count for new
     /// plans, restoring the previous value before returning. Our own planner calls are
     /// serialised, but a host thread that plans an FFTW transform at that same moment may
-    /// pick up this thread count. The default (`Auto`) never does any of this.
+    /// pick up this thread count. `Auto` does this only when it measures (see above).
+    /// With one thread this is the same as `SlicesAcrossWorkers`.
     FftwThreads,
 }
 
@@ -131,8 +155,10 @@ pub struct Plan {
     fftw_threaded: bool,
     /// Low beta slices per chunk.
     chunk: usize,
-    /// Slices per FFT group.
+    /// Slices per FFT group (inverse and real transforms).
     group: usize,
+    /// Slices per FFT group of the complex forward transform (see [`fft_group_forward`]).
+    fwd_group: usize,
     /// Bytes this plan holds.
     memory: usize,
     /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
@@ -243,6 +269,18 @@ fn fft_group(b: usize) -> usize {
     ((64usize << 20) / slice_bytes).clamp(1, 4)
 }
 
+/// Slices per group of the complex forward transform: 8 (two cache lines per pair-major
+/// row) while they take at most 64 MiB, else as [`fft_group`]. Measured at B = 128 on two
+/// threads: forward FFT stage 10% faster than with 4; the inverse gains nothing from it.
+fn fft_group_forward(b: usize) -> usize {
+    let (g, slice_bytes) = (fft_group(b), 64 * b * b);
+    if g == 4 && 8 * slice_bytes <= 64 << 20 {
+        8
+    } else {
+        g
+    }
+}
+
 /// Lock a free entry of `pool`, trying the current worker's own first; `None` if all are
 /// in use (possible only when one plan is executed from several threads at once).
 fn lock_free<T>(pool: &[Mutex<T>]) -> Option<std::sync::MutexGuard<'_, T>> {
@@ -287,6 +325,7 @@ fn default_workspace(b: usize, real: bool) -> usize {
 struct Layout {
     chunk: usize,
     group: usize,
+    fwd_group: usize,
     chunk_bytes: usize,
     fft_scratch_bytes: usize,
     table_bytes: usize,
@@ -297,6 +336,7 @@ impl Layout {
         let slice_bytes = 64 * b * b;
         let chunk = (budget / (2 * slice_bytes)).clamp(1, b);
         let group = fft_group(b);
+        let fwd_group = fft_group_forward(b);
         // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
         // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list, per-worker DWT scratch.
         let table_bytes = 16 * (b + 1) * (b + 2)
@@ -307,9 +347,11 @@ impl Layout {
         Layout {
             chunk,
             group,
+            fwd_group,
             chunk_bytes: 2 * chunk * slice_bytes,
-            // One slice more than a group: room for packing real samples (real path).
-            fft_scratch_bytes: threads * (group + 1) * slice_bytes,
+            // One slice more than a group: room for packing real samples (real path) and
+            // for the inverse FFT's output.
+            fft_scratch_bytes: threads * (group.max(fwd_group) + 1) * slice_bytes,
             table_bytes,
         }
     }
@@ -321,7 +363,19 @@ impl Layout {
 
 impl Plan {
     /// Make a plan for bandwidth `bandwidth` (1 ..= [`MAX_BANDWIDTH`]).
+    ///
+    /// With [`FftThreading::Auto`], a measuring rigour and more than one thread, this also
+    /// times both ways of threading the FFT stage and keeps the faster one (see
+    /// [`FftThreading::Auto`]; [`Plan::fft_threading`] tells which).
     pub fn new(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+        let mut plan = Plan::build(bandwidth, options)?;
+        plan.tune_fft_threading(options);
+        Ok(plan)
+    }
+
+    /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`] (which then
+    /// means slices across workers).
+    fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
         let b = bandwidth;
         if b == 0 || b > MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -406,7 +460,14 @@ impl Plan {
             };
         let fftw_threads = if fftw_threaded { threads } else { 1 };
         let fwd_fft = if want_fwd {
-            Some(SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads)?)
+            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads)?;
+            // Slices across workers copy each slice into their cache-resident scratch and
+            // transform it there (see `Plan::fft_group`).
+            Some(if fftw_threaded {
+                p
+            } else {
+                p.with_in_place(n, SIGN_PLUS, options.rigor)?
+            })
         } else {
             None
         };
@@ -425,7 +486,9 @@ impl Plan {
             None
         };
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new((layout.group + 1) * n * n).map(Mutex::new))
+            .map(|_| {
+                AlignedBuf::new((layout.group.max(layout.fwd_group) + 1) * n * n).map(Mutex::new)
+            })
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -463,6 +526,7 @@ impl Plan {
             fftw_threaded,
             chunk,
             group: layout.group,
+            fwd_group: layout.fwd_group,
             memory: layout.total(),
             skip_bits,
             skip,
@@ -494,6 +558,17 @@ impl Plan {
         self.isa
     }
 
+    /// How the FFT stage of the complex transforms uses the threads: the resolved variant,
+    /// never [`FftThreading::Auto`]. With one thread this is always
+    /// [`FftThreading::SlicesAcrossWorkers`] (FFTW's threads are not used).
+    pub fn fft_threading(&self) -> FftThreading {
+        if self.fftw_threaded {
+            FftThreading::FftwThreads
+        } else {
+            FftThreading::SlicesAcrossWorkers
+        }
+    }
+
     /// `(2B)^3`.
     pub fn num_samples(&self) -> usize {
         num_samples(self.b)
@@ -506,7 +581,8 @@ impl Plan {
 
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: `2h (2B)^2 16` for the chunk buffer (below) plus
-    /// `threads * (g + 1) * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`)
+    /// `threads * (g + 1) * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`,
+    /// or 8 when that is 4 and 8 slices take at most 64 MiB, i.e. for `B <= 362`)
     /// plus `O(B^2)` tables. A transform needs the caller's arrays on top
     /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
@@ -710,19 +786,22 @@ impl Plan {
         let _ = (cl, nb, buf, coef);
     }
 
-    /// Run `f` with a per-worker FFT scratch buffer (`group + 1` slices). A worker may take
+    /// Run `f` with a per-worker FFT scratch buffer (`max(group, fwd_group) + 1` slices). A worker may take
     /// on another execution's group while it waits inside a parallel copy, so buffers are
     /// taken by try_lock, never by blocking; when all are busy a private one is allocated.
     fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
         match lock_free(&self.fft_scratch) {
             Some(g) => f(&g),
-            None => f(&AlignedBuf::new((self.group + 1) * 4 * self.b * self.b)?),
+            None => f(&AlignedBuf::new(
+                (self.group.max(self.fwd_group) + 1) * 4 * self.b * self.b,
+            )?),
         }
     }
 
     /// FFT stage of one chunk. Forward: slices `ks[s]` of `grid` are transformed and
     /// transposed into the pair-major chunk buffer (`buf[fi * nb + s]`). Inverse: the
-    /// reverse, into `grid`. Groups of `self.group` slots are spread over the workers.
+    /// reverse, into `grid`. Groups of `self.fwd_group` (forward) or `self.group` (inverse)
+    /// slots are spread over the workers.
     fn fft_chunk(
         &self,
         ch: &Chunk,
@@ -736,10 +815,37 @@ impl Plan {
             self.inv_fft.as_ref()
         }
         .ok_or(Error::WrongDirection)?;
+        let group = if forward { self.fwd_group } else { self.group };
+        let ngroups = ch.ks.len().div_ceil(group);
+        self.fft_groups(
+            ch,
+            fft,
+            self.fftw_threaded,
+            forward,
+            grid,
+            buf,
+            group,
+            ngroups,
+        )
+    }
+
+    /// The first `ngroups` groups of `group` slots of [`Plan::fft_chunk`] with the slice plan `fft`:
+    /// with `fftw_threaded`, groups one after another (`fft` runs on FFTW's threads and
+    /// the copies are spread over the workers), else groups spread over the workers.
+    #[allow(clippy::too_many_arguments)]
+    fn fft_groups(
+        &self,
+        ch: &Chunk,
+        fft: &SliceFft,
+        fftw_threaded: bool,
+        forward: bool,
+        grid: *mut Complex64,
+        buf: *mut Complex64,
+        group: usize,
+        ngroups: usize,
+    ) -> Result<()> {
         let nb = ch.ks.len();
         let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        let group = self.group;
-        let ngroups = nb.div_ceil(group);
         let run = |gi: usize, parallel_copy: bool| -> Result<()> {
             let s0 = gi * group;
             let g = group.min(nb - s0);
@@ -758,7 +864,7 @@ impl Plan {
                 )
             })
         };
-        if self.fftw_threaded {
+        if fftw_threaded {
             // FFTW parallelises each slice; the copies are spread over the workers.
             (0..ngroups).try_for_each(|gi| run(gi, true))
         } else {
@@ -788,6 +894,13 @@ impl Plan {
         let nb = ch.ks.len();
         let spp = SyncPtr(sp);
         // Copy frequencies fi0..fi1 between the slice-major scratch and the pair-major buffer.
+        // Separate monomorphic loops for each case: a run-time switch inside one loop was
+        // measured to halve its speed. With 4 slots starting on a cache line (the usual
+        // case), each row is one whole line: written with non-temporal stores (no read of
+        // the line first), or read with a software prefetch (see `fft::from_pairs4`).
+        let lines = g.is_multiple_of(4)
+            && nb.is_multiple_of(4)
+            && (buf.get().add(s0) as usize).is_multiple_of(64);
         let to_pairs = |fi0: usize, fi1: usize| {
             let (sp, bp) = (spp.get(), buf.get());
             for fi in fi0..fi1 {
@@ -796,6 +909,9 @@ impl Plan {
                 }
             }
         };
+        let to_pairs4 = |fi0: usize, fi1: usize| {
+            fft::to_pairs_stream4(spp.get(), nn, g / 4, buf.get().add(s0), nb, fi0, fi1);
+        };
         let from_pairs = |fi0: usize, fi1: usize| {
             let (sp, bp) = (spp.get(), buf.get());
             for fi in fi0..fi1 {
@@ -803,6 +919,9 @@ impl Plan {
                     *sp.add(j * nn + fi) = *bp.add(fi * nb + s0 + j);
                 }
             }
+        };
+        let from_pairs4 = |fi0: usize, fi1: usize| {
+            fft::from_pairs4(spp.get(), nn, g / 4, buf.get().add(s0), nb, fi0, fi1);
         };
         const STEP: usize = 1 << 14;
         let copy_all = |copy: &(dyn Fn(usize, usize) + Sync)| {
@@ -816,11 +935,25 @@ impl Plan {
         };
         if forward {
             for j in 0..g {
-                fft.execute(grid.get().add(ch.ks[s0 + j] * nn), sp.add(j * nn));
+                let src = grid.get().add(ch.ks[s0 + j] * nn);
+                if fft.has_in_place() {
+                    // Copied first (a sequential read the prefetchers follow), then
+                    // transformed in the cache: faster than FFTW reading the samples.
+                    std::ptr::copy_nonoverlapping(src, sp.add(j * nn), nn);
+                    fft.in_place(sp.add(j * nn), sp.add(g * nn), n);
+                } else {
+                    fft.execute(src, sp.add(j * nn));
+                }
             }
-            copy_all(&to_pairs);
+            copy_all(if lines { &to_pairs4 } else { &to_pairs });
         } else {
-            copy_all(&from_pairs);
+            copy_all(if g.is_multiple_of(4) {
+                &from_pairs4
+            } else {
+                &from_pairs
+            });
+            // The spare slice after the group (the scratch holds `group + 1`).
+            let spare = sp.add(g * nn);
             for j in 0..g {
                 let slot = sp.add(j * nn);
                 // Frequency B (alpha or gamma) is outside the band limit.
@@ -828,7 +961,15 @@ impl Plan {
                     *slot.add(b * n + i) = Complex64::new(0.0, 0.0);
                     *slot.add(i * n + b) = Complex64::new(0.0, 0.0);
                 }
-                fft.execute(slot, grid.get().add(ch.ks[s0 + j] * nn));
+                let dst = grid.get().add(ch.ks[s0 + j] * nn);
+                if (dst as usize).is_multiple_of(16) {
+                    // Into the cache-resident spare slice, then streamed to the samples:
+                    // FFTW's own stores would first read every line of `dst` from memory.
+                    fft.execute(slot, spare);
+                    fft::stream_copy(spare, dst, nn);
+                } else {
+                    fft.execute(slot, dst);
+                }
             }
         }
         Ok(())
