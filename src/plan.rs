@@ -436,7 +436,7 @@ impl Plan {
             };
         let fftw_threads = if fftw_threaded { threads } else { 1 };
         let fwd_fft = if want_fwd {
-            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads)?;
+            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads, true)?;
             // Slices across workers copy each slice into their cache-resident scratch and
             // transform it there (see `Plan::fft_group`).
             Some(if fftw_threaded {
@@ -448,7 +448,14 @@ impl Plan {
             None
         };
         let inv_fft = if want_inv {
-            Some(SliceFft::new(n, SIGN_MINUS, options.rigor, fftw_threads)?)
+            // The inverse transforms the per-worker scratch, which it may overwrite.
+            Some(SliceFft::new(
+                n,
+                SIGN_MINUS,
+                options.rigor,
+                fftw_threads,
+                false,
+            )?)
         } else {
             None
         };
@@ -868,9 +875,10 @@ impl Plan {
         let spp = SyncPtr(sp);
         // Copy frequencies fi0..fi1 between the slice-major scratch and the pair-major buffer.
         // Separate monomorphic loops for each case: a run-time switch inside one loop was
-        // measured to halve its speed. With 4 slots starting on a cache line (the usual
-        // case), each row is one whole line: written with non-temporal stores (no read of
-        // the line first), or read with a software prefetch (see `fft::from_pairs4`).
+        // measured to halve its speed. With a multiple of 4 slots starting on a cache line
+        // (the usual case), each row of the group is whole lines: written with
+        // non-temporal stores (no read of the lines first), or read with a software
+        // prefetch (see `fft::from_pairs4`).
         let lines = g.is_multiple_of(4)
             && nb.is_multiple_of(4)
             && (buf.get().add(s0) as usize).is_multiple_of(64);
