@@ -76,17 +76,20 @@ pub enum FftThreading {
     /// - With [`Rigor::Measure`], [`Rigor::Patient`] or [`Rigor::Exhaustive`] and more than
     ///   one thread: both variants are planned and timed, and the faster one is kept
     ///   ([`Plan::fft_threading`] tells which). The timed work is the FFT stage, for every
-    ///   direction the plan has, of the first `2 * threads` slice groups of a chunk (up to
-    ///   4 or 8 slices per group), on a scratch array standing in for the samples and on
-    ///   the plan's own chunk buffer, so the transposition into the chunk runs with its
-    ///   real stride. The variants alternate over three rounds and each is judged by its
-    ///   fastest round (interference from other processes only adds time); FFTW's threads
-    ///   are kept only when at least 3% faster, as slices across workers balance their
-    ///   load dynamically and suffer less from other processes on the machine. This costs a few
-    ///   percent of one transform on top of FFTW's own planning of the second variant; the
-    ///   scratch array is freed before [`Plan::new`] returns. When the other variant cannot
-    ///   be planned, or the scratch array would take more than a quarter of the available
-    ///   memory, the plan keeps slices across workers.
+    ///   direction the plan has, of the first slice groups of a chunk (one group of 4 or 8
+    ///   slices per worker), on a scratch array standing in for the samples and on the
+    ///   plan's own chunk buffer, so the transposition into the chunk runs with its real
+    ///   stride. The variants alternate for up to two rounds (one when they differ by
+    ///   more than 25%) and each is judged by its fastest round (interference from other
+    ///   processes only adds time); FFTW's threads are kept only when at least 3% faster,
+    ///   as slices across workers balance their load dynamically and suffer less from other
+    ///   processes on the machine. On the development machine (two cores) this added about
+    ///   5 ms to plan creation at B = 64, 15 to 40 ms at B = 128 and 0.1 to 0.2 s at
+    ///   B = 256 (one transform takes about 0.01, 0.09 and 1.1 s there), plus FFTW's
+    ///   planning of the second variant: 0.2 to 0.5 s the first time at each bandwidth
+    ///   with `Rigor::Measure`. The scratch array is freed before [`Plan::new`] returns.
+    ///   When the other variant cannot be planned, or the scratch array would take more
+    ///   than a quarter of the available memory, the plan keeps slices across workers.
     ///
     ///   Measuring plans the FFTW-threaded variant, with the effects on FFTW's global state
     ///   described under [`FftThreading::FftwThreads`], even when it is not kept.

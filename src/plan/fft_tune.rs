@@ -2,18 +2,23 @@
 //!
 //! With a measuring rigour (`Rigor::Measure` or stronger), more than one thread and
 //! `FftThreading::Auto`, [`Plan::new`] builds the slice plans of both variants and times
-//! them on a sample of the real work: the FFT stage of the first few slice groups of a
-//! chunk (`2 * threads` groups, the least that gives every worker two groups), on a scratch
-//! array standing in for the sample grid and on the plan's own chunk buffer, so the
-//! pair-major copy runs with the real stride. Rounds alternate between the variants and
-//! each keeps its fastest round (interference from other processes only ever adds time);
-//! the faster variant is kept (FFTW's threads need a margin of [`FFTW_MARGIN`]) and the
-//! other's FFTW plans are destroyed.
+//! them on a sample of the real work: the FFT stage, for each direction the plan has, of
+//! the first slice groups of a chunk (one group per worker), on a scratch array standing in
+//! for the sample grid and on the plan's own chunk buffer, so the pair-major copy runs
+//! with the real stride. FFTW's threads are started by one untimed slice transform first.
+//! Rounds alternate between the variants and each keeps its fastest round (interference
+//! from other processes only ever adds time); after a round that shows a difference of
+//! more than [`CLEAR`], no more are run, else up to [`ROUNDS`]. The faster variant is kept
+//! (FFTW's threads need a margin of [`FFTW_MARGIN`]) and the other's FFTW plans are
+//! destroyed.
 
 use super::*;
 
-/// Timed rounds per variant (the fastest of them counts).
-const ROUNDS: usize = 3;
+/// Timed rounds per variant, at most (the fastest of them counts).
+const ROUNDS: usize = 2;
+
+/// Ratio of the two times beyond which no further round is run.
+const CLEAR: f64 = 1.25;
 
 /// FFTW's threads are kept only when faster by at least this fraction: within the noise
 /// of the measurement, slices across workers are preferred, as they balance their load
@@ -68,13 +73,12 @@ impl Plan {
         let n = 2 * self.b;
         // Slots of a full chunk (the first chunk always is one).
         let nb = 2 * self.chunk;
-        // Groups per direction; the sample grid holds the larger set of slices.
-        let ngroups = |group: usize| (2 * self.threads).min(nb.div_ceil(group));
-        let slices = [self.fwd_group, self.group]
-            .map(|g| (ngroups(g) * g).min(nb))
-            .into_iter()
-            .max()
-            .unwrap_or(1);
+        // One group per worker and direction. The sample grid holds the slices the inverse
+        // groups write (distinct, as the groups run concurrently); the forward groups,
+        // which may be larger, read them cyclically. (Mapping fresh memory costs more
+        // than the measurement itself when transparent huge pages must be compacted.)
+        let ngroups = |group: usize| self.threads.min(nb.div_ceil(group));
+        let slices = (ngroups(self.group) * self.group).min(nb);
         let bytes = slices * n * n * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {
             return None;
@@ -93,6 +97,12 @@ impl Plan {
         let g = SyncPtr(grid.as_mut_ptr());
         self.with_buf(|buf| {
             self.pool().install(|| {
+                // Start FFTW's threads (created on a plan's first execution) untimed.
+                if let Some(fft) = fwd.or(inv) {
+                    let sp = buf.as_mut_ptr();
+                    // SAFETY: the sample grid and the chunk buffer hold at least one slice.
+                    unsafe { fft.execute(sp, g.get()) };
+                }
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -116,6 +126,10 @@ impl Plan {
                             }
                         }
                         best[v] = best[v].min(t.elapsed().as_secs_f64());
+                    }
+                    // A clear difference needs no more rounds.
+                    if best[0].max(best[1]) > CLEAR * best[0].min(best[1]) {
+                        break;
                     }
                 }
                 Ok(())
