@@ -79,12 +79,12 @@ pub enum FftThreading {
     ///   direction the plan has, of the first slice groups of a chunk (one group of 4 or 8
     ///   slices per worker), on a scratch array standing in for the samples and on the
     ///   plan's own chunk buffer, so the transposition into the chunk runs with its real
-    ///   stride. The variants alternate for up to two rounds (one when they differ by
+    ///   stride. The variants alternate for up to three rounds (one when they differ by
     ///   more than 25%) and each is judged by its fastest round (interference from other
-    ///   processes only adds time); FFTW's threads are kept only when at least 3% faster,
+    ///   processes only adds time); FFTW's threads are kept only when at least 10% faster,
     ///   as slices across workers balance their load dynamically and suffer less from other
     ///   processes on the machine. On the development machine (two cores) this added about
-    ///   5 ms to plan creation at B = 64, 15 to 40 ms at B = 128 and 0.1 to 0.2 s at
+    ///   5 ms to plan creation at B = 64, 15 to 60 ms at B = 128 and 0.1 to 0.25 s at
     ///   B = 256 (one transform takes about 0.01, 0.09 and 1.1 s there), plus FFTW's
     ///   planning of the second variant: 0.2 to 0.5 s the first time at each bandwidth
     ///   with `Rigor::Measure`. The scratch array is freed before [`Plan::new`] returns.
