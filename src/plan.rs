@@ -79,17 +79,20 @@ pub enum FftThreading {
     /// - With [`Rigor::Measure`], [`Rigor::Patient`] or [`Rigor::Exhaustive`] and more than
     ///   one thread: both variants are planned and timed, and the faster one is kept
     ///   ([`Plan::fft_threading`] tells which). The timed work is the FFT stage, for every
-    ///   direction the plan has, of the first `2 * threads` slice groups of a chunk (up to
-    ///   4 or 8 slices per group), on a scratch array standing in for the samples and on
-    ///   the plan's own chunk buffer, so the transposition into the chunk runs with its
-    ///   real stride. The variants alternate over three rounds and each is judged by its
-    ///   fastest round (interference from other processes only adds time); FFTW's threads
-    ///   are kept only when at least 3% faster, as slices across workers balance their
-    ///   load dynamically and suffer less from other processes on the machine. This costs a few
-    ///   percent of one transform on top of FFTW's own planning of the second variant; the
-    ///   scratch array is freed before [`Plan::new`] returns. When the other variant cannot
-    ///   be planned, or the scratch array would take more than a quarter of the available
-    ///   memory, the plan keeps slices across workers.
+    ///   direction the plan has, of the first slice groups of a chunk (one group of 4 or 8
+    ///   slices per worker), on a scratch array standing in for the samples and on the
+    ///   plan's own chunk buffer, so the transposition into the chunk runs with its real
+    ///   stride. The variants alternate for up to three rounds (one when they differ by
+    ///   more than 25%) and each is judged by its fastest round (interference from other
+    ///   processes only adds time); FFTW's threads are kept only when at least 10% faster,
+    ///   as slices across workers balance their load dynamically and suffer less from other
+    ///   processes on the machine. On the development machine (two cores) this added about
+    ///   5 ms to plan creation at B = 64, 15 to 60 ms at B = 128 and 0.1 to 0.25 s at
+    ///   B = 256 (one transform takes about 0.01, 0.09 and 1.1 s there), plus FFTW's
+    ///   planning of the second variant: 0.2 to 0.5 s the first time at each bandwidth
+    ///   with `Rigor::Measure`. The scratch array is freed before [`Plan::new`] returns.
+    ///   When the other variant cannot be planned, or the scratch array would take more
+    ///   than a quarter of the available memory, the plan keeps slices across workers.
     ///
     ///   Measuring plans the FFTW-threaded variant, with the effects on FFTW's global state
     ///   described under [`FftThreading::FftwThreads`], even when it is not kept.
@@ -460,7 +463,7 @@ impl Plan {
             };
         let fftw_threads = if fftw_threaded { threads } else { 1 };
         let fwd_fft = if want_fwd {
-            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads)?;
+            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads, true)?;
             // Slices across workers copy each slice into their cache-resident scratch and
             // transform it there (see `Plan::fft_group`).
             Some(if fftw_threaded {
@@ -472,7 +475,14 @@ impl Plan {
             None
         };
         let inv_fft = if want_inv {
-            Some(SliceFft::new(n, SIGN_MINUS, options.rigor, fftw_threads)?)
+            // The inverse transforms the per-worker scratch, which it may overwrite.
+            Some(SliceFft::new(
+                n,
+                SIGN_MINUS,
+                options.rigor,
+                fftw_threads,
+                false,
+            )?)
         } else {
             None
         };
@@ -895,9 +905,10 @@ impl Plan {
         let spp = SyncPtr(sp);
         // Copy frequencies fi0..fi1 between the slice-major scratch and the pair-major buffer.
         // Separate monomorphic loops for each case: a run-time switch inside one loop was
-        // measured to halve its speed. With 4 slots starting on a cache line (the usual
-        // case), each row is one whole line: written with non-temporal stores (no read of
-        // the line first), or read with a software prefetch (see `fft::from_pairs4`).
+        // measured to halve its speed. With a multiple of 4 slots starting on a cache line
+        // (the usual case), each row of the group is whole lines: written with
+        // non-temporal stores (no read of the lines first), or read with a software
+        // prefetch (see `fft::from_pairs4`).
         let lines = g.is_multiple_of(4)
             && nb.is_multiple_of(4)
             && (buf.get().add(s0) as usize).is_multiple_of(64);

@@ -2,23 +2,30 @@
 //!
 //! With a measuring rigour (`Rigor::Measure` or stronger), more than one thread and
 //! `FftThreading::Auto`, [`Plan::new`] builds the slice plans of both variants and times
-//! them on a sample of the real work: the FFT stage of the first few slice groups of a
-//! chunk (`2 * threads` groups, the least that gives every worker two groups), on a scratch
-//! array standing in for the sample grid and on the plan's own chunk buffer, so the
-//! pair-major copy runs with the real stride. Rounds alternate between the variants and
-//! each keeps its fastest round (interference from other processes only ever adds time);
-//! the faster variant is kept (FFTW's threads need a margin of [`FFTW_MARGIN`]) and the
-//! other's FFTW plans are destroyed.
+//! them on a sample of the real work: the FFT stage, for each direction the plan has, of
+//! the first slice groups of a chunk (one group per worker), on a scratch array standing in
+//! for the sample grid and on the plan's own chunk buffer, so the pair-major copy runs
+//! with the real stride. FFTW's threads are started by one untimed slice transform first.
+//! Rounds alternate between the variants and each keeps its fastest round (interference
+//! from other processes only ever adds time); after a round that shows a difference of
+//! more than [`CLEAR`], no more are run, else up to [`ROUNDS`]. The faster variant is kept
+//! (FFTW's threads need a margin of [`FFTW_MARGIN`]) and the other's FFTW plans are
+//! destroyed.
 
 use super::*;
 
-/// Timed rounds per variant (the fastest of them counts).
+/// Timed rounds per variant, at most (the fastest of them counts).
 const ROUNDS: usize = 3;
+
+/// Ratio of the two times beyond which no further round is run.
+const CLEAR: f64 = 1.25;
 
 /// FFTW's threads are kept only when faster by at least this fraction: within the noise
 /// of the measurement, slices across workers are preferred, as they balance their load
-/// dynamically (a core taken by another process delays a worker, not every slice).
-const FFTW_MARGIN: f64 = 0.03;
+/// dynamically (a core taken by another process delays a worker, not every slice). With
+/// a margin of 3%, one of the plans made at B = 256 on the (shared) development machine
+/// kept FFTW's threads, whose whole FFT stage is 14% slower there.
+const FFTW_MARGIN: f64 = 0.1;
 
 impl Plan {
     /// Resolve [`FftThreading::Auto`] by measurement (see the module documentation). Does
@@ -36,7 +43,7 @@ impl Plan {
         let n = 2 * self.b;
         let plan_threaded = |have: bool, sign: i32| -> Result<Option<SliceFft>> {
             if have {
-                SliceFft::new(n, sign, options.rigor, self.threads).map(Some)
+                SliceFft::new(n, sign, options.rigor, self.threads, sign == SIGN_PLUS).map(Some)
             } else {
                 Ok(None)
             }
@@ -68,13 +75,12 @@ impl Plan {
         let n = 2 * self.b;
         // Slots of a full chunk (the first chunk always is one).
         let nb = 2 * self.chunk;
-        // Groups per direction; the sample grid holds the larger set of slices.
-        let ngroups = |group: usize| (2 * self.threads).min(nb.div_ceil(group));
-        let slices = [self.fwd_group, self.group]
-            .map(|g| (ngroups(g) * g).min(nb))
-            .into_iter()
-            .max()
-            .unwrap_or(1);
+        // One group per worker and direction. The sample grid holds the slices the inverse
+        // groups write (distinct, as the groups run concurrently); the forward groups,
+        // which may be larger, read them cyclically. (Mapping fresh memory costs more
+        // than the measurement itself when transparent huge pages must be compacted.)
+        let ngroups = |group: usize| self.threads.min(nb.div_ceil(group));
+        let slices = (ngroups(self.group) * self.group).min(nb);
         let bytes = slices * n * n * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {
             return None;
@@ -93,6 +99,12 @@ impl Plan {
         let g = SyncPtr(grid.as_mut_ptr());
         self.with_buf(|buf| {
             self.pool().install(|| {
+                // Start FFTW's threads (created on a plan's first execution) untimed.
+                if let Some(fft) = fwd.or(inv) {
+                    let sp = buf.as_mut_ptr();
+                    // SAFETY: the sample grid and the chunk buffer hold at least one slice.
+                    unsafe { fft.execute(sp, g.get()) };
+                }
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -117,6 +129,10 @@ impl Plan {
                         }
                         best[v] = best[v].min(t.elapsed().as_secs_f64());
                     }
+                    // A clear difference needs no more rounds.
+                    if best[0].max(best[1]) > CLEAR * best[0].min(best[1]) {
+                        break;
+                    }
                 }
                 Ok(())
             })
@@ -126,42 +142,41 @@ impl Plan {
     }
 }
 
-/// Test helper: wait (up to a minute) until both cores have been idle for 300 ms, so that
-/// timings are not taken while another process runs.
-#[cfg(test)]
-pub(crate) fn wait_idle() {
-    fn idle_total() -> (u64, u64) {
-        let s = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-        let v: Vec<u64> = s
-            .lines()
-            .next()
-            .unwrap_or("")
-            .split_whitespace()
-            .skip(1)
-            .filter_map(|x| x.parse().ok())
-            .collect();
-        if v.len() < 5 {
-            return (0, 0);
-        }
-        (v[3] + v[4], v.iter().sum())
-    }
-    let t0 = Instant::now();
-    while t0.elapsed().as_secs() < 60 {
-        let (i0, a0) = idle_total();
-        std::thread::sleep(std::time::Duration::from_millis(300));
-        let (i1, a1) = idle_total();
-        if a1 == a0 || (i1 - i0) as f64 >= 0.95 * (a1 - a0) as f64 {
-            return;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Test helper: wait (up to a minute) until both cores have been idle for 300 ms, so that
+    /// timings are not taken while another process runs.
+    fn wait_idle() {
+        fn idle_total() -> (u64, u64) {
+            let s = std::fs::read_to_string("/proc/stat").unwrap_or_default();
+            let v: Vec<u64> = s
+                .lines()
+                .next()
+                .unwrap_or("")
+                .split_whitespace()
+                .skip(1)
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            if v.len() < 5 {
+                return (0, 0);
+            }
+            (v[3] + v[4], v.iter().sum())
+        }
+        let t0 = Instant::now();
+        while t0.elapsed().as_secs() < 60 {
+            let (i0, a0) = idle_total();
+            std::thread::sleep(std::time::Duration::from_millis(300));
+            let (i1, a1) = idle_total();
+            if a1 == a0 || (i1 - i0) as f64 >= 0.95 * (a1 - a0) as f64 {
+                return;
+            }
+        }
+    }
+
     /// Whole FFT stage (every chunk) of one direction on `grid`, in seconds.
-    pub(super) fn fft_stage(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> f64 {
+    fn fft_stage(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> f64 {
         let g = SyncPtr(grid.as_mut_ptr());
         let t = Instant::now();
         plan.with_buf(|buf| {
@@ -241,424 +256,41 @@ mod tests {
             }
         }
     }
-}
 
-#[cfg(test)]
-mod experiments {
-    use super::*;
-
-    fn best(mut f: impl FnMut() -> f64, n: usize) -> f64 {
-        (0..n)
-            .map(|_| {
-                wait_idle();
-                f()
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// Whole FFT stage with smaller slice groups than the default (1 and 2 threads).
+    /// Repeated inverse (or forward, SO3FFT_FWD=1) FFT stages, for profiling.
     #[test]
     #[ignore]
-    fn fft_group_sizes() {
-        let bs: Vec<usize> = std::env::var("SO3FFT_B")
-            .unwrap_or("128,256".into())
-            .split(',')
-            .map(|x| x.trim().parse().unwrap())
-            .collect();
-        for b in bs {
-            let n = 2 * b;
-            let mut grid = vec![Complex64::new(1.0, 0.5); n * n * n];
-            for threads in [1, 2] {
-                let mut plan = Plan::new(
-                    b,
-                    &PlanOptions {
-                        threads,
-                        rigor: Rigor::Measure,
-                        fft_threading: FftThreading::SlicesAcrossWorkers,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
-                for g in [4, 8, 4, 8] {
-                    if g > plan.group {
-                        plan.fft_scratch = (0..threads)
-                            .map(|_| Mutex::new(AlignedBuf::new((g + 1) * n * n).unwrap()))
-                            .collect();
-                    }
-                    plan.group = g;
-                    plan.fwd_group = g;
-                    let mut tf = Vec::new();
-                    let mut ti = Vec::new();
-                    for _ in 0..3 {
-                        wait_idle();
-                        tf.push(tests::fft_stage(&plan, true, &mut grid));
-                        ti.push(tests::fft_stage(&plan, false, &mut grid));
-                    }
-                    let m = |v: &Vec<f64>| v.iter().cloned().fold(f64::INFINITY, f64::min);
-                    println!(
-                        "B={b} threads={threads} group={g}: fwd {:.4} inv {:.4}",
-                        m(&tf),
-                        m(&ti)
-                    );
-                }
-            }
+    fn fft_stage_loop() {
+        let b: usize = std::env::var("SO3FFT_B")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(128);
+        let threads: usize = std::env::var("SO3FFT_THREADS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(2);
+        let fwd = std::env::var("SO3FFT_FWD").is_ok();
+        let plan = Plan::new(
+            b,
+            &PlanOptions {
+                threads,
+                rigor: Rigor::Measure,
+                fft_threading: FftThreading::SlicesAcrossWorkers,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let n = 2 * b;
+        let mut grid = vec![Complex64::new(1.0, 0.5); n * n * n];
+        let t = Instant::now();
+        let mut k = 0;
+        while t.elapsed().as_secs_f64() < 5.0 {
+            fft_stage(&plan, fwd, &mut grid);
+            k += 1;
         }
-    }
-
-    /// Ways to run the slice FFTs of a whole stage (no pair-major copy), 1 and 2 threads.
-    #[test]
-    #[ignore]
-    fn fft_slice_variants() {
-        let bs: Vec<usize> = std::env::var("SO3FFT_B")
-            .unwrap_or("128,256".into())
-            .split(',')
-            .map(|x| x.trim().parse().unwrap())
-            .collect();
-        for b in bs {
-            let n = 2 * b;
-            let nn = n * n;
-            let fwd_ip = SliceFft::new(n, SIGN_PLUS, Rigor::Measure, 1)
-                .and_then(|p| p.with_in_place(n, SIGN_PLUS, Rigor::Measure))
-                .unwrap();
-            let inv_ip = SliceFft::new(n, SIGN_MINUS, Rigor::Measure, 1)
-                .and_then(|p| p.with_in_place(n, SIGN_MINUS, Rigor::Measure))
-                .unwrap();
-            let grid = AlignedBuf::new(n * nn).unwrap();
-            let gp = SyncPtr(grid.as_mut_ptr());
-            for threads in [1, 2] {
-                let plan = Plan::new(
-                    b,
-                    &PlanOptions {
-                        threads,
-                        rigor: Rigor::Measure,
-                        fft_threading: FftThreading::SlicesAcrossWorkers,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
-                let fft = plan.fwd_fft.as_ref().unwrap();
-                let ifft = plan.inv_fft.as_ref().unwrap();
-                let g = plan.group;
-                let stage = |f: &(dyn Fn(*mut Complex64, *mut Complex64, *mut Complex64)
-                                   + Sync)| {
-                    best(
-                        || {
-                            let t = Instant::now();
-                            plan.pool().install(|| {
-                                (0..n / g).into_par_iter().for_each(|gi| {
-                                    plan.with_fft_scratch(|s| {
-                                        for j in 0..g {
-                                            unsafe {
-                                                f(
-                                                    gp.get().add((gi * g + j) * nn),
-                                                    s.as_mut_ptr().add(j * nn),
-                                                    s.as_mut_ptr().add(g * nn),
-                                                )
-                                            };
-                                        }
-                                        Ok(())
-                                    })
-                                    .unwrap();
-                                })
-                            });
-                            t.elapsed().as_secs_f64()
-                        },
-                        3,
-                    )
-                };
-                let e1 = stage(&|gr, slot, _| unsafe { fft.execute(gr, slot) });
-                let e2 = stage(&|gr, slot, _| unsafe {
-                    std::ptr::copy_nonoverlapping(gr, slot, nn);
-                    fwd_ip.in_place(slot, std::ptr::null_mut(), n)
-                });
-                let e3 = stage(&|gr, slot, spare| unsafe {
-                    std::ptr::copy_nonoverlapping(gr, spare, nn);
-                    fft.execute(spare, slot)
-                });
-                let i0 = stage(&|gr, slot, _| unsafe { ifft.execute(slot, gr) });
-                let i1 = stage(&|gr, slot, spare| unsafe {
-                    ifft.execute(slot, spare);
-                    crate::fft::stream_copy(spare, gr, nn);
-                });
-                let i2 = stage(&|gr, slot, _| unsafe {
-                    inv_ip.in_place(slot, std::ptr::null_mut(), n);
-                    crate::fft::stream_copy(slot, gr, nn);
-                });
-                println!("B={b} threads={threads}: fwd: grid->slot {e1:.4}, copy+in-place {e2:.4}, copy to spare+oop {e3:.4}; inv: slot->grid {i0:.4}, slot->spare+NT {i1:.4}, in-place+NT {i2:.4}");
-            }
-        }
-    }
-
-    /// Components of the FFT stage: slice FFTs alone (grid -> per-worker scratch), and the
-    /// pair-major copy alone, with 1 and 2 threads.
-    #[test]
-    #[ignore]
-    fn fft_components() {
-        let bs: Vec<usize> = std::env::var("SO3FFT_B")
-            .unwrap_or("128,256".into())
-            .split(',')
-            .map(|x| x.trim().parse().unwrap())
-            .collect();
-        for b in bs {
-            for threads in [1, 2] {
-                let plan = Plan::new(
-                    b,
-                    &PlanOptions {
-                        threads,
-                        rigor: Rigor::Measure,
-                        fft_threading: FftThreading::SlicesAcrossWorkers,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
-                let n = 2 * b;
-                let nn = n * n;
-                let grid = AlignedBuf::new(n * nn).unwrap();
-                let gp = SyncPtr(grid.as_mut_ptr());
-                let fft = plan.fwd_fft.as_ref().unwrap();
-                let ifft = plan.inv_fft.as_ref().unwrap();
-                let g = plan.group;
-                // FFT only: every slice, groups across workers, into scratch.
-                let t_fft = best(
-                    || {
-                        let t = Instant::now();
-                        plan.pool().install(|| {
-                            (0..n / g).into_par_iter().for_each(|gi| {
-                                plan.with_fft_scratch(|s| {
-                                    for j in 0..g {
-                                        unsafe {
-                                            fft.execute(
-                                                gp.get().add((gi * g + j) * nn),
-                                                s.as_mut_ptr().add(j * nn),
-                                            )
-                                        };
-                                    }
-                                    Ok(())
-                                })
-                                .unwrap();
-                            })
-                        });
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                let t_ifft = best(
-                    || {
-                        let t = Instant::now();
-                        plan.pool().install(|| {
-                            (0..n / g).into_par_iter().for_each(|gi| {
-                                plan.with_fft_scratch(|s| {
-                                    for j in 0..g {
-                                        unsafe {
-                                            ifft.execute(
-                                                s.as_mut_ptr().add(j * nn),
-                                                gp.get().add((gi * g + j) * nn),
-                                            )
-                                        };
-                                    }
-                                    Ok(())
-                                })
-                                .unwrap();
-                            })
-                        });
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                // FFT in scratch only (no grid traffic).
-                let t_fft_l3 = best(
-                    || {
-                        let t = Instant::now();
-                        plan.pool().install(|| {
-                            (0..n / g).into_par_iter().for_each(|_| {
-                                plan.with_fft_scratch(|s| {
-                                    for j in 0..g {
-                                        unsafe {
-                                            fft.execute(
-                                                s.as_mut_ptr().add(j * nn),
-                                                s.as_mut_ptr().add(g * nn),
-                                            )
-                                        };
-                                    }
-                                    Ok(())
-                                })
-                                .unwrap();
-                            })
-                        });
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                // Copy only: scratch -> chunk buffer, all chunks' worth.
-                let t_copy = best(
-                    || {
-                        let t = Instant::now();
-                        plan.with_buf(|buf| {
-                            let bp = SyncPtr(buf.as_mut_ptr());
-                            plan.pool().install(|| {
-                                for ch in plan.chunks() {
-                                    let nb = ch.ks.len();
-                                    (0..nb / g).into_par_iter().for_each(|gi| {
-                                        plan.with_fft_scratch(|s| {
-                                            let sp = s.as_mut_ptr();
-                                            let s0 = gi * g;
-                                            for fi in 0..nn {
-                                                for j in 0..g {
-                                                    unsafe {
-                                                        *bp.get().add(fi * nb + s0 + j) =
-                                                            *sp.add(j * nn + fi)
-                                                    };
-                                                }
-                                            }
-                                            Ok(())
-                                        })
-                                        .unwrap();
-                                    });
-                                }
-                            });
-                            Ok(())
-                        })
-                        .unwrap();
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                let t_copy_nt = best(
-                    || {
-                        let t = Instant::now();
-                        plan.with_buf(|buf| {
-                            let bp = SyncPtr(buf.as_mut_ptr());
-                            plan.pool().install(|| {
-                                for ch in plan.chunks() {
-                                    let nb = ch.ks.len();
-                                    (0..nb / g).into_par_iter().for_each(|gi| {
-                                        plan.with_fft_scratch(|s| {
-                                            unsafe {
-                                                crate::fft::to_pairs_stream4(
-                                                    s.as_mut_ptr(),
-                                                    nn,
-                                                    1,
-                                                    bp.get().add(gi * g),
-                                                    nb,
-                                                    0,
-                                                    nn,
-                                                )
-                                            };
-                                            Ok(())
-                                        })
-                                        .unwrap();
-                                    });
-                                }
-                            });
-                            Ok(())
-                        })
-                        .unwrap();
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                let t_copy_back = best(
-                    || {
-                        let t = Instant::now();
-                        plan.with_buf(|buf| {
-                            let bp = SyncPtr(buf.as_mut_ptr());
-                            plan.pool().install(|| {
-                                for ch in plan.chunks() {
-                                    let nb = ch.ks.len();
-                                    (0..nb / g).into_par_iter().for_each(|gi| {
-                                        plan.with_fft_scratch(|s| {
-                                            let sp = s.as_mut_ptr();
-                                            let s0 = gi * g;
-                                            for fi in 0..nn {
-                                                for j in 0..g {
-                                                    unsafe {
-                                                        *sp.add(j * nn + fi) =
-                                                            *bp.get().add(fi * nb + s0 + j)
-                                                    };
-                                                }
-                                            }
-                                            Ok(())
-                                        })
-                                        .unwrap();
-                                    });
-                                }
-                            });
-                            Ok(())
-                        })
-                        .unwrap();
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                let t_copy_back_pf = best(
-                    || {
-                        let t = Instant::now();
-                        plan.with_buf(|buf| {
-                            let bp = SyncPtr(buf.as_mut_ptr());
-                            plan.pool().install(|| {
-                                for ch in plan.chunks() {
-                                    let nb = ch.ks.len();
-                                    (0..nb / g).into_par_iter().for_each(|gi| {
-                                        plan.with_fft_scratch(|s| {
-                                            unsafe {
-                                                crate::fft::from_pairs4(
-                                                    s.as_mut_ptr(),
-                                                    nn,
-                                                    1,
-                                                    bp.get().add(gi * g),
-                                                    nb,
-                                                    0,
-                                                    nn,
-                                                )
-                                            };
-                                            Ok(())
-                                        })
-                                        .unwrap();
-                                    });
-                                }
-                            });
-                            Ok(())
-                        })
-                        .unwrap();
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                println!("B={b} threads={threads}: copy back with prefetch {t_copy_back_pf:.4}");
-                // Inverse FFT into the spare scratch slice, then a streaming copy to the grid.
-                let t_ifft_nt = best(
-                    || {
-                        let t = Instant::now();
-                        plan.pool().install(|| {
-                            (0..n / g).into_par_iter().for_each(|gi| {
-                                plan.with_fft_scratch(|s| {
-                                    for j in 0..g {
-                                        unsafe {
-                                            let spare = s.as_mut_ptr().add(g * nn);
-                                            ifft.execute(s.as_mut_ptr().add(j * nn), spare);
-                                            crate::fft::stream_copy(
-                                                spare,
-                                                gp.get().add((gi * g + j) * nn),
-                                                nn,
-                                            );
-                                        };
-                                    }
-                                    Ok(())
-                                })
-                                .unwrap();
-                            })
-                        });
-                        t.elapsed().as_secs_f64()
-                    },
-                    3,
-                );
-                println!(
-                    "B={b} threads={threads}: copy NT {t_copy_nt:.4}, copy back {t_copy_back:.4}, ifft->spare + NT copy {t_ifft_nt:.4}"
-                );
-                println!(
-                    "B={b} threads={threads}: fft grid->scratch {t_fft:.4} s, ifft scratch->grid {t_ifft:.4}, fft scratch->scratch {t_fft_l3:.4}, copy scratch->buf {t_copy:.4}"
-                );
-            }
-        }
+        println!(
+            "{k} stages, {:.4} s each",
+            t.elapsed().as_secs_f64() / k as f64
+        );
     }
 }
