@@ -503,6 +503,23 @@ mod tests {
         (rc, tau, p, sc)
     }
 
+    /// Kernel lanes over `cluster_setup`'s arrays, default skip threshold.
+    pub(super) fn grid_lanes<'a>(
+        tau: &'a [f64],
+        p: &'a [f64],
+        sc: &'a [f64],
+        upper_from: usize,
+    ) -> Lanes<'a> {
+        Lanes {
+            tau,
+            p,
+            sc,
+            upper_from,
+            big: crate::wigner::big(DEFAULT_SKIP_BITS),
+            skip: true,
+        }
+    }
+
     /// Every SIMD path agrees with the portable scalar one, forward and inverse,
     /// including lanes that start scaled down (large m at betas near the poles).
     #[test]
@@ -513,14 +530,7 @@ mod tests {
             let nb = 2 * b;
             let (rc, x, p, sc) = cluster_setup(b, m, mp, nb);
             let rec = Rec::new(&rc, n);
-            let lanes = Lanes {
-                tau: &x,
-                p: &p,
-                sc: &sc,
-                upper_from: b,
-                big: crate::wigner::big(DEFAULT_SKIP_BITS),
-                skip: true,
-            };
+            let lanes = grid_lanes(&x, &p, &sc, b);
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
                 let fin = pseudo(n * pw, 11 + mp as u64);
@@ -559,7 +569,7 @@ mod tests {
 
 #[cfg(test)]
 mod kernel_speed {
-    use super::tests::cluster_setup;
+    use super::tests::{cluster_setup, grid_lanes};
     use super::*;
 
     /// Kernel-only throughput (run with --ignored --nocapture): GFLOP/s of the fused
@@ -572,14 +582,7 @@ mod kernel_speed {
             let n = b - m;
             let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
             let rec = Rec::new(&rc, n);
-            let lanes = Lanes {
-                tau: &x,
-                p: &p,
-                sc: &sc,
-                upper_from: nbs / 2,
-                big: crate::wigner::big(DEFAULT_SKIP_BITS),
-                skip: true,
-            };
+            let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
             let xin = vec![0.5; nbs * 16];
             let mut f = vec![0.0; n * 16];
             let mut y = vec![0.0; nbs * 16];
@@ -610,7 +613,7 @@ mod kernel_speed {
 
 #[cfg(test)]
 mod stage_speed {
-    use super::tests::cluster_setup;
+    use super::tests::{cluster_setup, grid_lanes};
     use super::*;
 
     /// Kernel time summed over every cluster of a bandwidth (all 2B betas as one chunk),
@@ -632,14 +635,7 @@ mod stage_speed {
                 let n = b - m;
                 let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
                 let rec = Rec::new(&rc, n);
-                let lanes = Lanes {
-                    tau: &x,
-                    p: &p,
-                    sc: &sc,
-                    upper_from: b,
-                    big: crate::wigner::big(DEFAULT_SKIP_BITS),
-                    skip: true,
-                };
+                let lanes = grid_lanes(&x, &p, &sc, b);
                 let pw = if m == mp || mp == 0 { 8 } else { 16 };
                 let t = std::time::Instant::now();
                 forward(isa, pw, &rec, &lanes, &xin, &mut f[..n * pw]);
