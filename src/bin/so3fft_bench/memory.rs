@@ -37,7 +37,12 @@ pub struct Phase {
 }
 
 /// Resets the peak, runs `f` and reports the phase's peak (`None` if not measurable).
+///
+/// The peak is process-wide, so phases are serialised by a lock: a reset by a second phase
+/// (another test thread, say) in the middle of this one would erase its peak.
 pub fn measure<R>(f: impl FnOnce() -> R) -> (R, Option<Phase>) {
+    static PHASE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _guard = PHASE.lock().unwrap_or_else(|e| e.into_inner());
     let ok = reset_peak();
     let start = rss_bytes();
     let r = f();
