@@ -4,8 +4,11 @@
 //! recurrence runs in registers, vectorised over `W` betas; nothing of size
 //! `(B - m) x 2B` is ever stored.
 //!
-//! * forward: `f[i][q] += sum_s dt_{l0+i}(beta_s) * xin[s][q]` (`P` real columns `q`)
-//! * inverse: `y[q][s] = sum_i dt_{l0+i}(beta_s) * fin[i][q]`
+//! * forward: `f[i][q] += sum_s dt_{l0+i}(beta_s) * xin[row(s)][q]` (`P` real columns `q`)
+//! * inverse: `y[row(s)][q] = sum_i dt_{l0+i}(beta_s) * fin[i][q]`
+//!
+//! where `row(s)` is `s` or, for the chunk buffer's blocks, interleaves each beta with its
+//! mirror ([`Lanes::interleaved`]).
 //!
 //! `P` is 16 (8 complex order pairs) or 8 (4 pairs). Each beta lane starts in the scaled
 //! form of `wigner.rs`; lanes below the skip threshold contribute nothing, and while no lane
@@ -61,6 +64,24 @@ pub(crate) struct Lanes<'a> {
     /// Skip the degrees where no lane of a vector is active yet (`false` only to measure
     /// what skipping saves: inactive lanes then accumulate exact zeros).
     pub skip: bool,
+    /// Row of lane `u` in the data arrays: `u`, or, interleaved, `2u` for `u < upper_from`
+    /// and `2(u - upper_from) + 1` above (the lanes count `2 upper_from`), so that lanes
+    /// `u` and `u + upper_from` (a beta and its mirror, see `plan/blocks.rs`) are adjacent.
+    pub interleaved: bool,
+}
+
+impl Lanes<'_> {
+    /// First row and row step (in rows) of the vector of lanes starting at `s0`.
+    #[inline(always)]
+    fn rows(&self, s0: usize) -> (usize, usize) {
+        if !self.interleaved {
+            (s0, 1)
+        } else if s0 < self.upper_from {
+            (2 * s0, 2)
+        } else {
+            (2 * (s0 - self.upper_from) + 1, 2)
+        }
+    }
 }
 
 /// Recurrence state of one vector of betas.
@@ -271,10 +292,11 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
             // A local copy, so the state lives in registers during the run.
             let mut st = *st;
             let s0 = g0 + gi * W;
+            let (r0, step) = lanes.rows(s0);
             let mut xr = [[S::zero(); NV]; W];
             for (w, row) in xr.iter_mut().enumerate() {
                 for (j, v) in row.iter_mut().enumerate() {
-                    *v = S::load(xin.as_ptr().add((s0 + w) * p + j * W));
+                    *v = S::load(xin.as_ptr().add((r0 + w * step) * p + j * W));
                 }
             }
             st.run(
@@ -342,8 +364,12 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
                     }
                 },
             );
-            for (q, a) in acc.iter().enumerate() {
-                S::store(y.as_mut_ptr().add(q * nb + s0), *a);
+            // Rows of the output are lanes: each W x W block of (order column, lane) is
+            // transposed in registers on the way out.
+            let (r0, step) = lanes.rows(s0);
+            for q0 in (0..P).step_by(W) {
+                let dst = y.as_mut_ptr().add(r0 * P + q0);
+                S::store_transposed(&acc[q0..q0 + W], dst, step * P);
             }
         }
         g0 += g * W;
@@ -372,7 +398,8 @@ entry!(inv_avx512_8, "avx512f,fma", inverse_body, Avx512, 8, 8);
 entry!(inv_avx2_16, "avx2,fma", inverse_body, Avx2, 4, 16);
 entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 
-/// Forward kernel: `f[i*P + q] += sum_s dt_{l0+i}(beta_s) xin[s*P + q]`, `P` = 8 or 16.
+/// Forward kernel: `f[i*P + q] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or 16
+/// (`row` see [`Lanes::interleaved`]).
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
@@ -400,7 +427,8 @@ pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64],
     }
 }
 
-/// Inverse kernel: `y[q*nb + s] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16.
+/// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
+/// (the layout of the forward kernel's input, see `plan/blocks.rs`).
 pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
     let n = rec.len();
     let nb = lanes.tau.len();
@@ -461,6 +489,7 @@ pub(crate) fn column(
         upper_from: if upper { 0 } else { w },
         big: crate::wigner::big(DEFAULT_SKIP_BITS),
         skip: true,
+        interleaved: false,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     (0..n).map(|i| f[i * 8]).collect()
@@ -517,6 +546,7 @@ mod tests {
             upper_from,
             big: crate::wigner::big(DEFAULT_SKIP_BITS),
             skip: true,
+            interleaved: true,
         }
     }
 

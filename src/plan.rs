@@ -4,12 +4,20 @@
 //!
 //! Beta slices are processed in chunks of `h` low slices `k` plus their mirrors
 //! `2B-1-k` (the Wigner-d symmetries pair `beta` with `pi - beta`), so the only large
-//! buffer is the chunk buffer of `2h` transformed slices, never a copy of the grid.
+//! buffer is the chunk buffer, which holds the `2h` transformed slices in the DWT
+//! kernels' own layout (`plan/blocks.rs`), never a copy of the grid.
+//!
+//! Modules: `blocks` (the chunk buffer's layout), `fft_stage` (FFTW and the moves in and
+//! out of the blocks), `dwt_stage` (kernels per cluster, coefficient signs and layout),
+//! `real` (the real-signal transforms), `fft_tune` (plan-time choice of FFT threading).
 
 use crate::dwt::{self, Lanes, Rec};
 use crate::error::{Error, Result};
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
 
+mod blocks;
+mod dwt_stage;
+mod fft_stage;
 mod fft_tune;
 mod real;
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
@@ -18,6 +26,8 @@ use crate::symmetry::{cluster_pairs, Cluster, Member};
 use crate::wigner::{
     big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
 };
+use blocks::Blocks;
+use dwt_stage::Scratch;
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -149,8 +159,8 @@ pub struct Plan {
     inv_fft: Option<SliceFft>,
     /// Real-data slice FFTs (with `PlanOptions::real`).
     real_fft: Option<SliceFftReal>,
-    /// Per-worker buffers of `group` slices, for transposing between the
-    /// slice-major sample arrays and the pair-major chunk buffer.
+    /// Per-worker buffers of three slices: a pair of beta slices in the FFT stage and a
+    /// spare one.
     fft_scratch: Vec<Mutex<AlignedBuf>>,
     /// Per-worker DWT scratch.
     dwt_scratch: Vec<Mutex<Scratch>>,
@@ -158,10 +168,12 @@ pub struct Plan {
     fftw_threaded: bool,
     /// Low beta slices per chunk.
     chunk: usize,
-    /// Slices per FFT group (inverse and real transforms).
-    group: usize,
-    /// Slices per FFT group of the complex forward transform (see [`fft_group_forward`]).
-    fwd_group: usize,
+    /// Lanes of every block in the chunk buffer (room for the padded lanes of a chunk).
+    block_lanes: usize,
+    /// Chunk-buffer layout of the complex transforms.
+    blocks: Blocks,
+    /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
+    blocks_real: Option<Blocks>,
     /// Bytes this plan holds.
     memory: usize,
     /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
@@ -185,102 +197,35 @@ impl<T> SyncPtr<T> {
     }
 }
 
-/// Per-task scratch, sized for the largest cluster and chunk.
-struct Scratch {
-    rec: RecCoeffs,
-    tau: Vec<f64>,
-    p: Vec<f64>,
-    sc: Vec<f64>,
-    data: Vec<f64>,
-    out: Vec<f64>,
-}
-
-impl Scratch {
-    fn new(b: usize, nbp: usize) -> Scratch {
-        Scratch {
-            rec: RecCoeffs::new(b),
-            tau: vec![0.0; nbp],
-            p: vec![0.0; nbp],
-            sc: vec![0.0; nbp],
-            data: vec![0.0; nbp.max(b) * 16],
-            out: vec![0.0; nbp.max(b) * 16],
-        }
-    }
-}
-
-impl Scratch {
-    /// Run the DWT kernel on this scratch after [`Plan::setup`]: forward from `data` (`nl`
-    /// lanes of `p` values) into `out` (`n` degrees, zeroed first), inverse from `data`
-    /// (`n` degrees) into `out` (`p` rows of `nl` lanes).
-    fn kernel(&mut self, plan: &Plan, forward: bool, p: usize, n: usize, ch: &Chunk) {
-        let nl = ch.lanes();
-        let rec = Rec::new(&self.rec, n);
-        let lanes = Lanes {
-            tau: &self.tau[..nl],
-            p: &self.p[..nl],
-            sc: &self.sc[..nl],
-            upper_from: ch.hp,
-            big: big(plan.skip_bits),
-            skip: plan.skip,
-        };
-        if forward {
-            let f = &mut self.out[..n * p];
-            f.fill(0.0);
-            dwt::forward(plan.isa, p, &rec, &lanes, &self.data[..nl * p], f);
-        } else {
-            dwt::inverse(
-                plan.isa,
-                p,
-                &rec,
-                &lanes,
-                &self.data[..n * p],
-                &mut self.out[..nl * p],
-            );
-        }
-    }
-}
-
-/// The beta slices of one chunk, in slot order: slots `0..h` hold betas `lo..lo+h`,
-/// slots `h..2h` the mirrored betas `2B-lo-h .. 2B-lo` (ascending), so slot `s` and
-/// slot `2h-1-s` hold `beta` and `pi - beta`.
-///
-/// The DWT kernels see the slots as lanes, each half padded to `hp` (a multiple of the
-/// vector width) so that no vector mixes the lower and upper half: lanes `0..h` are
-/// slots `0..h`, lanes `hp..hp+h` are slots `h..2h`.
+/// The beta slices of one chunk: the `h` low betas `lo .. lo+h` and their mirrors
+/// `2B-1-lo .. 2B-1-lo-h`. The DWT kernels see them as lanes, each half padded to `hp` (a
+/// multiple of the vector width) so that no vector mixes the lower and upper half: lane
+/// `j < h` is beta `lo + j` and lane `hp + j` its mirror `2B-1-lo-j` (the upper half runs
+/// down). In the blocks of the chunk buffer the two are adjacent rows `2j` and `2j+1`
+/// (`dwt::Lanes::interleaved`), so the FFT stage moves each mirrored pair of slices in
+/// and out of one contiguous piece of every block.
 struct Chunk {
-    ks: Vec<usize>,
+    lo: usize,
     h: usize,
     hp: usize,
 }
 
 impl Chunk {
-    /// `(first lane, first slot)` of the lower and upper half; each holds `h` slots.
-    fn halves(&self) -> [(usize, usize); 2] {
-        [(0, 0), (self.hp, self.h)]
+    /// `(first lane, lowest beta)` of the lower and upper half; each holds `h` betas,
+    /// ascending in the lower half and descending in the upper one.
+    fn halves(&self, b: usize) -> [(usize, usize); 2] {
+        [(0, self.lo), (self.hp, 2 * b - self.lo - self.h)]
     }
 
     /// Number of lanes.
     fn lanes(&self) -> usize {
         2 * self.hp
     }
-}
 
-/// Slices transformed and transposed together: 4 complex values fill a cache line; fewer
-/// when slices are large (the per-worker buffer holds a whole group).
-fn fft_group(b: usize) -> usize {
-    let slice_bytes = 64 * b * b;
-    ((64usize << 20) / slice_bytes).clamp(1, 4)
-}
-
-/// Slices per group of the complex forward transform: 8 (two cache lines per pair-major
-/// row) while they take at most 64 MiB, else as [`fft_group`]. Measured at B = 128 on two
-/// threads: forward FFT stage 10% faster than with 4; the inverse gains nothing from it.
-fn fft_group_forward(b: usize) -> usize {
-    let (g, slice_bytes) = (fft_group(b), 64 * b * b);
-    if g == 4 && 8 * slice_bytes <= 64 << 20 {
-        8
-    } else {
-        g
+    /// Betas of the mirrored pair `j < h` (lanes `j` and `hp + j`, block rows `2j` and
+    /// `2j + 1`): `lo + j` and `2B-1-lo-j`.
+    fn pair_betas(&self, b: usize, j: usize) -> (usize, usize) {
+        (self.lo + j, 2 * b - 1 - self.lo - j)
     }
 }
 
@@ -327,8 +272,7 @@ fn default_workspace(b: usize, real: bool) -> usize {
 /// How a plan's memory splits up (see [`Plan::memory_bytes`]).
 struct Layout {
     chunk: usize,
-    group: usize,
-    fwd_group: usize,
+    block_lanes: usize,
     chunk_bytes: usize,
     fft_scratch_bytes: usize,
     table_bytes: usize,
@@ -337,24 +281,29 @@ struct Layout {
 impl Layout {
     fn new(b: usize, threads: usize, budget: usize) -> Layout {
         let slice_bytes = 64 * b * b;
-        let chunk = (budget / (2 * slice_bytes)).clamp(1, b);
-        let group = fft_group(b);
-        let fwd_group = fft_group_forward(b);
+        // One lane of every block (the complex layout; the real one is smaller).
+        let lane_bytes = 8 * Blocks::doubles_per_lane(b, false);
+        let mut chunk = (budget / (2 * lane_bytes)).clamp(1, b);
+        if chunk >= 8 && chunk < b {
+            // Full chunks without padding lanes.
+            chunk -= chunk % 8;
+        }
+        let block_lanes = 2 * chunk.next_multiple_of(8);
+        let clusters = crate::symmetry::num_generic(b) + 2 * b;
         // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
-        // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list, per-worker DWT scratch.
+        // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list and slot tables
+        // (8 + 8 * 9 bytes per cluster, twice with the real layout), per-worker DWT scratch.
         let table_bytes = 16 * (b + 1) * (b + 2)
             + 8 * b * (b + 1)
             + 64 * b * (66 + b / 32)
-            + 8 * b * b
-            + threads * 8 * (6 * b + 3 * (2 * chunk + 8) + 32 * (2 * chunk + 8).max(b));
+            + 2 * 80 * clusters
+            + threads * 8 * (6 * b + 3 * block_lanes + 32 * b);
         Layout {
             chunk,
-            group,
-            fwd_group,
-            chunk_bytes: 2 * chunk * slice_bytes,
-            // One slice more than a group: room for packing real samples (real path) and
-            // for the inverse FFT's output.
-            fft_scratch_bytes: threads * (group.max(fwd_group) + 1) * slice_bytes,
+            block_lanes,
+            chunk_bytes: block_lanes * lane_bytes,
+            // A pair of slices and a spare one per worker.
+            fft_scratch_bytes: threads * 3 * slice_bytes,
             table_bytes,
         }
     }
@@ -486,9 +435,8 @@ impl Plan {
         } else {
             None
         };
-        let nbp = 2 * chunk.next_multiple_of(isa.lanes());
         let dwt_scratch = (0..threads)
-            .map(|_| Mutex::new(Scratch::new(b, nbp)))
+            .map(|_| Mutex::new(Scratch::new(b, layout.block_lanes)))
             .collect();
         let real_fft = if options.real {
             Some(SliceFftReal::new(n, options.rigor)?)
@@ -496,13 +444,14 @@ impl Plan {
             None
         };
         let fft_scratch = (0..threads)
-            .map(|_| {
-                AlignedBuf::new((layout.group.max(layout.fwd_group) + 1) * n * n).map(Mutex::new)
-            })
+            .map(|_| AlignedBuf::new(3 * n * n).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
-        let buf = AlignedBuf::new(2 * chunk * n * n)?;
+        let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
+        let clusters = cluster_pairs(b);
+        let blocks = Blocks::complex(b, &clusters);
+        let blocks_real = options.real.then(|| Blocks::real(b, &clusters));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
         let on_exit = live.clone();
@@ -523,7 +472,7 @@ impl Plan {
             isa,
             pool: Some(pool),
             live,
-            clusters: cluster_pairs(b),
+            clusters,
             bt: BetaTables::grid(b),
             norms: start_norms(b),
             wq,
@@ -535,8 +484,9 @@ impl Plan {
             dwt_scratch,
             fftw_threaded,
             chunk,
-            group: layout.group,
-            fwd_group: layout.fwd_group,
+            block_lanes: layout.block_lanes,
+            blocks,
+            blocks_real,
             memory: layout.total(),
             skip_bits,
             skip,
@@ -596,18 +546,28 @@ impl Plan {
     /// plus `O(B^2)` tables. A transform needs the caller's arrays on top
     /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
+    /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
+    /// computed before allocating: the chunk buffer ([`Plan::workspace_bytes`]) plus
+    /// `threads * 3 * (2B)^2 * 16` for the per-worker FFT buffers (a pair of beta slices
+    /// and a spare one) plus `O(B^2)` tables. A transform needs the caller's arrays on top
+    /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
+    /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
     pub fn memory_bytes(&self) -> usize {
         self.memory
     }
 
-    /// Bytes of the chunk buffer: `2 h (2B)^2 * 16` with `h` low beta slices per chunk,
-    /// `h = clamp(cap / (2 (2B)^2 16), 1, B)`. With `max_workspace_bytes` the cap is that
-    /// value. By default the whole plan ([`Plan::memory_bytes`]) is held to
-    /// `max(512 MiB, 4.5% of the sample and coefficient arrays)` (at most a quarter of the
-    /// available memory), and the cap is what the FFT buffers and tables leave of it. At
-    /// B = 512 that keeps a complex transform within the caller's arrays plus 5%.
+    /// Bytes of the chunk buffer: `2 h' * 8 * (8B^2 - 8B + 8)` with `h` low beta slices per
+    /// chunk and `h'` = `h` rounded up to a multiple of 8. (`8B^2 - 8B + 8` doubles per beta:
+    /// the `(2B-1)^2` in-band values of a transformed slice in the DWT kernels' layout,
+    /// `16` doubles per 8-member cluster, `8` per other one.) `h = clamp(cap / (2 * 8 *
+    /// (8B^2 - 8B + 8)), 1, B)`, rounded down to a multiple of 8 when between 8 and `B`.
+    /// With `max_workspace_bytes` the cap is that value. By default the whole plan
+    /// ([`Plan::memory_bytes`]) is held to `max(512 MiB, 4.5% of the sample and coefficient
+    /// arrays)` (at most a quarter of the available memory), and the cap is what the FFT
+    /// buffers and tables leave of it. At B = 512 that keeps a complex transform within the
+    /// caller's arrays plus 5%.
     pub fn workspace_bytes(&self) -> usize {
-        2 * self.chunk * 4 * self.b * self.b * 16
+        self.block_lanes * 8 * Blocks::doubles_per_lane(self.b, false)
     }
 
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
@@ -675,10 +635,8 @@ impl Plan {
         let b = self.b;
         (0..b).step_by(self.chunk).map(move |lo| {
             let h = self.chunk.min(b - lo);
-            let mut ks: Vec<usize> = (lo..lo + h).collect();
-            ks.extend(2 * b - lo - h..2 * b - lo);
             let hp = h.next_multiple_of(self.isa.lanes());
-            Chunk { ks, h, hp }
+            Chunk { lo, h, hp }
         })
     }
 
@@ -692,298 +650,13 @@ impl Plan {
         let coef = SyncPtr(coeffs.as_mut_ptr());
         self.run_chunks(
             true,
+            &self.blocks,
             coef,
             |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
-            |sc, cl, ch, buf, first| unsafe {
-                self.forward_cluster(sc, cl, ch, buf, coef, first);
+            |sc, c, cl, ch, buf, first| unsafe {
+                self.forward_cluster(sc, c, cl, ch, buf, coef, first);
             },
         )
-    }
-
-    /// The chunk loop shared by every transform: for each chunk, the FFT stage and the DWT
-    /// of every cluster, in the order of the direction (forward: FFT then DWT), timed.
-    /// `coef` is the coefficient array (for prefetching); `first` tells the cluster stage
-    /// whether this is the first chunk (the forward assigns rather than accumulates then).
-    fn run_chunks(
-        &self,
-        forward: bool,
-        coef: SyncPtr<Complex64>,
-        fft: impl Fn(&Chunk, *mut Complex64) -> Result<()> + Sync,
-        cluster: impl Fn(&mut Scratch, &Cluster, &Chunk, *mut Complex64, bool) + Sync,
-    ) -> Result<StageTimes> {
-        let t0 = Instant::now();
-        let mut times = StageTimes::default();
-        self.with_buf(|buf| {
-            let bp = SyncPtr(buf.as_mut_ptr());
-            self.pool().install(|| {
-                for (ci, ch) in self.chunks().enumerate() {
-                    let mut fft_stage = || -> Result<()> {
-                        let t = Instant::now();
-                        fft(&ch, bp.get())?;
-                        times.fft += t.elapsed().as_secs_f64();
-                        Ok(())
-                    };
-                    if forward {
-                        fft_stage()?;
-                    }
-                    let t = Instant::now();
-                    self.for_each_cluster(&ch, bp.get(), coef.get(), |sc, cl| {
-                        cluster(sc, cl, &ch, bp.get(), ci == 0)
-                    });
-                    times.dwt += t.elapsed().as_secs_f64();
-                    if !forward {
-                        fft_stage()?;
-                    }
-                }
-                Ok::<(), Error>(())
-            })
-        })?;
-        times.total = t0.elapsed().as_secs_f64();
-        Ok(times)
-    }
-
-    /// Run `f` on every cluster in parallel (work stealing over runs of consecutive
-    /// clusters). Before a cluster is processed, the chunk-buffer rows and coefficient
-    /// rows of the next one are prefetched: they are short streams in arrays far larger
-    /// than the caches, so without it each cluster would start by waiting on memory.
-    fn for_each_cluster(
-        &self,
-        ch: &Chunk,
-        buf: *mut Complex64,
-        coef: *mut Complex64,
-        f: impl Fn(&mut Scratch, &Cluster) + Sync,
-    ) {
-        let (buf, coef) = (SyncPtr(buf), SyncPtr(coef));
-        self.clusters.par_chunks(8).for_each(|run| {
-            let mut guard = lock_free(&self.dwt_scratch);
-            let mut own = None;
-            let sc: &mut Scratch = match guard.as_deref_mut() {
-                Some(s) => s,
-                // All busy (concurrent executions of this plan): use a private one.
-                None => own.insert(Scratch::new(self.b, 2 * self.chunk.next_multiple_of(8))),
-            };
-            let mut next = Cluster::new(run[0].0 as usize, run[0].1 as usize);
-            for i in 0..run.len() {
-                let cl = next;
-                if let Some(&(m, mp)) = run.get(i + 1) {
-                    next = Cluster::new(m as usize, mp as usize);
-                    self.prefetch(&next, ch.ks.len(), buf.get(), coef.get());
-                }
-                f(sc, &cl);
-            }
-        });
-    }
-
-    /// Hint the cache about the rows a cluster will touch.
-    fn prefetch(&self, cl: &Cluster, nb: usize, buf: *mut Complex64, coef: *mut Complex64) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let n = self.b - cl.l0();
-            for mem in cl.members() {
-                // 4 complex values per 64-byte line; wrapping_add: hints never fault.
-                let row = buf.wrapping_add(self.freq_index(mem.m, mem.mp) * nb);
-                for s in (0..nb).step_by(4) {
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(s) as *const i8) };
-                }
-                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
-                for i in (0..n).step_by(4) {
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(i) as *const i8) };
-                }
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (cl, nb, buf, coef);
-    }
-
-    /// Run `f` with a per-worker FFT scratch buffer (`max(group, fwd_group) + 1` slices). A worker may take
-    /// on another execution's group while it waits inside a parallel copy, so buffers are
-    /// taken by try_lock, never by blocking; when all are busy a private one is allocated.
-    fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
-        match lock_free(&self.fft_scratch) {
-            Some(g) => f(&g),
-            None => f(&AlignedBuf::new(
-                (self.group.max(self.fwd_group) + 1) * 4 * self.b * self.b,
-            )?),
-        }
-    }
-
-    /// FFT stage of one chunk. Forward: slices `ks[s]` of `grid` are transformed and
-    /// transposed into the pair-major chunk buffer (`buf[fi * nb + s]`). Inverse: the
-    /// reverse, into `grid`. Groups of `self.fwd_group` (forward) or `self.group` (inverse)
-    /// slots are spread over the workers.
-    fn fft_chunk(
-        &self,
-        ch: &Chunk,
-        forward: bool,
-        grid: *mut Complex64,
-        buf: *mut Complex64,
-    ) -> Result<()> {
-        let fft = if forward {
-            self.fwd_fft.as_ref()
-        } else {
-            self.inv_fft.as_ref()
-        }
-        .ok_or(Error::WrongDirection)?;
-        let group = if forward { self.fwd_group } else { self.group };
-        let ngroups = ch.ks.len().div_ceil(group);
-        self.fft_groups(
-            ch,
-            fft,
-            self.fftw_threaded,
-            forward,
-            grid,
-            buf,
-            group,
-            ngroups,
-        )
-    }
-
-    /// The first `ngroups` groups of `group` slots of [`Plan::fft_chunk`] with the slice plan `fft`:
-    /// with `fftw_threaded`, groups one after another (`fft` runs on FFTW's threads and
-    /// the copies are spread over the workers), else groups spread over the workers.
-    #[allow(clippy::too_many_arguments)]
-    fn fft_groups(
-        &self,
-        ch: &Chunk,
-        fft: &SliceFft,
-        fftw_threaded: bool,
-        forward: bool,
-        grid: *mut Complex64,
-        buf: *mut Complex64,
-        group: usize,
-        ngroups: usize,
-    ) -> Result<()> {
-        let nb = ch.ks.len();
-        let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        let run = |gi: usize, parallel_copy: bool| -> Result<()> {
-            let s0 = gi * group;
-            let g = group.min(nb - s0);
-            self.with_fft_scratch(|scratch| unsafe {
-                // SAFETY: the scratch holds `group` slices; group `gi` owns slots s0..s0+g.
-                self.fft_group(
-                    ch,
-                    fft,
-                    forward,
-                    grid,
-                    buf,
-                    scratch.as_mut_ptr(),
-                    s0,
-                    g,
-                    parallel_copy,
-                )
-            })
-        };
-        if fftw_threaded {
-            // FFTW parallelises each slice; the copies are spread over the workers.
-            (0..ngroups).try_for_each(|gi| run(gi, true))
-        } else {
-            (0..ngroups)
-                .into_par_iter()
-                .try_for_each(|gi| run(gi, false))
-        }
-    }
-
-    /// Transform slots `s0..s0+g` of a chunk through the scratch buffer `sp` (see
-    /// [`Plan::fft_chunk`]); `parallel_copy` spreads the transposition over the workers.
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn fft_group(
-        &self,
-        ch: &Chunk,
-        fft: &SliceFft,
-        forward: bool,
-        grid: SyncPtr<Complex64>,
-        buf: SyncPtr<Complex64>,
-        sp: *mut Complex64,
-        s0: usize,
-        g: usize,
-        parallel_copy: bool,
-    ) -> Result<()> {
-        let (b, n) = (self.b, 2 * self.b);
-        let nn = n * n;
-        let nb = ch.ks.len();
-        let spp = SyncPtr(sp);
-        // Copy frequencies fi0..fi1 between the slice-major scratch and the pair-major buffer.
-        // Separate monomorphic loops for each case: a run-time switch inside one loop was
-        // measured to halve its speed. With a multiple of 4 slots starting on a cache line
-        // (the usual case), each row of the group is whole lines: written with
-        // non-temporal stores (no read of the lines first), or read with a software
-        // prefetch (see `fft::from_pairs4`).
-        let lines = g.is_multiple_of(4)
-            && nb.is_multiple_of(4)
-            && (buf.get().add(s0) as usize).is_multiple_of(64);
-        let to_pairs = |fi0: usize, fi1: usize| {
-            let (sp, bp) = (spp.get(), buf.get());
-            for fi in fi0..fi1 {
-                for j in 0..g {
-                    *bp.add(fi * nb + s0 + j) = *sp.add(j * nn + fi);
-                }
-            }
-        };
-        let to_pairs4 = |fi0: usize, fi1: usize| {
-            fft::to_pairs_stream4(spp.get(), nn, g / 4, buf.get().add(s0), nb, fi0, fi1);
-        };
-        let from_pairs = |fi0: usize, fi1: usize| {
-            let (sp, bp) = (spp.get(), buf.get());
-            for fi in fi0..fi1 {
-                for j in 0..g {
-                    *sp.add(j * nn + fi) = *bp.add(fi * nb + s0 + j);
-                }
-            }
-        };
-        let from_pairs4 = |fi0: usize, fi1: usize| {
-            fft::from_pairs4(spp.get(), nn, g / 4, buf.get().add(s0), nb, fi0, fi1);
-        };
-        const STEP: usize = 1 << 14;
-        let copy_all = |copy: &(dyn Fn(usize, usize) + Sync)| {
-            if parallel_copy {
-                (0..nn.div_ceil(STEP))
-                    .into_par_iter()
-                    .for_each(|c| copy(c * STEP, ((c + 1) * STEP).min(nn)));
-            } else {
-                copy(0, nn);
-            }
-        };
-        if forward {
-            for j in 0..g {
-                let src = grid.get().add(ch.ks[s0 + j] * nn);
-                if fft.has_in_place() {
-                    // Copied first (a sequential read the prefetchers follow), then
-                    // transformed in the cache: faster than FFTW reading the samples.
-                    std::ptr::copy_nonoverlapping(src, sp.add(j * nn), nn);
-                    fft.in_place(sp.add(j * nn), sp.add(g * nn), n);
-                } else {
-                    fft.execute(src, sp.add(j * nn));
-                }
-            }
-            copy_all(if lines { &to_pairs4 } else { &to_pairs });
-        } else {
-            copy_all(if g.is_multiple_of(4) {
-                &from_pairs4
-            } else {
-                &from_pairs
-            });
-            // The spare slice after the group (the scratch holds `group + 1`).
-            let spare = sp.add(g * nn);
-            for j in 0..g {
-                let slot = sp.add(j * nn);
-                // Frequency B (alpha or gamma) is outside the band limit.
-                for i in 0..n {
-                    *slot.add(b * n + i) = Complex64::new(0.0, 0.0);
-                    *slot.add(i * n + b) = Complex64::new(0.0, 0.0);
-                }
-                let dst = grid.get().add(ch.ks[s0 + j] * nn);
-                if (dst as usize).is_multiple_of(16) {
-                    // Into the cache-resident spare slice, then streamed to the samples:
-                    // FFTW's own stores would first read every line of `dst` from memory.
-                    fft.execute(slot, spare);
-                    fft::stream_copy(spare, dst, nn);
-                } else {
-                    fft.execute(slot, dst);
-                }
-            }
-        }
-        Ok(())
     }
 
     /// Like [`Plan::inverse`], also returning the time of each stage.
@@ -996,159 +669,122 @@ impl Plan {
         let out = SyncPtr(samples.as_mut_ptr());
         self.run_chunks(
             false,
+            &self.blocks,
             SyncPtr(coeffs.as_ptr() as *mut Complex64),
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
-            |sc, cl, ch, buf, _| unsafe { self.inverse_cluster(sc, cl, ch, buf, coeffs) },
+            |sc, c, cl, ch, buf, _| unsafe { self.inverse_cluster(sc, c, cl, ch, buf, coeffs) },
         )
     }
 
-    /// Recurrence coefficients and per-beta lane inputs of a cluster for one chunk.
-    /// (The forward transform applies the quadrature weights to the gathered data.)
-    fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> (usize, usize) {
-        let n = self.b - cl.l0();
-        sc.rec.resize(n);
-        self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
-        let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
-        let nl = ch.lanes();
-        sc.tau[..nl].fill(0.0);
-        sc.p[..nl].fill(0.0);
-        sc.sc[..nl].fill(0.0);
-        for (half, (u0, s0)) in ch.halves().into_iter().enumerate() {
-            let tau = if half == 0 {
-                &self.bt.tau_lo
-            } else {
-                &self.bt.tau_hi
-            };
-            for j in 0..ch.h {
-                let k = ch.ks[s0 + j];
-                sc.tau[u0 + j] = tau[k];
-                let (p, scale) = self.bt.start(k, cl.m, cl.mp, norm, 1.0, self.skip_bits);
-                sc.p[u0 + j] = p;
-                sc.sc[u0 + j] = scale;
-            }
-        }
-        (n, nl)
-    }
-
-    /// Inverse DWT input: `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree
-    /// `l0 + i`, times the member's sign and `1/(2 pi)`; unused columns zero.
-    fn gather_coeffs(&self, fin: &mut [f64], cl: &Cluster, members: &[Member], coef: &[Complex64]) {
-        let p = fin.len() / (self.b - cl.l0());
-        if members.len() * 2 < p {
-            fin.fill(0.0);
-        }
-        let n = self.b - cl.l0();
-        let scale = 1.0 / (2.0 * PI);
-        for (q, mem) in members.iter().enumerate() {
-            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
-            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
-            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
-                let g = sg[i & 1];
-                row[2 * q] = z.re * g;
-                row[2 * q + 1] = z.im * g;
-            }
-        }
-    }
-
-    /// Index of order pair `(m, mp)` inside a transformed slice.
-    fn freq_index(&self, m: isize, mp: isize) -> usize {
-        let n = 2 * self.b as isize;
-        (m.rem_euclid(n) * n + mp.rem_euclid(n)) as usize
-    }
-
-    /// Forward DWT of one cluster over one chunk, accumulated into `coef`.
-    ///
-    /// # Safety
-    /// `buf` holds the chunk's transformed slices; `coef` has `num_coeffs` entries and
-    /// no other task writes this cluster's blocks.
-    unsafe fn forward_cluster(
+    /// The chunk loop shared by every transform: for each chunk, the FFT stage and the DWT
+    /// of every cluster of layout `t`, in the order of the direction (forward: FFT then
+    /// DWT), timed. `coef` is the coefficient array (for prefetching); `first` tells the
+    /// cluster stage whether this is the first chunk (the forward assigns rather than
+    /// accumulates then).
+    #[allow(clippy::type_complexity)]
+    fn run_chunks(
         &self,
-        sc: &mut Scratch,
-        cl: &Cluster,
-        ch: &Chunk,
-        buf: *const Complex64,
+        forward: bool,
+        t: &Blocks,
         coef: SyncPtr<Complex64>,
-        first: bool,
-    ) {
-        let (n, nl) = self.setup(sc, cl, ch);
-        let p = if cl.members().len() > 4 { 16 } else { 8 };
-        let nb = ch.ks.len();
-        let data = &mut sc.data[..nl * p];
-        if cl.members().len() * 2 < p || ch.h < ch.hp {
-            data.fill(0.0);
-        }
-        // All members' rows are read together (betas outer): several memory streams in
-        // flight instead of one short stream at a time.
-        let mut src = [(std::ptr::null::<Complex64>(), false); 8];
-        for (q, mem) in cl.members().iter().enumerate() {
-            src[q] = (buf.add(self.freq_index(mem.m, mem.mp) * nb), mem.reversed);
-        }
-        let src = &src[..cl.members().len()];
-        for (u0, s0) in ch.halves() {
-            let rows = data[u0 * p..].chunks_exact_mut(p).take(ch.h);
-            for (j, d) in rows.enumerate() {
-                let s = s0 + j;
-                // Quadrature weight (w_k = w_{2B-1-k}); applied to the data, not folded into
-                // the starting values, so the skip threshold bounds the Wigner-d values.
-                let w = self.wq[ch.ks[s]];
-                for (q, &(row, reversed)) in src.iter().enumerate() {
-                    let z = *row.add(if reversed { nb - 1 - s } else { s });
-                    d[2 * q] = z.re * w;
-                    d[2 * q + 1] = z.im * w;
+        fft: impl Fn(&Chunk, *mut f64) -> Result<()> + Sync,
+        cluster: impl Fn(&mut Scratch, usize, &Cluster, &Chunk, *mut f64, bool) + Sync,
+    ) -> Result<StageTimes> {
+        let t0 = Instant::now();
+        let mut times = StageTimes::default();
+        self.with_buf(|buf| {
+            let bp = SyncPtr(buf.as_mut_ptr() as *mut f64);
+            self.pool().install(|| {
+                for (ci, ch) in self.chunks().enumerate() {
+                    let mut fft_stage = || -> Result<()> {
+                        let t = Instant::now();
+                        fft(&ch, bp.get())?;
+                        times.fft += t.elapsed().as_secs_f64();
+                        Ok(())
+                    };
+                    if forward {
+                        fft_stage()?;
+                    }
+                    let t1 = Instant::now();
+                    self.for_each_cluster(t, coef.get(), |sc, c, cl| {
+                        cluster(sc, c, cl, &ch, bp.get(), ci == 0)
+                    });
+                    times.dwt += t1.elapsed().as_secs_f64();
+                    if !forward {
+                        fft_stage()?;
+                    }
                 }
-            }
-        }
-        sc.kernel(self, true, p, n, ch);
-        let f = &sc.out[..n * p];
-        for (q, mem) in cl.members().iter().enumerate() {
-            let dst = std::slice::from_raw_parts_mut(
-                coef.get().add(block_start(self.b, mem.m, mem.mp)),
-                n,
-            );
-            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            let rows = f.chunks_exact(p).map(|r| (r[2 * q], r[2 * q + 1]));
-            if first {
-                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1];
-                    *d = Complex64::new(re * g, im * g);
-                }
-            } else {
-                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1];
-                    *d += Complex64::new(re * g, im * g);
-                }
-            }
-        }
+                Ok::<(), Error>(())
+            })
+        })?;
+        times.total = t0.elapsed().as_secs_f64();
+        Ok(times)
     }
 
-    /// Inverse DWT of one cluster over one chunk, written into the chunk buffer.
-    ///
-    /// # Safety
-    /// `buf` is the chunk buffer; no other task writes this cluster's order pairs.
-    unsafe fn inverse_cluster(
+    /// Run `f(scratch, index, cluster)` on every cluster in parallel (work stealing over
+    /// runs of consecutive clusters, whose blocks are consecutive in the chunk buffer).
+    /// Before a cluster is processed, the coefficient rows of the next one are prefetched:
+    /// they are short streams far apart in an array much larger than the caches.
+    fn for_each_cluster(
         &self,
-        sc: &mut Scratch,
-        cl: &Cluster,
-        ch: &Chunk,
-        buf: *mut Complex64,
-        coef: &[Complex64],
+        t: &Blocks,
+        coef: *mut Complex64,
+        f: impl Fn(&mut Scratch, usize, &Cluster) + Sync,
     ) {
-        let (n, nl) = self.setup(sc, cl, ch);
-        let p = if cl.members().len() > 4 { 16 } else { 8 };
-        let nb = ch.ks.len();
-        self.gather_coeffs(&mut sc.data[..n * p], cl, cl.members(), coef);
-        sc.kernel(self, false, p, n, ch);
-        let y = &sc.out[..nl * p];
-        for (q, mem) in cl.members().iter().enumerate() {
-            let dst = buf.add(self.freq_index(mem.m, mem.mp) * nb);
-            let (yr, yi) = (&y[2 * q * nl..][..nl], &y[(2 * q + 1) * nl..][..nl]);
-            for (u0, s0) in ch.halves() {
-                for j in 0..ch.h {
-                    let s = s0 + j;
-                    let z = Complex64::new(yr[u0 + j], yi[u0 + j]);
-                    *dst.add(if mem.reversed { nb - 1 - s } else { s }) = z;
+        let coef = SyncPtr(coef);
+        let nc = t.len();
+        const RUN: usize = 8;
+        (0..nc.div_ceil(RUN)).into_par_iter().for_each(|r| {
+            let mut guard = lock_free(&self.dwt_scratch);
+            let mut own = None;
+            let sc: &mut Scratch = match guard.as_deref_mut() {
+                Some(s) => s,
+                // All busy (concurrent executions of this plan): use a private one.
+                None => own.insert(Scratch::new(self.b, self.block_lanes)),
+            };
+            let (c0, c1) = (r * RUN, ((r + 1) * RUN).min(nc));
+            let pair = |c: usize| {
+                let (m, mp) = self.clusters[c];
+                Cluster::new(m as usize, mp as usize)
+            };
+            let mut next = pair(c0);
+            for c in c0..c1 {
+                let cl = next;
+                if c + 1 < c1 {
+                    next = pair(c + 1);
+                    self.prefetch_coeffs(&next, coef.get());
+                }
+                f(sc, c, &cl);
+            }
+        });
+    }
+
+    /// Hint the cache about the first lines of the coefficient rows a cluster will touch
+    /// (the hardware prefetchers follow each row from there).
+    fn prefetch_coeffs(&self, cl: &Cluster, coef: *mut Complex64) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let n = self.b - cl.l0();
+            for mem in cl.members() {
+                // 4 complex values per 64-byte line; wrapping_add: hints never fault.
+                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
+                for i in (0..n.min(16)).step_by(4) {
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(i) as *const i8) };
                 }
             }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = (cl, coef);
+    }
+
+    /// Run `f` with a per-worker FFT scratch buffer (three slices). A worker may take on
+    /// another execution's pair while it waits inside a parallel copy, so buffers are taken
+    /// by try_lock, never by blocking; when all are busy a private one is allocated.
+    fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
+        match lock_free(&self.fft_scratch) {
+            Some(g) => f(&g),
+            None => f(&AlignedBuf::new(3 * 4 * self.b * self.b)?),
         }
     }
 }

@@ -82,6 +82,9 @@ pub(crate) trait Simd: Copy {
     unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
     /// Lane `w` of `v` in every lane.
     unsafe fn lane(v: Self::V, w: usize) -> Self::V;
+    /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
+    /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j`.
+    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize);
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
     /// pins the program order of what is computed before and after it.
     #[inline(always)]
@@ -135,6 +138,10 @@ impl Simd for Scalar {
     #[inline(always)]
     unsafe fn any_abs_ge(v: f64, t: f64) -> bool {
         v.abs() >= t
+    }
+    #[inline(always)]
+    unsafe fn store_transposed(v: &[f64], dst: *mut f64, _stride: usize) {
+        *dst = v[0];
     }
 }
 
@@ -198,6 +205,43 @@ mod x86 {
         unsafe fn any_abs_ge(v: __m512d, t: f64) -> bool {
             _mm512_cmp_pd_mask::<_CMP_GE_OQ>(_mm512_abs_pd(v), _mm512_set1_pd(t)) != 0
         }
+        #[inline(always)]
+        unsafe fn store_transposed(v: &[__m512d], dst: *mut f64, stride: usize) {
+            // 8 x 8 transpose: pairs of rows interleaved, then 2 x 2 blocks of 128 bits,
+            // then 4 x 4 blocks of 128 bits.
+            let t: [__m512d; 8] = [
+                _mm512_unpacklo_pd(v[0], v[1]),
+                _mm512_unpackhi_pd(v[0], v[1]),
+                _mm512_unpacklo_pd(v[2], v[3]),
+                _mm512_unpackhi_pd(v[2], v[3]),
+                _mm512_unpacklo_pd(v[4], v[5]),
+                _mm512_unpackhi_pd(v[4], v[5]),
+                _mm512_unpacklo_pd(v[6], v[7]),
+                _mm512_unpackhi_pd(v[6], v[7]),
+            ];
+            let even = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);
+            let odd = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);
+            // u[0]: lanes 0 and 4 of rows 0..4; u[1]: lanes 2, 6; u[2]: 1, 5; u[3]: 3, 7.
+            let u = [
+                _mm512_permutex2var_pd(t[0], even, t[2]),
+                _mm512_permutex2var_pd(t[0], odd, t[2]),
+                _mm512_permutex2var_pd(t[1], even, t[3]),
+                _mm512_permutex2var_pd(t[1], odd, t[3]),
+            ];
+            let w = [
+                _mm512_permutex2var_pd(t[4], even, t[6]),
+                _mm512_permutex2var_pd(t[4], odd, t[6]),
+                _mm512_permutex2var_pd(t[5], even, t[7]),
+                _mm512_permutex2var_pd(t[5], odd, t[7]),
+            ];
+            // Lane order of u: 0, 2, 1, 3 (and +4 in the upper halves).
+            for (i, lane) in [0usize, 2, 1, 3].into_iter().enumerate() {
+                let lo = _mm512_shuffle_f64x2::<0x44>(u[i], w[i]);
+                let hi = _mm512_shuffle_f64x2::<0xEE>(u[i], w[i]);
+                _mm512_storeu_pd(dst.add(lane * stride), lo);
+                _mm512_storeu_pd(dst.add((lane + 4) * stride), hi);
+            }
+        }
     }
 
     /// AVX2 + FMA: 4 doubles.
@@ -253,6 +297,17 @@ mod x86 {
         unsafe fn any_abs_ge(v: __m256d, t: f64) -> bool {
             let a = _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
             _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(a, _mm256_set1_pd(t))) != 0
+        }
+        #[inline(always)]
+        unsafe fn store_transposed(v: &[__m256d], dst: *mut f64, stride: usize) {
+            let t0 = _mm256_unpacklo_pd(v[0], v[1]); // v0[0] v1[0] v0[2] v1[2]
+            let t1 = _mm256_unpackhi_pd(v[0], v[1]); // v0[1] v1[1] v0[3] v1[3]
+            let t2 = _mm256_unpacklo_pd(v[2], v[3]);
+            let t3 = _mm256_unpackhi_pd(v[2], v[3]);
+            _mm256_storeu_pd(dst, _mm256_permute2f128_pd::<0x20>(t0, t2));
+            _mm256_storeu_pd(dst.add(stride), _mm256_permute2f128_pd::<0x20>(t1, t3));
+            _mm256_storeu_pd(dst.add(2 * stride), _mm256_permute2f128_pd::<0x31>(t0, t2));
+            _mm256_storeu_pd(dst.add(3 * stride), _mm256_permute2f128_pd::<0x31>(t1, t3));
         }
     }
 }

@@ -18,9 +18,11 @@
 //! mirrored beta slice. Duplicates (when `m' = 0` or `m = m'`) are dropped, leaving
 //! clusters of 8, 4 (`m' = 0` or `m = m' > 0`) or 1 (`m = m' = 0`) order pairs.
 //!
-//! Clusters with `m > m' > 0` are enumerated with the seed paper's triangle-to-rectangle
-//! map `kappa -> (i, j) -> (m, m')`, which pairs an expensive row (small `m`) with a
-//! cheap one (large `m`) so that consecutive kappa ranges carry similar work.
+//! The seed paper enumerates the clusters with `m > m' > 0` by its triangle-to-rectangle
+//! map `kappa -> (i, j) -> (m, m')`, which pairs an expensive row (small `m`) with a cheap
+//! one (large `m`) so that consecutive kappa ranges carry similar work. Here that map
+//! orders square tiles of clusters, which also keeps the FFT stage's accesses to a
+//! transformed slice local (see [`cluster_pairs`]).
 
 /// One order pair of a cluster and how its Wigner d follows from the base pair's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -146,21 +148,35 @@ pub(crate) fn kappa_to_pair(b: usize, kappa: usize) -> (usize, usize) {
     }
 }
 
-/// Base pairs of all clusters of bandwidth `b`: the generic ones in kappa order, then
-/// the `m' = 0` and `m = m'` groups, then `(0, 0)`. Together their clusters cover every
-/// order pair `(M, M')`, `|M|, |M'| < B`, exactly once.
+/// Side of the square tiles of base pairs that [`cluster_pairs`] keeps together.
+pub(crate) const TILE: usize = 8;
+
+/// Base pairs of all clusters of bandwidth `b`, `0 <= m' <= m < B`, in processing order.
+/// Together their clusters cover every order pair `(M, M')`, `|M|, |M'| < B`, exactly once.
+///
+/// The base pairs are cut into `TILE x TILE` tiles (`m` and `m'` each in one run of
+/// `TILE` values), and a tile's pairs are consecutive (`m` outer, `m'` inner). The FFT
+/// stage moves every cluster's values in or out of a transformed slice, at the rows and
+/// columns `+-m`, `+-m'` of the slice: within a tile these are a few rows and a few
+/// cache lines of each, which stay in L1, instead of a new line per member and cluster.
+/// The tiles themselves, a triangle `0 <= tb <= ta < T` (`T = ceil(B / TILE)`), are
+/// enumerated with the seed paper's index map ([`kappa_to_pair`] on the triangle
+/// `1 <= tb + 1 < ta + 2 <= T + 1`), which interleaves expensive rows of tiles (small
+/// `m`) with cheap ones, so any contiguous run of tiles carries a similar amount of work.
 pub(crate) fn cluster_pairs(b: usize) -> Vec<(u32, u32)> {
-    let mut v: Vec<(u32, u32)> = (0..num_generic(b))
-        .map(|k| {
-            let (m, mp) = kappa_to_pair(b, k);
-            (m as u32, mp as u32)
-        })
-        .collect();
-    for m in 1..b as u32 {
-        v.push((m, 0));
-        v.push((m, m));
+    let t = b.div_ceil(TILE);
+    let tiles = (0..t * (t + 1) / 2).map(|k| {
+        let (x, y) = kappa_to_pair(t + 2, k);
+        (x - 2, y - 1)
+    });
+    let mut v = Vec::with_capacity(b * (b + 1) / 2);
+    for (ta, tb) in tiles {
+        for m in ta * TILE..((ta + 1) * TILE).min(b) {
+            for mp in tb * TILE..((tb + 1) * TILE).min(m + 1) {
+                v.push((m as u32, mp as u32));
+            }
+        }
     }
-    v.push((0, 0));
     v
 }
 

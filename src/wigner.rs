@@ -139,11 +139,16 @@ pub(crate) fn start_norms(b: usize) -> Vec<Ext> {
 }
 
 /// Powers `base^a`, `0 <= a <= maxpow`, for a list of bases, stored in two levels
-/// (`a mod 64` and `64 * (a div 64)`) so one power costs one multiplication.
+/// (`a mod 64` and `64 * (a div 64)`) so one power costs one multiplication. Mantissas
+/// and exponents are kept in separate arrays (exponents as exact small integers in `f64`),
+/// with the bases contiguous, so that the starting values of consecutive betas load as
+/// vectors.
 pub(crate) struct PowTable {
     nb: usize,
-    lo: Vec<Ext>,
-    hi: Vec<Ext>,
+    lo_m: Vec<f64>,
+    lo_e: Vec<f64>,
+    hi_m: Vec<f64>,
+    hi_e: Vec<f64>,
 }
 
 impl PowTable {
@@ -162,7 +167,24 @@ impl PowTable {
                 hi[j * nb + k] = hi[(j - 1) * nb + k].mul(c64);
             }
         }
-        PowTable { nb, lo, hi }
+        PowTable {
+            nb,
+            lo_m: lo.iter().map(|x| x.mant).collect(),
+            lo_e: lo.iter().map(|x| x.exp as f64).collect(),
+            hi_m: hi.iter().map(|x| x.mant).collect(),
+            hi_e: hi.iter().map(|x| x.exp as f64).collect(),
+        }
+    }
+
+    /// Mantissas and exponents of `base_k^a` from `k = k0` on: low level, then high level.
+    fn rows(&self, a: usize, k0: usize) -> [&[f64]; 4] {
+        let (l, h) = ((a % 64) * self.nb + k0, (a / 64) * self.nb + k0);
+        [
+            &self.lo_m[l..],
+            &self.lo_e[l..],
+            &self.hi_m[h..],
+            &self.hi_e[h..],
+        ]
     }
 }
 
@@ -223,17 +245,113 @@ impl BetaTables {
         bits: u32,
     ) -> (f64, f64) {
         let (a, b) = (m + mp, m - mp);
-        let c1 = self.cpow.lo[(a % 64) * self.cpow.nb + k];
-        let c2 = self.cpow.hi[(a / 64) * self.cpow.nb + k];
-        let s1 = self.spow.lo[(b % 64) * self.spow.nb + k];
-        let s2 = self.spow.hi[(b / 64) * self.spow.nb + k];
+        let [c1m, c1e, c2m, c2e] = self.cpow.rows(a, k);
+        let [s1m, s1e, s2m, s2e] = self.spow.rows(b, k);
         // Five mantissas in [0.5, 1) and a weight: no intermediate renormalisation needed.
-        let (mant, e) = frexp(norm.mant * c1.mant * c2.mant * s1.mant * s2.mant * weight);
+        let (mant, e) = frexp(norm.mant * c1m[0] * c2m[0] * s1m[0] * s2m[0] * weight);
         let v = Ext {
             mant: if b % 2 == 1 { -mant } else { mant },
-            exp: e + norm.exp + c1.exp + c2.exp + s1.exp + s2.exp,
+            exp: e + norm.exp + (c1e[0] + c2e[0] + s1e[0] + s2e[0]) as i64,
         };
         v.to_scaled(bits)
+    }
+
+    /// [`BetaTables::start`] (weight 1) for the consecutive points `k0 .. k0 + p.len()`,
+    /// into `p` and `sc`: with AVX-512 eight points at a time (`getexp`, `getmant` and
+    /// `scalef` do the exponent arithmetic exactly), else one at a time. Both give the same
+    /// bits.
+    #[allow(clippy::too_many_arguments)]
+    pub fn starts(
+        &self,
+        isa: Isa,
+        k0: usize,
+        m: usize,
+        mp: usize,
+        norm: Ext,
+        bits: u32,
+        p: &mut [f64],
+        sc: &mut [f64],
+    ) {
+        let len = p.len();
+        assert!(sc.len() == len && k0 + len <= self.tau_lo.len());
+        #[cfg(target_arch = "x86_64")]
+        if isa == Isa::Avx512 && isa.is_supported() {
+            let (a, b) = (m + mp, m - mp);
+            let c = self.cpow.rows(a, k0);
+            let s = self.spow.rows(b, k0);
+            // SAFETY: AVX-512F checked; every row has at least `len` entries from k0 on
+            // (k0 + len <= number of points), as do `p` and `sc`.
+            unsafe { starts_avx512(c, s, norm, b % 2 == 1, bits, p, sc) };
+            return;
+        }
+        let _ = isa;
+        for (i, (p, sc)) in p.iter_mut().zip(sc.iter_mut()).enumerate() {
+            (*p, *sc) = self.start(k0 + i, m, mp, norm, 1.0, bits);
+        }
+    }
+}
+
+/// Eight starting values at a time, with the arithmetic of [`BetaTables::start`] and
+/// [`Ext::to_scaled`]: the product of the five mantissas is split by `getexp`/`getmant`
+/// into `frexp` form, and the scaled value is built by `scalef` (an exact power-of-two
+/// scaling) with the scale index `j = floor((S - bits - e) / S)` where the value is below
+/// `2^-bits`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn starts_avx512(
+    c: [&[f64]; 4],
+    s: [&[f64]; 4],
+    norm: Ext,
+    negative: bool,
+    bits: u32,
+    p: &mut [f64],
+    sc: &mut [f64],
+) {
+    use std::arch::x86_64::*;
+    let len = p.len();
+    let nm = _mm512_set1_pd(norm.mant);
+    let ne = _mm512_set1_pd(norm.exp as f64);
+    let neg_t = _mm512_set1_pd(-(bits as f64));
+    let step = _mm512_set1_pd(SCALE_STEP as f64);
+    let inv_step = _mm512_set1_pd(1.0 / SCALE_STEP as f64);
+    let zero = _mm512_setzero_pd();
+    let one = _mm512_set1_pd(1.0);
+    let sign = _mm512_set1_pd(if negative { -1.0 } else { 1.0 });
+    let mut i = 0;
+    while i < len {
+        let mask: __mmask8 = if len - i >= 8 {
+            0xff
+        } else {
+            (1u8 << (len - i)) - 1
+        };
+        let ld = |a: &[f64]| _mm512_maskz_loadu_pd(mask, a.as_ptr().add(i));
+        // Same order of multiplication as the scalar code (its weight is 1 here).
+        let mut mant = _mm512_mul_pd(nm, ld(c[0]));
+        mant = _mm512_mul_pd(mant, ld(c[2]));
+        mant = _mm512_mul_pd(mant, ld(s[0]));
+        mant = _mm512_mul_pd(mant, ld(s[2]));
+        let exps = _mm512_add_pd(
+            _mm512_add_pd(
+                _mm512_add_pd(ld(c[1]), ld(c[3])),
+                _mm512_add_pd(ld(s[1]), ld(s[3])),
+            ),
+            ne,
+        );
+        let nonzero = _mm512_cmp_pd_mask::<_CMP_NEQ_OQ>(mant, zero);
+        // frexp: mant = fm * 2^(E + 1), fm in [0.5, 1).
+        let big_e = _mm512_getexp_pd(mant);
+        let fm = _mm512_getmant_pd::<_MM_MANT_NORM_P5_1, _MM_MANT_SIGN_SRC>(mant);
+        let e = _mm512_add_pd(_mm512_add_pd(exps, big_e), one);
+        // Below the threshold (e <= -bits): j = floor((S - bits - e) / S) >= 1, else 0.
+        let low = _mm512_cmp_pd_mask::<_CMP_LE_OQ>(e, neg_t);
+        let q = _mm512_mul_pd(_mm512_add_pd(_mm512_sub_pd(neg_t, e), step), inv_step);
+        let j = _mm512_maskz_roundscale_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(low, q);
+        let pv = _mm512_scalef_pd(fm, _mm512_fmadd_pd(j, step, e));
+        let pv = _mm512_maskz_mul_pd(nonzero, pv, sign);
+        let scv = _mm512_maskz_sub_pd(nonzero, zero, j);
+        _mm512_mask_storeu_pd(p.as_mut_ptr().add(i), mask, pv);
+        _mm512_mask_storeu_pd(sc.as_mut_ptr().add(i), mask, scv);
+        i += 8;
     }
 }
 
@@ -475,6 +593,41 @@ mod tests {
             let (pm, pe) = frexp(p);
             assert_eq!(pm, 0.75);
             assert_eq!(pe + SCALE_STEP * (sc as i64), e);
+        }
+    }
+
+    /// The vectorised starting values are bitwise those of the scalar code, including
+    /// values far below the skip threshold and partial vectors.
+    #[test]
+    fn vector_starts_match_scalar() {
+        for b in [5usize, 37, 300] {
+            let bt = BetaTables::grid(b);
+            let norms = start_norms(b);
+            for &(m, mp) in &[
+                (0usize, 0usize),
+                (1, 0),
+                (4, 4),
+                (b - 1, 0),
+                (b - 1, b / 3),
+                (b / 2, b / 2 - 1),
+            ] {
+                let norm = norms[m * (m + 1) / 2 + mp];
+                for bits in [24u32, 300, 560] {
+                    for (k0, len) in [(0usize, 2 * b), (3, b - 1), (b, b)] {
+                        let (mut p, mut sc) = (vec![0.0; len], vec![0.0; len]);
+                        bt.starts(Isa::detect(), k0, m, mp, norm, bits, &mut p, &mut sc);
+                        for i in 0..len {
+                            let (p0, sc0) = bt.start(k0 + i, m, mp, norm, 1.0, bits);
+                            assert_eq!(
+                                (p[i].to_bits(), sc[i]),
+                                (p0.to_bits(), sc0),
+                                "b={b} m={m} mp={mp} bits={bits} k={}",
+                                k0 + i
+                            );
+                        }
+                    }
+                }
+            }
         }
     }
 

@@ -73,30 +73,31 @@ impl Plan {
         inv: Option<&SliceFft>,
     ) -> Option<[f64; 2]> {
         let n = 2 * self.b;
-        // Slots of a full chunk (the first chunk always is one).
-        let nb = 2 * self.chunk;
-        // One group per worker and direction. The sample grid holds the slices the inverse
-        // groups write (distinct, as the groups run concurrently); the forward groups,
-        // which may be larger, read them cyclically. (Mapping fresh memory costs more
+        let nn = n * n;
+        // One pair per worker and direction, from the first chunk (always a full one). The
+        // sample grid holds the slices the inverse pairs write (distinct, as the pairs run
+        // concurrently); every beta maps onto it cyclically. (Mapping fresh memory costs more
         // than the measurement itself when transparent huge pages must be compacted.)
-        let ngroups = |group: usize| self.threads.min(nb.div_ceil(group));
-        let slices = (ngroups(self.group) * self.group).min(nb);
-        let bytes = slices * n * n * 16;
+        let npairs = self.threads.min(self.chunk);
+        let slices = 2 * npairs;
+        let bytes = slices * nn * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {
             return None;
         }
-        let grid = AlignedBuf::new(slices * n * n).ok()?;
+        let grid = AlignedBuf::new(slices * nn).ok()?;
+        let h = self.chunk;
         let ch = Chunk {
-            ks: (0..nb).map(|s| s % slices).collect(),
-            h: nb / 2,
-            hp: nb / 2,
+            lo: 0,
+            h,
+            hp: h.next_multiple_of(self.isa.lanes()),
         };
+        let g = SyncPtr(grid.as_mut_ptr());
+        let slice = move |k: usize| SyncPtr(g.get().wrapping_add((k % slices) * nn));
         let variants: [(Option<&SliceFft>, Option<&SliceFft>, bool); 2] = [
             (self.fwd_fft.as_ref(), self.inv_fft.as_ref(), false),
             (fwd, inv, true),
         ];
         let mut best = [f64::INFINITY; 2];
-        let g = SyncPtr(grid.as_mut_ptr());
         self.with_buf(|buf| {
             self.pool().install(|| {
                 // Start FFTW's threads (created on a plan's first execution) untimed.
@@ -105,26 +106,16 @@ impl Plan {
                     // SAFETY: the sample grid and the chunk buffer hold at least one slice.
                     unsafe { fft.execute(sp, g.get()) };
                 }
+                let bp = buf.as_mut_ptr() as *mut f64;
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
                         let v = (i + round) % 2;
                         let (f, iv, threaded) = variants[v];
                         let t = Instant::now();
-                        for (fft, forward, group) in
-                            [(f, true, self.fwd_group), (iv, false, self.group)]
-                        {
+                        for (fft, forward) in [(f, true), (iv, false)] {
                             if let Some(fft) = fft {
-                                self.fft_groups(
-                                    &ch,
-                                    fft,
-                                    threaded,
-                                    forward,
-                                    g.get(),
-                                    buf.as_mut_ptr(),
-                                    group,
-                                    ngroups(group),
-                                )?;
+                                self.fft_pairs(&ch, fft, threaded, forward, &slice, bp, npairs)?;
                             }
                         }
                         best[v] = best[v].min(t.elapsed().as_secs_f64());
@@ -182,7 +173,7 @@ mod tests {
         plan.with_buf(|buf| {
             plan.pool().install(|| {
                 for ch in plan.chunks() {
-                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr())?;
+                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64)?;
                 }
                 Ok(())
             })

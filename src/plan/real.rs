@@ -17,7 +17,7 @@ fn representative(mem: &Member) -> bool {
 }
 
 /// The representatives of a cluster (1, 2 or 4 members) and their number.
-fn representatives(cl: &Cluster) -> ([Member; 4], usize) {
+pub(super) fn representatives(cl: &Cluster) -> ([Member; 4], usize) {
     let mut reps = [cl.members()[0]; 4];
     let mut nr = 0;
     for mem in cl.members().iter().filter(|m| representative(m)) {
@@ -119,10 +119,11 @@ impl Plan {
         let coef = SyncPtr(coeffs.as_mut_ptr());
         self.run_chunks(
             true,
+            self.real_blocks()?,
             coef,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
-            |sc, cl, ch, buf, first| unsafe {
-                self.forward_cluster_real(sc, cl, ch, buf, coef, first);
+            |sc, c, cl, ch, buf, first| unsafe {
+                self.forward_cluster_real(sc, c, cl, ch, buf, coef, first);
             },
         )
     }
@@ -138,125 +139,124 @@ impl Plan {
         let out = SyncPtr(samples.as_mut_ptr());
         self.run_chunks(
             false,
+            self.real_blocks()?,
             SyncPtr(coeffs.as_ptr() as *mut Complex64),
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
-            |sc, cl, ch, buf, _| unsafe { self.inverse_cluster_real(sc, cl, ch, buf, coeffs) },
+            |sc, c, cl, ch, buf, _| unsafe {
+                self.inverse_cluster_real(sc, c, cl, ch, buf, coeffs)
+            },
         )
     }
 
-    /// Row of the half-spectrum chunk buffer holding frequency `(a, b')`, `b' <= B`.
-    fn half_index(&self, a: isize, bp: isize) -> usize {
-        let n = 2 * self.b as isize;
-        (a.rem_euclid(n) * (self.b as isize + 1) + bp) as usize
+    fn real_blocks(&self) -> Result<&Blocks> {
+        self.blocks_real.as_ref().ok_or_else(|| {
+            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
+        })
     }
 
-    /// FFT stage of one chunk for real data (see the module documentation): forward from
-    /// `input`, or (with `input = None`) inverse into `grid`.
+    /// FFT stage of one chunk for real data (see the module documentation), one mirrored
+    /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
+    /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
+    /// into `grid` (c2r).
     fn fft_chunk_real(
         &self,
         ch: &Chunk,
         input: Option<SyncInput>,
         grid: *mut f64,
-        buf: *mut Complex64,
+        buf: *mut f64,
     ) -> Result<()> {
         let fft = self.real_fft()?;
+        let t = self.real_blocks()?;
         let (b, n) = (self.b, 2 * self.b);
         let (nn, nh) = (n * n, n * (b + 1));
-        let nb = ch.ks.len();
-        let group = self.group;
         let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        (0..nb.div_ceil(group))
-            .into_par_iter()
-            .try_for_each(|gi| -> Result<()> {
-                let s0 = gi * group;
-                let g = group.min(nb - s0);
-                self.with_fft_scratch(|scratch| {
-                    let (sp, bp) = (scratch.as_mut_ptr(), buf.get());
-                    // SAFETY: the scratch holds `group + 1` slices of n^2 complex values: g half
-                    // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; group `gi`
-                    // owns slots s0..s0+g of the buffer; grid slices are (2B)^2 reals each.
-                    unsafe {
-                        if let Some(SyncInput(input)) = input {
-                            // Real parts of complex samples are first packed into the free
-                            // part of the scratch (after the g half spectra), one slice each.
-                            let packed = sp.add(g * nh) as *mut f64;
-                            for j in 0..g {
-                                let src = match input {
-                                    RealInput::Real(p) => p.add(ch.ks[s0 + j] * nn),
-                                    RealInput::RealParts(p) => {
-                                        let slice = p.add(ch.ks[s0 + j] * nn);
-                                        for i in 0..nn {
-                                            *packed.add(i) = (*slice.add(i)).re;
-                                        }
-                                        packed as *const f64
+        (0..ch.h).into_par_iter().try_for_each(|j| -> Result<()> {
+            let (k0, k1) = ch.pair_betas(b, j);
+            self.with_fft_scratch(|scratch| {
+                let sp = scratch.as_mut_ptr();
+                // SAFETY: the scratch holds three slices of n^2 complex values: two half
+                // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; pair `j` owns
+                // its two rows of every block and its two sample slices (n^2 reals each).
+                unsafe {
+                    let s = [sp, sp.add(nh)];
+                    if let Some(SyncInput(input)) = input {
+                        // Real parts of complex samples are first packed into the free
+                        // part of the scratch, one slice at a time.
+                        let packed = sp.add(2 * nh) as *mut f64;
+                        for (&dst, k) in s.iter().zip([k0, k1]) {
+                            let src = match input {
+                                RealInput::Real(p) => p.add(k * nn),
+                                RealInput::RealParts(p) => {
+                                    let slice = p.add(k * nn);
+                                    for i in 0..nn {
+                                        *packed.add(i) = (*slice.add(i)).re;
                                     }
-                                };
-                                fft.r2c(src, sp.add(j * nh));
-                            }
-                            for fi in 0..nh {
-                                for j in 0..g {
-                                    *bp.add(fi * nb + s0 + j) = *sp.add(j * nh + fi);
+                                    packed as *const f64
                                 }
+                            };
+                            fft.r2c(src, dst);
+                        }
+                        // S(M,M') = conj(R[M][M']) for M' >= 0.
+                        fft_stage::scatter_pair(
+                            t,
+                            self.block_lanes,
+                            [s[0], s[1]],
+                            [self.wq[k0], self.wq[k1]],
+                            true,
+                            buf.get(),
+                            j,
+                            0..t.len(),
+                        );
+                    } else {
+                        fft_stage::gather_pair(
+                            t,
+                            self.block_lanes,
+                            s,
+                            true,
+                            buf.get(),
+                            j,
+                            0..t.len(),
+                        );
+                        for (&slot, k) in s.iter().zip([k0, k1]) {
+                            // Frequency B (alpha or gamma) is outside the band limit.
+                            for i in 0..=b {
+                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
                             }
-                        } else {
-                            for fi in 0..nh {
-                                for j in 0..g {
-                                    *sp.add(j * nh + fi) = *bp.add(fi * nb + s0 + j);
-                                }
+                            for a in 0..n {
+                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
                             }
-                            for j in 0..g {
-                                let slot = sp.add(j * nh);
-                                // Frequency B (alpha or gamma) is outside the band limit.
-                                for i in 0..=b {
-                                    *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
-                                }
-                                for a in 0..n {
-                                    *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
-                                }
-                                fft.c2r(slot, grid.get().add(ch.ks[s0 + j] * nn));
-                            }
+                            fft.c2r(slot, grid.get().add(k * nn));
                         }
                     }
-                    Ok(())
-                })
+                }
+                Ok(())
             })
+        })
     }
 
     /// Forward DWT of one cluster's representatives for real data; partners by symmetry.
     ///
     /// # Safety
-    /// As for `forward_cluster`, with the half-spectrum chunk buffer.
+    /// As for `forward_cluster`, with the real layout.
+    #[allow(clippy::too_many_arguments)]
     unsafe fn forward_cluster_real(
         &self,
         sc: &mut Scratch,
+        c: usize,
         cl: &Cluster,
         ch: &Chunk,
-        buf: *const Complex64,
+        buf: *mut f64,
         coef: SyncPtr<Complex64>,
         first: bool,
     ) {
-        let (n, nl) = self.setup(sc, cl, ch);
-        let p = 8;
-        let nb = ch.ks.len();
+        let n = self.setup(sc, cl, ch);
+        let t = self.blocks_real.as_ref().expect("real layout");
+        let p = t.p(c);
         let (reps, nr) = representatives(cl);
         let reps = &reps[..nr];
-        let data = &mut sc.data[..nl * p];
-        data.fill(0.0);
-        for (q, mem) in reps.iter().enumerate() {
-            // S(M,M') = conj(R[M][M']) for M' >= 0 (representatives have M' >= 0).
-            let row = buf.add(self.half_index(mem.m, mem.mp) * nb);
-            for (u0, s0) in ch.halves() {
-                for j in 0..ch.h {
-                    let s = s0 + j;
-                    let w = self.wq[ch.ks[s]];
-                    let z = *row.add(if mem.reversed { nb - 1 - s } else { s });
-                    let d = &mut data[(u0 + j) * p..];
-                    d[2 * q] = z.re * w;
-                    d[2 * q + 1] = -z.im * w;
-                }
-            }
-        }
-        sc.kernel(self, true, p, n, ch);
+        let blk = self.block(t, buf, c, ch);
+        Self::zero_padding(blk, p, ch);
+        self.run_forward(sc, ch, p, n, blk);
         let f = &sc.out[..n * p];
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
@@ -283,45 +283,30 @@ impl Plan {
         }
     }
 
-    /// Inverse DWT of one cluster's representatives for real data, into the half-spectrum
-    /// chunk buffer as the c2r input.
+    /// Inverse DWT of one cluster's representatives for real data, into its block of the
+    /// real layout (the FFT stage turns it into the c2r input).
     ///
     /// # Safety
-    /// As for `inverse_cluster`, with the half-spectrum chunk buffer.
+    /// As for `inverse_cluster`, with the real layout.
     unsafe fn inverse_cluster_real(
         &self,
         sc: &mut Scratch,
+        c: usize,
         cl: &Cluster,
         ch: &Chunk,
-        buf: *mut Complex64,
+        buf: *mut f64,
         coef: &[Complex64],
     ) {
-        let (n, nl) = self.setup(sc, cl, ch);
-        let p = 8;
-        let nb = ch.ks.len();
+        let n = self.setup(sc, cl, ch);
+        let t = self.blocks_real.as_ref().expect("real layout");
+        let p = t.p(c);
         let (reps, nr) = representatives(cl);
-        let reps = &reps[..nr];
-        self.gather_coeffs(&mut sc.data[..n * p], cl, reps, coef);
-        sc.kernel(self, false, p, n, ch);
-        let y = &sc.out[..nl * p];
-        for (q, mem) in reps.iter().enumerate() {
-            let own = buf.add(self.half_index(mem.m, mem.mp) * nb);
-            // For M' = 0 the mirrored frequency (-M, 0) is also in the half spectrum.
-            let mirror =
-                (mem.mp == 0 && mem.m != 0).then(|| buf.add(self.half_index(-mem.m, 0) * nb));
-            let (yr, yi) = (&y[2 * q * nl..][..nl], &y[(2 * q + 1) * nl..][..nl]);
-            for (u0, s0) in ch.halves() {
-                for j in 0..ch.h {
-                    let s = s0 + j;
-                    let slot = if mem.reversed { nb - 1 - s } else { s };
-                    let g = Complex64::new(yr[u0 + j], yi[u0 + j]);
-                    *own.add(slot) = g.conj();
-                    if let Some(mp) = mirror {
-                        *mp.add(slot) = g;
-                    }
-                }
-            }
-        }
+        let mut data = std::mem::take(&mut sc.data);
+        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef);
+        let blk = self.block(t, buf, c, ch);
+        let rec = Rec::new(&sc.rec, n);
+        dwt::inverse(self.isa, p, &rec, &sc.lanes(self, ch), &data[..n * p], blk);
+        sc.data = data;
     }
 }
 

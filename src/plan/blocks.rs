@@ -1,0 +1,168 @@
+//! Cluster-major layout of the chunk buffer: the DWT kernels' own layout.
+//!
+//! The chunk buffer holds one block per cluster, in the plan's cluster order. A block has
+//! one row per lane (beta point of the chunk) and `P` doubles per row: the (re, im) pairs of
+//! the cluster's order pairs ("slots"), `P = 16` for 8 slots, 8 for up to 4. The forward
+//! DWT kernel reads a block as it is (`xin[lane * P + q]`) and the inverse kernel writes its
+//! results straight into it, so the DWT stage neither gathers nor transposes: that work is
+//! done once, in cache, by the FFT stage, which moves each transformed slice into (or out
+//! of) the rows of all clusters.
+//!
+//! Slot `q` of cluster `c` holds the value of order pair `(M, M')` at the row's beta, or,
+//! for a "reversed" member (see `symmetry.rs`), at the mirrored beta `pi - beta`: `fi[8c+q]`
+//! is where that value sits in a transformed slice, and bit `q` of `rev[c]` says whether it
+//! is taken from the mirrored slice.
+
+use crate::symmetry::Cluster;
+
+/// No slot (unused entry of a cluster with fewer than 8 members).
+pub(super) const NONE: u32 = u32::MAX;
+
+/// Slot tables and block offsets of one layout (complex or real-signal transforms).
+pub(super) struct Blocks {
+    /// Doubles per lane row of each cluster's block.
+    p: Vec<u8>,
+    /// `pofs[c]`: doubles per lane of all blocks before cluster `c` (length `C + 1`).
+    pofs: Vec<usize>,
+    /// Source index of each slot in a transformed slice (`NONE` for unused slots).
+    pub fi: Vec<u32>,
+    /// Real layout only: a second index the inverse writes the slot's value to (`NONE`).
+    pub fi2: Vec<u32>,
+    /// Bit `q` set: slot `q` reads and writes the mirrored slice.
+    pub rev: Vec<u8>,
+}
+
+impl Blocks {
+    /// Layout of the complex transforms: every member of every cluster, in member order.
+    /// Slices are `2B x 2B`, `(M, M')` at `(M mod 2B) 2B + (M' mod 2B)`.
+    pub fn complex(b: usize, clusters: &[(u32, u32)]) -> Blocks {
+        let n = 2 * b as isize;
+        Blocks::build(clusters, |cl| {
+            let mut out = [(NONE, NONE, false); 8];
+            for (q, mem) in cl.members().iter().enumerate() {
+                let fi = mem.m.rem_euclid(n) * n + mem.mp.rem_euclid(n);
+                out[q] = (fi as u32, NONE, mem.reversed);
+            }
+            (out, cl.members().len())
+        })
+    }
+
+    /// Layout of the real-signal transforms: the representatives of each cluster (see
+    /// `real.rs`), indexed in the half spectrum of `2B x (B+1)` values of an r2c transform,
+    /// `(a, b')` at `(a mod 2B)(B+1) + b'`. For `M' = 0`, `M > 0` the inverse also writes
+    /// the value to `(-M, 0)` (`fi2`).
+    pub fn real(b: usize, clusters: &[(u32, u32)]) -> Blocks {
+        let n = 2 * b as isize;
+        let half = |a: isize, bp: isize| (a.rem_euclid(n) * (b as isize + 1) + bp) as u32;
+        Blocks::build(clusters, |cl| {
+            let mut out = [(NONE, NONE, false); 8];
+            let (reps, nr) = super::real::representatives(cl);
+            for (q, mem) in reps[..nr].iter().enumerate() {
+                let fi2 = if mem.mp == 0 && mem.m != 0 {
+                    half(-mem.m, 0)
+                } else {
+                    NONE
+                };
+                out[q] = (half(mem.m, mem.mp), fi2, mem.reversed);
+            }
+            (out, nr)
+        })
+    }
+
+    fn build(
+        clusters: &[(u32, u32)],
+        slots: impl Fn(&Cluster) -> ([(u32, u32, bool); 8], usize),
+    ) -> Blocks {
+        let nc = clusters.len();
+        let mut t = Blocks {
+            p: Vec::with_capacity(nc),
+            pofs: Vec::with_capacity(nc + 1),
+            fi: vec![NONE; 8 * nc],
+            fi2: vec![NONE; 8 * nc],
+            rev: vec![0; nc],
+        };
+        let mut acc = 0;
+        for (c, &(m, mp)) in clusters.iter().enumerate() {
+            let cl = Cluster::new(m as usize, mp as usize);
+            let (s, len) = slots(&cl);
+            let p = if len > 4 { 16 } else { 8 };
+            t.p.push(p as u8);
+            t.pofs.push(acc);
+            acc += p;
+            for (q, &(fi, fi2, rev)) in s[..len].iter().enumerate() {
+                t.fi[8 * c + q] = fi;
+                t.fi2[8 * c + q] = fi2;
+                t.rev[c] |= (rev as u8) << q;
+            }
+        }
+        t.pofs.push(acc);
+        t
+    }
+
+    /// Number of clusters.
+    pub fn len(&self) -> usize {
+        self.p.len()
+    }
+
+    /// Doubles per lane row of cluster `c`'s block.
+    pub fn p(&self, c: usize) -> usize {
+        self.p[c] as usize
+    }
+
+    /// Offset (in doubles) of cluster `c`'s block in a buffer of `lanes` lanes per block.
+    pub fn offset(&self, c: usize, lanes: usize) -> usize {
+        self.pofs[c] * lanes
+    }
+
+    /// Doubles of the whole buffer for `lanes` lanes per block.
+    #[cfg(test)]
+    pub fn total(&self, lanes: usize) -> usize {
+        self.pofs[self.len()] * lanes
+    }
+
+    /// Doubles per lane over all blocks (for memory estimates before the tables exist):
+    /// 16 per generic cluster, 8 per other cluster (complex), 8 per cluster (real).
+    pub fn doubles_per_lane(b: usize, real: bool) -> usize {
+        let generic = crate::symmetry::num_generic(b);
+        let other = 2 * b.saturating_sub(1) + 1;
+        if real {
+            8 * (generic + other)
+        } else {
+            16 * generic + 8 * other
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::symmetry::cluster_pairs;
+    use std::collections::HashSet;
+
+    /// Every in-band frequency of a slice appears in exactly one slot; the per-lane size
+    /// formula matches the tables.
+    #[test]
+    fn complex_slots_cover_the_band_once() {
+        for b in 1..20usize {
+            let cl = cluster_pairs(b);
+            let t = Blocks::complex(b, &cl);
+            let n = 2 * b;
+            let mut seen = HashSet::new();
+            for c in 0..t.len() {
+                for q in 0..8 {
+                    let fi = t.fi[8 * c + q];
+                    if fi != NONE {
+                        assert!(2 * q < t.p(c));
+                        assert!(seen.insert(fi));
+                        let (a, g) = (fi as usize / n, fi as usize % n);
+                        assert!(a != b && g != b, "frequency B is out of band");
+                    }
+                }
+            }
+            assert_eq!(seen.len(), (n - 1) * (n - 1));
+            assert_eq!(t.total(1), Blocks::doubles_per_lane(b, false));
+            let r = Blocks::real(b, &cl);
+            assert_eq!(r.total(1), Blocks::doubles_per_lane(b, true));
+        }
+    }
+}

@@ -1,0 +1,209 @@
+//! The DWT stage of the complex transforms: per cluster and chunk, the recurrence
+//! coefficients and starting values, the kernel on the cluster's block of the chunk buffer
+//! (see `blocks.rs`), and the coefficients' signs and layout.
+
+use super::*;
+
+/// Per-worker scratch, sized for the largest cluster and chunk.
+pub(super) struct Scratch {
+    pub rec: RecCoeffs,
+    pub tau: Vec<f64>,
+    pub p: Vec<f64>,
+    pub sc: Vec<f64>,
+    /// Inverse: coefficients in the kernel's layout (`n` degrees x `P`).
+    pub data: Vec<f64>,
+    /// Forward: the kernel's sums (`n` degrees x `P`).
+    pub out: Vec<f64>,
+}
+
+impl Scratch {
+    pub fn new(b: usize, lanes: usize) -> Scratch {
+        Scratch {
+            rec: RecCoeffs::new(b),
+            tau: vec![0.0; lanes],
+            p: vec![0.0; lanes],
+            sc: vec![0.0; lanes],
+            data: vec![0.0; b * 16],
+            out: vec![0.0; b * 16],
+        }
+    }
+
+    /// Lane inputs of the kernels after [`Plan::setup`].
+    pub fn lanes<'a>(&'a self, plan: &Plan, ch: &Chunk) -> Lanes<'a> {
+        let nl = ch.lanes();
+        Lanes {
+            tau: &self.tau[..nl],
+            p: &self.p[..nl],
+            sc: &self.sc[..nl],
+            upper_from: ch.hp,
+            big: big(plan.skip_bits),
+            skip: plan.skip,
+            interleaved: true,
+        }
+    }
+}
+
+impl Plan {
+    /// Recurrence coefficients and per-lane inputs (recurrence argument, scaled starting
+    /// value) of a cluster for one chunk; returns the number of degrees. Padding lanes get
+    /// zeros (a zero starting value keeps them at exactly 0).
+    pub(super) fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> usize {
+        let n = self.b - cl.l0();
+        sc.rec.resize(n);
+        self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
+        let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
+        let nl = ch.lanes();
+        for (half, (u0, k0)) in ch.halves(self.b).into_iter().enumerate() {
+            let (u1, pad) = (u0 + ch.h, u0 + ch.hp);
+            let (p, scale) = (&mut sc.p[u0..u1], &mut sc.sc[u0..u1]);
+            self.bt
+                .starts(self.isa, k0, cl.m, cl.mp, norm, self.skip_bits, p, scale);
+            if half == 0 {
+                sc.tau[u0..u1].copy_from_slice(&self.bt.tau_lo[k0..k0 + ch.h]);
+            } else {
+                // The upper half runs down from 2B-1-lo (the mirrors of the lower half).
+                sc.tau[u0..u1].copy_from_slice(&self.bt.tau_hi[k0..k0 + ch.h]);
+                for v in [&mut sc.tau, &mut sc.p, &mut sc.sc] {
+                    v[u0..u1].reverse();
+                }
+            }
+            for v in [&mut sc.tau, &mut sc.p, &mut sc.sc] {
+                v[u1..pad.min(nl)].fill(0.0);
+            }
+        }
+        n
+    }
+
+    /// Inverse DWT input: `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree
+    /// `l0 + i`, times the member's sign and `1/(2 pi)`; unused columns zero.
+    pub(super) fn gather_coeffs(
+        &self,
+        fin: &mut [f64],
+        cl: &Cluster,
+        members: &[Member],
+        coef: &[Complex64],
+    ) {
+        let p = fin.len() / (self.b - cl.l0());
+        if members.len() * 2 < p {
+            fin.fill(0.0);
+        }
+        let n = self.b - cl.l0();
+        let scale = 1.0 / (2.0 * PI);
+        for (q, mem) in members.iter().enumerate() {
+            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
+            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
+            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
+                let g = sg[i & 1];
+                row[2 * q] = z.re * g;
+                row[2 * q + 1] = z.im * g;
+            }
+        }
+    }
+
+    /// The block of cluster `c` in the chunk buffer `buf` of layout `t`, as a slice of
+    /// the chunk's lanes.
+    ///
+    /// # Safety
+    /// `buf` is a chunk buffer of layout `t`; the caller owns the block.
+    pub(super) unsafe fn block<'a>(
+        &self,
+        t: &Blocks,
+        buf: *mut f64,
+        c: usize,
+        ch: &Chunk,
+    ) -> &'a mut [f64] {
+        let p = t.p(c);
+        std::slice::from_raw_parts_mut(buf.add(t.offset(c, self.block_lanes)), ch.lanes() * p)
+    }
+
+    /// Zero the padding rows of a block (lanes `h..hp` of each half, rows `2h..2hp`),
+    /// which the FFT stage does not write: the forward kernel multiplies them by exact
+    /// zeros, which must not meet a stale non-finite value.
+    pub(super) fn zero_padding(blk: &mut [f64], p: usize, ch: &Chunk) {
+        blk[2 * ch.h * p..2 * ch.hp * p].fill(0.0);
+    }
+
+    /// The forward kernel on `xin` (a block) into `sc.out[..n * p]`, zeroed first.
+    pub(super) fn run_forward(
+        &self,
+        sc: &mut Scratch,
+        ch: &Chunk,
+        p: usize,
+        n: usize,
+        xin: &[f64],
+    ) {
+        let mut out = std::mem::take(&mut sc.out);
+        let f = &mut out[..n * p];
+        f.fill(0.0);
+        let rec = Rec::new(&sc.rec, n);
+        dwt::forward(self.isa, p, &rec, &sc.lanes(self, ch), xin, f);
+        sc.out = out;
+    }
+
+    /// Forward DWT of cluster `c` over one chunk, accumulated into `coef`.
+    ///
+    /// # Safety
+    /// `buf` holds the chunk's blocks; `coef` has `num_coeffs` entries and no other task
+    /// writes this cluster's blocks or coefficients.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn forward_cluster(
+        &self,
+        sc: &mut Scratch,
+        c: usize,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *mut f64,
+        coef: SyncPtr<Complex64>,
+        first: bool,
+    ) {
+        let n = self.setup(sc, cl, ch);
+        let p = self.blocks.p(c);
+        let blk = self.block(&self.blocks, buf, c, ch);
+        Self::zero_padding(blk, p, ch);
+        self.run_forward(sc, ch, p, n, blk);
+        for (q, mem) in cl.members().iter().enumerate() {
+            let dst = std::slice::from_raw_parts_mut(
+                coef.get().add(block_start(self.b, mem.m, mem.mp)),
+                n,
+            );
+            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
+            let rows = sc.out[..n * p]
+                .chunks_exact(p)
+                .map(|r| (r[2 * q], r[2 * q + 1]));
+            if first {
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
+                    *d = Complex64::new(re * g, im * g);
+                }
+            } else {
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
+                    *d += Complex64::new(re * g, im * g);
+                }
+            }
+        }
+    }
+
+    /// Inverse DWT of cluster `c` over one chunk, written into its block.
+    ///
+    /// # Safety
+    /// `buf` is the chunk buffer; no other task writes this cluster's block.
+    pub(super) unsafe fn inverse_cluster(
+        &self,
+        sc: &mut Scratch,
+        c: usize,
+        cl: &Cluster,
+        ch: &Chunk,
+        buf: *mut f64,
+        coef: &[Complex64],
+    ) {
+        let n = self.setup(sc, cl, ch);
+        let p = self.blocks.p(c);
+        let mut data = std::mem::take(&mut sc.data);
+        self.gather_coeffs(&mut data[..n * p], cl, cl.members(), coef);
+        let blk = self.block(&self.blocks, buf, c, ch);
+        let rec = Rec::new(&sc.rec, n);
+        dwt::inverse(self.isa, p, &rec, &sc.lanes(self, ch), &data[..n * p], blk);
+        sc.data = data;
+    }
+}
