@@ -86,7 +86,7 @@ impl Lanes<'_> {
 
 /// Recurrence state of one vector of betas.
 #[derive(Clone, Copy)]
-struct State<'r, S: Simd, const W: usize> {
+struct State<'r, S: Simd> {
     tau: S::V,
     /// `-A` (lower half) or `A` (upper half).
     ka: &'r [f64],
@@ -94,30 +94,22 @@ struct State<'r, S: Simd, const W: usize> {
     kc: &'r [f64],
     p0: S::V,
     p1: S::V,
-    sc: [f64; W],
-    mask: [f64; W],
-    active: usize,
+    /// Scale index of each lane (`<= 0`, see `wigner.rs`).
+    sc: S::V,
+    /// 1 for the active lanes (scale index 0), else 0.
+    mask: S::V,
     /// Next degree index (`l - l0`).
     i: usize,
     /// Rescale threshold (see [`Lanes::big`]).
-    big: f64,
+    big: S::V,
     /// See [`Lanes::skip`].
     skip: bool,
 }
 
-impl<'r, S: Simd, const W: usize> State<'r, S, W> {
+impl<'r, S: Simd> State<'r, S> {
     #[inline(always)]
     unsafe fn new(rec: &Rec<'r>, lanes: &Lanes, s0: usize) -> Self {
-        let mut sc = [0.0; W];
-        sc.copy_from_slice(&lanes.sc[s0..s0 + W]);
-        let mut mask = [0.0; W];
-        let mut active = 0;
-        for w in 0..W {
-            if sc[w] == 0.0 {
-                mask[w] = 1.0;
-                active += 1;
-            }
-        }
+        let sc = S::load(lanes.sc.as_ptr().add(s0));
         let (ka, kc) = if s0 >= lanes.upper_from {
             (rec.a, rec.e)
         } else {
@@ -130,71 +122,142 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
             p0: S::zero(),
             p1: S::load(lanes.p.as_ptr().add(s0)),
             sc,
-            mask,
-            active,
+            mask: S::blend_ge(sc, S::zero(), S::splat(1.0), S::zero()),
             i: 0,
-            big: lanes.big,
+            big: S::splat(lanes.big),
             skip: lanes.skip,
         }
     }
 
-    /// Advance from degree `l0+i` to `l0+i+1`.
+    /// Whether no lane is active yet.
     #[inline(always)]
-    ///
-    /// # Safety
-    /// `i < rec.len()` (all coefficient slices have that length, checked by the entry points).
-    unsafe fn step(&mut self, rec: &Rec, i: usize) {
-        debug_assert!(i < self.ka.len() && i < self.kc.len() && i < rec.bb.len());
+    unsafe fn none_active(&self) -> bool {
+        !S::any_ge(self.mask, S::splat(0.5))
+    }
+
+    /// Whether every lane is active.
+    #[inline(always)]
+    unsafe fn all_active(&self) -> bool {
+        !S::any_ge(S::splat(0.5), self.mask)
+    }
+
+    /// Rescale the scaled-down lanes of `(p0, p1)` that grew past `big` by `2^-SCALE_STEP`
+    /// (at most once per `2^SCALE_STEP` of growth), activating those that reach scale
+    /// index 0. All in registers: with a low skip threshold nearly every lane passes
+    /// through here once on its way to being active.
+    #[inline(always)]
+    unsafe fn rescale(&mut self, p0: &mut S::V, p1: &mut S::V) {
+        let (zero, one) = (S::zero(), S::splat(1.0));
+        // |p1| of the scaled-down lanes, 0 for the active ones.
+        let a = S::blend_ge(self.sc, zero, zero, S::abs(*p1));
+        let f = S::blend_ge(a, self.big, S::splat(TINY), one);
+        *p0 = S::mul(*p0, f);
+        *p1 = S::mul(*p1, f);
+        self.sc = S::add(self.sc, S::blend_ge(a, self.big, one, zero));
+        self.mask = S::blend_ge(self.sc, zero, one, zero);
+    }
+
+    /// The first part of a forward run: like [`State::run`] up to the degree where every
+    /// lane is active, handing the values over `W` degrees at a time, transposed:
+    /// `f(e, i0)` gets `e[w]` = the values of lane `w` at degrees `i0 .. i0 + W` (zero past
+    /// `n`, and for lanes still scaled down). The fully active rest is left to the caller
+    /// (`forward_body`), which interleaves it with the accumulation.
+    #[inline(always)]
+    unsafe fn run_masked_blocks<const W: usize>(
+        &mut self,
+        rec: &Rec,
+        n: usize,
+        mut f: impl FnMut(&[S::V; W], usize),
+    ) {
+        let mut i = self.i;
+        let (tau, ka, kc, bb) = (self.tau, self.ka, self.kc, rec.bb);
+        let (mut p0, mut p1) = (self.p0, self.p1);
+        let step = |p0: S::V, p1: S::V, i: usize| {
+            let t = S::fma(
+                S::splat(*ka.get_unchecked(i)),
+                tau,
+                S::splat(*kc.get_unchecked(i)),
+            );
+            S::fms(t, p1, S::mul(S::splat(*bb.get_unchecked(i)), p0))
+        };
+        // The rest of the negligible prefix (see `skip_inactive`).
+        if self.skip {
+            while i < n && self.none_active() {
+                let p2 = step(p0, p1, i);
+                (p0, p1) = (p1, p2);
+                i += 1;
+                if S::any_ge(S::abs(p1), self.big) {
+                    self.rescale(&mut p0, &mut p1);
+                }
+            }
+        }
+        // Blocks with lanes still scaled down (masked to zero).
+        while i < n && !self.all_active() {
+            let i0 = i;
+            let mut d = [S::zero(); W];
+            for dj in d.iter_mut() {
+                if i < n {
+                    *dj = S::mul(p1, self.mask);
+                    let p2 = step(p0, p1, i);
+                    (p0, p1) = (p1, p2);
+                    i += 1;
+                    if S::any_ge(S::abs(p1), self.big) {
+                        self.rescale(&mut p0, &mut p1);
+                    }
+                }
+            }
+            S::transpose(&mut d);
+            f(&d, i0);
+        }
+        (self.p0, self.p1) = (p0, p1);
+        self.i = i;
+    }
+
+    /// One recurrence step from `(p0, p1)` at degree index `i`: the next value.
+    #[inline(always)]
+    unsafe fn step(&self, rec: &Rec, p0: S::V, p1: S::V, i: usize) -> S::V {
         let t = S::fma(
             S::splat(*self.ka.get_unchecked(i)),
             self.tau,
             S::splat(*self.kc.get_unchecked(i)),
         );
-        let u = S::mul(S::splat(*rec.bb.get_unchecked(i)), self.p0);
-        let p2 = S::fms(t, self.p1, u);
-        self.p0 = self.p1;
-        self.p1 = p2;
-    }
-
-    /// Rescale lanes that grew past `big` (rare: at most once per `2^600` of growth).
-    #[inline(never)]
-    unsafe fn rescale(&mut self) {
-        let mut a0 = [0.0; W];
-        let mut a1 = [0.0; W];
-        S::store(a0.as_mut_ptr(), self.p0);
-        S::store(a1.as_mut_ptr(), self.p1);
-        for w in 0..W {
-            if self.sc[w] < 0.0 && a1[w].abs() >= self.big {
-                a0[w] *= TINY;
-                a1[w] *= TINY;
-                self.sc[w] += 1.0;
-                if self.sc[w] == 0.0 {
-                    self.mask[w] = 1.0;
-                    self.active += 1;
-                }
-            }
-        }
-        self.p0 = S::load(a0.as_ptr());
-        self.p1 = S::load(a1.as_ptr());
+        S::fms(t, p1, S::mul(S::splat(*rec.bb.get_unchecked(i)), p0))
     }
 
     /// Run the remaining degrees up to `n`, calling `acc(v, i)` with the value vector at
-    /// each degree from the first one where some lane is active.
+    /// each degree from the first one where some lane is active. The recurrence values
+    /// live in locals (registers) throughout.
     #[inline(always)]
     unsafe fn run(&mut self, rec: &Rec, n: usize, mut acc: impl FnMut(S::V, usize)) {
         let mut i = self.i;
-        // Slow phase: some lanes still scaled down.
-        while i < n && self.active < W {
-            let accumulate = self.active > 0 || !self.skip;
-            let v = S::mul(self.p1, S::load(self.mask.as_ptr()));
-            self.step(rec, i);
-            self.p1 = S::fence(self.p1);
-            if accumulate {
-                acc(v, i);
-            }
-            i += 1;
-            if S::any_abs_ge(self.p1, self.big) {
-                self.rescale();
+        let (tau, ka, kc, bb) = (self.tau, self.ka, self.kc, rec.bb);
+        let (mut p0, mut p1) = (self.p0, self.p1);
+        let step = |p0: S::V, p1: S::V, i: usize| {
+            let t = S::fma(
+                S::splat(*ka.get_unchecked(i)),
+                tau,
+                S::splat(*kc.get_unchecked(i)),
+            );
+            S::fms(t, p1, S::mul(S::splat(*bb.get_unchecked(i)), p0))
+        };
+        // Slow phase: some lanes still scaled down (and masked to zero).
+        if !self.all_active() {
+            let mut accumulate = !self.none_active() || !self.skip;
+            while i < n {
+                let v = S::mul(p1, self.mask);
+                let p2 = S::fence(step(p0, p1, i));
+                (p0, p1) = (p1, p2);
+                if accumulate {
+                    acc(v, i);
+                }
+                i += 1;
+                if S::any_ge(S::abs(p1), self.big) {
+                    self.rescale(&mut p0, &mut p1);
+                    accumulate = !self.none_active() || !self.skip;
+                    if self.all_active() {
+                        break;
+                    }
+                }
             }
         }
         // Fast phase: all lanes hold true values. The step to the next degree comes first
@@ -202,12 +265,13 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
         // placed after the accumulation would queue behind it and put its latency on the
         // critical path at every degree (measured: 13.4 against 10.7 cycles per degree).
         while i < n {
-            let v = self.p1;
-            self.step(rec, i);
-            self.p1 = S::fence(self.p1);
+            let v = p1;
+            let p2 = S::fence(step(p0, p1, i));
+            (p0, p1) = (p1, p2);
             acc(v, i);
             i += 1;
         }
+        (self.p0, self.p1) = (p0, p1);
         self.i = i;
     }
 }
@@ -215,31 +279,59 @@ impl<'r, S: Simd, const W: usize> State<'r, S, W> {
 /// Vectors whose recurrences are advanced together through their negligible prefix.
 const GROUP: usize = 4;
 
-/// Advance every state of `st` through the degrees where none of its lanes is active yet.
+/// Advance the states of `st` through the degrees where none of their lanes is active yet.
 ///
 /// That prefix needs only the recurrence, whose one-FMA-per-degree dependency chain would
-/// leave a lone vector latency-bound; interleaving `GROUP` independent chains keeps the
-/// floating-point pipes busy.
+/// leave a lone vector latency-bound. While all `GROUP` vectors are in their prefix they
+/// step together, held in registers, with one test per degree of whether any value has
+/// reached the rescale threshold. The vectors are neighbouring betas, whose prefixes end at
+/// similar degrees; once one of them has an active lane, each finishes its own prefix in
+/// [`State::run`].
 #[inline(always)]
-unsafe fn skip_inactive<S: Simd, const W: usize>(
-    st: &mut [State<'_, S, W>; GROUP],
-    rec: &Rec,
-    n: usize,
-) {
+unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: usize) {
+    if st.iter().any(|s| !s.none_active() || s.i >= n) {
+        return;
+    }
+    let mut i = st[0].i;
+    debug_assert!(st.iter().all(|s| s.i == i));
+    let big = st[0].big;
+    let (mut p0, mut p1, mut tau) = ([S::zero(); GROUP], [S::zero(); GROUP], [S::zero(); GROUP]);
+    let (mut ka, mut kc) = ([rec.a; GROUP], [rec.a; GROUP]);
+    for k in 0..GROUP {
+        (p0[k], p1[k], tau[k], ka[k], kc[k]) = (st[k].p0, st[k].p1, st[k].tau, st[k].ka, st[k].kc);
+    }
     loop {
-        let mut any = false;
-        for s in st.iter_mut() {
-            if s.active == 0 && s.i < n {
-                s.step(rec, s.i);
-                s.i += 1;
-                if S::any_abs_ge(s.p1, s.big) {
-                    s.rescale();
-                }
-                any = true;
+        let mut hit = false;
+        while i < n {
+            let b = S::splat(*rec.bb.get_unchecked(i));
+            let mut m = S::zero();
+            for k in 0..GROUP {
+                let t = S::fma(
+                    S::splat(*ka[k].get_unchecked(i)),
+                    tau[k],
+                    S::splat(*kc[k].get_unchecked(i)),
+                );
+                let p2 = S::fms(t, p1[k], S::mul(b, p0[k]));
+                p0[k] = p1[k];
+                p1[k] = p2;
+                m = S::max(m, S::abs(p2));
+            }
+            i += 1;
+            if S::any_ge(m, big) {
+                hit = true;
+                break;
             }
         }
-        if !any {
-            break;
+        let mut activated = false;
+        for k in 0..GROUP {
+            if hit {
+                st[k].rescale(&mut p0[k], &mut p1[k]);
+                activated |= !st[k].none_active();
+            }
+            (st[k].p0, st[k].p1, st[k].i) = (p0[k], p1[k], i);
+        }
+        if !hit || activated {
+            return;
         }
     }
 }
@@ -253,12 +345,12 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     s0: usize,
     nb: usize,
     n: usize,
-) -> (usize, [State<'r, S, W>; GROUP]) {
+) -> (usize, [State<'r, S>; GROUP]) {
     let g = ((nb - s0) / W).min(GROUP);
     // Written out rather than `std::array::from_fn`, which is not inlined into the
     // `target_feature` entry points and so would call the SIMD loads out of line.
     let at = |j: usize| s0 + j.min(g - 1) * W;
-    let mut st: [State<'r, S, W>; GROUP] = [
+    let mut st: [State<'r, S>; GROUP] = [
         State::new(rec, lanes, at(0)),
         State::new(rec, lanes, at(1)),
         State::new(rec, lanes, at(2)),
@@ -273,18 +365,73 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     (g, st)
 }
 
+/// The accumulators `ft[q][i0 .. i0 + W]` of the forward kernel.
 #[inline(always)]
-unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
+unsafe fn load_acc<S: Simd, const P: usize>(fp: *mut f64, ld: usize, i0: usize) -> [S::V; P] {
+    let mut acc = [S::zero(); P];
+    for (q, a) in acc.iter_mut().enumerate() {
+        *a = S::load(fp.add(q * ld + i0));
+    }
+    acc
+}
+
+/// Store what [`load_acc`] loaded.
+#[inline(always)]
+unsafe fn store_acc<S: Simd, const P: usize>(fp: *mut f64, ld: usize, acc: &[S::V; P], i0: usize) {
+    for (q, a) in acc.iter().enumerate() {
+        S::store(fp.add(q * ld + i0), *a);
+    }
+}
+
+/// `acc[q] += e * x[q]` for the `P` data of one beta's block row `xw` (broadcast loads).
+#[inline(always)]
+unsafe fn lane_fmas<S: Simd, const P: usize>(acc: &mut [S::V; P], e: S::V, xw: *const f64) {
+    for (q, a) in acc.iter_mut().enumerate() {
+        *a = S::fma(e, S::splat(*xw.add(q)), *a);
+    }
+}
+
+/// One block of the forward kernel: `ft[q][i0..i0+W] += sum_w e[w] x[w][q]` (rows of `x`
+/// `xs` apart).
+#[inline(always)]
+unsafe fn block_fmas<S: Simd, const W: usize, const P: usize>(
+    fp: *mut f64,
+    ld: usize,
+    x: *const f64,
+    xs: usize,
+    e: &[S::V; W],
+    i0: usize,
+) {
+    let mut acc = load_acc::<S, P>(fp, ld, i0);
+    for (w, ew) in e.iter().enumerate() {
+        lane_fmas::<S, P>(&mut acc, *ew, x.add(w * xs));
+    }
+    store_acc::<S, P>(fp, ld, &acc, i0);
+}
+
+/// Forward kernel body. Per vector of `W` betas the recurrence produces the values of
+/// `W` consecutive degrees, which are transposed in registers (lane = degree) and
+/// accumulated as `ft[q][i0..i0+W] += sum_w e_w * x[w][q]`: the data `x` enter as
+/// broadcasts from memory (the block row of beta `w`, in L1), so no lane of a register
+/// has to be broadcast by a shuffle.
+///
+/// Once all lanes are active the recurrence runs one block ahead of the accumulation, one
+/// step before each lane's 16 (or 8) multiply-adds in program order: the floating-point
+/// pipes issue the oldest ready instruction first, so the latency-bound chain of steps
+/// never waits behind a block of independent multiply-adds.
+#[inline(always)]
+unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
     rec: &Rec,
     lanes: &Lanes,
     xin: &[f64],
-    f: &mut [f64],
+    ft: &mut [f64],
+    ld: usize,
 ) {
-    let p = W * NV;
     let n = rec.len();
     let nb = lanes.tau.len();
-    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * p && f.len() >= n * p);
-    let fp = f.as_mut_ptr();
+    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P && ld >= n + W);
+    debug_assert!(ft.len() >= P * ld);
+    let fp = ft.as_mut_ptr();
     let mut g0 = 0;
     while g0 < nb {
         let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
@@ -292,43 +439,71 @@ unsafe fn forward_body<S: Simd, const W: usize, const NV: usize>(
             // A local copy, so the state lives in registers during the run.
             let mut st = *st;
             let s0 = g0 + gi * W;
-            let (r0, step) = lanes.rows(s0);
-            let mut xr = [[S::zero(); NV]; W];
-            for (w, row) in xr.iter_mut().enumerate() {
-                for (j, v) in row.iter_mut().enumerate() {
-                    *v = S::load(xin.as_ptr().add((r0 + w * step) * p + j * W));
-                }
-            }
-            st.run(
+            let (r0, rstep) = lanes.rows(s0);
+            let x = xin.as_ptr().add(r0 * P);
+            let xs = rstep * P;
+            let block = |e: &[S::V; W], i0: usize| block_fmas::<S, W, P>(fp, ld, x, xs, e, i0);
+            st.run_masked_blocks::<W>(
                 rec,
                 n,
                 #[inline(always)]
-                |v, i| {
-                    let row = fp.add(i * p);
-                    let mut acc0 = [S::zero(); NV];
-                    let mut acc1 = [S::zero(); NV];
-                    for (j, a) in acc0.iter_mut().enumerate() {
-                        *a = S::load(row.add(j * W));
-                    }
-                    let mut w = 0;
-                    while w < W {
-                        let t = S::lane(v, w);
-                        for j in 0..NV {
-                            acc0[j] = S::fma(t, xr[w][j], acc0[j]);
-                        }
-                        if w + 1 < W {
-                            let t = S::lane(v, w + 1);
-                            for j in 0..NV {
-                                acc1[j] = S::fma(t, xr[w + 1][j], acc1[j]);
-                            }
-                        }
-                        w += 2;
-                    }
-                    for j in 0..NV {
-                        S::store(row.add(j * W), S::add(acc0[j], acc1[j]));
-                    }
-                },
+                |e, i0| block(e, i0),
             );
+            let (mut p0, mut p1, mut i) = (st.p0, st.p1, st.i);
+            if i + W <= n {
+                let mut e = [S::zero(); W];
+                for (j, ej) in e.iter_mut().enumerate() {
+                    *ej = p1;
+                    let p2 = S::fence(st.step(rec, p0, p1, i + j));
+                    (p0, p1) = (p1, p2);
+                }
+                S::transpose(&mut e);
+                let mut i0 = i;
+                i += W;
+                while i + W <= n {
+                    let mut acc = load_acc::<S, P>(fp, ld, i0);
+                    let mut d = e;
+                    // Written out for each lane (the compiler then keeps `d` and `e` in
+                    // registers): step first, then the lane's multiply-adds.
+                    macro_rules! lane {
+                        ($w:literal) => {
+                            if $w < W {
+                                let ew = e[$w];
+                                d[$w] = p1;
+                                let p2 = S::fence(st.step(rec, p0, p1, i + $w));
+                                (p0, p1) = (p1, p2);
+                                lane_fmas::<S, P>(&mut acc, ew, x.add($w * xs));
+                            }
+                        };
+                    }
+                    lane!(0);
+                    lane!(1);
+                    lane!(2);
+                    lane!(3);
+                    lane!(4);
+                    lane!(5);
+                    lane!(6);
+                    lane!(7);
+                    store_acc::<S, P>(fp, ld, &acc, i0);
+                    S::transpose(&mut d);
+                    e = d;
+                    i0 = i;
+                    i += W;
+                }
+                block(&e, i0);
+            }
+            if i < n {
+                let i0 = i;
+                let mut d = [S::zero(); W];
+                for dj in d.iter_mut().take(n - i) {
+                    *dj = p1;
+                    let p2 = st.step(rec, p0, p1, i);
+                    (p0, p1) = (p1, p2);
+                    i += 1;
+                }
+                S::transpose(&mut d);
+                block(&d, i0);
+            }
         }
         g0 += g * W;
     }
@@ -377,11 +552,18 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
 }
 
 macro_rules! entry {
-    ($name:ident, $feat:literal, $body:ident, $S:ty, $W:literal, $N:literal) => {
+    ($name:ident, $feat:literal, inverse_body, $S:ty, $W:literal, $N:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
         unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) {
-            $body::<$S, $W, $N>(rec, lanes, a, b)
+            inverse_body::<$S, $W, $N>(rec, lanes, a, b)
+        }
+    };
+    ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64], ld: usize) {
+            forward_body::<$S, $W, $N>(rec, lanes, a, b, ld)
         }
     };
 }
@@ -389,39 +571,49 @@ macro_rules! entry {
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512};
 
-entry!(fwd_avx512_16, "avx512f,fma", forward_body, Avx512, 8, 2);
-entry!(fwd_avx512_8, "avx512f,fma", forward_body, Avx512, 8, 1);
-entry!(fwd_avx2_16, "avx2,fma", forward_body, Avx2, 4, 4);
-entry!(fwd_avx2_8, "avx2,fma", forward_body, Avx2, 4, 2);
+entry!(fwd_avx512_16, "avx512f,fma", forward_body, Avx512, 8, 16);
+entry!(fwd_avx512_8, "avx512f,fma", forward_body, Avx512, 8, 8);
+entry!(fwd_avx2_16, "avx2,fma", forward_body, Avx2, 4, 16);
+entry!(fwd_avx2_8, "avx2,fma", forward_body, Avx2, 4, 8);
 entry!(inv_avx512_16, "avx512f,fma", inverse_body, Avx512, 8, 16);
 entry!(inv_avx512_8, "avx512f,fma", inverse_body, Avx512, 8, 8);
 entry!(inv_avx2_16, "avx2,fma", inverse_body, Avx2, 4, 16);
 entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 
-/// Forward kernel: `f[i*P + q] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or 16
-/// (`row` see [`Lanes::interleaved`]).
+/// Forward kernel: `ft[q*ld + i] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or
+/// 16 (`row` see [`Lanes::interleaved`]); `ld >= n + W` (entries `n..ld` of each row may be
+/// written with zeros added).
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
-pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], f: &mut [f64]) {
+pub(crate) fn forward(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    xin: &[f64],
+    ft: &mut [f64],
+    ld: usize,
+) {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(xin.len() >= nb * p && f.len() >= n * p && isa.is_supported());
+    assert!(xin.len() >= nb * p && ld >= n + isa.lanes() && ft.len() >= p * ld);
+    assert!(isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
     unsafe {
         match (isa, p) {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, xin, f),
+            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, xin, ft, ld),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, xin, f),
+            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, xin, ft, ld),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, f),
+            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, ft, ld),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, f),
-            (_, 16) => forward_body::<Scalar, 1, 16>(rec, lanes, xin, f),
-            (_, 8) => forward_body::<Scalar, 1, 8>(rec, lanes, xin, f),
+            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, ft, ld),
+            (_, 16) => forward_body::<Scalar, 1, 16>(rec, lanes, xin, ft, ld),
+            (_, 8) => forward_body::<Scalar, 1, 8>(rec, lanes, xin, ft, ld),
             _ => unreachable!("P must be 8 or 16"),
         }
     }
@@ -480,7 +672,8 @@ pub(crate) fn column(
     sc[0] = sc0;
     let mut xin = vec![0.0; w * 8];
     xin[0] = 1.0;
-    let mut f = vec![0.0; n * 8];
+    let ld = n + w;
+    let mut f = vec![0.0; 8 * ld];
     let rec = Rec::new(&rc, n);
     let lanes = Lanes {
         tau: &tau,
@@ -491,8 +684,8 @@ pub(crate) fn column(
         skip: true,
         interleaved: false,
     };
-    forward(isa, 8, &rec, &lanes, &xin, &mut f);
-    (0..n).map(|i| f[i * 8]).collect()
+    forward(isa, 8, &rec, &lanes, &xin, &mut f, ld);
+    f[..n].to_vec()
 }
 
 #[cfg(test)]
@@ -511,6 +704,14 @@ mod tests {
             .collect()
     }
 
+    /// Skip threshold of the kernel tests and benchmarks: `SO3FFT_SKIP_BITS` or the default.
+    pub(super) fn test_skip_bits() -> u32 {
+        std::env::var("SO3FFT_SKIP_BITS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(DEFAULT_SKIP_BITS)
+    }
+
     /// Recurrence coefficients of base pair `(m, mp)` at bandwidth `b` and lane inputs for
     /// `nbs` points spread evenly over the grid (lower half first, as in a chunk).
     pub(super) fn cluster_setup(
@@ -527,7 +728,7 @@ mod tests {
         for s in 0..nbs {
             let k = s * (2 * b) / nbs;
             tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
-            (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0, DEFAULT_SKIP_BITS);
+            (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0, test_skip_bits());
         }
         (rc, tau, p, sc)
     }
@@ -544,7 +745,7 @@ mod tests {
             p,
             sc,
             upper_from,
-            big: crate::wigner::big(DEFAULT_SKIP_BITS),
+            big: crate::wigner::big(test_skip_bits()),
             skip: true,
             interleaved: true,
         }
@@ -564,17 +765,18 @@ mod tests {
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
                 let fin = pseudo(n * pw, 11 + mp as u64);
-                let mut f_ref = vec![0.0; n * pw];
+                let ld = n + 8;
+                let mut f_ref = vec![0.0; ld * pw];
                 let mut y_ref = vec![0.0; nb * pw];
-                forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref);
+                forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref, ld);
                 inverse(Isa::Scalar, pw, &rec, &lanes, &fin, &mut y_ref);
                 for isa in [Isa::Avx512, Isa::Avx2] {
                     if !isa.is_supported() {
                         continue;
                     }
-                    let mut f = vec![0.0; n * pw];
+                    let mut f = vec![0.0; ld * pw];
                     let mut y = vec![0.0; nb * pw];
-                    forward(isa, pw, &rec, &lanes, &xin, &mut f);
+                    forward(isa, pw, &rec, &lanes, &xin, &mut f, ld);
                     inverse(isa, pw, &rec, &lanes, &fin, &mut y);
                     // FMA and plain multiply-add round differently; the recurrence error
                     // grows like l * eps (l <= 200 here), so compare relative to the largest value.
@@ -614,7 +816,8 @@ mod kernel_speed {
             let rec = Rec::new(&rc, n);
             let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
             let xin = vec![0.5; nbs * 16];
-            let mut f = vec![0.0; n * 16];
+            let ld = n + 8;
+            let mut f = vec![0.0; ld * 16];
             let mut y = vec![0.0; nbs * 16];
             let isa = Isa::detect();
             // Best of several batches: the machine is shared and noisy.
@@ -629,8 +832,8 @@ mod kernel_speed {
                     })
                     .fold(f64::INFINITY, f64::min)
             };
-            let tf = best(&mut || forward(isa, 16, &rec, &lanes, &xin, &mut f));
-            let ti = best(&mut || inverse(isa, 16, &rec, &lanes, &f, &mut y));
+            let tf = best(&mut || forward(isa, 16, &rec, &lanes, &xin, &mut f, ld));
+            let ti = best(&mut || inverse(isa, 16, &rec, &lanes, &f[..n * 16], &mut y));
             let flops = (n * nbs * 16 * 2) as f64;
             println!(
                 "B={b} nb={nbs} L={n}: forward {:.1} GFLOP/s, inverse {:.1} GFLOP/s",
@@ -658,7 +861,7 @@ mod stage_speed {
             let mut qt = [0.0f64; 4];
             let mut qf = [0.0f64; 4];
             let xin = vec![0.5; nbs * 16];
-            let mut f = vec![0.0; b * 16];
+            let mut f = vec![0.0; (b + 8) * 16];
             let mut y = vec![0.0; nbs * 16];
             for (m, mp) in crate::symmetry::cluster_pairs(b) {
                 let (m, mp) = (m as usize, mp as usize);
@@ -668,7 +871,7 @@ mod stage_speed {
                 let lanes = grid_lanes(&x, &p, &sc, b);
                 let pw = if m == mp || mp == 0 { 8 } else { 16 };
                 let t = std::time::Instant::now();
-                forward(isa, pw, &rec, &lanes, &xin, &mut f[..n * pw]);
+                forward(isa, pw, &rec, &lanes, &xin, &mut f[..(n + 8) * pw], n + 8);
                 tf += t.elapsed().as_secs_f64();
                 let t = std::time::Instant::now();
                 inverse(isa, pw, &rec, &lanes, &f[..n * pw], &mut y[..nbs * pw]);

@@ -78,13 +78,29 @@ pub(crate) trait Simd: Copy {
     unsafe fn fma(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
     /// `a * b - c`
     unsafe fn fms(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
-    /// Whether any lane has `|v| >= t`.
-    unsafe fn any_abs_ge(v: Self::V, t: f64) -> bool;
-    /// Lane `w` of `v` in every lane.
-    unsafe fn lane(v: Self::V, w: usize) -> Self::V;
+    /// Whether any lane has `a >= b`.
+    unsafe fn any_ge(a: Self::V, b: Self::V) -> bool;
+    /// `|v|`
+    unsafe fn abs(v: Self::V) -> Self::V;
+    /// Lane-wise `if a >= b { x } else { y }`.
+    unsafe fn blend_ge(a: Self::V, b: Self::V, x: Self::V, y: Self::V) -> Self::V;
+    /// Lane-wise maximum.
+    unsafe fn max(a: Self::V, b: Self::V) -> Self::V;
+    /// Transpose the `W x W` block `v` (vector `j`, lane `w`) in registers: afterwards
+    /// vector `w` holds lane `w` of every former vector.
+    unsafe fn transpose(v: &mut [Self::V]);
     /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
     /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j`.
-    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize);
+    #[inline(always)]
+    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize) {
+        let mut t = [Self::zero(); 8];
+        let w = v.len();
+        t[..w].copy_from_slice(v);
+        Self::transpose(&mut t[..w]);
+        for (r, x) in t[..w].iter().enumerate() {
+            Self::store(dst.add(r * stride), *x);
+        }
+    }
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
     /// pins the program order of what is computed before and after it.
     #[inline(always)]
@@ -132,17 +148,27 @@ impl Simd for Scalar {
         a * b - c
     }
     #[inline(always)]
-    unsafe fn lane(v: f64, _w: usize) -> f64 {
-        v
+    unsafe fn any_ge(a: f64, b: f64) -> bool {
+        a >= b
     }
     #[inline(always)]
-    unsafe fn any_abs_ge(v: f64, t: f64) -> bool {
-        v.abs() >= t
+    unsafe fn abs(v: f64) -> f64 {
+        v.abs()
     }
     #[inline(always)]
-    unsafe fn store_transposed(v: &[f64], dst: *mut f64, _stride: usize) {
-        *dst = v[0];
+    unsafe fn blend_ge(a: f64, b: f64, x: f64, y: f64) -> f64 {
+        if a >= b {
+            x
+        } else {
+            y
+        }
     }
+    #[inline(always)]
+    unsafe fn max(a: f64, b: f64) -> f64 {
+        a.max(b)
+    }
+    #[inline(always)]
+    unsafe fn transpose(_v: &mut [f64]) {}
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -187,11 +213,6 @@ mod x86 {
         unsafe fn fms(a: __m512d, b: __m512d, c: __m512d) -> __m512d {
             _mm512_fmsub_pd(a, b, c)
         }
-        #[inline(always)]
-        unsafe fn lane(v: __m512d, w: usize) -> __m512d {
-            // One full-width permute per lane (no extract + broadcast pairs).
-            _mm512_permutexvar_pd(_mm512_set1_epi64(w as i64), v)
-        }
         #[inline]
         #[target_feature(enable = "avx512f")]
         unsafe fn fence(mut v: __m512d) -> __m512d {
@@ -202,13 +223,25 @@ mod x86 {
             v
         }
         #[inline(always)]
-        unsafe fn any_abs_ge(v: __m512d, t: f64) -> bool {
-            _mm512_cmp_pd_mask::<_CMP_GE_OQ>(_mm512_abs_pd(v), _mm512_set1_pd(t)) != 0
+        unsafe fn any_ge(a: __m512d, b: __m512d) -> bool {
+            _mm512_cmp_pd_mask::<_CMP_GE_OQ>(a, b) != 0
         }
         #[inline(always)]
-        unsafe fn store_transposed(v: &[__m512d], dst: *mut f64, stride: usize) {
-            // 8 x 8 transpose: pairs of rows interleaved, then 2 x 2 blocks of 128 bits,
-            // then 4 x 4 blocks of 128 bits.
+        unsafe fn abs(v: __m512d) -> __m512d {
+            _mm512_abs_pd(v)
+        }
+        #[inline(always)]
+        unsafe fn blend_ge(a: __m512d, b: __m512d, x: __m512d, y: __m512d) -> __m512d {
+            _mm512_mask_blend_pd(_mm512_cmp_pd_mask::<_CMP_GE_OQ>(a, b), y, x)
+        }
+        #[inline(always)]
+        unsafe fn max(a: __m512d, b: __m512d) -> __m512d {
+            _mm512_max_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn transpose(v: &mut [__m512d]) {
+            // 8 x 8: pairs of rows interleaved, then 2 x 2 blocks of 128 bits, then 4 x 4
+            // blocks of 128 bits.
             let t: [__m512d; 8] = [
                 _mm512_unpacklo_pd(v[0], v[1]),
                 _mm512_unpackhi_pd(v[0], v[1]),
@@ -236,10 +269,8 @@ mod x86 {
             ];
             // Lane order of u: 0, 2, 1, 3 (and +4 in the upper halves).
             for (i, lane) in [0usize, 2, 1, 3].into_iter().enumerate() {
-                let lo = _mm512_shuffle_f64x2::<0x44>(u[i], w[i]);
-                let hi = _mm512_shuffle_f64x2::<0xEE>(u[i], w[i]);
-                _mm512_storeu_pd(dst.add(lane * stride), lo);
-                _mm512_storeu_pd(dst.add((lane + 4) * stride), hi);
+                v[lane] = _mm512_shuffle_f64x2::<0x44>(u[i], w[i]);
+                v[lane + 4] = _mm512_shuffle_f64x2::<0xEE>(u[i], w[i]);
             }
         }
     }
@@ -278,12 +309,6 @@ mod x86 {
         unsafe fn fms(a: __m256d, b: __m256d, c: __m256d) -> __m256d {
             _mm256_fmsub_pd(a, b, c)
         }
-        #[inline(always)]
-        unsafe fn lane(v: __m256d, w: usize) -> __m256d {
-            let mut t = [0.0; 4];
-            _mm256_storeu_pd(t.as_mut_ptr(), v);
-            _mm256_set1_pd(t[w])
-        }
         #[inline]
         #[target_feature(enable = "avx")]
         unsafe fn fence(mut v: __m256d) -> __m256d {
@@ -294,20 +319,31 @@ mod x86 {
             v
         }
         #[inline(always)]
-        unsafe fn any_abs_ge(v: __m256d, t: f64) -> bool {
-            let a = _mm256_andnot_pd(_mm256_set1_pd(-0.0), v);
-            _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(a, _mm256_set1_pd(t))) != 0
+        unsafe fn any_ge(a: __m256d, b: __m256d) -> bool {
+            _mm256_movemask_pd(_mm256_cmp_pd::<_CMP_GE_OQ>(a, b)) != 0
         }
         #[inline(always)]
-        unsafe fn store_transposed(v: &[__m256d], dst: *mut f64, stride: usize) {
+        unsafe fn abs(v: __m256d) -> __m256d {
+            _mm256_andnot_pd(_mm256_set1_pd(-0.0), v)
+        }
+        #[inline(always)]
+        unsafe fn blend_ge(a: __m256d, b: __m256d, x: __m256d, y: __m256d) -> __m256d {
+            _mm256_blendv_pd(y, x, _mm256_cmp_pd::<_CMP_GE_OQ>(a, b))
+        }
+        #[inline(always)]
+        unsafe fn max(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_max_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn transpose(v: &mut [__m256d]) {
             let t0 = _mm256_unpacklo_pd(v[0], v[1]); // v0[0] v1[0] v0[2] v1[2]
             let t1 = _mm256_unpackhi_pd(v[0], v[1]); // v0[1] v1[1] v0[3] v1[3]
             let t2 = _mm256_unpacklo_pd(v[2], v[3]);
             let t3 = _mm256_unpackhi_pd(v[2], v[3]);
-            _mm256_storeu_pd(dst, _mm256_permute2f128_pd::<0x20>(t0, t2));
-            _mm256_storeu_pd(dst.add(stride), _mm256_permute2f128_pd::<0x20>(t1, t3));
-            _mm256_storeu_pd(dst.add(2 * stride), _mm256_permute2f128_pd::<0x31>(t0, t2));
-            _mm256_storeu_pd(dst.add(3 * stride), _mm256_permute2f128_pd::<0x31>(t1, t3));
+            v[0] = _mm256_permute2f128_pd::<0x20>(t0, t2);
+            v[1] = _mm256_permute2f128_pd::<0x20>(t1, t3);
+            v[2] = _mm256_permute2f128_pd::<0x31>(t0, t2);
+            v[3] = _mm256_permute2f128_pd::<0x31>(t1, t3);
         }
     }
 }

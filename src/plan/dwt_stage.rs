@@ -12,7 +12,7 @@ pub(super) struct Scratch {
     pub sc: Vec<f64>,
     /// Inverse: coefficients in the kernel's layout (`n` degrees x `P`).
     pub data: Vec<f64>,
-    /// Forward: the kernel's sums (`n` degrees x `P`).
+    /// Forward: the kernel's sums (`P` rows of `n + 8` degrees, see [`Plan::run_forward`]).
     pub out: Vec<f64>,
 }
 
@@ -24,7 +24,7 @@ impl Scratch {
             p: vec![0.0; lanes],
             sc: vec![0.0; lanes],
             data: vec![0.0; b * 16],
-            out: vec![0.0; b * 16],
+            out: vec![0.0; (b + 8) * 16],
         }
     }
 
@@ -123,7 +123,8 @@ impl Plan {
         blk[2 * ch.h * p..2 * ch.hp * p].fill(0.0);
     }
 
-    /// The forward kernel on `xin` (a block) into `sc.out[..n * p]`, zeroed first.
+    /// The forward kernel on `xin` (a block) into `sc.out`, zeroed first: row `q` (the
+    /// real or imaginary part of a slot) at `q * ld`, degrees contiguous; returns `ld`.
     pub(super) fn run_forward(
         &self,
         sc: &mut Scratch,
@@ -131,13 +132,15 @@ impl Plan {
         p: usize,
         n: usize,
         xin: &[f64],
-    ) {
+    ) -> usize {
+        let ld = n + 8;
         let mut out = std::mem::take(&mut sc.out);
-        let f = &mut out[..n * p];
+        let f = &mut out[..p * ld];
         f.fill(0.0);
         let rec = Rec::new(&sc.rec, n);
-        dwt::forward(self.isa, p, &rec, &sc.lanes(self, ch), xin, f);
+        dwt::forward(self.isa, p, &rec, &sc.lanes(self, ch), xin, f, ld);
         sc.out = out;
+        ld
     }
 
     /// Forward DWT of cluster `c` over one chunk, accumulated into `coef`.
@@ -160,16 +163,15 @@ impl Plan {
         let p = self.blocks.p(c);
         let blk = self.block(&self.blocks, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        self.run_forward(sc, ch, p, n, blk);
+        let ld = self.run_forward(sc, ch, p, n, blk);
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
                 coef.get().add(block_start(self.b, mem.m, mem.mp)),
                 n,
             );
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            let rows = sc.out[..n * p]
-                .chunks_exact(p)
-                .map(|r| (r[2 * q], r[2 * q + 1]));
+            let (re, im) = (&sc.out[2 * q * ld..][..n], &sc.out[(2 * q + 1) * ld..][..n]);
+            let rows = re.iter().zip(im).map(|(&r, &i)| (r, i));
             if first {
                 for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
                     let g = sg[i & 1];

@@ -256,8 +256,8 @@ impl Plan {
         let reps = &reps[..nr];
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        self.run_forward(sc, ch, p, n, blk);
-        let f = &sc.out[..n * p];
+        let ld = self.run_forward(sc, ch, p, n, blk);
+        let f = &sc.out[..p * ld];
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let partner = (mem.m != 0 || mem.mp != 0)
@@ -266,7 +266,7 @@ impl Plan {
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
             for i in 0..n {
                 let g = sg[i & 1];
-                let z = Complex64::new(f[i * p + 2 * q] * g, f[i * p + 2 * q + 1] * g);
+                let z = Complex64::new(f[2 * q * ld + i] * g, f[(2 * q + 1) * ld + i] * g);
                 let zp = z.conj() * ps;
                 if first {
                     *dst.add(i) = z;
