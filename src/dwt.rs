@@ -157,60 +157,45 @@ impl<'r, S: Simd> State<'r, S> {
         self.mask = S::blend_ge(self.sc, zero, one, zero);
     }
 
-    /// The first part of a forward run: like [`State::run`] up to the degree where every
-    /// lane is active, handing the values over `W` degrees at a time, transposed:
-    /// `f(e, i0)` gets `e[w]` = the values of lane `w` at degrees `i0 .. i0 + W` (zero past
-    /// `n`, and for lanes still scaled down). The fully active rest is left to the caller
-    /// (`forward_body`), which interleaves it with the accumulation.
+    /// Step without accumulating until some lane is active (or degree `n`): the rest of
+    /// the negligible prefix after [`skip_inactive`], one vector at a time.
     #[inline(always)]
-    unsafe fn run_masked_blocks<const W: usize>(
-        &mut self,
-        rec: &Rec,
-        n: usize,
-        mut f: impl FnMut(&[S::V; W], usize),
-    ) {
-        let mut i = self.i;
-        let (tau, ka, kc, bb) = (self.tau, self.ka, self.kc, rec.bb);
-        let (mut p0, mut p1) = (self.p0, self.p1);
-        let step = |p0: S::V, p1: S::V, i: usize| {
-            let t = S::fma(
-                S::splat(*ka.get_unchecked(i)),
-                tau,
-                S::splat(*kc.get_unchecked(i)),
-            );
-            S::fms(t, p1, S::mul(S::splat(*bb.get_unchecked(i)), p0))
-        };
-        // The rest of the negligible prefix (see `skip_inactive`).
-        if self.skip {
-            while i < n && self.none_active() {
-                let p2 = step(p0, p1, i);
-                (p0, p1) = (p1, p2);
-                i += 1;
-                if S::any_ge(S::abs(p1), self.big) {
-                    self.rescale(&mut p0, &mut p1);
-                }
+    unsafe fn finish_prefix(&mut self, rec: &Rec, n: usize) {
+        if !self.skip {
+            return;
+        }
+        let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
+        while i < n && self.none_active() {
+            let p2 = self.step(rec, p0, p1, i);
+            (p0, p1) = (p1, p2);
+            i += 1;
+            if S::any_ge(S::abs(p1), self.big) {
+                self.rescale(&mut p0, &mut p1);
             }
         }
-        // Blocks with lanes still scaled down (masked to zero).
-        while i < n && !self.all_active() {
-            let i0 = i;
-            let mut d = [S::zero(); W];
-            for dj in d.iter_mut() {
-                if i < n {
-                    *dj = S::mul(p1, self.mask);
-                    let p2 = step(p0, p1, i);
-                    (p0, p1) = (p1, p2);
-                    i += 1;
-                    if S::any_ge(S::abs(p1), self.big) {
-                        self.rescale(&mut p0, &mut p1);
-                    }
-                }
+        (self.p0, self.p1, self.i) = (p0, p1, i);
+    }
+
+    /// The values of degrees `i0 .. i0 + W` (the state is at degree `i >= i0`), masked to
+    /// the active lanes, zero before `i` and from `n` on; advances the state to
+    /// `min(i0 + W, n)`. For the blocks where not all lanes are active yet, or which start
+    /// before the state does, or end past `n`.
+    #[inline(always)]
+    unsafe fn masked_block<const W: usize>(&mut self, rec: &Rec, i0: usize, n: usize) -> [S::V; W] {
+        let mut d = [S::zero(); W];
+        let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
+        let end = (i0 + W).min(n);
+        while i < end {
+            d[i - i0] = S::mul(p1, self.mask);
+            let p2 = self.step(rec, p0, p1, i);
+            (p0, p1) = (p1, p2);
+            i += 1;
+            if S::any_ge(S::abs(p1), self.big) {
+                self.rescale(&mut p0, &mut p1);
             }
-            S::transpose(&mut d);
-            f(&d, i0);
         }
-        (self.p0, self.p1) = (p0, p1);
-        self.i = i;
+        (self.p0, self.p1, self.i) = (p0, p1, i);
+        d
     }
 
     /// One recurrence step from `(p0, p1)` at degree index `i`: the next value.
@@ -365,24 +350,6 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     (g, st)
 }
 
-/// The accumulators `ft[q][i0 .. i0 + W]` of the forward kernel.
-#[inline(always)]
-unsafe fn load_acc<S: Simd, const P: usize>(fp: *mut f64, ld: usize, i0: usize) -> [S::V; P] {
-    let mut acc = [S::zero(); P];
-    for (q, a) in acc.iter_mut().enumerate() {
-        *a = S::load(fp.add(q * ld + i0));
-    }
-    acc
-}
-
-/// Store what [`load_acc`] loaded.
-#[inline(always)]
-unsafe fn store_acc<S: Simd, const P: usize>(fp: *mut f64, ld: usize, acc: &[S::V; P], i0: usize) {
-    for (q, a) in acc.iter().enumerate() {
-        S::store(fp.add(q * ld + i0), *a);
-    }
-}
-
 /// `acc[q] += e * x[q]` for the `P` data of one beta's block row `xw` (broadcast loads).
 #[inline(always)]
 unsafe fn lane_fmas<S: Simd, const P: usize>(acc: &mut [S::V; P], e: S::V, xw: *const f64) {
@@ -391,34 +358,38 @@ unsafe fn lane_fmas<S: Simd, const P: usize>(acc: &mut [S::V; P], e: S::V, xw: *
     }
 }
 
-/// One block of the forward kernel: `ft[q][i0..i0+W] += sum_w e[w] x[w][q]` (rows of `x`
-/// `xs` apart).
+/// One block of the forward kernel: `acc[q] += sum_w e[w] x[w][q]` (rows of `x` `xs`
+/// apart).
 #[inline(always)]
 unsafe fn block_fmas<S: Simd, const W: usize, const P: usize>(
-    fp: *mut f64,
-    ld: usize,
+    acc: &mut [S::V; P],
     x: *const f64,
     xs: usize,
     e: &[S::V; W],
-    i0: usize,
 ) {
-    let mut acc = load_acc::<S, P>(fp, ld, i0);
     for (w, ew) in e.iter().enumerate() {
-        lane_fmas::<S, P>(&mut acc, *ew, x.add(w * xs));
+        lane_fmas::<S, P>(acc, *ew, x.add(w * xs));
     }
-    store_acc::<S, P>(fp, ld, &acc, i0);
 }
 
-/// Forward kernel body. Per vector of `W` betas the recurrence produces the values of
-/// `W` consecutive degrees, which are transposed in registers (lane = degree) and
-/// accumulated as `ft[q][i0..i0+W] += sum_w e_w * x[w][q]`: the data `x` enter as
-/// broadcasts from memory (the block row of beta `w`, in L1), so no lane of a register
-/// has to be broadcast by a shuffle.
+/// Vectors of betas whose states the forward kernel keeps at once.
+const FWD_VECTORS: usize = 16;
+
+/// Forward kernel body: `ft[q][i] += sum_s dt_i(beta_s) x[s][q]`, a reduction over the
+/// betas for each degree.
 ///
-/// Once all lanes are active the recurrence runs one block ahead of the accumulation, one
-/// step before each lane's 16 (or 8) multiply-adds in program order: the floating-point
-/// pipes issue the oldest ready instruction first, so the latency-bound chain of steps
-/// never waits behind a block of independent multiply-adds.
+/// The loops run degree blocks outer and beta vectors inner, so that the sums of a block
+/// of `W` degrees stay in registers (`P` vectors, lane = degree) while every vector of
+/// betas adds its share, and are stored once per block. Each vector's recurrence state
+/// (kept in L1 between blocks) produces the values of `W` degrees, which are transposed
+/// in registers (lane = degree) and enter as `acc[q] += e_w * x[w][q]`, the data `x`
+/// as broadcasts from memory (the vector's block rows, in L1): no lane of a register has
+/// to be broadcast by a shuffle.
+///
+/// For the vectors whose lanes are all active, the recurrence of the next vector runs one
+/// step before each lane's multiply-adds of the current one in program order: the
+/// floating-point pipes issue the oldest ready instruction first, so the latency-bound
+/// chain of steps never waits behind a block of independent multiply-adds.
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
     rec: &Rec,
@@ -429,48 +400,82 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P && ld >= n + W);
-    debug_assert!(ft.len() >= P * ld);
+    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
+    debug_assert!(ld >= n + W && ft.len() >= P * ld);
     let fp = ft.as_mut_ptr();
-    let mut g0 = 0;
-    while g0 < nb {
-        let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
-        for (gi, st) in group.iter().enumerate().take(g) {
-            // A local copy, so the state lives in registers during the run.
-            let mut st = *st;
-            let s0 = g0 + gi * W;
-            let (r0, rstep) = lanes.rows(s0);
-            let x = xin.as_ptr().add(r0 * P);
-            let xs = rstep * P;
-            let block = |e: &[S::V; W], i0: usize| block_fmas::<S, W, P>(fp, ld, x, xs, e, i0);
-            st.run_masked_blocks::<W>(
-                rec,
-                n,
-                #[inline(always)]
-                |e, i0| block(e, i0),
-            );
-            let (mut p0, mut p1, mut i) = (st.p0, st.p1, st.i);
-            if i + W <= n {
+    let xrows = |s0: usize| {
+        let (r0, step) = lanes.rows(s0);
+        (xin.as_ptr().add(r0 * P), step * P)
+    };
+    let mut v0 = 0;
+    while v0 < nb {
+        // Up to FWD_VECTORS vectors, each through its negligible prefix.
+        let nv = ((nb - v0) / W).min(FWD_VECTORS);
+        // Only the first `nv` entries are used; they are written below before any read.
+        let mut st_mem = [const { std::mem::MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
+        let mut g = 0;
+        while g < nv {
+            let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
+            for (k, s) in group.iter().enumerate().take(gn) {
+                let mut s = *s;
+                s.finish_prefix(rec, n);
+                st_mem[g + k].write(s);
+            }
+            g += gn;
+        }
+        // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
+        let st = std::slice::from_raw_parts_mut(st_mem.as_mut_ptr() as *mut State<S>, nv);
+        let first = st.iter().map(|s| s.i).min().unwrap_or(n);
+        let mut i0 = first - first % W;
+        let mut fast = [0usize; FWD_VECTORS];
+        while i0 < n {
+            let mut acc = [S::zero(); P];
+            for (q, a) in acc.iter_mut().enumerate() {
+                *a = S::load(fp.add(q * ld + i0));
+            }
+            // Vectors that start inside this block, still have inactive lanes or end in
+            // it, one at a time; the others are listed for the pipelined loop.
+            let mut nf = 0;
+            for (v, s) in st.iter_mut().enumerate() {
+                if s.i >= i0 + W || s.i >= n {
+                    continue;
+                }
+                if s.i == i0 && i0 + W <= n && s.all_active() {
+                    fast[nf] = v;
+                    nf += 1;
+                    continue;
+                }
+                let mut d = s.masked_block::<W>(rec, i0, n);
+                S::transpose(&mut d);
+                let (x, xs) = xrows(v0 + v * W);
+                block_fmas::<S, W, P>(&mut acc, x, xs, &d);
+            }
+            if nf > 0 {
+                // The first fast vector's block, then each next vector's steps
+                // interleaved with the previous one's multiply-adds.
+                let s = &mut st[fast[0]];
+                let (mut p0, mut p1) = (s.p0, s.p1);
                 let mut e = [S::zero(); W];
                 for (j, ej) in e.iter_mut().enumerate() {
                     *ej = p1;
-                    let p2 = S::fence(st.step(rec, p0, p1, i + j));
+                    let p2 = S::fence(s.step(rec, p0, p1, i0 + j));
                     (p0, p1) = (p1, p2);
                 }
+                (s.p0, s.p1, s.i) = (p0, p1, i0 + W);
                 S::transpose(&mut e);
-                let mut i0 = i;
-                i += W;
-                while i + W <= n {
-                    let mut acc = load_acc::<S, P>(fp, ld, i0);
+                let mut ev = fast[0];
+                for &v in &fast[1..nf] {
+                    let (x, xs) = xrows(v0 + ev * W);
+                    let s = &mut st[v];
+                    let (mut p0, mut p1) = (s.p0, s.p1);
                     let mut d = e;
-                    // Written out for each lane (the compiler then keeps `d` and `e` in
-                    // registers): step first, then the lane's multiply-adds.
+                    // Written out for each lane, so that `d` and `e` stay in registers.
                     macro_rules! lane {
                         ($w:literal) => {
                             if $w < W {
                                 let ew = e[$w];
                                 d[$w] = p1;
-                                let p2 = S::fence(st.step(rec, p0, p1, i + $w));
+                                let p2 = S::fence(s.step(rec, p0, p1, i0 + $w));
                                 (p0, p1) = (p1, p2);
                                 lane_fmas::<S, P>(&mut acc, ew, x.add($w * xs));
                             }
@@ -484,28 +489,20 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
                     lane!(5);
                     lane!(6);
                     lane!(7);
-                    store_acc::<S, P>(fp, ld, &acc, i0);
+                    (s.p0, s.p1, s.i) = (p0, p1, i0 + W);
                     S::transpose(&mut d);
                     e = d;
-                    i0 = i;
-                    i += W;
+                    ev = v;
                 }
-                block(&e, i0);
+                let (x, xs) = xrows(v0 + ev * W);
+                block_fmas::<S, W, P>(&mut acc, x, xs, &e);
             }
-            if i < n {
-                let i0 = i;
-                let mut d = [S::zero(); W];
-                for dj in d.iter_mut().take(n - i) {
-                    *dj = p1;
-                    let p2 = st.step(rec, p0, p1, i);
-                    (p0, p1) = (p1, p2);
-                    i += 1;
-                }
-                S::transpose(&mut d);
-                block(&d, i0);
+            for (q, a) in acc.iter().enumerate() {
+                S::store(fp.add(q * ld + i0), *a);
             }
+            i0 += W;
         }
-        g0 += g * W;
+        v0 += nv * W;
     }
 }
 
@@ -540,11 +537,13 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
                 },
             );
             // Rows of the output are lanes: each W x W block of (order column, lane) is
-            // transposed in registers on the way out.
+            // transposed in registers on the way out, and written without reading the
+            // lines first (the chunk buffer is far larger than the caches, and read back
+            // only by the FFT stage).
             let (r0, step) = lanes.rows(s0);
             for q0 in (0..P).step_by(W) {
                 let dst = y.as_mut_ptr().add(r0 * P + q0);
-                S::store_transposed(&acc[q0..q0 + W], dst, step * P);
+                S::stream_transposed(&acc[q0..q0 + W], dst, step * P);
             }
         }
         g0 += g * W;
@@ -643,6 +642,8 @@ pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64],
             _ => unreachable!("P must be 8 or 16"),
         }
     }
+    // The output rows were written with non-temporal stores.
+    crate::simd::sfence();
 }
 
 /// `dt^l_{m,mp}` of the base pair at point `k` of `bt`, for `l = m..lend`, through the

@@ -89,16 +89,24 @@ pub(crate) trait Simd: Copy {
     /// Transpose the `W x W` block `v` (vector `j`, lane `w`) in registers: afterwards
     /// vector `w` holds lane `w` of every former vector.
     unsafe fn transpose(v: &mut [Self::V]);
-    /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
-    /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j`.
+    /// Store `v` at `p` without reading the cache line first (a non-temporal store) where
+    /// `p` is aligned to the vector size, else an ordinary store. Callers end a run of these
+    /// with [`sfence`].
     #[inline(always)]
-    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize) {
+    unsafe fn stream(p: *mut f64, v: Self::V) {
+        Self::store(p, v)
+    }
+    /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
+    /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j` (with
+    /// [`Simd::stream`]).
+    #[inline(always)]
+    unsafe fn stream_transposed(v: &[Self::V], dst: *mut f64, stride: usize) {
         let mut t = [Self::zero(); 8];
         let w = v.len();
         t[..w].copy_from_slice(v);
         Self::transpose(&mut t[..w]);
         for (r, x) in t[..w].iter().enumerate() {
-            Self::store(dst.add(r * stride), *x);
+            Self::stream(dst.add(r * stride), *x);
         }
     }
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
@@ -111,6 +119,16 @@ pub(crate) trait Simd: Copy {
     unsafe fn zero() -> Self::V {
         Self::splat(0.0)
     }
+}
+
+/// Orders earlier non-temporal stores ([`Simd::stream`]) before everything after it.
+#[inline(always)]
+pub(crate) fn sfence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a store fence has no operands; SSE is part of x86-64.
+    unsafe {
+        std::arch::x86_64::_mm_sfence()
+    };
 }
 
 /// Portable scalar implementation (also the reference the SIMD paths are tested against).
@@ -223,6 +241,14 @@ mod x86 {
             v
         }
         #[inline(always)]
+        unsafe fn stream(p: *mut f64, v: __m512d) {
+            if (p as usize).is_multiple_of(64) {
+                _mm512_stream_pd(p, v)
+            } else {
+                _mm512_storeu_pd(p, v)
+            }
+        }
+        #[inline(always)]
         unsafe fn any_ge(a: __m512d, b: __m512d) -> bool {
             _mm512_cmp_pd_mask::<_CMP_GE_OQ>(a, b) != 0
         }
@@ -317,6 +343,14 @@ mod x86 {
                 std::arch::asm!("/* {0} */", inout(ymm_reg) v, options(nomem, nostack, preserves_flags))
             };
             v
+        }
+        #[inline(always)]
+        unsafe fn stream(p: *mut f64, v: __m256d) {
+            if (p as usize).is_multiple_of(32) {
+                _mm256_stream_pd(p, v)
+            } else {
+                _mm256_storeu_pd(p, v)
+            }
         }
         #[inline(always)]
         unsafe fn any_ge(a: __m256d, b: __m256d) -> bool {
