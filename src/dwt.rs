@@ -805,8 +805,46 @@ mod kernel_speed {
     use super::tests::{cluster_setup, grid_lanes};
     use super::*;
 
+    /// FMA peak of one core, GFLOP/s: 16 independent chains of AVX-512 FMAs (AVX2 or
+    /// scalar where missing), best of a few short runs.
+    pub(super) fn fma_peak() -> f64 {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx512f,fma")]
+        unsafe fn chains(iters: usize) -> f64 {
+            use crate::simd::Avx512;
+            let mut a = [Avx512::zero(); 16];
+            let b = Avx512::splat(0.999_999_9);
+            let c = Avx512::splat(1e-9);
+            for _ in 0..iters {
+                for x in a.iter_mut() {
+                    *x = Avx512::fma(*x, b, c);
+                }
+                a[0] = Avx512::fence(a[0]);
+            }
+            let mut t = [0.0; 8];
+            Avx512::store(
+                t.as_mut_ptr(),
+                a.iter().fold(Avx512::zero(), |s, x| Avx512::add(s, *x)),
+            );
+            t.iter().sum()
+        }
+        if !Isa::Avx512.is_supported() {
+            return f64::NAN;
+        }
+        let iters = 2_000_000;
+        (0..5)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                std::hint::black_box(unsafe { chains(iters) });
+                (iters * 16 * 16) as f64 / t.elapsed().as_secs_f64() / 1e9
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Kernel-only throughput (run with --ignored --nocapture): GFLOP/s of the fused
-    /// recurrence + accumulation for one generic cluster, all 2B grid betas.
+    /// recurrence + accumulation for one generic cluster, all 2B grid betas, against the
+    /// FMA peak. Forward, inverse and the peak are measured in alternation and each keeps
+    /// its best batch: the machine is shared and noisy.
     #[test]
     #[ignore]
     fn kernel_gflops() {
@@ -821,25 +859,29 @@ mod kernel_speed {
             let mut f = vec![0.0; ld * 16];
             let mut y = vec![0.0; nbs * 16];
             let isa = Isa::detect();
-            // Best of several batches: the machine is shared and noisy.
-            let best = |f: &mut dyn FnMut()| {
-                (0..7)
-                    .map(|_| {
-                        let t = std::time::Instant::now();
-                        for _ in 0..50 {
-                            f();
-                        }
-                        t.elapsed().as_secs_f64() / 50.0
-                    })
-                    .fold(f64::INFINITY, f64::min)
+            let batch = |f: &mut dyn FnMut()| {
+                let t = std::time::Instant::now();
+                for _ in 0..50 {
+                    f();
+                }
+                t.elapsed().as_secs_f64() / 50.0
             };
-            let tf = best(&mut || forward(isa, 16, &rec, &lanes, &xin, &mut f, ld));
-            let ti = best(&mut || inverse(isa, 16, &rec, &lanes, &f[..n * 16], &mut y));
+            let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
+            for _ in 0..7 {
+                tf = tf.min(batch(&mut || {
+                    forward(isa, 16, &rec, &lanes, &xin, &mut f, ld)
+                }));
+                ti = ti.min(batch(&mut || {
+                    inverse(isa, 16, &rec, &lanes, &f[..n * 16], &mut y)
+                }));
+                peak = peak.max(fma_peak());
+            }
             let flops = (n * nbs * 16 * 2) as f64;
+            let (gf, gi) = (flops / tf / 1e9, flops / ti / 1e9);
             println!(
-                "B={b} nb={nbs} L={n}: forward {:.1} GFLOP/s, inverse {:.1} GFLOP/s",
-                flops / tf / 1e9,
-                flops / ti / 1e9
+                "B={b} nb={nbs} L={n}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}",
+                100.0 * gf / peak,
+                100.0 * gi / peak
             );
         }
     }
@@ -860,6 +902,7 @@ mod stage_speed {
             let nbs = 2 * b;
             let (mut tf, mut ti) = (0.0, 0.0);
             let mut qt = [0.0f64; 4];
+            let mut qtf = [0.0f64; 4];
             let mut qf = [0.0f64; 4];
             let xin = vec![0.5; nbs * 16];
             let mut f = vec![0.0; (b + 8) * 16];
@@ -873,7 +916,9 @@ mod stage_speed {
                 let pw = if m == mp || mp == 0 { 8 } else { 16 };
                 let t = std::time::Instant::now();
                 forward(isa, pw, &rec, &lanes, &xin, &mut f[..(n + 8) * pw], n + 8);
-                tf += t.elapsed().as_secs_f64();
+                let dt = t.elapsed().as_secs_f64();
+                tf += dt;
+                qtf[4 * m / b] += dt;
                 let t = std::time::Instant::now();
                 inverse(isa, pw, &rec, &lanes, &f[..n * pw], &mut y[..nbs * pw]);
                 let dt = t.elapsed().as_secs_f64();
@@ -883,18 +928,23 @@ mod stage_speed {
             }
             for q in 0..4 {
                 println!(
-                    "  m in quarter {q}: inverse {:.1} GFLOP/s nominal, {:.3} s",
+                    "  m in quarter {q}: forward {:.1}, inverse {:.1} GFLOP/s nominal, {:.3} s / {:.3} s",
+                    qf[q] / qtf[q] / 1e9,
                     qf[q] / qt[q] / 1e9,
+                    qtf[q],
                     qt[q]
                 );
             }
             let flops = 8.0 * b as f64 * (4.0 * (b as f64).powi(3) - b as f64) / 3.0;
+            let peak = super::kernel_speed::fma_peak();
             println!(
-                "B={b}: kernels over all clusters: forward {:.3} s ({:.1} GFLOP/s), inverse {:.3} s ({:.1} GFLOP/s)",
+                "B={b}: kernels over all clusters: forward {:.3} s ({:.1} GFLOP/s, {:.0}%), inverse {:.3} s ({:.1} GFLOP/s, {:.0}%), peak {peak:.1}",
                 tf,
                 flops / tf / 1e9,
+                100.0 * flops / tf / 1e9 / peak,
                 ti,
-                flops / ti / 1e9
+                flops / ti / 1e9,
+                100.0 * flops / ti / 1e9 / peak
             );
         }
     }

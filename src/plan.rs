@@ -171,10 +171,6 @@ pub struct Plan {
     dwt_scratch: Vec<Mutex<Scratch>>,
     /// Whether the slice FFTs run on FFTW's threads (else slices are spread over workers).
     fftw_threaded: bool,
-    /// Low beta slices per chunk.
-    chunk: usize,
-    /// Lanes of every block in the chunk buffer (room for the padded lanes of a chunk).
-    block_lanes: usize,
     /// Chunk-buffer layout of the complex transforms.
     blocks: Blocks,
     /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
@@ -259,15 +255,16 @@ pub(crate) fn mem_available() -> Option<usize> {
     meminfo("MemAvailable:")
 }
 
-/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.5%` of the
-/// sample plus coefficient arrays`)` (real samples for a real plan), and at most a quarter of the available memory. The
-/// chunk buffer gets what the FFT buffers and tables leave of it (at least one slice pair).
+/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.6%` of the
+/// sample plus coefficient arrays`)` (real samples for a real plan), and at most a quarter
+/// of the available memory. The chunk buffer gets what the FFT buffers and tables leave of
+/// it (at least one slice pair).
 fn default_workspace(b: usize, real: bool) -> usize {
-    // Real plans: real samples (8 bytes each). A margin of 0.5% is left for the rest of
+    // Real plans: real samples (8 bytes each). A margin of 0.4% is left for the rest of
     // the process.
     let sample_bytes = if real { 8 } else { 16 };
     let grid_bytes = num_samples(b) * sample_bytes + num_coeffs(b) * 16;
-    let d = (512usize << 20).max(grid_bytes / 1000 * 45);
+    let d = (512usize << 20).max(grid_bytes / 1000 * 46);
     match mem_available() {
         Some(avail) => d.min(avail / 4),
         None => d,
@@ -277,7 +274,6 @@ fn default_workspace(b: usize, real: bool) -> usize {
 /// How a plan's memory splits up (see [`Plan::memory_bytes`]).
 struct Layout {
     chunk: usize,
-    block_lanes: usize,
     chunk_bytes: usize,
     fft_scratch_bytes: usize,
     table_bytes: usize,
@@ -288,12 +284,8 @@ impl Layout {
         let slice_bytes = 64 * b * b;
         // One lane of every block (the complex layout; the real one is smaller).
         let lane_bytes = 8 * Blocks::doubles_per_lane(b, false);
-        let mut chunk = (budget / (2 * lane_bytes)).clamp(1, b);
-        if chunk >= 8 && chunk < b {
-            // Full chunks without padding lanes.
-            chunk -= chunk % 8;
-        }
-        let block_lanes = 2 * chunk.next_multiple_of(8);
+        let chunk = Blocks::chunk_for(budget / 8, lane_bytes / 8, b);
+        let block_lanes = Blocks::lanes_for(chunk);
         let clusters = crate::symmetry::num_generic(b) + 2 * b;
         // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
         // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list and slot tables
@@ -305,7 +297,6 @@ impl Layout {
             + threads * 8 * (6 * b + 3 * block_lanes + 32 * b);
         Layout {
             chunk,
-            block_lanes,
             chunk_bytes: block_lanes * lane_bytes,
             // A pair of slices and a spare one per worker.
             fft_scratch_bytes: threads * 3 * slice_bytes,
@@ -397,7 +388,6 @@ impl Plan {
                 bytes: layout.total().saturating_add(arrays),
             });
         }
-        let chunk = layout.chunk;
         // The tables below are ordinary (aborting) allocations of O(B^2) bytes; reserving their
         // total once, fallibly, first turns a shortage (e.g. an address-space limit) into an
         // error. The large buffers are mapped fallibly in `AlignedBuf::new`.
@@ -440,8 +430,19 @@ impl Plan {
         } else {
             None
         };
+        let clusters = cluster_pairs(b);
+        let blocks = Blocks::complex(b, &clusters, layout.chunk);
+        // The real layout is about half as large per beta: its chunks take twice the betas.
+        let buf_doubles = layout.chunk_bytes / 8;
+        let blocks_real = options.real.then(|| {
+            let dpl = Blocks::doubles_per_lane(b, true);
+            Blocks::real(b, &clusters, Blocks::chunk_for(buf_doubles, dpl, b))
+        });
+        let scratch_lanes = blocks
+            .lanes
+            .max(blocks_real.as_ref().map_or(0, |t| t.lanes));
         let dwt_scratch = (0..threads)
-            .map(|_| Mutex::new(Scratch::new(b, layout.block_lanes)))
+            .map(|_| Mutex::new(Scratch::new(b, scratch_lanes)))
             .collect();
         let real_fft = if options.real {
             Some(SliceFftReal::new(n, options.rigor)?)
@@ -454,9 +455,6 @@ impl Plan {
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
-        let clusters = cluster_pairs(b);
-        let blocks = Blocks::complex(b, &clusters);
-        let blocks_real = options.real.then(|| Blocks::real(b, &clusters));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
         let on_exit = live.clone();
@@ -488,8 +486,6 @@ impl Plan {
             fft_scratch,
             dwt_scratch,
             fftw_threaded,
-            chunk,
-            block_lanes: layout.block_lanes,
             blocks,
             blocks_real,
             memory: layout.total(),
@@ -562,17 +558,18 @@ impl Plan {
     }
 
     /// Bytes of the chunk buffer: `2 h' * 8 * (8B^2 - 8B + 8)` with `h` low beta slices per
-    /// chunk and `h'` = `h` rounded up to a multiple of 8. (`8B^2 - 8B + 8` doubles per beta:
-    /// the `(2B-1)^2` in-band values of a transformed slice in the DWT kernels' layout,
-    /// `16` doubles per 8-member cluster, `8` per other one.) `h = clamp(cap / (2 * 8 *
-    /// (8B^2 - 8B + 8)), 1, B)`, rounded down to a multiple of 8 when between 8 and `B`.
-    /// With `max_workspace_bytes` the cap is that value. By default the whole plan
-    /// ([`Plan::memory_bytes`]) is held to `max(512 MiB, 4.5% of the sample and coefficient
+    /// chunk of the complex transforms and `h'` = `h` rounded up to a multiple of 8.
+    /// (`8B^2 - 8B + 8` doubles per beta: the `(2B-1)^2` in-band values of a transformed
+    /// slice in the DWT kernels' layout, `16` doubles per 8-member cluster, `8` per other
+    /// one.) `h = min(B, max(1, 8 floor(cap / (16 * 8 * (8B^2 - 8B + 8)))))`. With
+    /// `max_workspace_bytes` the cap is that value. By default the whole plan
+    /// ([`Plan::memory_bytes`]) is held to `max(512 MiB, 4.6% of the sample and coefficient
     /// arrays)` (at most a quarter of the available memory), and the cap is what the FFT
     /// buffers and tables leave of it. At B = 512 that keeps a complex transform within the
-    /// caller's arrays plus 5%.
+    /// caller's arrays plus 5%. The real-signal transforms use the same buffer with their
+    /// own layout, about half as large per beta, so their chunks hold about twice the betas.
     pub fn workspace_bytes(&self) -> usize {
-        self.block_lanes * 8 * Blocks::doubles_per_lane(self.b, false)
+        self.blocks.total() * 8
     }
 
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
@@ -636,10 +633,11 @@ impl Plan {
         f(g.as_ref().expect("plan buffer present"))
     }
 
-    fn chunks(&self) -> impl Iterator<Item = Chunk> + '_ {
-        let b = self.b;
-        (0..b).step_by(self.chunk).map(move |lo| {
-            let h = self.chunk.min(b - lo);
+    /// The chunks of layout `t`.
+    fn chunks(&self, t: &Blocks) -> impl Iterator<Item = Chunk> + '_ {
+        let (b, chunk) = (self.b, t.chunk);
+        (0..b).step_by(chunk).map(move |lo| {
+            let h = chunk.min(b - lo);
             let hp = h.next_multiple_of(self.isa.lanes());
             Chunk { lo, h, hp }
         })
@@ -700,7 +698,7 @@ impl Plan {
         self.with_buf(|buf| {
             let bp = SyncPtr(buf.as_mut_ptr() as *mut f64);
             self.pool().install(|| {
-                for (ci, ch) in self.chunks().enumerate() {
+                for (ci, ch) in self.chunks(t).enumerate() {
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
                         fft(&ch, bp.get())?;
@@ -745,7 +743,12 @@ impl Plan {
             let sc: &mut Scratch = match guard.as_deref_mut() {
                 Some(s) => s,
                 // All busy (concurrent executions of this plan): use a private one.
-                None => own.insert(Scratch::new(self.b, self.block_lanes)),
+                None => own.insert(Scratch::new(
+                    self.b,
+                    self.blocks
+                        .lanes
+                        .max(self.blocks_real.as_ref().map_or(0, |t| t.lanes)),
+                )),
             };
             let (c0, c1) = (r * RUN, ((r + 1) * RUN).min(nc));
             let pair = |c: usize| {

@@ -30,14 +30,19 @@ pub(super) struct Blocks {
     pub fi2: Vec<u32>,
     /// Bit `q` set: slot `q` reads and writes the mirrored slice.
     pub rev: Vec<u8>,
+    /// Low betas per chunk (`h` of a full chunk) for this layout.
+    pub chunk: usize,
+    /// Lanes of every block: room for the padded lanes of a full chunk,
+    /// `2 * chunk` rounded up to a multiple of 16.
+    pub lanes: usize,
 }
 
 impl Blocks {
     /// Layout of the complex transforms: every member of every cluster, in member order.
     /// Slices are `2B x 2B`, `(M, M')` at `(M mod 2B) 2B + (M' mod 2B)`.
-    pub fn complex(b: usize, clusters: &[(u32, u32)]) -> Blocks {
+    pub fn complex(b: usize, clusters: &[(u32, u32)], chunk: usize) -> Blocks {
         let n = 2 * b as isize;
-        Blocks::build(clusters, |cl| {
+        Blocks::build(clusters, chunk, |cl| {
             let mut out = [(NONE, NONE, false); 8];
             for (q, mem) in cl.members().iter().enumerate() {
                 let fi = mem.m.rem_euclid(n) * n + mem.mp.rem_euclid(n);
@@ -51,10 +56,10 @@ impl Blocks {
     /// `real.rs`), indexed in the half spectrum of `2B x (B+1)` values of an r2c transform,
     /// `(a, b')` at `(a mod 2B)(B+1) + b'`. For `M' = 0`, `M > 0` the inverse also writes
     /// the value to `(-M, 0)` (`fi2`).
-    pub fn real(b: usize, clusters: &[(u32, u32)]) -> Blocks {
+    pub fn real(b: usize, clusters: &[(u32, u32)], chunk: usize) -> Blocks {
         let n = 2 * b as isize;
         let half = |a: isize, bp: isize| (a.rem_euclid(n) * (b as isize + 1) + bp) as u32;
-        Blocks::build(clusters, |cl| {
+        Blocks::build(clusters, chunk, |cl| {
             let mut out = [(NONE, NONE, false); 8];
             let (reps, nr) = super::real::representatives(cl);
             for (q, mem) in reps[..nr].iter().enumerate() {
@@ -71,6 +76,7 @@ impl Blocks {
 
     fn build(
         clusters: &[(u32, u32)],
+        chunk: usize,
         slots: impl Fn(&Cluster) -> ([(u32, u32, bool); 8], usize),
     ) -> Blocks {
         let nc = clusters.len();
@@ -80,6 +86,8 @@ impl Blocks {
             fi: vec![NONE; 8 * nc],
             fi2: vec![NONE; 8 * nc],
             rev: vec![0; nc],
+            chunk,
+            lanes: Blocks::lanes_for(chunk),
         };
         let mut acc = 0;
         for (c, &(m, mp)) in clusters.iter().enumerate() {
@@ -109,15 +117,27 @@ impl Blocks {
         self.p[c] as usize
     }
 
-    /// Offset (in doubles) of cluster `c`'s block in a buffer of `lanes` lanes per block.
-    pub fn offset(&self, c: usize, lanes: usize) -> usize {
-        self.pofs[c] * lanes
+    /// Lanes of every block for chunks of `chunk` low betas (see [`Blocks::lanes`]).
+    pub fn lanes_for(chunk: usize) -> usize {
+        2 * chunk.next_multiple_of(8)
     }
 
-    /// Doubles of the whole buffer for `lanes` lanes per block.
-    #[cfg(test)]
-    pub fn total(&self, lanes: usize) -> usize {
-        self.pofs[self.len()] * lanes
+    /// The largest chunk whose blocks fit in `doubles` doubles, with [`Blocks::lanes_for`]
+    /// lanes of `doubles_per_lane` each: a multiple of 8 (the padding lanes take memory
+    /// too), or 1 where not even 8 fit, and at most `b`.
+    pub fn chunk_for(doubles: usize, doubles_per_lane: usize, b: usize) -> usize {
+        let h = doubles / (16 * doubles_per_lane) * 8;
+        h.max(1).min(b)
+    }
+
+    /// Offset (in doubles) of cluster `c`'s block.
+    pub fn offset(&self, c: usize) -> usize {
+        self.pofs[c] * self.lanes
+    }
+
+    /// Doubles of the whole buffer.
+    pub fn total(&self) -> usize {
+        self.pofs[self.len()] * self.lanes
     }
 
     /// Doubles per lane over all blocks (for memory estimates before the tables exist):
@@ -145,7 +165,7 @@ mod tests {
     fn complex_slots_cover_the_band_once() {
         for b in 1..20usize {
             let cl = cluster_pairs(b);
-            let t = Blocks::complex(b, &cl);
+            let t = Blocks::complex(b, &cl, 1);
             let n = 2 * b;
             let mut seen = HashSet::new();
             for c in 0..t.len() {
@@ -160,9 +180,9 @@ mod tests {
                 }
             }
             assert_eq!(seen.len(), (n - 1) * (n - 1));
-            assert_eq!(t.total(1), Blocks::doubles_per_lane(b, false));
-            let r = Blocks::real(b, &cl);
-            assert_eq!(r.total(1), Blocks::doubles_per_lane(b, true));
+            assert_eq!(t.total(), 16 * Blocks::doubles_per_lane(b, false));
+            let r = Blocks::real(b, &cl, 1);
+            assert_eq!(r.total(), 16 * Blocks::doubles_per_lane(b, true));
         }
     }
 }

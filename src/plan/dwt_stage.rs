@@ -113,7 +113,7 @@ impl Plan {
         ch: &Chunk,
     ) -> &'a mut [f64] {
         let p = t.p(c);
-        std::slice::from_raw_parts_mut(buf.add(t.offset(c, self.block_lanes)), ch.lanes() * p)
+        std::slice::from_raw_parts_mut(buf.add(t.offset(c)), ch.lanes() * p)
     }
 
     /// Zero the padding rows of a block (lanes `h..hp` of each half, rows `2h..2hp`),

@@ -112,7 +112,6 @@ impl Plan {
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
                 scatter_pair(
                     &self.blocks,
-                    self.block_lanes,
                     [s0.get(), s1.get()],
                     w,
                     false,
@@ -127,7 +126,6 @@ impl Plan {
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
                 gather_pair(
                     &self.blocks,
-                    self.block_lanes,
                     [s0.get(), s1.get()],
                     false,
                     b.get(),
@@ -180,12 +178,11 @@ impl Plan {
 /// slots are zero.
 ///
 /// # Safety
-/// `s` are valid for every index in the slot tables; `buf` holds the blocks with
-/// `block_lanes` lanes each, 64-byte aligned, and nobody else writes these rows.
+/// `s` are valid for every index in the slot tables; `buf` holds the blocks of `t`,
+/// 64-byte aligned, and nobody else writes these rows.
 #[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter_pair(
     t: &Blocks,
-    block_lanes: usize,
     s: [*const Complex64; 2],
     w: [f64; 2],
     conj: bool,
@@ -212,7 +209,7 @@ pub(super) unsafe fn scatter_pair(
             rows[p - r + 2 * q] = b.re * w[1];
             rows[p - r + 2 * q + 1] = b.im * wi[1];
         }
-        stream_rows(buf.add(t.offset(c, block_lanes) + 2 * j * p), &rows, 2 * p);
+        stream_rows(buf.add(t.offset(c) + 2 * j * p), &rows, 2 * p);
     }
     fence();
 }
@@ -225,7 +222,6 @@ pub(super) unsafe fn scatter_pair(
 /// As for [`scatter_pair`], with `s` written.
 pub(super) unsafe fn gather_pair(
     t: &Blocks,
-    block_lanes: usize,
     s: [*mut Complex64; 2],
     conj: bool,
     buf: *const f64,
@@ -239,13 +235,13 @@ pub(super) unsafe fn gather_pair(
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             let cf = c + PREFETCH_CLUSTERS;
             let pf = t.p(cf);
-            let rows = buf.add(t.offset(cf, block_lanes) + 2 * j * pf) as *const i8;
+            let rows = buf.add(t.offset(cf) + 2 * j * pf) as *const i8;
             for line in 0..pf / 4 {
                 _mm_prefetch::<_MM_HINT_T0>(rows.add(64 * line));
             }
         }
         let p = t.p(c);
-        let row = buf.add(t.offset(c, block_lanes) + 2 * j * p);
+        let row = buf.add(t.offset(c) + 2 * j * p);
         let rev = t.rev[c];
         for q in 0..p / 2 {
             let fi = *t.fi.get_unchecked(8 * c + q);

@@ -78,14 +78,14 @@ impl Plan {
         // sample grid holds the slices the inverse pairs write (distinct, as the pairs run
         // concurrently); every beta maps onto it cyclically. (Mapping fresh memory costs more
         // than the measurement itself when transparent huge pages must be compacted.)
-        let npairs = self.threads.min(self.chunk);
+        let npairs = self.threads.min(self.blocks.chunk);
         let slices = 2 * npairs;
         let bytes = slices * nn * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {
             return None;
         }
         let grid = AlignedBuf::new(slices * nn).ok()?;
-        let h = self.chunk;
+        let h = self.blocks.chunk;
         let ch = Chunk {
             lo: 0,
             h,
@@ -172,7 +172,7 @@ mod tests {
         let t = Instant::now();
         plan.with_buf(|buf| {
             plan.pool().install(|| {
-                for ch in plan.chunks() {
+                for ch in plan.chunks(&plan.blocks) {
                     plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64)?;
                 }
                 Ok(())

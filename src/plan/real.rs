@@ -199,7 +199,6 @@ impl Plan {
                         // S(M,M') = conj(R[M][M']) for M' >= 0.
                         fft_stage::scatter_pair(
                             t,
-                            self.block_lanes,
                             [s[0], s[1]],
                             [self.wq[k0], self.wq[k1]],
                             true,
@@ -208,15 +207,7 @@ impl Plan {
                             0..t.len(),
                         );
                     } else {
-                        fft_stage::gather_pair(
-                            t,
-                            self.block_lanes,
-                            s,
-                            true,
-                            buf.get(),
-                            j,
-                            0..t.len(),
-                        );
+                        fft_stage::gather_pair(t, s, true, buf.get(), j, 0..t.len());
                         for (&slot, k) in s.iter().zip([k0, k1]) {
                             // Frequency B (alpha or gamma) is outside the band limit.
                             for i in 0..=b {
