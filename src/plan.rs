@@ -256,9 +256,9 @@ pub(crate) fn mem_available() -> Option<usize> {
 }
 
 /// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.6%` of the
-/// sample plus coefficient arrays`)` (real samples for a real plan), and at most a quarter
-/// of the available memory. The chunk buffer gets what the FFT buffers and tables leave of
-/// it (at least one slice pair).
+/// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
+/// available memory. The chunk buffer gets what the FFT buffers and tables leave of it (at
+/// least one slice pair).
 fn default_workspace(b: usize, real: bool) -> usize {
     // Real plans: real samples (8 bytes each). A margin of 0.4% is left for the rest of
     // the process.
@@ -266,7 +266,7 @@ fn default_workspace(b: usize, real: bool) -> usize {
     let grid_bytes = num_samples(b) * sample_bytes + num_coeffs(b) * 16;
     let d = (512usize << 20).max(grid_bytes / 1000 * 46);
     match mem_available() {
-        Some(avail) => d.min(avail / 4),
+        Some(avail) => d.min(avail / 2),
         None => d,
     }
 }
@@ -564,9 +564,9 @@ impl Plan {
     /// one.) `h = min(B, max(1, 8 floor(cap / (16 * 8 * (8B^2 - 8B + 8)))))`. With
     /// `max_workspace_bytes` the cap is that value. By default the whole plan
     /// ([`Plan::memory_bytes`]) is held to `max(512 MiB, 4.6% of the sample and coefficient
-    /// arrays)` (at most a quarter of the available memory), and the cap is what the FFT
-    /// buffers and tables leave of it. At B = 512 that keeps a complex transform within the
-    /// caller's arrays plus 5%. The real-signal transforms use the same buffer with their
+    /// arrays)` (at most half the available memory), and the cap is what the FFT buffers and
+    /// tables leave of it. At B = 512 that keeps a complex transform within the caller's
+    /// arrays plus 5%. The real-signal transforms use the same buffer with their
     /// own layout, about half as large per beta, so their chunks hold about twice the betas.
     pub fn workspace_bytes(&self) -> usize {
         self.blocks.total() * 8
