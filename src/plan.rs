@@ -182,6 +182,8 @@ pub struct Plan {
     /// Whether degrees below the threshold are skipped (`PlanOptions::skip_bits` not `Some(0)`).
     skip: bool,
     buf: Mutex<Option<AlignedBuf>>,
+    /// Bytes of the chunk buffer.
+    buf_bytes: usize,
 }
 
 /// Shared mutable pointer for disjoint parallel writes.
@@ -255,16 +257,16 @@ pub(crate) fn mem_available() -> Option<usize> {
     meminfo("MemAvailable:")
 }
 
-/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.6%` of the
+/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.7%` of the
 /// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
 /// available memory. The chunk buffer gets what the FFT buffers and tables leave of it (at
 /// least one slice pair).
 fn default_workspace(b: usize, real: bool) -> usize {
-    // Real plans: real samples (8 bytes each). A margin of 0.4% is left for the rest of
+    // Real plans: real samples (8 bytes each). A margin of 0.3% is left for the rest of
     // the process.
     let sample_bytes = if real { 8 } else { 16 };
     let grid_bytes = num_samples(b) * sample_bytes + num_coeffs(b) * 16;
-    let d = (512usize << 20).max(grid_bytes / 1000 * 46);
+    let d = (512usize << 20).max(grid_bytes / 1000 * 47);
     match mem_available() {
         Some(avail) => d.min(avail / 2),
         None => d,
@@ -273,19 +275,32 @@ fn default_workspace(b: usize, real: bool) -> usize {
 
 /// How a plan's memory splits up (see [`Plan::memory_bytes`]).
 struct Layout {
+    /// Low betas per chunk of the complex layout.
     chunk: usize,
+    /// Low betas per chunk of the real layout (plans with `PlanOptions::real`).
+    chunk_real: Option<usize>,
     chunk_bytes: usize,
     fft_scratch_bytes: usize,
     table_bytes: usize,
 }
 
 impl Layout {
-    fn new(b: usize, threads: usize, budget: usize) -> Layout {
+    /// The layout whose chunk buffer takes at most `budget` bytes (but at least one beta
+    /// pair): each chunk layout gets the largest chunk that fits, and the buffer is the
+    /// larger of the two.
+    fn new(b: usize, threads: usize, budget: usize, real: bool) -> Layout {
         let slice_bytes = 64 * b * b;
-        // One lane of every block (the complex layout; the real one is smaller).
-        let lane_bytes = 8 * Blocks::doubles_per_lane(b, false);
-        let chunk = Blocks::chunk_for(budget / 8, lane_bytes / 8, b);
-        let block_lanes = Blocks::lanes_for(chunk);
+        let (cdpl, rdpl) = (
+            Blocks::doubles_per_lane(b, false),
+            Blocks::doubles_per_lane(b, true),
+        );
+        let chunk = Blocks::chunk_for(budget / 8, cdpl, b);
+        let chunk_real = real.then(|| Blocks::chunk_for(budget / 8, rdpl, b));
+        let mut chunk_bytes = 8 * Blocks::lanes_for(chunk) * cdpl;
+        if let Some(h) = chunk_real {
+            chunk_bytes = chunk_bytes.max(8 * Blocks::lanes_for(h) * rdpl);
+        }
+        let block_lanes = Blocks::lanes_for(chunk.max(chunk_real.unwrap_or(0)));
         let clusters = crate::symmetry::num_generic(b) + 2 * b;
         // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
         // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list and slot tables
@@ -297,7 +312,8 @@ impl Layout {
             + threads * 8 * (6 * b + 3 * block_lanes + 32 * b);
         Layout {
             chunk,
-            chunk_bytes: block_lanes * lane_bytes,
+            chunk_real,
+            chunk_bytes,
             // A pair of slices and a spare one per worker.
             fft_scratch_bytes: threads * 3 * slice_bytes,
             table_bytes,
@@ -362,16 +378,16 @@ impl Plan {
         }
         let n = 2 * b;
         let layout = match options.max_workspace_bytes {
-            Some(cap) => Layout::new(b, threads, cap),
+            Some(cap) => Layout::new(b, threads, cap, options.real),
             None => {
                 // The default caps the plan's whole memory, not only the chunk buffer, so
                 // that at large B a transform needs at most 5% beyond the caller's arrays.
                 let target = default_workspace(b, options.real);
                 let rest = {
-                    let probe = Layout::new(b, threads, target);
+                    let probe = Layout::new(b, threads, target, options.real);
                     probe.total() - probe.chunk_bytes
                 };
-                Layout::new(b, threads, target.saturating_sub(rest))
+                Layout::new(b, threads, target.saturating_sub(rest), options.real)
             }
         };
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
@@ -433,11 +449,7 @@ impl Plan {
         let clusters = cluster_pairs(b);
         let blocks = Blocks::complex(b, &clusters, layout.chunk);
         // The real layout is about half as large per beta: its chunks take twice the betas.
-        let buf_doubles = layout.chunk_bytes / 8;
-        let blocks_real = options.real.then(|| {
-            let dpl = Blocks::doubles_per_lane(b, true);
-            Blocks::real(b, &clusters, Blocks::chunk_for(buf_doubles, dpl, b))
-        });
+        let blocks_real = layout.chunk_real.map(|h| Blocks::real(b, &clusters, h));
         let scratch_lanes = blocks
             .lanes
             .max(blocks_real.as_ref().map_or(0, |t| t.lanes));
@@ -492,6 +504,7 @@ impl Plan {
             skip_bits,
             skip,
             buf: Mutex::new(Some(buf)),
+            buf_bytes: layout.chunk_bytes,
         })
     }
 
@@ -557,19 +570,21 @@ impl Plan {
         self.memory
     }
 
-    /// Bytes of the chunk buffer: `2 h' * 8 * (8B^2 - 8B + 8)` with `h` low beta slices per
-    /// chunk of the complex transforms and `h'` = `h` rounded up to a multiple of 8.
-    /// (`8B^2 - 8B + 8` doubles per beta: the `(2B-1)^2` in-band values of a transformed
-    /// slice in the DWT kernels' layout, `16` doubles per 8-member cluster, `8` per other
-    /// one.) `h = min(B, max(1, 8 floor(cap / (16 * 8 * (8B^2 - 8B + 8)))))`. With
-    /// `max_workspace_bytes` the cap is that value. By default the whole plan
-    /// ([`Plan::memory_bytes`]) is held to `max(512 MiB, 4.6% of the sample and coefficient
-    /// arrays)` (at most half the available memory), and the cap is what the FFT buffers and
+    /// Bytes of the chunk buffer. For the complex transforms it holds `2 h'` betas of
+    /// `8B^2 - 8B + 8` doubles (the `(2B-1)^2` in-band values of a transformed slice in the
+    /// DWT kernels' layout: 16 doubles per 8-member cluster, 8 per other one), with `h` low
+    /// betas per chunk and `h'` = `h` rounded up to a multiple of 8; the real-signal
+    /// transforms ([`PlanOptions::real`]) hold `4B^2 + 4B` doubles per beta (8 per
+    /// cluster), and so about twice the betas per chunk. For a cap `c` bytes each layout
+    /// takes `h = min(B, max(1, 8 floor(c / (16 * 8 * d))))` with `d` its doubles per beta,
+    /// and the buffer is the larger of the two. With `max_workspace_bytes` the cap is that
+    /// value. By default the whole plan ([`Plan::memory_bytes`]) is held to
+    /// `max(512 MiB, 4.7% of the sample and coefficient arrays)` (real samples for a real
+    /// plan; at most half the available memory), and the cap is what the FFT buffers and
     /// tables leave of it. At B = 512 that keeps a complex transform within the caller's
-    /// arrays plus 5%. The real-signal transforms use the same buffer with their
-    /// own layout, about half as large per beta, so their chunks hold about twice the betas.
+    /// arrays plus 5%.
     pub fn workspace_bytes(&self) -> usize {
-        self.blocks.total() * 8
+        self.buf_bytes
     }
 
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {

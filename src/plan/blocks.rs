@@ -136,6 +136,7 @@ impl Blocks {
     }
 
     /// Doubles of the whole buffer.
+    #[cfg(test)]
     pub fn total(&self) -> usize {
         self.pofs[self.len()] * self.lanes
     }
