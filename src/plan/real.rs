@@ -290,8 +290,8 @@ impl Plan {
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            for i in 0..n {
-                let g = sg[i & 1];
+            for (i, s) in sc.rec.s[..n].iter().enumerate() {
+                let g = sg[i & 1] * s;
                 let z = Complex64::new(f[2 * q * ld + i] * g, f[(2 * q + 1) * ld + i] * g);
                 if first {
                     *dst.add(i) = z;
@@ -321,7 +321,7 @@ impl Plan {
         let p = t.p(c);
         let (reps, nr) = representatives(cl);
         let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef);
+        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef, &sc.rec.s[..n]);
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         dwt::inverse(self.isa, p, &rec, &sc.lanes(self, ch), &data[..n * p], blk);
