@@ -171,6 +171,8 @@ pub struct Plan {
     dwt_scratch: Vec<Mutex<Scratch>>,
     /// Whether the slice FFTs run on FFTW's threads (else slices are spread over workers).
     fftw_threaded: bool,
+    /// Mirrored pairs of beta slices per group of the complex FFT stage.
+    group: usize,
     /// Chunk-buffer layout of the complex transforms.
     blocks: Blocks,
     /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
@@ -314,8 +316,10 @@ impl Layout {
             chunk,
             chunk_real,
             chunk_bytes,
-            // A pair of slices and a spare one per worker.
-            fft_scratch_bytes: threads * 3 * slice_bytes,
+            // A group of pairs of slices and a spare one per worker.
+            fft_scratch_bytes: threads
+                * (2 * fft_stage::pairs_per_group(slice_bytes) + 1)
+                * slice_bytes,
             table_bytes,
         }
     }
@@ -464,8 +468,9 @@ impl Plan {
         } else {
             None
         };
+        let group = fft_stage::pairs_per_group(16 * n * n);
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new(3 * n * n).map(Mutex::new))
+            .map(|_| AlignedBuf::new((2 * group + 1) * n * n).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -501,6 +506,7 @@ impl Plan {
             fft_scratch,
             dwt_scratch,
             fftw_threaded,
+            group,
             blocks,
             blocks_real,
             memory: layout.total(),
@@ -565,8 +571,9 @@ impl Plan {
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: the chunk buffer ([`Plan::workspace_bytes`]) plus
-    /// `threads * 3 * (2B)^2 * 16` for the per-worker FFT buffers (a pair of beta slices
-    /// and a spare one) plus `O(B^2)` tables. A transform needs the caller's arrays on top
+    /// `threads * (2g + 1) * (2B)^2 * 16` for the per-worker FFT buffers (a group of `g`
+    /// pairs of beta slices and a spare one; `g = clamp(8 MiB / (2 (2B)^2 16), 1, 4)`, i.e.
+    /// 4 for B <= 128 and 1 from B = 256 on) plus `O(B^2)` tables. A transform needs the caller's arrays on top
     /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
     pub fn memory_bytes(&self) -> usize {
@@ -804,13 +811,16 @@ impl Plan {
         let _ = (cl, coef);
     }
 
-    /// Run `f` with a per-worker FFT scratch buffer (three slices). A worker may take on
-    /// another execution's pair while it waits inside a parallel copy, so buffers are taken
-    /// by try_lock, never by blocking; when all are busy a private one is allocated.
+    /// Run `f` with a per-worker FFT scratch buffer (`2 group + 1` slices). A worker may
+    /// take on another execution's group while it waits inside a parallel copy, so buffers
+    /// are taken by try_lock, never by blocking; when all are busy a private one is
+    /// allocated.
     fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
         match lock_free(&self.fft_scratch) {
             Some(g) => f(&g),
-            None => f(&AlignedBuf::new(3 * 4 * self.b * self.b)?),
+            None => f(&AlignedBuf::new(
+                (2 * self.group + 1) * 4 * self.b * self.b,
+            )?),
         }
     }
 }

@@ -1,18 +1,30 @@
-//! The FFT stage of the complex transforms, one mirrored pair of beta slices at a time.
+//! The FFT stage of the complex transforms, a group of mirrored pairs of beta slices at a
+//! time.
 //!
-//! Forward: both slices of a pair (`beta` and `pi - beta`) are copied into the worker's
-//! cache-resident scratch, transformed in place, and moved, weighted, into the rows of
-//! every cluster's block (`blocks.rs`): the pair fills the rows of two lanes completely,
-//! each written as whole cache lines with non-temporal stores. Inverse: the two rows of
-//! every block are read back into two slices, which are transformed into a spare slice and
-//! streamed to the samples. The pairs are spread over the workers, or, with FFTW's threads,
-//! run one after another with the block copies spread over the workers.
+//! Forward: the slices of a group of pairs (`beta` and `pi - beta`) are copied into the
+//! worker's cache-resident scratch, transformed in place, and moved, weighted, into the
+//! rows of every cluster's block (`blocks.rs`): the group fills `2g` adjacent rows of each
+//! block completely, written as whole cache lines with non-temporal stores. Inverse: those
+//! rows of every block are read back into the slices, which are transformed into a spare
+//! slice and streamed to the samples. Groups of `g` pairs (up to 4, as many as keep the
+//! scratch within a few MiB) turn the block accesses, one short piece per cluster, into
+//! longer ones. The groups are spread over the workers, or, with FFTW's threads, run one
+//! after another with the block copies spread over the workers.
 
 use super::blocks::{Blocks, NONE};
 use super::*;
 
 /// Clusters whose rows are prefetched ahead by the inverse copy.
 const PREFETCH_CLUSTERS: usize = 16;
+
+/// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
+pub(super) const MAX_GROUP: usize = 4;
+
+/// Pairs per group for slices of `slice_bytes`: up to [`MAX_GROUP`], as many as keep the
+/// group's slices within 8 MiB (B = 128: 4, B = 256: 1).
+pub(super) fn pairs_per_group(slice_bytes: usize) -> usize {
+    ((8usize << 20) / (2 * slice_bytes)).clamp(1, MAX_GROUP)
+}
 
 impl Plan {
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
@@ -37,9 +49,9 @@ impl Plan {
     }
 
     /// The first `npairs` pairs of [`Plan::fft_chunk`] with the slice plan `fft`; `slice(k)`
-    /// is where the samples of beta `k` are. With `fftw_threaded`, pairs one after another
+    /// is where the samples of beta `k` are. With `fftw_threaded`, groups one after another
     /// (`fft` runs on FFTW's threads, the block copies are spread over the workers), else
-    /// pairs spread over the workers.
+    /// groups spread over the workers.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn fft_pairs(
         &self,
@@ -52,88 +64,87 @@ impl Plan {
         npairs: usize,
     ) -> Result<()> {
         let buf = SyncPtr(buf);
-        let run = |j: usize| -> Result<()> {
-            let (k0, k1) = ch.pair_betas(self.b, j);
+        let g = self.group;
+        let run = |gi: usize| -> Result<()> {
+            let j0 = gi * g;
+            let gn = g.min(npairs - j0);
+            let mut grid = [std::ptr::null_mut(); 2 * MAX_GROUP];
+            let mut w = [0.0; 2 * MAX_GROUP];
+            for jj in 0..gn {
+                let (k0, k1) = ch.pair_betas(self.b, j0 + jj);
+                (grid[2 * jj], grid[2 * jj + 1]) = (slice(k0).get(), slice(k1).get());
+                (w[2 * jj], w[2 * jj + 1]) = (self.wq[k0], self.wq[k1]);
+            }
             self.with_fft_scratch(|scratch| unsafe {
-                // SAFETY: the scratch holds three slices; pair `j` owns its two rows of
-                // every block and its two sample slices.
-                self.fft_pair(
+                // SAFETY: the scratch holds 2g + 1 slices; the group owns its rows of every
+                // block and its sample slices.
+                self.fft_group(
                     fft,
                     forward,
-                    [slice(k0).get(), slice(k1).get()],
-                    [self.wq[k0], self.wq[k1]],
+                    &grid[..2 * gn],
+                    &w[..2 * gn],
                     scratch.as_mut_ptr(),
                     buf.get(),
-                    j,
+                    j0,
                     fftw_threaded,
                 );
                 Ok(())
             })
         };
+        let ngroups = npairs.div_ceil(g);
         if fftw_threaded {
-            (0..npairs).try_for_each(run)
+            (0..ngroups).try_for_each(run)
         } else {
-            (0..npairs).into_par_iter().try_for_each(run)
+            (0..ngroups).into_par_iter().try_for_each(run)
         }
     }
 
-    /// One pair of a chunk through the scratch `sp` (three slices): `grid` are the pair's
-    /// sample slices, `w` their forward weights; `parallel_copy` spreads the block copies
-    /// over the workers.
+    /// One group of pairs of a chunk through the scratch `sp` (`2g + 1` slices): `grid` are
+    /// the group's sample slices (beta, mirror, beta, mirror, ...), `w` their forward
+    /// weights, `j0` its first pair; `parallel_copy` spreads the block copies over the
+    /// workers.
     #[allow(clippy::too_many_arguments)]
-    unsafe fn fft_pair(
+    unsafe fn fft_group(
         &self,
         fft: &SliceFft,
         forward: bool,
-        grid: [*mut Complex64; 2],
-        w: [f64; 2],
+        grid: &[*mut Complex64],
+        w: &[f64],
         sp: *mut Complex64,
         buf: *mut f64,
-        j: usize,
+        j0: usize,
         parallel_copy: bool,
     ) {
         let n = 2 * self.b;
         let nn = n * n;
-        let s = [sp, sp.add(nn)];
-        let spare = sp.add(2 * nn);
+        let ns = grid.len();
+        let mut s = [SyncPtr(std::ptr::null_mut()); 2 * MAX_GROUP];
+        for (i, si) in s.iter_mut().enumerate().take(ns) {
+            *si = SyncPtr(sp.add(i * nn));
+        }
+        let s = &s[..ns];
+        let spare = sp.add(ns * nn);
+        let b = SyncPtr(buf);
         if forward {
-            for (&dst, &src) in s.iter().zip(&grid) {
+            for (dst, &src) in s.iter().zip(grid) {
                 if fft.has_in_place() {
                     // Copied first (a sequential read the prefetchers follow), then
                     // transformed in the cache: faster than FFTW reading the samples.
-                    std::ptr::copy_nonoverlapping(src, dst, nn);
-                    fft.in_place(dst, spare, n);
+                    std::ptr::copy_nonoverlapping(src, dst.get(), nn);
+                    fft.in_place(dst.get(), spare, n);
                 } else {
-                    fft.execute(src, dst);
+                    fft.execute(src, dst.get());
                 }
             }
-            let (s0, s1) = (SyncPtr(s[0]), SyncPtr(s[1]));
-            let b = SyncPtr(buf);
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
-                scatter_pair(
-                    &self.blocks,
-                    [s0.get(), s1.get()],
-                    w,
-                    false,
-                    b.get(),
-                    j,
-                    c0..c1,
-                )
+                scatter_group(&self.blocks, s, w, false, b.get(), j0, c0..c1)
             });
         } else {
-            let (s0, s1) = (SyncPtr(s[0]), SyncPtr(s[1]));
-            let b = SyncPtr(buf);
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
-                gather_pair(
-                    &self.blocks,
-                    [s0.get(), s1.get()],
-                    false,
-                    b.get(),
-                    j,
-                    c0..c1,
-                )
+                gather_group(&self.blocks, s, false, b.get(), j0, c0..c1)
             });
-            for (&src, &dst) in s.iter().zip(&grid) {
+            for (src, &dst) in s.iter().zip(grid) {
+                let src = src.get();
                 // Frequency B (alpha or gamma) is outside the band limit.
                 for i in 0..n {
                     *src.add(self.b * n + i) = Complex64::new(0.0, 0.0);
@@ -171,63 +182,77 @@ impl Plan {
     }
 }
 
-/// Write the rows of pair `j` (rows `2j` and `2j + 1`, adjacent) of the blocks of
-/// clusters `cs` from a pair of transformed slices `s` (beta, then pi - beta), scaled by
-/// their weights `w` (and conjugated with `conj`): the first row takes each slot from its
-/// own slice, the second from the other one; reversed slots the other way round. Unused
-/// slots are zero.
+/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, adjacent) of the blocks of
+/// clusters `cs` from the transformed slices `s` (beta, then pi - beta, for each pair),
+/// scaled by their weights `w` (and conjugated with `conj`): the first row of a pair
+/// takes each slot from its own slice, the second from the other one; reversed slots the
+/// other way round. Unused slots are zero.
 ///
 /// # Safety
 /// `s` are valid for every index in the slot tables; `buf` holds the blocks of `t`,
 /// 64-byte aligned, and nobody else writes these rows.
-#[allow(clippy::too_many_arguments)]
-pub(super) unsafe fn scatter_pair(
+pub(super) unsafe fn scatter_group<T: Copy + Into<*const Complex64>>(
     t: &Blocks,
-    s: [*const Complex64; 2],
-    w: [f64; 2],
+    s: &[T],
+    w: &[f64],
     conj: bool,
     buf: *mut f64,
-    j: usize,
+    j0: usize,
     cs: std::ops::Range<usize>,
 ) {
-    let ci = if conj { -1.0 } else { 1.0 };
-    let wi = [w[0] * ci, w[1] * ci];
+    let ns = s.len();
+    debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP && w.len() == ns);
+    let mut sp = [std::ptr::null::<Complex64>(); 2 * MAX_GROUP];
+    let (mut wr, mut wi) = ([0.0; 2 * MAX_GROUP], [0.0; 2 * MAX_GROUP]);
+    for i in 0..ns {
+        sp[i] = s[i].into();
+        (wr[i], wi[i]) = (w[i], if conj { -w[i] } else { w[i] });
+    }
     for c in cs {
         let p = t.p(c);
         let rev = t.rev[c];
-        let mut rows = [0.0f64; 32];
+        let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
         for q in 0..p / 2 {
             let fi = *t.fi.get_unchecked(8 * c + q);
             if fi == NONE {
                 continue;
             }
             let fi = fi as usize;
-            let (a, b) = (*s[0].add(fi), *s[1].add(fi));
-            let r = ((rev >> q) & 1) as usize * p;
-            rows[r + 2 * q] = a.re * w[0];
-            rows[r + 2 * q + 1] = a.im * wi[0];
-            rows[p - r + 2 * q] = b.re * w[1];
-            rows[p - r + 2 * q + 1] = b.im * wi[1];
+            let r = ((rev >> q) & 1) as usize;
+            for jj in 0..ns / 2 {
+                let (a, b) = (*sp[2 * jj].add(fi), *sp[2 * jj + 1].add(fi));
+                let (ra, rb) = ((2 * jj + r) * p + 2 * q, (2 * jj + 1 - r) * p + 2 * q);
+                rows[ra] = a.re * wr[2 * jj];
+                rows[ra + 1] = a.im * wi[2 * jj];
+                rows[rb] = b.re * wr[2 * jj + 1];
+                rows[rb + 1] = b.im * wi[2 * jj + 1];
+            }
         }
-        stream_rows(buf.add(t.offset(c) + 2 * j * p), &rows, 2 * p);
+        stream_rows(buf.add(t.offset(c) + 2 * j0 * p), &rows[..ns * p]);
     }
     fence();
 }
 
-/// The reverse of [`scatter_pair`] without weights: slots of the rows of pair `j` into
-/// the pair of slices `s` (conjugated with `conj`; the real layout's second index `fi2`
-/// gets the value itself).
+/// The reverse of [`scatter_group`] without weights: slots of the rows of the pairs
+/// `j0 ..` into the slices `s` (conjugated with `conj`; the real layout's second index
+/// `fi2` gets the value itself).
 ///
 /// # Safety
-/// As for [`scatter_pair`], with `s` written.
-pub(super) unsafe fn gather_pair(
+/// As for [`scatter_group`], with `s` written.
+pub(super) unsafe fn gather_group<T: Copy + Into<*const Complex64>>(
     t: &Blocks,
-    s: [*mut Complex64; 2],
+    s: &[T],
     conj: bool,
     buf: *const f64,
-    j: usize,
+    j0: usize,
     cs: std::ops::Range<usize>,
 ) {
+    let ns = s.len();
+    debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP);
+    let mut sp = [std::ptr::null_mut::<Complex64>(); 2 * MAX_GROUP];
+    for i in 0..ns {
+        sp[i] = s[i].into() as *mut Complex64;
+    }
     let end = cs.end;
     for c in cs {
         #[cfg(target_arch = "x86_64")]
@@ -235,54 +260,58 @@ pub(super) unsafe fn gather_pair(
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             let cf = c + PREFETCH_CLUSTERS;
             let pf = t.p(cf);
-            let rows = buf.add(t.offset(cf) + 2 * j * pf) as *const i8;
-            for line in 0..pf / 4 {
+            let rows = buf.add(t.offset(cf) + 2 * j0 * pf) as *const i8;
+            for line in 0..ns * pf / 8 {
                 _mm_prefetch::<_MM_HINT_T0>(rows.add(64 * line));
             }
         }
         let p = t.p(c);
-        let row = buf.add(t.offset(c) + 2 * j * p);
+        let row = buf.add(t.offset(c) + 2 * j0 * p);
         let rev = t.rev[c];
         for q in 0..p / 2 {
             let fi = *t.fi.get_unchecked(8 * c + q);
             if fi == NONE {
                 continue;
             }
-            let r = ((rev >> q) & 1) as usize * p;
-            let a = Complex64::new(*row.add(r + 2 * q), *row.add(r + 2 * q + 1));
-            let b = Complex64::new(*row.add(p - r + 2 * q), *row.add(p - r + 2 * q + 1));
             let fi = fi as usize;
-            if conj {
-                *s[0].add(fi) = a.conj();
-                *s[1].add(fi) = b.conj();
-                let fi2 = *t.fi2.get_unchecked(8 * c + q);
-                if fi2 != NONE {
-                    *s[0].add(fi2 as usize) = a;
-                    *s[1].add(fi2 as usize) = b;
+            let fi2 = *t.fi2.get_unchecked(8 * c + q);
+            let r = ((rev >> q) & 1) as usize;
+            for jj in 0..ns / 2 {
+                let (ra, rb) = ((2 * jj + r) * p + 2 * q, (2 * jj + 1 - r) * p + 2 * q);
+                let a = Complex64::new(*row.add(ra), *row.add(ra + 1));
+                let b = Complex64::new(*row.add(rb), *row.add(rb + 1));
+                let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
+                if conj {
+                    *s0.add(fi) = a.conj();
+                    *s1.add(fi) = b.conj();
+                    if fi2 != NONE {
+                        *s0.add(fi2 as usize) = a;
+                        *s1.add(fi2 as usize) = b;
+                    }
+                } else {
+                    *s0.add(fi) = a;
+                    *s1.add(fi) = b;
                 }
-            } else {
-                *s[0].add(fi) = a;
-                *s[1].add(fi) = b;
             }
         }
     }
 }
 
-/// Store `len` doubles (16 or 32: whole 64-byte lines at a 64-byte aligned `dst`) without
-/// reading the lines first.
+/// Store `rows` (whole 64-byte lines at a 64-byte aligned `dst`) without reading the
+/// lines first.
 #[inline(always)]
-unsafe fn stream_rows(dst: *mut f64, rows: &[f64; 32], len: usize) {
+unsafe fn stream_rows(dst: *mut f64, rows: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_loadu_pd, _mm_stream_pd};
         if (dst as usize).is_multiple_of(64) {
-            for i in (0..len).step_by(2) {
+            for i in (0..rows.len()).step_by(2) {
                 _mm_stream_pd(dst.add(i), _mm_loadu_pd(rows.as_ptr().add(i)));
             }
             return;
         }
     }
-    std::ptr::copy_nonoverlapping(rows.as_ptr(), dst, len);
+    std::ptr::copy_nonoverlapping(rows.as_ptr(), dst, rows.len());
 }
 
 /// Orders the non-temporal stores of [`stream_rows`] before later stores and loads.
@@ -293,4 +322,10 @@ fn fence() {
     unsafe {
         std::arch::x86_64::_mm_sfence()
     };
+}
+
+impl From<SyncPtr<Complex64>> for *const Complex64 {
+    fn from(p: SyncPtr<Complex64>) -> *const Complex64 {
+        p.get()
+    }
 }

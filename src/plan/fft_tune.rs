@@ -78,7 +78,7 @@ impl Plan {
         // sample grid holds the slices the inverse pairs write (distinct, as the pairs run
         // concurrently); every beta maps onto it cyclically. (Mapping fresh memory costs more
         // than the measurement itself when transparent huge pages must be compacted.)
-        let npairs = self.threads.min(self.blocks.chunk);
+        let npairs = (self.threads * self.group).min(self.blocks.chunk);
         let slices = 2 * npairs;
         let bytes = slices * nn * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {

@@ -234,17 +234,18 @@ impl Plan {
                             fft.r2c(src, dst);
                         }
                         // S(M,M') = conj(R[M][M']) for M' >= 0.
-                        fft_stage::scatter_pair(
+                        fft_stage::scatter_group(
                             t,
-                            [s[0], s[1]],
-                            [self.wq[k0], self.wq[k1]],
+                            &[s[0] as *const Complex64, s[1]],
+                            &[self.wq[k0], self.wq[k1]],
                             true,
                             buf.get(),
                             j,
                             0..t.len(),
                         );
                     } else {
-                        fft_stage::gather_pair(t, s, true, buf.get(), j, 0..t.len());
+                        let sc = [s[0] as *const Complex64, s[1]];
+                        fft_stage::gather_group(t, &sc, true, buf.get(), j, 0..t.len());
                         for (&slot, k) in s.iter().zip([k0, k1]) {
                             // Frequency B (alpha or gamma) is outside the band limit.
                             for i in 0..=b {
