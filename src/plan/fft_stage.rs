@@ -329,3 +329,58 @@ impl From<SyncPtr<Complex64>> for *const Complex64 {
         p.get()
     }
 }
+
+#[cfg(test)]
+mod speed {
+    use super::*;
+
+    /// Time of the block copies of one group of pairs over all clusters (run with
+    /// --ignored --nocapture): scatter and gather, against a plain copy of as many bytes.
+    #[test]
+    #[ignore]
+    fn copy_speed() {
+        for b in [64usize, 128, 256] {
+            let n = 2 * b;
+            let nn = n * n;
+            let g = std::env::var("G")
+                .ok()
+                .and_then(|x| x.parse().ok())
+                .unwrap_or(pairs_per_group(16 * nn));
+            let t = Blocks::complex(b, &crate::symmetry::cluster_pairs(b), 8);
+            let buf = AlignedBuf::new(t.total() / 2 + 8).unwrap();
+            let sl = AlignedBuf::new(2 * g * nn).unwrap();
+            let s: Vec<*const Complex64> = (0..2 * g)
+                .map(|i| unsafe { sl.as_mut_ptr().add(i * nn) as *const Complex64 })
+                .collect();
+            let w = vec![1.0; 2 * g];
+            let reps = 20;
+            let time = |f: &dyn Fn()| {
+                (0..5)
+                    .map(|_| {
+                        let t0 = Instant::now();
+                        for _ in 0..reps {
+                            f();
+                        }
+                        t0.elapsed().as_secs_f64() / reps as f64
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let bp = buf.as_mut_ptr() as *mut f64;
+            let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, 0, 0..t.len()) });
+            let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, 0, 0..t.len()) });
+            let bytes = 2 * g * nn * 16;
+            let src = AlignedBuf::new(bytes / 16).unwrap();
+            let dst = AlignedBuf::new(bytes / 16).unwrap();
+            let tc = time(&|| unsafe {
+                std::ptr::copy_nonoverlapping(src.as_mut_ptr(), dst.as_mut_ptr(), bytes / 16)
+            });
+            println!(
+                "B={b} g={g}: scatter {:.2} ms, gather {:.2} ms per pair, memcpy of the same bytes {:.2} ms ({:.1} GB/s)",
+                ts * 1e3 / g as f64,
+                tg * 1e3 / g as f64,
+                tc * 1e3 / g as f64,
+                bytes as f64 / tc / 1e9
+            );
+        }
+    }
+}
