@@ -17,6 +17,10 @@ use super::*;
 /// Clusters whose rows are prefetched ahead by the inverse copy.
 const PREFETCH_CLUSTERS: usize = 16;
 
+/// Reversal bits of the 8-member clusters: the last four members read the mirrored slice
+/// (see `symmetry.rs`).
+const GENERIC_REV: u8 = 0xF0;
+
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
 pub(super) const MAX_GROUP: usize = 4;
 
@@ -211,6 +215,25 @@ pub(super) unsafe fn scatter_group<T: Copy + Into<*const Complex64>>(
     for c in cs {
         let p = t.p(c);
         let rev = t.rev[c];
+        if p == 16 && rev == GENERIC_REV && !conj {
+            // The common case, written out: 8 slots, the last 4 reversed, no conjugation.
+            let f: [usize; 8] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+            let mut rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
+            for jj in 0..ns / 2 {
+                let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
+                let (w0, w1) = (wr[2 * jj], wr[2 * jj + 1]);
+                let (lo, hi) = (16 * jj, 16 * jj + 8);
+                for q in 0..4 {
+                    rows[lo + q] = *s0.add(f[q]) * w0;
+                    rows[hi + q] = *s1.add(f[q]) * w1;
+                    rows[hi + 4 + q] = *s0.add(f[4 + q]) * w0;
+                    rows[lo + 4 + q] = *s1.add(f[4 + q]) * w1;
+                }
+            }
+            let rows = std::slice::from_raw_parts(rows.as_ptr() as *const f64, ns * 16);
+            stream_rows(buf.add(t.offset(c) + 2 * j0 * p), rows);
+            continue;
+        }
         let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
         for q in 0..p / 2 {
             let fi = *t.fi.get_unchecked(8 * c + q);
@@ -268,6 +291,22 @@ pub(super) unsafe fn gather_group<T: Copy + Into<*const Complex64>>(
         let p = t.p(c);
         let row = buf.add(t.offset(c) + 2 * j0 * p);
         let rev = t.rev[c];
+        if p == 16 && rev == GENERIC_REV && !conj {
+            // The common case, written out (see `scatter_group`).
+            let f: [usize; 8] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+            let rows = row as *const Complex64;
+            for jj in 0..ns / 2 {
+                let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
+                let (lo, hi) = (rows.add(16 * jj), rows.add(16 * jj + 8));
+                for q in 0..4 {
+                    *s0.add(f[q]) = *lo.add(q);
+                    *s1.add(f[q]) = *hi.add(q);
+                    *s0.add(f[4 + q]) = *hi.add(4 + q);
+                    *s1.add(f[4 + q]) = *lo.add(4 + q);
+                }
+            }
+            continue;
+        }
         for q in 0..p / 2 {
             let fi = *t.fi.get_unchecked(8 * c + q);
             if fi == NONE {
