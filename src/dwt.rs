@@ -69,6 +69,66 @@ pub(crate) struct Lanes<'a> {
     /// and `2(u - upper_from) + 1` above (the lanes count `2 upper_from`), so that lanes
     /// `u` and `u + upper_from` (a beta and its mirror, see `plan/blocks.rs`) are adjacent.
     pub interleaved: bool,
+    /// Memory to prefetch into L2 while the kernel runs, a few lines at a time (the next
+    /// cluster's block and coefficient rows); hints only, never read.
+    pub prefetch: Prefetch,
+}
+
+/// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
+#[derive(Clone, Copy)]
+pub(crate) struct Prefetch {
+    /// `(start, 64-byte lines)`.
+    ranges: [(*const u8, usize); Prefetch::MAX],
+    n: usize,
+    /// Position: range index and line within it.
+    at: (usize, usize),
+}
+
+impl Prefetch {
+    const MAX: usize = 9;
+
+    /// Nothing to prefetch.
+    pub fn none() -> Prefetch {
+        Prefetch {
+            ranges: [(std::ptr::null(), 0); Prefetch::MAX],
+            n: 0,
+            at: (0, 0),
+        }
+    }
+
+    /// Add `len` doubles from `p` (ignored beyond [`Prefetch::MAX`] ranges).
+    pub fn push(&mut self, p: *const f64, len: usize) {
+        if self.n < Prefetch::MAX && len > 0 {
+            self.ranges[self.n] = (p as *const u8, (len * 8).div_ceil(64));
+            self.n += 1;
+        }
+    }
+
+    /// Lines in all ranges.
+    fn lines(&self) -> usize {
+        self.ranges[..self.n].iter().map(|r| r.1).sum()
+    }
+
+    /// Issue the next `k` prefetches (into L2).
+    #[inline(always)]
+    fn issue(&mut self, mut k: usize) {
+        while k > 0 && self.at.0 < self.n {
+            let (p, len) = self.ranges[self.at.0];
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: a prefetch is a hint; it never faults.
+            unsafe {
+                use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
+                _mm_prefetch::<_MM_HINT_T1>(p.wrapping_add(64 * self.at.1) as *const i8);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            let _ = p;
+            self.at.1 += 1;
+            if self.at.1 >= len {
+                self.at = (self.at.0 + 1, 0);
+            }
+            k -= 1;
+        }
+    }
 }
 
 impl Lanes<'_> {
@@ -403,6 +463,11 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
     debug_assert!(ld >= n + W && ft.len() >= P * ld);
     let fp = ft.as_mut_ptr();
+    // Prefetch hints: the lines of `lanes.prefetch`, a few per degree block.
+    let mut pf = lanes.prefetch;
+    let pf_per_block = pf
+        .lines()
+        .div_ceil((n / W).max(1) * nb.div_ceil(W * FWD_VECTORS));
     let xrows = |s0: usize| {
         let (r0, step) = lanes.rows(s0);
         (xin.as_ptr().add(r0 * P), step * P)
@@ -429,6 +494,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
         let mut i0 = first - first % W;
         let mut fast = [0usize; FWD_VECTORS];
         while i0 < n {
+            pf.issue(pf_per_block);
             let mut acc = [S::zero(); P];
             for (q, a) in acc.iter_mut().enumerate() {
                 *a = S::load(fp.add(q * ld + i0));
@@ -517,10 +583,13 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
     let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
     let fp = fin.as_ptr();
+    let mut pf = lanes.prefetch;
+    let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
     let mut g0 = 0;
     while g0 < nb {
         let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
         for (gi, st) in group.iter().enumerate().take(g) {
+            pf.issue(pf_per_vector);
             // A local copy, so the state lives in registers during the run.
             let mut st = *st;
             let s0 = g0 + gi * W;
@@ -685,6 +754,7 @@ pub(crate) fn column(
         big: crate::wigner::big(bits),
         skip: false,
         interleaved: false,
+        prefetch: Prefetch::none(),
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f, ld);
     f[..n].iter().zip(&rc.s).map(|(u, s)| u * s).collect()
@@ -750,6 +820,7 @@ mod tests {
             big: crate::wigner::big(test_skip_bits()),
             skip: true,
             interleaved: true,
+            prefetch: Prefetch::none(),
         }
     }
 

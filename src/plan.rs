@@ -11,7 +11,7 @@
 //! out of the blocks), `dwt_stage` (kernels per cluster, coefficient signs and layout),
 //! `real` (the real-signal transforms), `fft_tune` (plan-time choice of FFT threading).
 
-use crate::dwt::{self, Lanes, Rec};
+use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::error::{Error, Result};
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
 
@@ -679,7 +679,6 @@ impl Plan {
         self.run_chunks(
             true,
             &self.blocks,
-            coef,
             |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
             |sc, c, cl, ch, buf, first| unsafe {
                 self.forward_cluster(sc, c, cl, ch, buf, coef, first);
@@ -698,7 +697,6 @@ impl Plan {
         self.run_chunks(
             false,
             &self.blocks,
-            SyncPtr(coeffs.as_ptr() as *mut Complex64),
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
             |sc, c, cl, ch, buf, _| unsafe { self.inverse_cluster(sc, c, cl, ch, buf, coeffs) },
         )
@@ -706,15 +704,13 @@ impl Plan {
 
     /// The chunk loop shared by every transform: for each chunk, the FFT stage and the DWT
     /// of every cluster of layout `t`, in the order of the direction (forward: FFT then
-    /// DWT), timed. `coef` is the coefficient array (for prefetching); `first` tells the
-    /// cluster stage whether this is the first chunk (the forward assigns rather than
-    /// accumulates then).
+    /// DWT), timed. `first` tells the cluster stage whether this is the first chunk (the
+    /// forward assigns rather than accumulates then).
     #[allow(clippy::type_complexity)]
     fn run_chunks(
         &self,
         forward: bool,
         t: &Blocks,
-        coef: SyncPtr<Complex64>,
         fft: impl Fn(&Chunk, *mut f64) -> Result<()> + Sync,
         cluster: impl Fn(&mut Scratch, usize, &Cluster, &Chunk, *mut f64, bool) + Sync,
     ) -> Result<StageTimes> {
@@ -734,7 +730,7 @@ impl Plan {
                         fft_stage()?;
                     }
                     let t1 = Instant::now();
-                    self.for_each_cluster(t, coef.get(), |sc, c, cl| {
+                    self.for_each_cluster(t, |sc, c, cl| {
                         cluster(sc, c, cl, &ch, bp.get(), ci == 0)
                     });
                     times.dwt += t1.elapsed().as_secs_f64();
@@ -751,15 +747,9 @@ impl Plan {
 
     /// Run `f(scratch, index, cluster)` on every cluster in parallel (work stealing over
     /// runs of consecutive clusters, whose blocks are consecutive in the chunk buffer).
-    /// Before a cluster is processed, the coefficient rows of the next one are prefetched:
-    /// they are short streams far apart in an array much larger than the caches.
-    fn for_each_cluster(
-        &self,
-        t: &Blocks,
-        coef: *mut Complex64,
-        f: impl Fn(&mut Scratch, usize, &Cluster) + Sync,
-    ) {
-        let coef = SyncPtr(coef);
+    /// While a cluster's kernel runs it prefetches what the next one will touch (see
+    /// `Plan::next_cluster`).
+    fn for_each_cluster(&self, t: &Blocks, f: impl Fn(&mut Scratch, usize, &Cluster) + Sync) {
         let nc = t.len();
         const RUN: usize = 8;
         (0..nc.div_ceil(RUN)).into_par_iter().for_each(|r| {
@@ -780,35 +770,10 @@ impl Plan {
                 let (m, mp) = self.clusters[c];
                 Cluster::new(m as usize, mp as usize)
             };
-            let mut next = pair(c0);
             for c in c0..c1 {
-                let cl = next;
-                if c + 1 < c1 {
-                    next = pair(c + 1);
-                    self.prefetch_coeffs(&next, coef.get());
-                }
-                f(sc, c, &cl);
+                f(sc, c, &pair(c));
             }
         });
-    }
-
-    /// Hint the cache about the first lines of the coefficient rows a cluster will touch
-    /// (the hardware prefetchers follow each row from there).
-    fn prefetch_coeffs(&self, cl: &Cluster, coef: *mut Complex64) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let n = self.b - cl.l0();
-            for mem in cl.members() {
-                // 4 complex values per 64-byte line; wrapping_add: hints never fault.
-                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
-                for i in (0..n.min(16)).step_by(4) {
-                    unsafe { _mm_prefetch::<_MM_HINT_T0>(row.wrapping_add(i) as *const i8) };
-                }
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (cl, coef);
     }
 
     /// Run `f` with a per-worker FFT scratch buffer (`2 group + 1` slices). A worker may

@@ -4,6 +4,13 @@
 
 use super::*;
 
+/// All members of a cluster (for [`Plan::next_cluster`]).
+pub(super) fn all_members(cl: &Cluster) -> ([Member; 8], usize) {
+    let mut m = [cl.members()[0]; 8];
+    m[..cl.members().len()].copy_from_slice(cl.members());
+    (m, cl.members().len())
+}
+
 /// Per-worker scratch, sized for the largest cluster and chunk.
 pub(super) struct Scratch {
     pub rec: RecCoeffs,
@@ -39,6 +46,7 @@ impl Scratch {
             big: big(plan.skip_bits),
             skip: plan.skip,
             interleaved: true,
+            prefetch: Prefetch::none(),
         }
     }
 }
@@ -127,6 +135,8 @@ impl Plan {
 
     /// The forward kernel on `xin` (a block) into `sc.out`, zeroed first: row `q` (the
     /// real or imaginary part of a slot) at `q * ld`, degrees contiguous; returns `ld`.
+    /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn run_forward(
         &self,
         sc: &mut Scratch,
@@ -134,15 +144,49 @@ impl Plan {
         p: usize,
         n: usize,
         xin: &[f64],
+        next: Prefetch,
     ) -> usize {
         let ld = n + 8;
         let mut out = std::mem::take(&mut sc.out);
         let f = &mut out[..p * ld];
         f.fill(0.0);
         let rec = Rec::new(&sc.rec, n);
-        dwt::forward(self.isa, p, &rec, &sc.lanes(self, ch), xin, f, ld);
+        let mut lanes = sc.lanes(self, ch);
+        lanes.prefetch = next;
+        dwt::forward(self.isa, p, &rec, &lanes, xin, f, ld);
         sc.out = out;
         ld
+    }
+
+    /// What the cluster after `c` in layout `t` will touch: its block of the chunk buffer
+    /// (with `block`) and its coefficient rows (`members` of it), as prefetch hints (never
+    /// read through these pointers).
+    pub(super) fn next_cluster(
+        &self,
+        t: &Blocks,
+        buf: *mut f64,
+        c: usize,
+        ch: &Chunk,
+        block: bool,
+        coef: *const Complex64,
+        members: impl Fn(&Cluster) -> ([Member; 8], usize),
+    ) -> Prefetch {
+        let mut pf = Prefetch::none();
+        if c + 1 < t.len() {
+            if block {
+                let lanes = ch.lanes() * t.p(c + 1);
+                pf.push(buf.wrapping_add(t.offset(c + 1)) as *const f64, lanes);
+            }
+            let (m, mp) = self.clusters[c + 1];
+            let cl = Cluster::new(m as usize, mp as usize);
+            let n = self.b - cl.l0();
+            let (mem, nm) = members(&cl);
+            for mem in &mem[..nm] {
+                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
+                pf.push(row as *const f64, 2 * n);
+            }
+        }
+        pf
     }
 
     /// Forward DWT of cluster `c` over one chunk, accumulated into `coef`.
@@ -165,7 +209,8 @@ impl Plan {
         let p = self.blocks.p(c);
         let blk = self.block(&self.blocks, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        let ld = self.run_forward(sc, ch, p, n, blk);
+        let next = self.next_cluster(&self.blocks, buf, c, ch, true, coef.get(), all_members);
+        let ld = self.run_forward(sc, ch, p, n, blk, next);
         let scale = &sc.rec.s[..n];
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
@@ -208,7 +253,10 @@ impl Plan {
         self.gather_coeffs(&mut data[..n * p], cl, cl.members(), coef, &sc.rec.s[..n]);
         let blk = self.block(&self.blocks, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
-        dwt::inverse(self.isa, p, &rec, &sc.lanes(self, ch), &data[..n * p], blk);
+        let mut lanes = sc.lanes(self, ch);
+        lanes.prefetch =
+            self.next_cluster(&self.blocks, buf, c, ch, false, coef.as_ptr(), all_members);
+        dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
         sc.data = data;
     }
 }

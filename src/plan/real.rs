@@ -27,6 +27,14 @@ pub(super) fn representatives(cl: &Cluster) -> ([Member; 4], usize) {
     (reps, nr)
 }
 
+/// The representatives of a cluster, in the form [`Plan::next_cluster`] takes.
+fn reps_of(cl: &Cluster) -> ([Member; 8], usize) {
+    let (r, n) = representatives(cl);
+    let mut m = [r[0]; 8];
+    m[..4].copy_from_slice(&r);
+    (m, n)
+}
+
 /// `(-1)^(M - M')`.
 fn neg_sign(m: isize, mp: isize) -> f64 {
     if (m - mp).rem_euclid(2) == 0 {
@@ -120,7 +128,6 @@ impl Plan {
         let mut times = self.run_chunks(
             true,
             self.real_blocks()?,
-            coef,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
             |sc, c, cl, ch, buf, first| unsafe {
                 self.forward_cluster_real(sc, c, cl, ch, buf, coef, first);
@@ -177,7 +184,6 @@ impl Plan {
         self.run_chunks(
             false,
             self.real_blocks()?,
-            SyncPtr(coeffs.as_ptr() as *mut Complex64),
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
             |sc, c, cl, ch, buf, _| unsafe {
                 self.inverse_cluster_real(sc, c, cl, ch, buf, coeffs)
@@ -286,7 +292,8 @@ impl Plan {
         let reps = &reps[..nr];
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        let ld = self.run_forward(sc, ch, p, n, blk);
+        let next = self.next_cluster(t, buf, c, ch, true, coef.get(), reps_of);
+        let ld = self.run_forward(sc, ch, p, n, blk, next);
         let f = &sc.out[..p * ld];
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
@@ -325,7 +332,9 @@ impl Plan {
         self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef, &sc.rec.s[..n]);
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
-        dwt::inverse(self.isa, p, &rec, &sc.lanes(self, ch), &data[..n * p], blk);
+        let mut lanes = sc.lanes(self, ch);
+        lanes.prefetch = self.next_cluster(t, buf, c, ch, false, coef.as_ptr(), reps_of);
+        dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
         sc.data = data;
     }
 }
