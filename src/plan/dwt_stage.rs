@@ -161,6 +161,7 @@ impl Plan {
     /// What the cluster after `c` in layout `t` will touch: its block of the chunk buffer
     /// (with `block`) and its coefficient rows (`members` of it), as prefetch hints (never
     /// read through these pointers).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn next_cluster(
         &self,
         t: &Blocks,
