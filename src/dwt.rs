@@ -27,9 +27,8 @@ pub(crate) struct Rec<'a> {
     pub d: &'a [f64],
     /// `C_l - A_l`
     pub e: &'a [f64],
-    /// Scales `s_i` of the recurrence values (`dt = s u`, see `RecTables::coeffs`); the
-    /// kernels work on `u` and leave the scaling to their callers.
-    pub s: &'a [f64],
+    /// `Bc_l`
+    pub bb: &'a [f64],
 }
 
 impl<'a> Rec<'a> {
@@ -40,7 +39,7 @@ impl<'a> Rec<'a> {
             an: &r.an[..n],
             d: &r.d[..n],
             e: &r.e[..n],
-            s: &r.s[..n],
+            bb: &r.bb[..n],
         }
     }
 
@@ -221,13 +220,13 @@ impl<'r, S: Simd> State<'r, S> {
     /// Step without accumulating until some lane is active (or degree `n`): the rest of
     /// the negligible prefix after [`skip_inactive`], one vector at a time.
     #[inline(always)]
-    unsafe fn finish_prefix(&mut self, n: usize) {
+    unsafe fn finish_prefix(&mut self, rec: &Rec, n: usize) {
         if !self.skip {
             return;
         }
         let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
         while i < n && self.none_active() {
-            let p2 = self.step(p0, p1, i);
+            let p2 = self.step(rec, p0, p1, i);
             (p0, p1) = (p1, p2);
             i += 1;
             if S::any_ge(S::abs(p1), self.big) {
@@ -242,13 +241,13 @@ impl<'r, S: Simd> State<'r, S> {
     /// `min(i0 + W, n)`. For the blocks where not all lanes are active yet, or which start
     /// before the state does, or end past `n`.
     #[inline(always)]
-    unsafe fn masked_block<const W: usize>(&mut self, i0: usize, n: usize) -> [S::V; W] {
+    unsafe fn masked_block<const W: usize>(&mut self, rec: &Rec, i0: usize, n: usize) -> [S::V; W] {
         let mut d = [S::zero(); W];
         let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
         let end = (i0 + W).min(n);
         while i < end {
             d[i - i0] = S::mul(p1, self.mask);
-            let p2 = self.step(p0, p1, i);
+            let p2 = self.step(rec, p0, p1, i);
             (p0, p1) = (p1, p2);
             i += 1;
             if S::any_ge(S::abs(p1), self.big) {
@@ -261,22 +260,22 @@ impl<'r, S: Simd> State<'r, S> {
 
     /// One recurrence step from `(p0, p1)` at degree index `i`: the next value.
     #[inline(always)]
-    unsafe fn step(&self, p0: S::V, p1: S::V, i: usize) -> S::V {
+    unsafe fn step(&self, rec: &Rec, p0: S::V, p1: S::V, i: usize) -> S::V {
         let t = S::fma(
             S::splat(*self.ka.get_unchecked(i)),
             self.tau,
             S::splat(*self.kc.get_unchecked(i)),
         );
-        S::fms(t, p1, p0)
+        S::fms(t, p1, S::mul(S::splat(*rec.bb.get_unchecked(i)), p0))
     }
 
     /// Run the remaining degrees up to `n`, calling `acc(v, i)` with the value vector at
     /// each degree from the first one where some lane is active. The recurrence values
     /// live in locals (registers) throughout.
     #[inline(always)]
-    unsafe fn run(&mut self, n: usize, mut acc: impl FnMut(S::V, usize)) {
+    unsafe fn run(&mut self, rec: &Rec, n: usize, mut acc: impl FnMut(S::V, usize)) {
         let mut i = self.i;
-        let (tau, ka, kc) = (self.tau, self.ka, self.kc);
+        let (tau, ka, kc, bb) = (self.tau, self.ka, self.kc, rec.bb);
         let (mut p0, mut p1) = (self.p0, self.p1);
         let step = |p0: S::V, p1: S::V, i: usize| {
             let t = S::fma(
@@ -284,7 +283,7 @@ impl<'r, S: Simd> State<'r, S> {
                 tau,
                 S::splat(*kc.get_unchecked(i)),
             );
-            S::fms(t, p1, p0)
+            S::fms(t, p1, S::mul(S::splat(*bb.get_unchecked(i)), p0))
         };
         // Slow phase: some lanes still scaled down (and masked to zero).
         if !self.all_active() {
@@ -349,6 +348,7 @@ unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: u
     loop {
         let mut hit = false;
         while i < n {
+            let b = S::splat(*rec.bb.get_unchecked(i));
             let mut m = S::zero();
             for k in 0..GROUP {
                 let t = S::fma(
@@ -356,7 +356,7 @@ unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: u
                     tau[k],
                     S::splat(*kc[k].get_unchecked(i)),
                 );
-                let p2 = S::fms(t, p1[k], p0[k]);
+                let p2 = S::fms(t, p1[k], S::mul(b, p0[k]));
                 p0[k] = p1[k];
                 p1[k] = p2;
                 m = S::max(m, S::abs(p2));
@@ -483,7 +483,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
             let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
             for (k, s) in group.iter().enumerate().take(gn) {
                 let mut s = *s;
-                s.finish_prefix(n);
+                s.finish_prefix(rec, n);
                 st_mem[g + k].write(s);
             }
             g += gn;
@@ -511,7 +511,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
                     nf += 1;
                     continue;
                 }
-                let mut d = s.masked_block::<W>(i0, n);
+                let mut d = s.masked_block::<W>(rec, i0, n);
                 S::transpose(&mut d);
                 let (x, xs) = xrows(v0 + v * W);
                 block_fmas::<S, W, P>(&mut acc, x, xs, &d);
@@ -524,7 +524,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
                 let mut e = [S::zero(); W];
                 for (j, ej) in e.iter_mut().enumerate() {
                     *ej = p1;
-                    let p2 = S::fence(s.step(p0, p1, i0 + j));
+                    let p2 = S::fence(s.step(rec, p0, p1, i0 + j));
                     (p0, p1) = (p1, p2);
                 }
                 (s.p0, s.p1, s.i) = (p0, p1, i0 + W);
@@ -541,7 +541,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
                             if $w < W {
                                 let ew = e[$w];
                                 d[$w] = p1;
-                                let p2 = S::fence(s.step(p0, p1, i0 + $w));
+                                let p2 = S::fence(s.step(rec, p0, p1, i0 + $w));
                                 (p0, p1) = (p1, p2);
                                 lane_fmas::<S, P>(&mut acc, ew, x.add($w * xs));
                             }
@@ -595,6 +595,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
             let s0 = g0 + gi * W;
             let mut acc = [S::zero(); P];
             st.run(
+                rec,
                 n,
                 #[inline(always)]
                 |v, i| {
@@ -664,7 +665,7 @@ pub(crate) fn forward(
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.s.len() == n);
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(xin.len() >= nb * p && ld >= n + isa.lanes() && ft.len() >= p * ld);
     assert!(isa.is_supported());
@@ -691,7 +692,7 @@ pub(crate) fn forward(
 pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.s.len() == n);
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && y.len() >= nb * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
@@ -757,7 +758,7 @@ pub(crate) fn column(
         prefetch: Prefetch::none(),
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f, ld);
-    f[..n].iter().zip(&rc.s).map(|(u, s)| u * s).collect()
+    f[..n].to_vec()
 }
 
 #[cfg(test)]

@@ -374,9 +374,6 @@ impl Plan {
                 "skip_bits {skip_bits} outside {SKIP_BITS_RANGE:?}"
             )));
         }
-        // The kernels test the scaled recurrence values `u = dt / s` with `s <= 2^0.2`
-        // (`RecTables::coeffs`): one more bit keeps every skipped `dt` below `2^-skip_bits`.
-        let skip_bits = skip_bits + 1;
         let isa = options.isa.unwrap_or_else(Isa::detect);
         if !isa.is_supported() {
             return Err(Error::InvalidArgument(format!(

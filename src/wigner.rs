@@ -417,25 +417,17 @@ impl RecTables {
         }
     }
 
-    /// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + n`, `l = m + i`.
+    /// Recurrence coefficients of base pair `(m, mp)` for `l = m .. m + n`, `l = m + i`:
+    /// `dt^{l+1} = (A_l x + C_l) dt^l - Bc_l dt^{l-1}` with (`q(l) = sqrt((l^2-m^2)(l^2-m'^2))`)
+    /// `A_l = (l+1) sqrt((2l+3)(2l+1)) / q(l+1)`, `C_l = -A_l m m' / (l(l+1))`,
+    /// `Bc_l = sqrt((2l+3)/(2l-1)) (l+1)/l q(l)/q(l+1)`.
     ///
-    /// The three-term recurrence `dt^{l+1} = (A_l x + C_l) dt^l - Bc_l dt^{l-1}` with
-    /// (`q(l) = sqrt((l^2-m^2)(l^2-m'^2))`) `A_l = (l+1) sqrt((2l+3)(2l+1)) / q(l+1)`,
-    /// `C_l = -A_l m m' / (l(l+1))`, `Bc_l = sqrt((2l+3)/(2l-1)) (l+1)/l q(l)/q(l+1)` is run
-    /// on scaled values `u_i = dt^{m+i} / s_i`, with `s_0 = s_1 = 1` and
-    /// `s_{i+1} = Bc_i s_{i-1}`, which turns it into `u_{i+1} = t_i u_i - u_{i-1}`,
-    /// `t_i = (A x + C) s_i / s_{i+1}`: two operations per step instead of three. (`Bc` at
-    /// `l = m` is 0 and `u_{-1}` = 0, so the first step needs no special case.) The scales
-    /// stay within `[2^-5, 2^0.2]` for every order pair up to B = 2048 and are applied to the
-    /// kernels' data (inverse) and sums (forward) once per degree, outside the kernels.
-    ///
-    /// The multipliers are stored for the two argument forms the kernels use: with
-    /// `x = 1 - tau`, `A' x + C' = (A' + C') - A' tau`, and with `x = tau - 1`,
-    /// `A' x + C' = A' tau + (C' - A')` (`A' = A s_i / s_{i+1}`, `C'` likewise).
+    /// Stored for the two argument forms the kernels use: with `x = 1 - tau`,
+    /// `A x + C = (A + C) - A tau`, and with `x = tau - 1`, `A x + C = A tau + (C - A)`.
     pub fn coeffs(&self, m: usize, mp: usize, r: &mut RecCoeffs) {
         let n = r.a.len();
         assert!(
-            r.an.len() == n && r.d.len() == n && r.e.len() == n && r.s.len() == n,
+            r.an.len() == n && r.d.len() == n && r.e.len() == n && r.bb.len() == n,
             "coefficient arrays of unequal length"
         );
         assert!(m + n < self.stride && mp <= m);
@@ -449,21 +441,15 @@ impl RecTables {
         let rng1 = m + 1..m + n + 1;
         let (rm, rmp) = (&self.r[m * st..][rng1.clone()], &self.r[mp * st..][rng1]);
         let (k1, k2, k3) = (&self.k1[rng.clone()], &self.k2[rng.clone()], &self.k3[rng]);
-        // Scales: s_{i+1} = Bc_i s_{i-1}, s_0 = s_1 = 1.
-        let (mut s_prev, mut s_cur) = (1.0, 1.0);
         for i in 0..n {
             let inv = rm[i] * rmp[i];
-            let bc = k2[i] * sm[i] * smp[i] * inv;
-            let s_next = if i == 0 { 1.0 } else { bc * s_prev };
-            let f = s_cur / s_next;
-            let ai = k1[i] * inv * f;
+            let ai = k1[i] * inv;
             let ci = -ai * mm * k3[i];
             r.a[i] = ai;
             r.an[i] = -ai;
             r.d[i] = ai + ci;
             r.e[i] = ci - ai;
-            r.s[i] = s_cur;
-            (s_prev, s_cur) = (s_cur, s_next);
+            r.bb[i] = k2[i] * sm[i] * smp[i] * inv;
         }
     }
 }
@@ -475,8 +461,7 @@ pub(crate) struct RecCoeffs {
     pub an: Vec<f64>,
     pub d: Vec<f64>,
     pub e: Vec<f64>,
-    /// Scale `s_i` of degree `l0 + i`: `dt = s_i u_i`.
-    pub s: Vec<f64>,
+    pub bb: Vec<f64>,
 }
 
 impl RecCoeffs {
@@ -487,7 +472,7 @@ impl RecCoeffs {
             an: vec![0.0; n],
             d: vec![0.0; n],
             e: vec![0.0; n],
-            s: vec![0.0; n],
+            bb: vec![0.0; n],
         }
     }
 
@@ -498,7 +483,7 @@ impl RecCoeffs {
             &mut self.an,
             &mut self.d,
             &mut self.e,
-            &mut self.s,
+            &mut self.bb,
         ] {
             v.resize(n, 0.0);
         }

@@ -83,27 +83,25 @@ impl Plan {
     }
 
     /// Inverse DWT input: `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree
-    /// `l0 + i`, times the member's sign, `1/(2 pi)` and the recurrence scale `scale[i]`
-    /// (see `RecTables::coeffs`); unused columns zero.
+    /// `l0 + i`, times the member's sign and `1/(2 pi)`; unused columns zero.
     pub(super) fn gather_coeffs(
         &self,
         fin: &mut [f64],
         cl: &Cluster,
         members: &[Member],
         coef: &[Complex64],
-        scale: &[f64],
     ) {
         let p = fin.len() / (self.b - cl.l0());
         if members.len() * 2 < p {
             fin.fill(0.0);
         }
         let n = self.b - cl.l0();
-        let norm = 1.0 / (2.0 * PI);
+        let scale = 1.0 / (2.0 * PI);
         for (q, mem) in members.iter().enumerate() {
             let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
-            let sg = [mem.sign_at(cl.m) * norm, mem.sign_at(cl.m + 1) * norm];
-            for (i, ((row, z), s)) in fin.chunks_exact_mut(p).zip(src).zip(scale).enumerate() {
-                let g = sg[i & 1] * s;
+            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
+            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
+                let g = sg[i & 1];
                 row[2 * q] = z.re * g;
                 row[2 * q + 1] = z.im * g;
             }
@@ -212,7 +210,6 @@ impl Plan {
         Self::zero_padding(blk, p, ch);
         let next = self.next_cluster(&self.blocks, buf, c, ch, true, coef.get(), all_members);
         let ld = self.run_forward(sc, ch, p, n, blk, next);
-        let scale = &sc.rec.s[..n];
         for (q, mem) in cl.members().iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
                 coef.get().add(block_start(self.b, mem.m, mem.mp)),
@@ -220,15 +217,15 @@ impl Plan {
             );
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
             let (re, im) = (&sc.out[2 * q * ld..][..n], &sc.out[(2 * q + 1) * ld..][..n]);
-            let rows = re.iter().zip(im).zip(scale);
+            let rows = re.iter().zip(im).map(|(&r, &i)| (r, i));
             if first {
-                for (i, (d, ((re, im), s))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1] * s;
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
                     *d = Complex64::new(re * g, im * g);
                 }
             } else {
-                for (i, (d, ((re, im), s))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1] * s;
+                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
+                    let g = sg[i & 1];
                     *d += Complex64::new(re * g, im * g);
                 }
             }
@@ -251,7 +248,7 @@ impl Plan {
         let n = self.setup(sc, cl, ch);
         let p = self.blocks.p(c);
         let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, cl.members(), coef, &sc.rec.s[..n]);
+        self.gather_coeffs(&mut data[..n * p], cl, cl.members(), coef);
         let blk = self.block(&self.blocks, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);

@@ -298,8 +298,8 @@ impl Plan {
         for (q, mem) in reps.iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            for (i, s) in sc.rec.s[..n].iter().enumerate() {
-                let g = sg[i & 1] * s;
+            for i in 0..n {
+                let g = sg[i & 1];
                 let z = Complex64::new(f[2 * q * ld + i] * g, f[(2 * q + 1) * ld + i] * g);
                 if first {
                     *dst.add(i) = z;
@@ -329,7 +329,7 @@ impl Plan {
         let p = t.p(c);
         let (reps, nr) = representatives(cl);
         let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef, &sc.rec.s[..n]);
+        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef);
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
