@@ -89,7 +89,7 @@ pub enum FftThreading {
     /// Library's choice, made when the plan is created.
     ///
     /// - With [`Rigor::Estimate`] (no measuring), or with one thread: slices across workers.
-    ///   With the pair-major copy that follows each slice FFT this was faster than FFTW's
+    ///   With the block copies that follow each slice FFT this was faster than FFTW's
     ///   threads at every bandwidth measured on the development machine.
     /// - With [`Rigor::Measure`], [`Rigor::Patient`] or [`Rigor::Exhaustive`] and more than
     ///   one thread: both variants are planned and timed, and the faster one is kept

@@ -82,7 +82,7 @@ fn run(opts: &Options) -> ExitCode {
     }
     if rows.iter().any(|r| r.variant == Variant::NoSkip) || !noskip_missing.is_empty() {
         println!(
-            "Skipping of negligible Wigner-d prefixes: default (skip below 2^-300) against \
+            "Skipping of negligible Wigner-d prefixes: default (skip below 2^-64) against \
              skip_bits = Some(0) (every degree of every beta); DWT stage times, ratio = no-skip / skip:\n{}",
             report::skip_table(&rows, &noskip_missing)
         );

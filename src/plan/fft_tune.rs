@@ -4,7 +4,7 @@
 //! `FftThreading::Auto`, [`Plan::new`] builds the slice plans of both variants and times
 //! them on a sample of the real work: the FFT stage, for each direction the plan has, of
 //! the first slice groups of a chunk (one group per worker), on a scratch array standing in
-//! for the sample grid and on the plan's own chunk buffer, so the pair-major copy runs
+//! for the sample grid and on the plan's own chunk buffer, so the block copies run
 //! with the real stride. FFTW's threads are started by one untimed slice transform first.
 //! Rounds alternate between the variants and each keeps its fastest round (interference
 //! from other processes only ever adds time); after a round that shows a difference of
