@@ -161,6 +161,17 @@ static void bad_arrays(void) {
     CHECK_ERR(SO3FFT_ENULL);
     CHECK(so3fft_get_fft_threading(NULL) == SO3FFT_ENULL);
     CHECK_ERR(SO3FFT_ENULL);
+    CHECK(so3fft_get_memory(NULL) == SO3FFT_ENULL);
+    CHECK_ERR(SO3FFT_ENULL);
+    /* memory estimate: invalid bandwidth, flags, thread count */
+    CHECK(so3fft_plan_memory(0, 0, 1) == SO3FFT_EBANDWIDTH);
+    CHECK_ERR(SO3FFT_EBANDWIDTH);
+    CHECK(so3fft_plan_memory(SO3FFT_MAX_BANDWIDTH + 1, 0, 1) == SO3FFT_EBANDWIDTH);
+    CHECK_ERR(SO3FFT_EBANDWIDTH);
+    CHECK(so3fft_plan_memory(8, 1u << 30, 1) == SO3FFT_EINVAL);
+    CHECK_ERR(SO3FFT_EINVAL);
+    CHECK(so3fft_plan_memory(8, 0, -1) == SO3FFT_EINVAL);
+    CHECK_ERR(SO3FFT_EINVAL);
     so3fft_destroy_plan(NULL); /* no-op, not an error */
     CHECK_NO_ERR();
 

@@ -212,6 +212,29 @@ static void real_signal(void) {
     free(back);
 }
 
+/* The planning-time memory estimate is what the plan then holds, and covers at least one
+   chunk of the transformed beta slices; B = 2048 is only estimated (about a gigabyte). */
+static void memory_estimate(void) {
+    const int Bs[] = {1, 5, 16, 33};
+    size_t i;
+    for (i = 0; i < sizeof Bs / sizeof Bs[0]; i++) {
+        int B = Bs[i];
+        unsigned flags;
+        for (flags = 0; flags <= SO3FFT_REAL; flags += SO3FFT_REAL) {
+            ptrdiff_t est = so3fft_plan_memory(B, flags, 2);
+            so3fft_plan p = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, flags, 2);
+            CHECK(p != NULL);
+            CHECK(est > 0);
+            CHECK(so3fft_get_memory(p) == est);
+            /* at least one beta pair of in-band values (16 bytes each) */
+            CHECK((size_t)est >= 2 * (size_t)(2 * B - 1) * (size_t)(2 * B - 1) * 16 / 2);
+            so3fft_destroy_plan(p);
+        }
+    }
+    CHECK(so3fft_plan_memory(2048, 0, 2) > 0);
+    CHECK_NO_ERR();
+}
+
 static void threads_setting(void) {
     so3fft_plan p;
     CHECK(so3fft_planner_nthreads() == 0);
@@ -236,6 +259,7 @@ int main(void) {
     alignment_and_c99_complex();
     several_plans();
     real_signal();
+    memory_estimate();
     threads_setting();
     return finish("test_roundtrip");
 }

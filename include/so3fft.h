@@ -368,6 +368,30 @@ int so3fft_get_bandwidth(so3fft_plan p);
 int so3fft_get_nthreads(so3fft_plan p);
 
 /**
+ * Bytes of memory a plan holds: its chunk buffer (beta slices in the layout of the
+ * Wigner transforms), per-worker FFT buffers and `O(B^2)` tables; `SO3FFT_ENULL` if `p`
+ * is NULL. A transform needs its input and output arrays on top and nothing else large.
+ * Thread-safe.
+ *
+ * Requirements: `p` is NULL or a live plan.
+ */
+ptrdiff_t so3fft_get_memory(so3fft_plan p);
+
+/**
+ * Bytes of memory a plan made now by `so3fft_plan_general(B, direction, ..., flags,
+ * nthreads)` would hold (what `so3fft_get_memory` would then report), computed without
+ * making it: nothing is allocated. `nthreads`: 0 = all cores. The default workspace uses
+ * at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
+ * the memory available at the time of the call, so a plan made later may differ if that
+ * has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and
+ * `Plan::workspace_bytes`.
+ *
+ * Returns the byte count, or a negative `SO3FFT_E*` code (`SO3FFT_EBANDWIDTH` for an
+ * invalid `B`, `SO3FFT_EINVAL` for unknown flags or `nthreads < 0`). Thread-safe.
+ */
+ptrdiff_t so3fft_plan_memory(int B, unsigned int flags, int nthreads);
+
+/**
  * How the FFT stage of a plan uses its threads: `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or
  * `SO3FFT_FFT_FFTW_THREADS`; `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
  *

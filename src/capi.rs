@@ -200,6 +200,23 @@ fn boundary<R>(fail: R, f: impl FnOnce() -> Result<R, CErr>) -> R {
 }
 
 /// Like [`boundary`] for functions returning an error code.
+/// Like [`boundary`] for functions returning a count: the error's (negative) code on
+/// failure.
+fn boundary_count(f: impl FnOnce() -> Result<isize, CErr>) -> isize {
+    clear_error();
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(v)) => v,
+        Ok(Err(e)) => {
+            set_error(e.code, &e.msg);
+            e.code as isize
+        }
+        Err(p) => {
+            set_error(SO3FFT_EPANIC, &panic_message(&*p));
+            SO3FFT_EPANIC as isize
+        }
+    }
+}
+
 fn boundary_code(f: impl FnOnce() -> Result<(), CErr>) -> c_int {
     clear_error();
     match catch_unwind(AssertUnwindSafe(f)) {
@@ -725,6 +742,43 @@ pub unsafe extern "C" fn so3fft_get_bandwidth(p: so3fft_plan) -> c_int {
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_nthreads(p: so3fft_plan) -> c_int {
     boundary(SO3FFT_ENULL, || Ok(plan_ref(p)?.plan.threads() as c_int))
+}
+
+/// Bytes of memory a plan holds: its chunk buffer (beta slices in the layout of the
+/// Wigner transforms), per-worker FFT buffers and `O(B^2)` tables; `SO3FFT_ENULL` if `p`
+/// is NULL. A transform needs its input and output arrays on top and nothing else large.
+/// Thread-safe.
+///
+/// Requirements: `p` is NULL or a live plan.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
+    boundary_count(|| Ok(plan_ref(p)?.plan.memory_bytes() as isize))
+}
+
+/// Bytes of memory a plan made now by `so3fft_plan_general(B, direction, ..., flags,
+/// nthreads)` would hold (what `so3fft_get_memory` would then report), computed without
+/// making it: nothing is allocated. `nthreads`: 0 = all cores. The default workspace uses
+/// at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
+/// the memory available at the time of the call, so a plan made later may differ if that
+/// has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and
+/// `Plan::workspace_bytes`.
+///
+/// Returns the byte count, or a negative `SO3FFT_E*` code (`SO3FFT_EBANDWIDTH` for an
+/// invalid `B`, `SO3FFT_EINVAL` for unknown flags or `nthreads < 0`). Thread-safe.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -> isize {
+    boundary_count(|| {
+        let b = check_bandwidth(B)?;
+        let rigor = rigor_of(flags)?;
+        let threads = threads_of(nthreads)?;
+        let options = PlanOptions {
+            threads,
+            rigor,
+            real: flags & SO3FFT_REAL != 0,
+            ..PlanOptions::default()
+        };
+        Ok(Plan::memory_needed(b, &options)? as isize)
+    })
 }
 
 /// How the FFT stage of a plan uses its threads: `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or

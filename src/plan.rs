@@ -341,9 +341,18 @@ impl Plan {
         Ok(plan)
     }
 
-    /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`] (which then
-    /// means slices across workers).
-    fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+    /// Bytes of memory a plan made now with these arguments would hold
+    /// ([`Plan::memory_bytes`]), without making it: the same checks as [`Plan::new`]
+    /// (bandwidth, threads, options) and the same formulas, nothing allocated. The default
+    /// workspace depends on the memory available at the time of the call (at most half of
+    /// it is used), so a plan made later may differ if that has changed.
+    pub fn memory_needed(bandwidth: usize, options: &PlanOptions) -> Result<usize> {
+        let (threads, _, _) = Plan::validate(bandwidth, options)?;
+        Ok(Plan::layout(bandwidth, threads, options).total())
+    }
+
+    /// Checked threads, skip threshold and instruction set of a plan.
+    fn validate(bandwidth: usize, options: &PlanOptions) -> Result<(usize, u32, Isa)> {
         let b = bandwidth;
         if b == 0 || b > MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -363,7 +372,6 @@ impl Plan {
                 "{threads} threads requested (at most 1024)"
             )));
         }
-        let skip = options.skip_bits != Some(0);
         let skip_bits = match options.skip_bits {
             None => DEFAULT_SKIP_BITS,
             Some(0) => *SKIP_BITS_RANGE.end(),
@@ -380,8 +388,12 @@ impl Plan {
                 "instruction set {isa:?} not supported by this CPU"
             )));
         }
-        let n = 2 * b;
-        let layout = match options.max_workspace_bytes {
+        Ok((threads, skip_bits, isa))
+    }
+
+    /// How a plan's memory splits up (see [`Plan::workspace_bytes`]).
+    fn layout(b: usize, threads: usize, options: &PlanOptions) -> Layout {
+        match options.max_workspace_bytes {
             Some(cap) => Layout::new(b, threads, cap, options.real),
             None => {
                 // The default caps the plan's whole memory, not only the chunk buffer, so
@@ -393,7 +405,17 @@ impl Plan {
                 };
                 Layout::new(b, threads, target.saturating_sub(rest), options.real)
             }
-        };
+        }
+    }
+
+    /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`] (which then
+    /// means slices across workers).
+    fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+        let b = bandwidth;
+        let (threads, skip_bits, isa) = Plan::validate(b, options)?;
+        let skip = options.skip_bits != Some(0);
+        let n = 2 * b;
+        let layout = Plan::layout(b, threads, options);
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
         // available memory, and plan plus the caller's arrays in the machine.
         let arrays = (num_samples(b) + num_coeffs(b)).saturating_mul(16);

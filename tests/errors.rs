@@ -421,10 +421,19 @@ fn default_plan_memory_within_five_percent_at_512() {
         direction: Direction::Forward,
         ..Default::default()
     };
+    let estimate = Plan::memory_needed(b, &options).unwrap();
     match Plan::new(b, &options) {
         Ok(plan) => {
             let arrays = (plan.num_samples() + plan.num_coeffs()) * 16;
             let ratio = plan.memory_bytes() as f64 / arrays as f64;
+            // The estimate made before planning is what the plan holds (unless the memory
+            // available changed in between by enough to move the default).
+            let rel = (estimate as f64 - plan.memory_bytes() as f64).abs() / estimate as f64;
+            assert!(
+                rel < 0.05,
+                "estimate {estimate}, plan {}",
+                plan.memory_bytes()
+            );
             println!(
                 "B = 512: plan {} MiB (workspace {} MiB), {:.2}% of the arrays",
                 plan.memory_bytes() >> 20,
@@ -442,4 +451,43 @@ fn default_plan_memory_within_five_percent_at_512() {
         Err(Error::OutOfMemory { .. }) => println!("B = 512 plan refused: out of memory"),
         Err(e) => panic!("unexpected error {e:?}"),
     }
+}
+
+/// `Plan::memory_needed` validates like `Plan::new` and predicts `memory_bytes` exactly for
+/// small plans (whose default workspace does not depend on the available memory), for both
+/// layouts and explicit workspace caps.
+#[test]
+fn memory_estimate_matches_plans() {
+    for b in [1usize, 7, 24, 64] {
+        for real in [false, true] {
+            for cap in [None, Some(1usize << 20), Some(64 << 20)] {
+                let options = PlanOptions {
+                    real,
+                    threads: 2,
+                    max_workspace_bytes: cap,
+                    ..Default::default()
+                };
+                let estimate = Plan::memory_needed(b, &options).unwrap();
+                let plan = Plan::new(b, &options).unwrap();
+                assert_eq!(
+                    estimate,
+                    plan.memory_bytes(),
+                    "B={b} real={real} cap={cap:?}"
+                );
+                assert!(plan.workspace_bytes() < plan.memory_bytes());
+            }
+        }
+    }
+    assert!(matches!(
+        Plan::memory_needed(0, &PlanOptions::default()),
+        Err(Error::InvalidBandwidth { .. })
+    ));
+    assert!(Plan::memory_needed(
+        8,
+        &PlanOptions {
+            skip_bits: Some(7),
+            ..Default::default()
+        }
+    )
+    .is_err());
 }
