@@ -199,7 +199,6 @@ fn boundary<R>(fail: R, f: impl FnOnce() -> Result<R, CErr>) -> R {
     }
 }
 
-/// Like [`boundary`] for functions returning an error code.
 /// Like [`boundary`] for functions returning a count: the error's (negative) code on
 /// failure.
 fn boundary_count(f: impl FnOnce() -> Result<isize, CErr>) -> isize {
@@ -217,6 +216,7 @@ fn boundary_count(f: impl FnOnce() -> Result<isize, CErr>) -> isize {
     }
 }
 
+/// Like [`boundary`] for functions returning an error code.
 fn boundary_code(f: impl FnOnce() -> Result<(), CErr>) -> c_int {
     clear_error();
     match catch_unwind(AssertUnwindSafe(f)) {

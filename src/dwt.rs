@@ -170,6 +170,7 @@ impl<'r, S: Simd> State<'r, S> {
     #[inline(always)]
     unsafe fn new(rec: &Rec<'r>, lanes: &Lanes, s0: usize) -> Self {
         let sc = S::load(lanes.sc.as_ptr().add(s0));
+        let p1 = S::load(lanes.p.as_ptr().add(s0));
         let (ka, kc) = if s0 >= lanes.upper_from {
             (rec.a, rec.e)
         } else {
@@ -180,9 +181,20 @@ impl<'r, S: Simd> State<'r, S> {
             ka,
             kc,
             p0: S::zero(),
-            p1: S::load(lanes.p.as_ptr().add(s0)),
+            p1,
             sc,
-            mask: S::blend_ge(sc, S::zero(), S::splat(1.0), S::zero()),
+            // Active: scale index 0 and a nonzero value. Padding lanes (value 0, scale 0)
+            // are neither active nor scaled down: they never hold back the skipping of
+            // their vector's prefix, nor its fast phase.
+            mask: S::mul(
+                S::blend_ge(sc, S::zero(), S::splat(1.0), S::zero()),
+                S::blend_ge(
+                    S::abs(p1),
+                    S::splat(f64::MIN_POSITIVE),
+                    S::splat(1.0),
+                    S::zero(),
+                ),
+            ),
             i: 0,
             big: S::splat(lanes.big),
             skip: lanes.skip,
@@ -198,7 +210,7 @@ impl<'r, S: Simd> State<'r, S> {
     /// Whether every lane is active.
     #[inline(always)]
     unsafe fn all_active(&self) -> bool {
-        !S::any_ge(S::splat(0.5), self.mask)
+        !S::any_ge(S::splat(-0.5), self.sc)
     }
 
     /// Rescale the scaled-down lanes of `(p0, p1)` that grew past `big` by `2^-SCALE_STEP`
@@ -213,8 +225,13 @@ impl<'r, S: Simd> State<'r, S> {
         let f = S::blend_ge(a, self.big, S::splat(TINY), one);
         *p0 = S::mul(*p0, f);
         *p1 = S::mul(*p1, f);
-        self.sc = S::add(self.sc, S::blend_ge(a, self.big, one, zero));
-        self.mask = S::blend_ge(self.sc, zero, one, zero);
+        let hit = S::blend_ge(a, self.big, one, zero);
+        self.sc = S::add(self.sc, hit);
+        // Lanes rescaled to scale index 0 become active; the others keep their state.
+        self.mask = S::max(
+            self.mask,
+            S::mul(hit, S::blend_ge(self.sc, zero, one, zero)),
+        );
     }
 
     /// Step without accumulating until some lane is active (or degree `n`): the rest of

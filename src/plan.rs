@@ -71,9 +71,11 @@ pub struct PlanOptions {
     /// B = 128 that is about a fifth of all (degree, beta) pairs with the default, against 3%
     /// with `2^-300`. A skipped contribution is below `2^-skip_bits` times the data it
     /// multiplies: the forward changes a coefficient by less than `2 * 2^-skip_bits` times the
-    /// largest transformed sample (the quadrature weights sum to 2), the inverse a sample by
-    /// less than `B 2^-skip_bits` times the largest coefficient, both far below the rounding
-    /// error of the transform for `skip_bits >= 64`. Accepted: 24..=560, and `Some(0)`, which
+    /// largest value of the transformed slices (the quadrature weights sum to 2); the inverse
+    /// changes a value of a transformed slice by less than `B 2^-skip_bits` times the largest
+    /// coefficient (a sample, a 2-D DFT of such values, by at most `(2B-1)^2` times that, a
+    /// worst case of aligned errors). The benchmark (`so3fft-bench`) shows round-trip errors
+    /// with and without skipping equal to the printed digits at every bandwidth up to 512. Accepted: 24..=560, and `Some(0)`, which
     /// turns skipping off: every degree of every beta runs the full recurrence and accumulation
     /// (values below `2^-560` still enter as exact zeros). That mode exists to measure what
     /// skipping saves; it gives the same results up to rounding, only slower.
@@ -94,10 +96,10 @@ pub enum FftThreading {
     /// - With [`Rigor::Measure`], [`Rigor::Patient`] or [`Rigor::Exhaustive`] and more than
     ///   one thread: both variants are planned and timed, and the faster one is kept
     ///   ([`Plan::fft_threading`] tells which). The timed work is the FFT stage, for every
-    ///   direction the plan has, of the first slice groups of a chunk (one group of 4 or 8
-    ///   slices per worker), on a scratch array standing in for the samples and on the
-    ///   plan's own chunk buffer, so the transposition into the chunk runs with its real
-    ///   stride. The variants alternate for up to three rounds (one when they differ by
+    ///   direction the plan has, of the first groups of a chunk (one group of up to 4
+    ///   mirrored pairs of slices per worker), on a scratch array standing in for the
+    ///   samples and on the plan's own chunk buffer, so the block copies run with their real
+    ///   strides. The variants alternate for up to three rounds (one when they differ by
     ///   more than 25%) and each is judged by its fastest round (interference from other
     ///   processes only adds time); FFTW's threads are kept only when at least 10% faster,
     ///   as slices across workers balance their load dynamically and suffer less from other
@@ -131,9 +133,10 @@ pub enum FftThreading {
 /// Wall time of each stage of one execution, in seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTimes {
-    /// FFTW stage.
+    /// FFT stage: FFTW and the copies between the slices and the chunk buffer.
     pub fft: f64,
-    /// Discrete Wigner transform stage (including gathers and scatters).
+    /// Discrete Wigner transform stage: recurrence coefficients, starting values, kernels,
+    /// and the coefficients' gather (inverse) or accumulation (forward).
     pub dwt: f64,
     /// Whole call.
     pub total: f64,
@@ -153,7 +156,8 @@ pub struct Plan {
     pool: Option<rayon::ThreadPool>,
     /// Number of pool threads still running; `Drop` waits for zero.
     live: std::sync::Arc<(Mutex<usize>, std::sync::Condvar)>,
-    /// Base pairs of the clusters, in scheduling order (kappa order first).
+    /// Base pairs of the clusters, in processing order (8 x 8 tiles, see
+    /// `symmetry::cluster_pairs`).
     clusters: Vec<(u32, u32)>,
     bt: BetaTables,
     norms: Vec<Ext>,
@@ -164,8 +168,8 @@ pub struct Plan {
     inv_fft: Option<SliceFft>,
     /// Real-data slice FFTs (with `PlanOptions::real`).
     real_fft: Option<SliceFftReal>,
-    /// Per-worker buffers of three slices: a pair of beta slices in the FFT stage and a
-    /// spare one.
+    /// Per-worker buffers of `2 group + 1` slices: a group of mirrored pairs of beta slices
+    /// in the FFT stage and a spare one.
     fft_scratch: Vec<Mutex<AlignedBuf>>,
     /// Per-worker DWT scratch.
     dwt_scratch: Vec<Mutex<Scratch>>,
@@ -582,18 +586,12 @@ impl Plan {
     }
 
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
-    /// computed before allocating: `2h (2B)^2 16` for the chunk buffer (below) plus
-    /// `threads * (g + 1) * (2B)^2 * 16` for the FFT group buffers (`g = clamp(64 MiB / slice, 1, 4)`,
-    /// or 8 when that is 4 and 8 slices take at most 64 MiB, i.e. for `B <= 362`)
-    /// plus `O(B^2)` tables. A transform needs the caller's arrays on top
-    /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
-    /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
-    /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: the chunk buffer ([`Plan::workspace_bytes`]) plus
     /// `threads * (2g + 1) * (2B)^2 * 16` for the per-worker FFT buffers (a group of `g`
     /// pairs of beta slices and a spare one; `g = clamp(8 MiB / (2 (2B)^2 16), 1, 4)`, i.e.
-    /// 4 for B <= 128 and 1 from B = 256 on) plus `O(B^2)` tables. A transform needs the caller's arrays on top
-    /// (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else large.
+    /// 4 for B <= 128 and 1 from B = 256 on) plus `O(B^2)` tables. A transform needs the
+    /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
+    /// large. [`Plan::memory_needed`] gives the same number before planning.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
     pub fn memory_bytes(&self) -> usize {
         self.memory
@@ -605,7 +603,7 @@ impl Plan {
     /// betas per chunk and `h'` = `h` rounded up to a multiple of 8; the real-signal
     /// transforms ([`PlanOptions::real`]) hold `4B^2 + 4B` doubles per beta (8 per
     /// cluster), and so about twice the betas per chunk. For a cap `c` bytes each layout
-    /// takes `h = min(B, max(1, 8 floor(c / (16 * 8 * d))))` with `d` its doubles per beta,
+    /// takes `h = min(B, max(8, 8 floor(c / (16 * 8 * d))))` with `d` its doubles per beta,
     /// and the buffer is the larger of the two. With `max_workspace_bytes` the cap is that
     /// value. By default the whole plan ([`Plan::memory_bytes`]) is held to
     /// `max(512 MiB, 4.7% of the sample and coefficient arrays)` (real samples for a real
@@ -665,7 +663,7 @@ impl Plan {
             Err(std::sync::TryLockError::WouldBlock) => {
                 let bytes = self.workspace_bytes();
                 if mem_available().is_none_or(|a| a / 2 >= bytes) {
-                    let tmp = AlignedBuf::new(bytes / 16)?;
+                    let tmp = AlignedBuf::new(bytes.div_ceil(16))?;
                     return f(&tmp);
                 }
                 if rayon::current_thread_index().is_some() {

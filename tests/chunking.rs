@@ -1,6 +1,5 @@
-//! Chunked transforms (several chunks, a partial last chunk with padding lanes, one beta
-//! pair per chunk) and every instruction set against direct summation, for the complex
-//! and the real-signal paths. (The direct sums use explicit factorial formulas, good to
+//! Chunked transforms (several chunks, a partial last chunk with padding lanes) and every
+//! instruction set against direct summation, for the complex and the real-signal paths. (The direct sums use explicit factorial formulas, good to
 //! about 1e-14 relative up to B = 13 or so; at B = 20 their own error is 1e-12.)
 
 mod common;
@@ -13,7 +12,8 @@ fn lane_doubles(b: usize) -> usize {
     8 * b * b - 8 * b + 8
 }
 
-/// Plan options whose chunk buffer holds chunks of `h` low betas (1 or a multiple of 8).
+/// Plan options whose chunk buffer holds chunks of `h` low betas (a multiple of 8; smaller
+/// caps give 8).
 fn opts(b: usize, h: usize, isa: Isa, real: bool) -> PlanOptions {
     PlanOptions {
         max_workspace_bytes: Some(2 * h.next_multiple_of(8) * lane_doubles(b) * 8),
@@ -40,7 +40,7 @@ fn chunks_and_isas_match_direct_sums() {
         let want_c = direct_forward(b, &samples);
         let scale_f = max_abs(&want_f);
         let scale_c = max_abs(&want_c);
-        for h in [1usize, 8, 16] {
+        for h in [8usize, 16] {
             for isa in isas() {
                 let plan = Plan::new(b, &opts(b, h, isa, false)).unwrap();
                 assert!(plan.workspace_bytes() <= 2 * 16 * lane_doubles(b) * 8 * h.div_ceil(8));
@@ -68,7 +68,7 @@ fn real_chunks_match_direct_sums() {
         let coefs = random_real_signal_coefs(b, &mut rng);
         let want = direct_inverse(b, &coefs);
         let scale = max_abs(&want);
-        for h in [1usize, 8] {
+        for h in [8usize, 16] {
             for isa in isas() {
                 let plan = Plan::new(b, &opts(b, h, isa, true)).unwrap();
                 let mut f = vec![0.0; n_samples(b)];

@@ -124,10 +124,11 @@ impl Blocks {
 
     /// The largest chunk whose blocks fit in `doubles` doubles, with [`Blocks::lanes_for`]
     /// lanes of `doubles_per_lane` each: a multiple of 8 (the padding lanes take memory
-    /// too), or 1 where not even 8 fit, and at most `b`.
+    /// too), at least 8 (a smaller chunk would take the same memory for less work) and at
+    /// most `b`.
     pub fn chunk_for(doubles: usize, doubles_per_lane: usize, b: usize) -> usize {
         let h = doubles / (16 * doubles_per_lane) * 8;
-        h.max(1).min(b)
+        h.max(8).min(b)
     }
 
     /// Offset (in doubles) of cluster `c`'s block.

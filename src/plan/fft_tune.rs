@@ -74,10 +74,11 @@ impl Plan {
     ) -> Option<[f64; 2]> {
         let n = 2 * self.b;
         let nn = n * n;
-        // One pair per worker and direction, from the first chunk (always a full one). The
-        // sample grid holds the slices the inverse pairs write (distinct, as the pairs run
-        // concurrently); every beta maps onto it cyclically. (Mapping fresh memory costs more
-        // than the measurement itself when transparent huge pages must be compacted.)
+        // One group of pairs per worker and direction, from the first chunk (always a full
+        // one). The sample grid holds the slices the timed pairs write: pair `j` (beta `j`
+        // and its mirror `2B-1-j`) uses slices `2j` and `2j+1`, distinct for the pairs timed
+        // concurrently. (Mapping fresh memory costs more than the measurement itself when
+        // transparent huge pages must be compacted.)
         let npairs = (self.threads * self.group).min(self.blocks.chunk);
         let slices = 2 * npairs;
         let bytes = slices * nn * 16;
@@ -92,7 +93,11 @@ impl Plan {
             hp: h.next_multiple_of(self.isa.lanes()),
         };
         let g = SyncPtr(grid.as_mut_ptr());
-        let slice = move |k: usize| SyncPtr(g.get().wrapping_add((k % slices) * nn));
+        let b = self.b;
+        let slice = move |k: usize| {
+            let (j, mirror) = if k < b { (k, 0) } else { (2 * b - 1 - k, 1) };
+            SyncPtr(g.get().wrapping_add((2 * (j % npairs) + mirror) * nn))
+        };
         let variants: [(Option<&SliceFft>, Option<&SliceFft>, bool); 2] = [
             (self.fwd_fft.as_ref(), self.inv_fft.as_ref(), false),
             (fwd, inv, true),
