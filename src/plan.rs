@@ -588,8 +588,8 @@ impl Plan {
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: the chunk buffer ([`Plan::workspace_bytes`]) plus
     /// `threads * (2g + 1) * (2B)^2 * 16` for the per-worker FFT buffers (a group of `g`
-    /// pairs of beta slices and a spare one; `g = clamp(8 MiB / (2 (2B)^2 16), 1, 4)`, i.e.
-    /// 4 for B <= 128 and 1 from B = 256 on) plus `O(B^2)` tables. A transform needs the
+    /// pairs of beta slices and a spare one; `g = clamp(512 KiB / (2 (2B)^2 16), 1, 4)`,
+    /// i.e. 4 for B <= 32 and 1 from B = 64 on) plus `O(B^2)` tables. A transform needs the
     /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
     /// large. [`Plan::memory_needed`] gives the same number before planning.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.

@@ -6,9 +6,9 @@
 //! rows of every cluster's block (`blocks.rs`): the group fills `2g` adjacent rows of each
 //! block completely, written as whole cache lines with non-temporal stores. Inverse: those
 //! rows of every block are read back into the slices, which are transformed into a spare
-//! slice and streamed to the samples. Groups of `g` pairs (up to 4, as many as keep the
-//! scratch within a few MiB) turn the block accesses, one short piece per cluster, into
-//! longer ones. The groups are spread over the workers, or, with FFTW's threads, run one
+//! slice and streamed to the samples. Small slices move in groups of up to 4 pairs (one
+//! longer piece of each block per group), larger ones a pair at a time, which keeps the
+//! slices' random accesses in L2. The groups are spread over the workers, or, with FFTW's threads, run one
 //! after another with the block copies spread over the workers.
 
 use super::blocks::{Blocks, NONE};
@@ -25,9 +25,11 @@ const GENERIC_REV: u8 = 0xF0;
 pub(super) const MAX_GROUP: usize = 4;
 
 /// Pairs per group for slices of `slice_bytes`: up to [`MAX_GROUP`], as many as keep the
-/// group's slices within 8 MiB (B = 128: 4, B = 256: 1).
+/// group's slices within 512 KiB, about half of a core's L2 (B <= 32: 4, from B = 64 on: 1).
+/// The copies between slices and blocks are bound by the slice side's cache misses: one
+/// pair at B = 64 copies twice as fast per pair as a group of four (`copy_speed` test).
 pub(super) fn pairs_per_group(slice_bytes: usize) -> usize {
-    ((8usize << 20) / (2 * slice_bytes)).clamp(1, MAX_GROUP)
+    ((512usize << 10) / (2 * slice_bytes)).clamp(1, MAX_GROUP)
 }
 
 impl Plan {
