@@ -27,7 +27,7 @@ use crate::wigner::{
     big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
 };
 use blocks::Blocks;
-use dwt_stage::Scratch;
+use dwt_stage::{all_members, Scratch};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -480,11 +480,8 @@ impl Plan {
         let blocks = Blocks::complex(b, &clusters, layout.chunk);
         // The real layout is about half as large per beta: its chunks take twice the betas.
         let blocks_real = layout.chunk_real.map(|h| Blocks::real(b, &clusters, h));
-        let scratch_lanes = blocks
-            .lanes
-            .max(blocks_real.as_ref().map_or(0, |t| t.lanes));
         let dwt_scratch = (0..threads)
-            .map(|_| Mutex::new(Scratch::new(b, scratch_lanes)))
+            .map(|_| Mutex::new(Scratch::for_layouts(b, &blocks, blocks_real.as_ref())))
             .collect();
         let real_fft = if options.real {
             Some(SliceFftReal::new(n, options.rigor)?)
@@ -698,7 +695,7 @@ impl Plan {
             &self.blocks,
             |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
             |sc, c, cl, ch, buf, first| unsafe {
-                self.forward_cluster(sc, c, cl, ch, buf, coef, first);
+                self.forward_cluster(sc, &self.blocks, all_members, c, cl, ch, buf, coef, first);
             },
         )
     }
@@ -715,7 +712,9 @@ impl Plan {
             false,
             &self.blocks,
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
-            |sc, c, cl, ch, buf, _| unsafe { self.inverse_cluster(sc, c, cl, ch, buf, coeffs) },
+            |sc, c, cl, ch, buf, _| unsafe {
+                self.inverse_cluster(sc, &self.blocks, all_members, c, cl, ch, buf, coeffs)
+            },
         )
     }
 
@@ -775,11 +774,10 @@ impl Plan {
             let sc: &mut Scratch = match guard.as_deref_mut() {
                 Some(s) => s,
                 // All busy (concurrent executions of this plan): use a private one.
-                None => own.insert(Scratch::new(
+                None => own.insert(Scratch::for_layouts(
                     self.b,
-                    self.blocks
-                        .lanes
-                        .max(self.blocks_real.as_ref().map_or(0, |t| t.lanes)),
+                    &self.blocks,
+                    self.blocks_real.as_ref(),
                 )),
             };
             let (c0, c1) = (r * RUN, ((r + 1) * RUN).min(nc));

@@ -475,6 +475,20 @@ fn memory_estimate_matches_plans() {
                     "B={b} real={real} cap={cap:?}"
                 );
                 assert!(plan.workspace_bytes() < plan.memory_bytes());
+                if let Some(cap) = cap {
+                    // The documented formula (`Plan::workspace_bytes`), written out here:
+                    // per layout, h = min(B, max(8, 8 floor(cap / (128 d)))) betas of d
+                    // doubles, h rounded up to 8, two halves; the buffer is the larger.
+                    let bytes = |d: usize| {
+                        let h = (8 * (cap / (128 * d))).max(8).min(b);
+                        2 * h.next_multiple_of(8) * 8 * d
+                    };
+                    let mut want = bytes(8 * b * b - 8 * b + 8);
+                    if real {
+                        want = want.max(bytes(4 * b * b + 4 * b));
+                    }
+                    assert_eq!(plan.workspace_bytes(), want, "B={b} real={real} cap={cap}");
+                }
             }
         }
     }

@@ -4,7 +4,11 @@
 
 use super::*;
 
-/// All members of a cluster (for [`Plan::next_cluster`]).
+/// The order pairs of a cluster a layout transforms, in slot order, and their number:
+/// [`all_members`] (complex layout) or `real::representatives` (real layout).
+pub(super) type Members = fn(&Cluster) -> ([Member; 8], usize);
+
+/// All members of a cluster (the complex layout's slots).
 pub(super) fn all_members(cl: &Cluster) -> ([Member; 8], usize) {
     let mut m = [cl.members()[0]; 8];
     m[..cl.members().len()].copy_from_slice(cl.members());
@@ -33,6 +37,11 @@ impl Scratch {
             data: vec![0.0; b * 16],
             out: vec![0.0; (b + 8) * 16],
         }
+    }
+
+    /// Scratch for the chunks of the complex layout and, if present, the real one.
+    pub fn for_layouts(b: usize, complex: &Blocks, real: Option<&Blocks>) -> Scratch {
+        Scratch::new(b, complex.lanes.max(real.map_or(0, |t| t.lanes)))
     }
 
     /// Lane inputs of the kernels after [`Plan::setup`].
@@ -168,7 +177,7 @@ impl Plan {
         ch: &Chunk,
         block: bool,
         coef: *const Complex64,
-        members: impl Fn(&Cluster) -> ([Member; 8], usize),
+        members: Members,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
         if c + 1 < t.len() {
@@ -188,7 +197,9 @@ impl Plan {
         pf
     }
 
-    /// Forward DWT of cluster `c` over one chunk, accumulated into `coef`.
+    /// Forward DWT of cluster `c` of layout `t` over one chunk, accumulated into `coef`
+    /// for the order pairs `members` gives (the real forward fills the other half of the
+    /// coefficients afterwards, see `Plan::fill_partners`).
     ///
     /// # Safety
     /// `buf` holds the chunk's blocks; `coef` has `num_coeffs` entries and no other task
@@ -197,6 +208,8 @@ impl Plan {
     pub(super) unsafe fn forward_cluster(
         &self,
         sc: &mut Scratch,
+        t: &Blocks,
+        members: Members,
         c: usize,
         cl: &Cluster,
         ch: &Chunk,
@@ -205,12 +218,13 @@ impl Plan {
         first: bool,
     ) {
         let n = self.setup(sc, cl, ch);
-        let p = self.blocks.p(c);
-        let blk = self.block(&self.blocks, buf, c, ch);
+        let p = t.p(c);
+        let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        let next = self.next_cluster(&self.blocks, buf, c, ch, true, coef.get(), all_members);
+        let next = self.next_cluster(t, buf, c, ch, true, coef.get(), members);
         let ld = self.run_forward(sc, ch, p, n, blk, next);
-        for (q, mem) in cl.members().iter().enumerate() {
+        let (mem, nm) = members(cl);
+        for (q, mem) in mem[..nm].iter().enumerate() {
             let dst = std::slice::from_raw_parts_mut(
                 coef.get().add(block_start(self.b, mem.m, mem.mp)),
                 n,
@@ -232,13 +246,17 @@ impl Plan {
         }
     }
 
-    /// Inverse DWT of cluster `c` over one chunk, written into its block.
+    /// Inverse DWT of cluster `c` of layout `t` over one chunk (the order pairs `members`
+    /// gives), written into its block.
     ///
     /// # Safety
     /// `buf` is the chunk buffer; no other task writes this cluster's block.
+    #[allow(clippy::too_many_arguments)]
     pub(super) unsafe fn inverse_cluster(
         &self,
         sc: &mut Scratch,
+        t: &Blocks,
+        members: Members,
         c: usize,
         cl: &Cluster,
         ch: &Chunk,
@@ -246,14 +264,14 @@ impl Plan {
         coef: &[Complex64],
     ) {
         let n = self.setup(sc, cl, ch);
-        let p = self.blocks.p(c);
+        let p = t.p(c);
+        let (mem, nm) = members(cl);
         let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, cl.members(), coef);
-        let blk = self.block(&self.blocks, buf, c, ch);
+        self.gather_coeffs(&mut data[..n * p], cl, &mem[..nm], coef);
+        let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
-        lanes.prefetch =
-            self.next_cluster(&self.blocks, buf, c, ch, false, coef.as_ptr(), all_members);
+        lanes.prefetch = self.next_cluster(t, buf, c, ch, false, coef.as_ptr(), members);
         dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
         sc.data = data;
     }

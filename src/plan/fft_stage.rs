@@ -197,9 +197,9 @@ impl Plan {
 /// # Safety
 /// `s` are valid for every index in the slot tables; `buf` holds the blocks of `t`,
 /// 64-byte aligned, and nobody else writes these rows.
-pub(super) unsafe fn scatter_group<T: Copy + Into<*const Complex64>>(
+pub(super) unsafe fn scatter_group(
     t: &Blocks,
-    s: &[T],
+    s: &[SyncPtr<Complex64>],
     w: &[f64],
     conj: bool,
     buf: *mut f64,
@@ -211,7 +211,7 @@ pub(super) unsafe fn scatter_group<T: Copy + Into<*const Complex64>>(
     let mut sp = [std::ptr::null::<Complex64>(); 2 * MAX_GROUP];
     let (mut wr, mut wi) = ([0.0; 2 * MAX_GROUP], [0.0; 2 * MAX_GROUP]);
     for i in 0..ns {
-        sp[i] = s[i].into();
+        sp[i] = s[i].get();
         (wr[i], wi[i]) = (w[i], if conj { -w[i] } else { w[i] });
     }
     for c in cs {
@@ -264,9 +264,9 @@ pub(super) unsafe fn scatter_group<T: Copy + Into<*const Complex64>>(
 ///
 /// # Safety
 /// As for [`scatter_group`], with `s` written.
-pub(super) unsafe fn gather_group<T: Copy + Into<*const Complex64>>(
+pub(super) unsafe fn gather_group(
     t: &Blocks,
-    s: &[T],
+    s: &[SyncPtr<Complex64>],
     conj: bool,
     buf: *const f64,
     j0: usize,
@@ -276,7 +276,7 @@ pub(super) unsafe fn gather_group<T: Copy + Into<*const Complex64>>(
     debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP);
     let mut sp = [std::ptr::null_mut::<Complex64>(); 2 * MAX_GROUP];
     for i in 0..ns {
-        sp[i] = s[i].into() as *mut Complex64;
+        sp[i] = s[i].get();
     }
     let end = cs.end;
     for c in cs {
@@ -365,12 +365,6 @@ fn fence() {
     };
 }
 
-impl From<SyncPtr<Complex64>> for *const Complex64 {
-    fn from(p: SyncPtr<Complex64>) -> *const Complex64 {
-        p.get()
-    }
-}
-
 #[cfg(test)]
 mod speed {
     use super::*;
@@ -390,8 +384,8 @@ mod speed {
             let t = Blocks::complex(b, &crate::symmetry::cluster_pairs(b), 8);
             let buf = AlignedBuf::new(t.total() / 2 + 8).unwrap();
             let sl = AlignedBuf::new(2 * g * nn).unwrap();
-            let s: Vec<*const Complex64> = (0..2 * g)
-                .map(|i| unsafe { sl.as_mut_ptr().add(i * nn) as *const Complex64 })
+            let s: Vec<SyncPtr<Complex64>> = (0..2 * g)
+                .map(|i| SyncPtr(unsafe { sl.as_mut_ptr().add(i * nn) }))
                 .collect();
             let w = vec![1.0; 2 * g];
             let reps = 20;

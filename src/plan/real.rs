@@ -16,23 +16,15 @@ fn representative(mem: &Member) -> bool {
     mem.mp > 0 || (mem.mp == 0 && mem.m >= 0)
 }
 
-/// The representatives of a cluster (1, 2 or 4 members) and their number.
-pub(super) fn representatives(cl: &Cluster) -> ([Member; 4], usize) {
-    let mut reps = [cl.members()[0]; 4];
+/// The representatives of a cluster (1, 2 or 4 members, then padding) and their number.
+pub(super) fn representatives(cl: &Cluster) -> ([Member; 8], usize) {
+    let mut reps = [cl.members()[0]; 8];
     let mut nr = 0;
     for mem in cl.members().iter().filter(|m| representative(m)) {
         reps[nr] = *mem;
         nr += 1;
     }
     (reps, nr)
-}
-
-/// The representatives of a cluster, in the form [`Plan::next_cluster`] takes.
-fn reps_of(cl: &Cluster) -> ([Member; 8], usize) {
-    let (r, n) = representatives(cl);
-    let mut m = [r[0]; 8];
-    m[..4].copy_from_slice(&r);
-    (m, n)
 }
 
 /// `(-1)^(M - M')`.
@@ -130,7 +122,8 @@ impl Plan {
             self.real_blocks()?,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
             |sc, c, cl, ch, buf, first| unsafe {
-                self.forward_cluster_real(sc, c, cl, ch, buf, coef, first);
+                let t = self.blocks_real.as_ref().expect("real layout");
+                self.forward_cluster(sc, t, representatives, c, cl, ch, buf, coef, first);
             },
         )?;
         // The chunks accumulated the representatives only (half the coefficient traffic per
@@ -186,7 +179,8 @@ impl Plan {
             self.real_blocks()?,
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
             |sc, c, cl, ch, buf, _| unsafe {
-                self.inverse_cluster_real(sc, c, cl, ch, buf, coeffs)
+                let t = self.blocks_real.as_ref().expect("real layout");
+                self.inverse_cluster(sc, t, representatives, c, cl, ch, buf, coeffs)
             },
         )
     }
@@ -242,7 +236,7 @@ impl Plan {
                         // S(M,M') = conj(R[M][M']) for M' >= 0.
                         fft_stage::scatter_group(
                             t,
-                            &[s[0] as *const Complex64, s[1]],
+                            &[SyncPtr(s[0]), SyncPtr(s[1])],
                             &[self.wq[k0], self.wq[k1]],
                             true,
                             buf.get(),
@@ -250,7 +244,7 @@ impl Plan {
                             0..t.len(),
                         );
                     } else {
-                        let sc = [s[0] as *const Complex64, s[1]];
+                        let sc = [SyncPtr(s[0]), SyncPtr(s[1])];
                         fft_stage::gather_group(t, &sc, true, buf.get(), j, 0..t.len());
                         for (&slot, k) in s.iter().zip([k0, k1]) {
                             // Frequency B (alpha or gamma) is outside the band limit.
@@ -267,75 +261,6 @@ impl Plan {
                 Ok(())
             })
         })
-    }
-
-    /// Forward DWT of one cluster's representatives for real data (their partners are
-    /// filled at the end, see [`Plan::fill_partners`]).
-    ///
-    /// # Safety
-    /// As for `forward_cluster`, with the real layout.
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn forward_cluster_real(
-        &self,
-        sc: &mut Scratch,
-        c: usize,
-        cl: &Cluster,
-        ch: &Chunk,
-        buf: *mut f64,
-        coef: SyncPtr<Complex64>,
-        first: bool,
-    ) {
-        let n = self.setup(sc, cl, ch);
-        let t = self.blocks_real.as_ref().expect("real layout");
-        let p = t.p(c);
-        let (reps, nr) = representatives(cl);
-        let reps = &reps[..nr];
-        let blk = self.block(t, buf, c, ch);
-        Self::zero_padding(blk, p, ch);
-        let next = self.next_cluster(t, buf, c, ch, true, coef.get(), reps_of);
-        let ld = self.run_forward(sc, ch, p, n, blk, next);
-        let f = &sc.out[..p * ld];
-        for (q, mem) in reps.iter().enumerate() {
-            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
-            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            for i in 0..n {
-                let g = sg[i & 1];
-                let z = Complex64::new(f[2 * q * ld + i] * g, f[(2 * q + 1) * ld + i] * g);
-                if first {
-                    *dst.add(i) = z;
-                } else {
-                    *dst.add(i) += z;
-                }
-            }
-        }
-    }
-
-    /// Inverse DWT of one cluster's representatives for real data, into its block of the
-    /// real layout (the FFT stage turns it into the c2r input).
-    ///
-    /// # Safety
-    /// As for `inverse_cluster`, with the real layout.
-    unsafe fn inverse_cluster_real(
-        &self,
-        sc: &mut Scratch,
-        c: usize,
-        cl: &Cluster,
-        ch: &Chunk,
-        buf: *mut f64,
-        coef: &[Complex64],
-    ) {
-        let n = self.setup(sc, cl, ch);
-        let t = self.blocks_real.as_ref().expect("real layout");
-        let p = t.p(c);
-        let (reps, nr) = representatives(cl);
-        let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, &reps[..nr], coef);
-        let blk = self.block(t, buf, c, ch);
-        let rec = Rec::new(&sc.rec, n);
-        let mut lanes = sc.lanes(self, ch);
-        lanes.prefetch = self.next_cluster(t, buf, c, ch, false, coef.as_ptr(), reps_of);
-        dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
-        sc.data = data;
     }
 }
 
