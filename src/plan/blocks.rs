@@ -30,6 +30,11 @@ pub(super) struct Blocks {
     pub fi2: Vec<u32>,
     /// Bit `q` set: slot `q` reads and writes the mirrored slice.
     pub rev: Vec<u8>,
+    /// Whether a cluster's block is regular: every slot used, the first half of the slots
+    /// from the own slice and the second half from the mirrored one, no second index. All
+    /// 8-member clusters are (complex layout: 8 slots; real: their 4 representatives); the
+    /// block copies have a written-out path for them.
+    pub regular: Vec<bool>,
     /// Low betas per chunk (`h` of a full chunk) for this layout.
     pub chunk: usize,
     /// Lanes of every block: room for the padded lanes of a full chunk,
@@ -86,6 +91,7 @@ impl Blocks {
             fi: vec![NONE; 8 * nc],
             fi2: vec![NONE; 8 * nc],
             rev: vec![0; nc],
+            regular: vec![false; nc],
             chunk,
             lanes: Blocks::lanes_for(chunk),
         };
@@ -102,6 +108,10 @@ impl Blocks {
                 t.fi2[8 * c + q] = fi2;
                 t.rev[c] |= (rev as u8) << q;
             }
+            let half = p / 4;
+            t.regular[c] = len == p / 2
+                && t.rev[c] as usize == ((1 << len) - 1) & !((1 << half) - 1)
+                && s[..len].iter().all(|x| x.1 == NONE);
         }
         t.pofs.push(acc);
         t
@@ -182,6 +192,29 @@ mod tests {
                 }
             }
             assert_eq!(seen.len(), (n - 1) * (n - 1));
+            // The fast path of the block copies covers every 8-member cluster, and its
+            // premise holds exactly where it is taken: all slots used, the first half
+            // from the own slice, the second from the mirrored one.
+            let r = Blocks::real(b, &cl, 8);
+            for (c, &(m, mp)) in cl.iter().enumerate() {
+                let cluster = Cluster::new(m as usize, mp as usize);
+                let (reps, nr) = crate::plan::real::representatives(&cluster);
+                let slots = [(&t, cluster.members()), (&r, &reps[..nr])];
+                for (l, members) in slots {
+                    let p = if members.len() > 4 { 16 } else { 8 };
+                    let half = p / 4;
+                    let pattern = members.len() == p / 2
+                        && members
+                            .iter()
+                            .enumerate()
+                            .all(|(q, x)| x.reversed == (q >= half))
+                        && members.iter().all(|x| x.mp != 0);
+                    assert_eq!(l.regular[c], pattern, "({m},{mp})");
+                }
+                if m > mp && mp > 0 {
+                    assert!(t.regular[c] && r.regular[c], "({m},{mp})");
+                }
+            }
             assert_eq!(t.total(), 16 * Blocks::doubles_per_lane(b, false));
             let r = Blocks::real(b, &cl, 1);
             assert_eq!(r.total(), 16 * Blocks::doubles_per_lane(b, true));

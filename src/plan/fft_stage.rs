@@ -17,10 +17,6 @@ use super::*;
 /// Clusters whose rows are prefetched ahead by the inverse copy.
 const PREFETCH_CLUSTERS: usize = 16;
 
-/// Reversal bits of the 8-member clusters: the last four members read the mirrored slice
-/// (see `symmetry.rs`).
-const GENERIC_REV: u8 = 0xF0;
-
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
 pub(super) const MAX_GROUP: usize = 4;
 
@@ -217,23 +213,13 @@ pub(super) unsafe fn scatter_group(
     for c in cs {
         let p = t.p(c);
         let rev = t.rev[c];
-        if p == 16 && rev == GENERIC_REV && !conj {
-            // The common case, written out: 8 slots, the last 4 reversed, no conjugation.
-            let f: [usize; 8] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
-            let mut rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
-            for jj in 0..ns / 2 {
-                let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
-                let (w0, w1) = (wr[2 * jj], wr[2 * jj + 1]);
-                let (lo, hi) = (16 * jj, 16 * jj + 8);
-                for q in 0..4 {
-                    rows[lo + q] = *s0.add(f[q]) * w0;
-                    rows[hi + q] = *s1.add(f[q]) * w1;
-                    rows[hi + 4 + q] = *s0.add(f[4 + q]) * w0;
-                    rows[lo + 4 + q] = *s1.add(f[4 + q]) * w1;
-                }
+        if t.regular[c] {
+            // The common case (`Blocks::regular`), written out.
+            let dst = buf.add(t.offset(c) + 2 * j0 * p);
+            match p {
+                16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst),
+                _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst),
             }
-            let rows = std::slice::from_raw_parts(rows.as_ptr() as *const f64, ns * 16);
-            stream_rows(buf.add(t.offset(c) + 2 * j0 * p), rows);
             continue;
         }
         let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
@@ -293,19 +279,11 @@ pub(super) unsafe fn gather_group(
         let p = t.p(c);
         let row = buf.add(t.offset(c) + 2 * j0 * p);
         let rev = t.rev[c];
-        if p == 16 && rev == GENERIC_REV && !conj {
-            // The common case, written out (see `scatter_group`).
-            let f: [usize; 8] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
-            let rows = row as *const Complex64;
-            for jj in 0..ns / 2 {
-                let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
-                let (lo, hi) = (rows.add(16 * jj), rows.add(16 * jj + 8));
-                for q in 0..4 {
-                    *s0.add(f[q]) = *lo.add(q);
-                    *s1.add(f[q]) = *hi.add(q);
-                    *s0.add(f[4 + q]) = *hi.add(4 + q);
-                    *s1.add(f[4 + q]) = *lo.add(4 + q);
-                }
+        if t.regular[c] {
+            // The common case (`Blocks::regular`), written out.
+            match p {
+                16 => gather_regular::<8>(t, c, &sp[..ns], conj, row),
+                _ => gather_regular::<4>(t, c, &sp[..ns], conj, row),
             }
             continue;
         }
@@ -334,6 +312,67 @@ pub(super) unsafe fn gather_group(
                     *s1.add(fi) = b;
                 }
             }
+        }
+    }
+}
+
+/// [`scatter_group`] for a regular block of `S` slots (`Blocks::regular`): slots below
+/// `S/2` from the own slice, the others from the mirrored one.
+#[inline(always)]
+unsafe fn scatter_regular<const S: usize>(
+    t: &Blocks,
+    c: usize,
+    sp: &[*const Complex64],
+    w: &[f64],
+    conj: bool,
+    dst: *mut f64,
+) {
+    let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+    let (h, ns) = (S / 2, sp.len());
+    let mut rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
+    for jj in 0..ns / 2 {
+        let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
+        let (w0, w1) = (w[2 * jj], w[2 * jj + 1]);
+        let (lo, hi) = (2 * S * jj, 2 * S * jj + S);
+        for q in 0..h {
+            rows[lo + q] = *s0.add(f[q]) * w0;
+            rows[hi + q] = *s1.add(f[q]) * w1;
+            rows[hi + h + q] = *s0.add(f[h + q]) * w0;
+            rows[lo + h + q] = *s1.add(f[h + q]) * w1;
+        }
+    }
+    if conj {
+        for z in &mut rows[..ns * S] {
+            *z = z.conj();
+        }
+    }
+    stream_rows(
+        dst,
+        std::slice::from_raw_parts(rows.as_ptr() as *const f64, ns * 2 * S),
+    );
+}
+
+/// [`gather_group`] for a regular block of `S` slots (see [`scatter_regular`]).
+#[inline(always)]
+unsafe fn gather_regular<const S: usize>(
+    t: &Blocks,
+    c: usize,
+    sp: &[*mut Complex64],
+    conj: bool,
+    row: *const f64,
+) {
+    let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+    let h = S / 2;
+    let rows = row as *const Complex64;
+    let v = |z: Complex64| if conj { z.conj() } else { z };
+    for jj in 0..sp.len() / 2 {
+        let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
+        let (lo, hi) = (rows.add(2 * S * jj), rows.add(2 * S * jj + S));
+        for q in 0..h {
+            *s0.add(f[q]) = v(*lo.add(q));
+            *s1.add(f[q]) = v(*hi.add(q));
+            *s0.add(f[h + q]) = v(*hi.add(h + q));
+            *s1.add(f[h + q]) = v(*lo.add(h + q));
         }
     }
 }
