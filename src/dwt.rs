@@ -418,68 +418,81 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     (g, st)
 }
 
-/// `acc[q] += e * x[q]` for the `P` data of one beta's block row `xw` (broadcast loads).
-#[inline(always)]
-unsafe fn lane_fmas<S: Simd, const P: usize>(acc: &mut [S::V; P], e: S::V, xw: *const f64) {
-    for (q, a) in acc.iter_mut().enumerate() {
-        *a = S::fma(e, S::splat(*xw.add(q)), *a);
-    }
-}
-
-/// One block of the forward kernel: `acc[q] += sum_w e[w] x[w][q]` (rows of `x` `xs`
-/// apart).
-#[inline(always)]
-unsafe fn block_fmas<S: Simd, const W: usize, const P: usize>(
-    acc: &mut [S::V; P],
-    x: *const f64,
-    xs: usize,
-    e: &[S::V; W],
-) {
-    for (w, ew) in e.iter().enumerate() {
-        lane_fmas::<S, P>(acc, *ew, x.add(w * xs));
-    }
-}
-
 /// Vectors of betas whose states the forward kernel keeps at once.
 const FWD_VECTORS: usize = 16;
 
-/// Forward kernel body: `ft[q][i] += sum_s dt_i(beta_s) x[s][q]`, a reduction over the
+/// Small buffer for one vector's Wigner-d block (`DB` degrees x `W` betas), read back as
+/// broadcasts.
+#[repr(C, align(64))]
+#[derive(Clone, Copy)]
+struct DBlock([f64; 64]);
+
+/// The multiply-adds of one beta lane `w` of a stored d block: for each degree `j` of the
+/// block, `acc[j][h] += d[j][w] * x[h]` with `x` the `P / W` vectors of the beta's data
+/// row `xw` (lane = data column) and `d[j][w]` a broadcast load.
+#[inline(always)]
+unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
+    acc: &mut [S::V; P],
+    db: *const f64,
+    w: usize,
+    xw: *const f64,
+) {
+    let pv = P / W;
+    let mut x = [S::zero(); P];
+    for (h, xh) in x.iter_mut().enumerate().take(pv) {
+        *xh = S::load(xw.add(h * W));
+    }
+    for j in 0..DB {
+        let e = S::splat(*db.add(j * W + w));
+        for h in 0..pv {
+            // Pinned in program order: left alone, LLVM hoists the broadcasts of the next
+            // lanes above these multiply-adds and spills them and half of the sums
+            // (measured: 40% of the FMA peak against 51%).
+            acc[j * pv + h] = S::fence(S::fma(e, x[h], acc[j * pv + h]));
+        }
+    }
+}
+
+/// Forward kernel body: `ft[i][q] += sum_s dt_i(beta_s) x[s][q]`, a reduction over the
 /// betas for each degree.
 ///
-/// The loops run degree blocks outer and beta vectors inner, so that the sums of a block
-/// of `W` degrees stay in registers (`P` vectors, lane = degree) while every vector of
-/// betas adds its share, and are stored once per block. Each vector's recurrence state
-/// (kept in L1 between blocks) produces the values of `W` degrees, which are transposed
-/// in registers (lane = degree) and enter as `acc[q] += e_w * x[w][q]`, the data `x`
-/// as broadcasts from memory (the vector's block rows, in L1): no lane of a register has
-/// to be broadcast by a shuffle.
+/// The loops run degree blocks (`DB` degrees) outer and beta vectors inner, so that the
+/// sums of a block stay in registers while every vector of betas adds its share, and are
+/// stored once per block: `DB x P / W` vectors, lane = data column (the output is
+/// degree-major, the inverse kernel's input layout). Each vector's recurrence state
+/// (kept in L1 between blocks) produces its `DB x W` values, which are stored to a small
+/// buffer and read back as broadcasts, one per (degree, beta), each feeding `P / W`
+/// multiply-adds with the beta's data row in registers: no shuffles, the same instruction
+/// mix as the inverse kernel.
 ///
 /// For the vectors whose lanes are all active, the recurrence of the next vector runs one
 /// step before each lane's multiply-adds of the current one in program order: the
 /// floating-point pipes issue the oldest ready instruction first, so the latency-bound
 /// chain of steps never waits behind a block of independent multiply-adds.
 #[inline(always)]
-unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
+unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
     rec: &Rec,
     lanes: &Lanes,
     xin: &[f64],
     ft: &mut [f64],
-    ld: usize,
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
+    let pv = P / W;
+    debug_assert!(DB * W <= 64 && DB * pv <= P && DB <= W);
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
-    debug_assert!(ld >= n + W && ft.len() >= P * ld);
+    debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
     let fp = ft.as_mut_ptr();
     // Prefetch hints: the lines of `lanes.prefetch`, a few per degree block.
     let mut pf = lanes.prefetch;
     let pf_per_block = pf
         .lines()
-        .div_ceil((n / W).max(1) * nb.div_ceil(W * FWD_VECTORS));
+        .div_ceil((n / DB).max(1) * nb.div_ceil(W * FWD_VECTORS));
     let xrows = |s0: usize| {
         let (r0, step) = lanes.rows(s0);
         (xin.as_ptr().add(r0 * P), step * P)
     };
+    let mut dbuf = [DBlock([0.0; 64]); 2];
     let mut v0 = 0;
     while v0 < nb {
         // Up to FWD_VECTORS vectors, each through its negligible prefix.
@@ -499,59 +512,68 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
         // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
         let st = std::slice::from_raw_parts_mut(st_mem.as_mut_ptr() as *mut State<S>, nv);
         let first = st.iter().map(|s| s.i).min().unwrap_or(n);
-        let mut i0 = first - first % W;
+        let mut i0 = first - first % DB;
         let mut fast = [0usize; FWD_VECTORS];
         while i0 < n {
             pf.issue(pf_per_block);
             let mut acc = [S::zero(); P];
-            for (q, a) in acc.iter_mut().enumerate() {
-                *a = S::load(fp.add(q * ld + i0));
+            for j in 0..DB {
+                for h in 0..pv {
+                    acc[j * pv + h] = S::load(fp.add((i0 + j) * P + h * W));
+                }
             }
             // Vectors that start inside this block, still have inactive lanes or end in
             // it, one at a time; the others are listed for the pipelined loop.
             let mut nf = 0;
             for (v, s) in st.iter_mut().enumerate() {
-                if s.i >= i0 + W || s.i >= n {
+                if s.i >= i0 + DB || s.i >= n {
                     continue;
                 }
-                if s.i == i0 && i0 + W <= n && s.all_active() {
+                if s.i == i0 && i0 + DB <= n && s.all_active() {
                     fast[nf] = v;
                     nf += 1;
                     continue;
                 }
-                let mut d = s.masked_block::<W>(rec, i0, n);
-                S::transpose(&mut d);
+                let d = s.masked_block::<DB>(rec, i0, n);
+                let db = dbuf[0].0.as_mut_ptr();
+                for (j, dj) in d.iter().enumerate() {
+                    S::store(db.add(j * W), *dj);
+                }
                 let (x, xs) = xrows(v0 + v * W);
-                block_fmas::<S, W, P>(&mut acc, x, xs, &d);
+                for w in 0..W {
+                    beta_fmas::<S, W, P, DB>(&mut acc, db, w, x.add(w * xs));
+                }
             }
             if nf > 0 {
                 // The first fast vector's block, then each next vector's steps
                 // interleaved with the previous one's multiply-adds.
+                let mut cur = 0;
                 let s = &mut st[fast[0]];
                 let (mut p0, mut p1) = (s.p0, s.p1);
-                let mut e = [S::zero(); W];
-                for (j, ej) in e.iter_mut().enumerate() {
-                    *ej = p1;
+                let db = dbuf[cur].0.as_mut_ptr();
+                for j in 0..DB {
+                    S::store(db.add(j * W), p1);
                     let p2 = S::fence(s.step(rec, p0, p1, i0 + j));
                     (p0, p1) = (p1, p2);
                 }
-                (s.p0, s.p1, s.i) = (p0, p1, i0 + W);
-                S::transpose(&mut e);
+                (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
                 let mut ev = fast[0];
                 for &v in &fast[1..nf] {
                     let (x, xs) = xrows(v0 + ev * W);
                     let s = &mut st[v];
                     let (mut p0, mut p1) = (s.p0, s.p1);
-                    let mut d = e;
-                    // Written out for each lane, so that `d` and `e` stay in registers.
+                    let dc = dbuf[cur].0.as_ptr();
+                    let dn = dbuf[1 - cur].0.as_mut_ptr();
+                    // Written out for each lane, so that the state stays in registers.
                     macro_rules! lane {
                         ($w:literal) => {
                             if $w < W {
-                                let ew = e[$w];
-                                d[$w] = p1;
-                                let p2 = S::fence(s.step(rec, p0, p1, i0 + $w));
-                                (p0, p1) = (p1, p2);
-                                lane_fmas::<S, P>(&mut acc, ew, x.add($w * xs));
+                                if $w < DB {
+                                    S::store(dn.add($w * W), p1);
+                                    let p2 = S::fence(s.step(rec, p0, p1, i0 + $w));
+                                    (p0, p1) = (p1, p2);
+                                }
+                                beta_fmas::<S, W, P, DB>(&mut acc, dc, $w, x.add($w * xs));
                             }
                         };
                     }
@@ -563,18 +585,22 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize>(
                     lane!(5);
                     lane!(6);
                     lane!(7);
-                    (s.p0, s.p1, s.i) = (p0, p1, i0 + W);
-                    S::transpose(&mut d);
-                    e = d;
+                    (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
+                    cur = 1 - cur;
                     ev = v;
                 }
                 let (x, xs) = xrows(v0 + ev * W);
-                block_fmas::<S, W, P>(&mut acc, x, xs, &e);
+                let dc = dbuf[cur].0.as_ptr();
+                for w in 0..W {
+                    beta_fmas::<S, W, P, DB>(&mut acc, dc, w, x.add(w * xs));
+                }
             }
-            for (q, a) in acc.iter().enumerate() {
-                S::store(fp.add(q * ld + i0), *a);
+            for j in 0..DB {
+                for h in 0..pv {
+                    S::store(fp.add((i0 + j) * P + h * W), acc[j * pv + h]);
+                }
             }
-            i0 += W;
+            i0 += DB;
         }
         v0 += nv * W;
     }
@@ -635,11 +661,11 @@ macro_rules! entry {
             inverse_body::<$S, $W, $N>(rec, lanes, a, b)
         }
     };
-    ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal) => {
+    ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal, $DB:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64], ld: usize) {
-            forward_body::<$S, $W, $N>(rec, lanes, a, b, ld)
+        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) {
+            forward_body::<$S, $W, $N, $DB>(rec, lanes, a, b)
         }
     };
 }
@@ -647,49 +673,42 @@ macro_rules! entry {
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512};
 
-entry!(fwd_avx512_16, "avx512f,fma", forward_body, Avx512, 8, 16);
-entry!(fwd_avx512_8, "avx512f,fma", forward_body, Avx512, 8, 8);
-entry!(fwd_avx2_16, "avx2,fma", forward_body, Avx2, 4, 16);
-entry!(fwd_avx2_8, "avx2,fma", forward_body, Avx2, 4, 8);
+entry!(fwd_avx512_16, "avx512f,fma", forward_body, Avx512, 8, 16, 8);
+entry!(fwd_avx512_8, "avx512f,fma", forward_body, Avx512, 8, 8, 8);
+entry!(fwd_avx2_16, "avx2,fma", forward_body, Avx2, 4, 16, 2);
+entry!(fwd_avx2_8, "avx2,fma", forward_body, Avx2, 4, 8, 4);
 entry!(inv_avx512_16, "avx512f,fma", inverse_body, Avx512, 8, 16);
 entry!(inv_avx512_8, "avx512f,fma", inverse_body, Avx512, 8, 8);
 entry!(inv_avx2_16, "avx2,fma", inverse_body, Avx2, 4, 16);
 entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 
-/// Forward kernel: `ft[q*ld + i] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or
-/// 16 (`row` see [`Lanes::interleaved`]); `ld >= n + W` (entries `n..ld` of each row may be
-/// written with zeros added).
+/// Forward kernel: `ft[i*P + q] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or
+/// 16 (`row` see [`Lanes::interleaved`]): degree-major, the inverse kernel's input layout.
+/// `ft` holds at least `(n + W) * P` values, `W = isa.lanes()` (the rows from `n` on may
+/// be written with zeros added).
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
-pub(crate) fn forward(
-    isa: Isa,
-    p: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    xin: &[f64],
-    ft: &mut [f64],
-    ld: usize,
-) {
+pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(xin.len() >= nb * p && ld >= n + isa.lanes() && ft.len() >= p * ld);
+    assert!(xin.len() >= nb * p && ft.len() >= (n + isa.lanes()) * p);
     assert!(isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
     unsafe {
         match (isa, p) {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, xin, ft, ld),
+            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, xin, ft),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, xin, ft, ld),
+            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, xin, ft),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, ft, ld),
+            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, ft),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, ft, ld),
-            (_, 16) => forward_body::<Scalar, 1, 16>(rec, lanes, xin, ft, ld),
-            (_, 8) => forward_body::<Scalar, 1, 8>(rec, lanes, xin, ft, ld),
+            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, ft),
+            (_, 16) => forward_body::<Scalar, 1, 16, 1>(rec, lanes, xin, ft),
+            (_, 8) => forward_body::<Scalar, 1, 8, 1>(rec, lanes, xin, ft),
             _ => unreachable!("P must be 8 or 16"),
         }
     }
@@ -752,8 +771,7 @@ pub(crate) fn column(
     sc[0] = sc0;
     let mut xin = vec![0.0; w * 8];
     xin[0] = 1.0;
-    let ld = n + w;
-    let mut f = vec![0.0; 8 * ld];
+    let mut f = vec![0.0; (n + w) * 8];
     let rec = Rec::new(&rc, n);
     let lanes = Lanes {
         tau: &tau,
@@ -765,8 +783,8 @@ pub(crate) fn column(
         interleaved: false,
         prefetch: Prefetch::none(),
     };
-    forward(isa, 8, &rec, &lanes, &xin, &mut f, ld);
-    f[..n].to_vec()
+    forward(isa, 8, &rec, &lanes, &xin, &mut f);
+    f.iter().step_by(8).take(n).copied().collect()
 }
 
 #[cfg(test)]
@@ -847,18 +865,17 @@ mod tests {
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
                 let fin = pseudo(n * pw, 11 + mp as u64);
-                let ld = n + 8;
-                let mut f_ref = vec![0.0; ld * pw];
+                let mut f_ref = vec![0.0; (n + 8) * pw];
                 let mut y_ref = vec![0.0; nb * pw];
-                forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref, ld);
+                forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref);
                 inverse(Isa::Scalar, pw, &rec, &lanes, &fin, &mut y_ref);
                 for isa in [Isa::Avx512, Isa::Avx2] {
                     if !isa.is_supported() {
                         continue;
                     }
-                    let mut f = vec![0.0; ld * pw];
+                    let mut f = vec![0.0; (n + 8) * pw];
                     let mut y = vec![0.0; nb * pw];
-                    forward(isa, pw, &rec, &lanes, &xin, &mut f, ld);
+                    forward(isa, pw, &rec, &lanes, &xin, &mut f);
                     inverse(isa, pw, &rec, &lanes, &fin, &mut y);
                     // FMA and plain multiply-add round differently; the recurrence error
                     // grows like l * eps (l <= 200 here), so compare relative to the largest value.
@@ -936,8 +953,7 @@ mod kernel_speed {
             let rec = Rec::new(&rc, n);
             let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
             let xin = vec![0.5; nbs * 16];
-            let ld = n + 8;
-            let mut f = vec![0.0; ld * 16];
+            let mut f = vec![0.0; (n + 8) * 16];
             let mut y = vec![0.0; nbs * 16];
             let isa = Isa::detect();
             let batch = |f: &mut dyn FnMut()| {
@@ -949,9 +965,7 @@ mod kernel_speed {
             };
             let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
             for _ in 0..7 {
-                tf = tf.min(batch(&mut || {
-                    forward(isa, 16, &rec, &lanes, &xin, &mut f, ld)
-                }));
+                tf = tf.min(batch(&mut || forward(isa, 16, &rec, &lanes, &xin, &mut f)));
                 ti = ti.min(batch(&mut || {
                     inverse(isa, 16, &rec, &lanes, &f[..n * 16], &mut y)
                 }));
@@ -996,7 +1010,7 @@ mod stage_speed {
                 let lanes = grid_lanes(&x, &p, &sc, b);
                 let pw = if m == mp || mp == 0 { 8 } else { 16 };
                 let t = std::time::Instant::now();
-                forward(isa, pw, &rec, &lanes, &xin, &mut f[..(n + 8) * pw], n + 8);
+                forward(isa, pw, &rec, &lanes, &xin, &mut f[..(n + 8) * pw]);
                 let dt = t.elapsed().as_secs_f64();
                 tf += dt;
                 qtf[4 * m / b] += dt;

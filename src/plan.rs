@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
 
 mod blocks;
+mod coeffs;
 mod dwt_stage;
 mod fft_stage;
 mod fft_tune;

@@ -23,7 +23,7 @@ pub(super) struct Scratch {
     pub sc: Vec<f64>,
     /// Inverse: coefficients in the kernel's layout (`n` degrees x `P`).
     pub data: Vec<f64>,
-    /// Forward: the kernel's sums (`P` rows of `n + 8` degrees, see [`Plan::run_forward`]).
+    /// Forward: the kernel's sums (`n + 8` degrees x `P`, see [`Plan::run_forward`]).
     pub out: Vec<f64>,
 }
 
@@ -109,11 +109,8 @@ impl Plan {
         for (q, mem) in members.iter().enumerate() {
             let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
             let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
-            for (i, (row, z)) in fin.chunks_exact_mut(p).zip(src).enumerate() {
-                let g = sg[i & 1];
-                row[2 * q] = z.re * g;
-                row[2 * q + 1] = z.im * g;
-            }
+            // SAFETY: `fin` has `n` rows of `p >= 2 members.len()` values.
+            unsafe { coeffs::gather(fin[2 * q..].as_mut_ptr(), src.as_ptr(), p, n, sg) };
         }
     }
 
@@ -140,10 +137,9 @@ impl Plan {
         blk[2 * ch.h * p..2 * ch.hp * p].fill(0.0);
     }
 
-    /// The forward kernel on `xin` (a block) into `sc.out`, zeroed first: row `q` (the
-    /// real or imaginary part of a slot) at `q * ld`, degrees contiguous; returns `ld`.
+    /// The forward kernel on `xin` (a block) into `sc.out`, zeroed first: degree `i` of
+    /// column `q` (the real or imaginary part of a slot) at `i * p + q`.
     /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn run_forward(
         &self,
         sc: &mut Scratch,
@@ -152,17 +148,15 @@ impl Plan {
         n: usize,
         xin: &[f64],
         next: Prefetch,
-    ) -> usize {
-        let ld = n + 8;
+    ) {
         let mut out = std::mem::take(&mut sc.out);
-        let f = &mut out[..p * ld];
+        let f = &mut out[..(n + 8) * p];
         f.fill(0.0);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.prefetch = next;
-        dwt::forward(self.isa, p, &rec, &lanes, xin, f, ld);
+        dwt::forward(self.isa, p, &rec, &lanes, xin, f);
         sc.out = out;
-        ld
     }
 
     /// What the cluster after `c` in layout `t` will touch: its block of the chunk buffer
@@ -222,27 +216,12 @@ impl Plan {
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
         let next = self.next_cluster(t, buf, c, ch, true, coef.get(), members);
-        let ld = self.run_forward(sc, ch, p, n, blk, next);
+        self.run_forward(sc, ch, p, n, blk, next);
         let (mem, nm) = members(cl);
         for (q, mem) in mem[..nm].iter().enumerate() {
-            let dst = std::slice::from_raw_parts_mut(
-                coef.get().add(block_start(self.b, mem.m, mem.mp)),
-                n,
-            );
+            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            let (re, im) = (&sc.out[2 * q * ld..][..n], &sc.out[(2 * q + 1) * ld..][..n]);
-            let rows = re.iter().zip(im).map(|(&r, &i)| (r, i));
-            if first {
-                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1];
-                    *d = Complex64::new(re * g, im * g);
-                }
-            } else {
-                for (i, (d, (re, im))) in dst.iter_mut().zip(rows).enumerate() {
-                    let g = sg[i & 1];
-                    *d += Complex64::new(re * g, im * g);
-                }
-            }
+            coeffs::scatter(dst, sc.out.as_ptr().add(2 * q), p, n, sg, !first);
         }
     }
 

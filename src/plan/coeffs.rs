@@ -1,0 +1,123 @@
+//! The coefficients' side of the DWT stage: the kernels read and write degree-major rows
+//! of `P` doubles (`(re, im)` of each slot side by side), the coefficient array holds one
+//! contiguous run of degrees per order pair. These copies move one pair's run between the
+//! two, with the pair's sign for even and odd degree offsets applied on the way.
+//!
+//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64): the scalar
+//! element-by-element loop this replaces took about a fifth of the inverse DWT stage
+//! with several chunks.
+
+use num_complex::Complex64;
+
+/// `dst[i * p .. i * p + 2] = src[i] * sg[i % 2]` for `i < n`.
+///
+/// # Safety
+/// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
+pub(super) unsafe fn gather(
+    dst: *mut f64,
+    src: *const Complex64,
+    p: usize,
+    n: usize,
+    sg: [f64; 2],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let g = [_mm_set1_pd(sg[0]), _mm_set1_pd(sg[1])];
+        for i in 0..n {
+            let z = _mm_loadu_pd(src.add(i) as *const f64);
+            _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, g[i & 1]));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for i in 0..n {
+        let z = *src.add(i);
+        let g = sg[i & 1];
+        *dst.add(i * p) = z.re * g;
+        *dst.add(i * p + 1) = z.im * g;
+    }
+}
+
+/// `dst[i] = src[i * p .. i * p + 2] * sg[i % 2]` (or `+=` if `add`) for `i < n`.
+///
+/// # Safety
+/// `dst` valid for `n` reads and writes, `src` for reads at `i * p` and `i * p + 1`,
+/// `i < n`; no overlap.
+pub(super) unsafe fn scatter(
+    dst: *mut Complex64,
+    src: *const f64,
+    p: usize,
+    n: usize,
+    sg: [f64; 2],
+    add: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let g = [_mm_set1_pd(sg[0]), _mm_set1_pd(sg[1])];
+        let d = dst as *mut f64;
+        if add {
+            for i in 0..n {
+                let z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g[i & 1]);
+                _mm_storeu_pd(d.add(2 * i), _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z));
+            }
+        } else {
+            for i in 0..n {
+                _mm_storeu_pd(
+                    d.add(2 * i),
+                    _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g[i & 1]),
+                );
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    for i in 0..n {
+        let g = sg[i & 1];
+        let z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
+        if add {
+            *dst.add(i) += z;
+        } else {
+            *dst.add(i) = z;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both copies against the definition, with a row length wider than the data.
+    #[test]
+    fn copies_follow_the_definition() {
+        let (p, n) = (16, 13);
+        let z: Vec<Complex64> = (0..n)
+            .map(|i| Complex64::new(i as f64 + 0.5, -(i as f64) * 0.25))
+            .collect();
+        let sg = [-1.5, 2.0];
+        let mut rows = vec![7.0; n * p];
+        unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg) };
+        for i in 0..n {
+            for q in 0..p {
+                let want = match q {
+                    4 if i < n - 1 => z[i].re * sg[i % 2],
+                    5 if i < n - 1 => z[i].im * sg[i % 2],
+                    _ => 7.0,
+                };
+                assert_eq!(rows[i * p + q], want, "i={i} q={q}");
+            }
+        }
+        let mut back = vec![Complex64::new(1.0, 1.0); n];
+        unsafe { scatter(back.as_mut_ptr(), rows[4..].as_ptr(), p, n - 1, sg, false) };
+        for i in 0..n - 1 {
+            // Signs squared: 2.25 and 4.
+            let s2 = sg[i % 2] * sg[i % 2];
+            assert_eq!(back[i], z[i] * s2);
+        }
+        assert_eq!(back[n - 1], Complex64::new(1.0, 1.0));
+        unsafe { scatter(back.as_mut_ptr(), rows[4..].as_ptr(), p, n - 1, sg, true) };
+        for i in 0..n - 1 {
+            let s2 = sg[i % 2] * sg[i % 2];
+            assert_eq!(back[i], z[i] * (2.0 * s2));
+        }
+    }
+}
