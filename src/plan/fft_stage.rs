@@ -184,6 +184,37 @@ impl Plan {
     }
 }
 
+/// Clusters ahead whose slice values [`prefetch_slots`] requests.
+const PREFETCH_SLOTS: usize = 32;
+
+/// Prefetch the slice values of cluster `c`'s slots in the slices `sp` (into L2 for
+/// reading, into L1 for writing with `write`): the slots of a cluster lie in different
+/// rows of the slices, which from B = 256 on are larger than L2. Measured with
+/// `copy_speed` at B = 256: gather 1.6 -> 1.3 ms per pair of slices, scatter 1.24 -> 1.16.
+#[inline(always)]
+unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[*const Complex64], write: bool) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_ET0, _MM_HINT_T1};
+        for q in 0..t.p(c) / 2 {
+            let fi = *t.fi.get_unchecked(8 * c + q);
+            if fi == NONE {
+                continue;
+            }
+            for s in sp {
+                let a = s.wrapping_add(fi as usize) as *const i8;
+                if write {
+                    _mm_prefetch::<_MM_HINT_ET0>(a);
+                } else {
+                    _mm_prefetch::<_MM_HINT_T1>(a);
+                }
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (t, c, sp, write);
+}
+
 /// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, adjacent) of the blocks of
 /// clusters `cs` from the transformed slices `s` (beta, then pi - beta, for each pair),
 /// scaled by their weights `w` (and conjugated with `conj`): the first row of a pair
@@ -210,7 +241,11 @@ pub(super) unsafe fn scatter_group(
         sp[i] = s[i].get();
         (wr[i], wi[i]) = (w[i], if conj { -w[i] } else { w[i] });
     }
+    let end = cs.end;
     for c in cs {
+        if c + PREFETCH_SLOTS < end {
+            prefetch_slots(t, c + PREFETCH_SLOTS, &sp[..ns], false);
+        }
         let p = t.p(c);
         let rev = t.rev[c];
         if t.regular[c] {
@@ -261,8 +296,10 @@ pub(super) unsafe fn gather_group(
     let ns = s.len();
     debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP);
     let mut sp = [std::ptr::null_mut::<Complex64>(); 2 * MAX_GROUP];
+    let mut spr = [std::ptr::null::<Complex64>(); 2 * MAX_GROUP];
     for i in 0..ns {
         sp[i] = s[i].get();
+        spr[i] = sp[i];
     }
     let end = cs.end;
     for c in cs {
@@ -275,6 +312,9 @@ pub(super) unsafe fn gather_group(
             for line in 0..ns * pf / 8 {
                 _mm_prefetch::<_MM_HINT_T0>(rows.add(64 * line));
             }
+        }
+        if c + PREFETCH_SLOTS < end {
+            prefetch_slots(t, c + PREFETCH_SLOTS, &spr[..ns], true);
         }
         let p = t.p(c);
         let row = buf.add(t.offset(c) + 2 * j0 * p);
