@@ -946,7 +946,12 @@ mod kernel_speed {
     #[test]
     #[ignore]
     fn kernel_gflops() {
-        for &(b, nbs) in &[(256usize, 512usize), (256, 128), (128, 256)] {
+        for &(b, nbs, pw) in &[
+            (256usize, 512usize, 16usize),
+            (256, 128, 16),
+            (128, 256, 16),
+            (256, 512, 8),
+        ] {
             let (m, mp) = (b / 8, b / 16);
             let n = b - m;
             let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
@@ -965,16 +970,16 @@ mod kernel_speed {
             };
             let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
             for _ in 0..7 {
-                tf = tf.min(batch(&mut || forward(isa, 16, &rec, &lanes, &xin, &mut f)));
+                tf = tf.min(batch(&mut || forward(isa, pw, &rec, &lanes, &xin, &mut f)));
                 ti = ti.min(batch(&mut || {
-                    inverse(isa, 16, &rec, &lanes, &f[..n * 16], &mut y)
+                    inverse(isa, pw, &rec, &lanes, &f[..n * pw], &mut y)
                 }));
                 peak = peak.max(fma_peak());
             }
-            let flops = (n * nbs * 16 * 2) as f64;
+            let flops = (n * nbs * pw * 2) as f64;
             let (gf, gi) = (flops / tf / 1e9, flops / ti / 1e9);
             println!(
-                "B={b} nb={nbs} L={n}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}",
+                "B={b} nb={nbs} L={n} P={pw}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}",
                 100.0 * gf / peak,
                 100.0 * gi / peak
             );
