@@ -243,7 +243,7 @@ pub(super) unsafe fn scatter_group(
     }
     let end = cs.end;
     for c in cs {
-        if c + PREFETCH_SLOTS < end {
+        if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, &sp[..ns], false);
         }
         let p = t.p(c);
@@ -313,7 +313,7 @@ pub(super) unsafe fn gather_group(
                 _mm_prefetch::<_MM_HINT_T0>(rows.add(64 * line));
             }
         }
-        if c + PREFETCH_SLOTS < end {
+        if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, &spr[..ns], true);
         }
         let p = t.p(c);
