@@ -502,11 +502,11 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
     debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
     let fp = ft.as_mut_ptr();
-    // Prefetch hints: the lines of `lanes.prefetch`, a few per degree block.
+    // Prefetch hints: the lines of `lanes.prefetch`, one or two per vector and block.
+    // (Issued in bursts at each block start they stalled the core when the miss buffers
+    // ran full: 9% of the 8-column kernel's time in the real forward at B = 256.)
     let mut pf = lanes.prefetch;
-    let pf_per_block = pf
-        .lines()
-        .div_ceil((n / DB).max(1) * nb.div_ceil(W * FWD_VECTORS));
+    let pf_per_vector = pf.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
     let xrows = |s0: usize| {
         let (r0, step) = lanes.rows(s0);
         (xin.as_ptr().add(r0 * P), step * P)
@@ -534,7 +534,6 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let mut i0 = first - first % DB;
         let mut fast = [0usize; FWD_VECTORS];
         while i0 < n {
-            pf.issue(pf_per_block);
             let mut acc = [S::zero(); ACC];
             for j in 0..DB {
                 for h in 0..pv {
@@ -553,6 +552,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     nf += 1;
                     continue;
                 }
+                pf.issue(pf_per_vector);
                 let d = s.masked_block::<DB>(rec, i0, n);
                 let db = dbuf[0].0.as_mut_ptr();
                 for (j, dj) in d.iter().enumerate() {
@@ -578,6 +578,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
                 let mut ev = fast[0];
                 for &v in &fast[1..nf] {
+                    pf.issue(pf_per_vector);
                     let (x, xs) = xrows(v0 + ev * W);
                     let s = &mut st[v];
                     let (mut p0, mut p1) = (s.p0, s.p1);
@@ -609,6 +610,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     cur = 1 - cur;
                     ev = v;
                 }
+                pf.issue(pf_per_vector);
                 let (x, xs) = xrows(v0 + ev * W);
                 let dc = dbuf[cur].0.as_ptr();
                 for w in 0..W {
