@@ -253,15 +253,15 @@ impl<'r, S: Simd> State<'r, S> {
         (self.p0, self.p1, self.i) = (p0, p1, i);
     }
 
-    /// The values of degrees `i0 .. i0 + W` (the state is at degree `i >= i0`), masked to
+    /// The values of degrees `i0 .. i0 + D` (the state is at degree `i >= i0`), masked to
     /// the active lanes, zero before `i` and from `n` on; advances the state to
-    /// `min(i0 + W, n)`. For the blocks where not all lanes are active yet, or which start
+    /// `min(i0 + D, n)`. For the blocks where not all lanes are active yet, or which start
     /// before the state does, or end past `n`.
     #[inline(always)]
-    unsafe fn masked_block<const W: usize>(&mut self, rec: &Rec, i0: usize, n: usize) -> [S::V; W] {
-        let mut d = [S::zero(); W];
+    unsafe fn masked_block<const D: usize>(&mut self, rec: &Rec, i0: usize, n: usize) -> [S::V; D] {
+        let mut d = [S::zero(); D];
         let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
-        let end = (i0 + W).min(n);
+        let end = (i0 + D).min(n);
         while i < end {
             d[i - i0] = S::mul(p1, self.mask);
             let p2 = self.step(rec, p0, p1, i);
@@ -355,7 +355,7 @@ const GROUP: usize = 4;
 /// step together, held in registers, with one test per degree of whether any value has
 /// reached the rescale threshold. The vectors are neighbouring betas, whose prefixes end at
 /// similar degrees; once one of them has an active lane, each finishes its own prefix in
-/// [`State::run`].
+/// [`State::finish_prefix`] (forward) or [`State::run_slow`] (inverse).
 #[inline(always)]
 unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: usize) {
     if st.iter().any(|s| !s.none_active() || s.i >= n) {
@@ -484,10 +484,13 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 /// multiply-adds with the beta's data row in registers: no shuffles, the same instruction
 /// mix as the inverse kernel.
 ///
-/// For the vectors whose lanes are all active, the recurrence of the next vector runs one
-/// step before each lane's multiply-adds of the current one in program order: the
-/// floating-point pipes issue the oldest ready instruction first, so the latency-bound
-/// chain of steps never waits behind a block of independent multiply-adds.
+/// For the vectors whose lanes are all active, the recurrence steps of the next vector are
+/// spread over the lanes of the current one (`DB / W` steps before each lane's
+/// multiply-adds, in program order): the floating-point pipes issue the oldest ready
+/// instruction first, so the latency-bound chain of steps never waits behind a block of
+/// independent multiply-adds.
+///
+/// `DB <= W`: callers size `ft` for `n + W` degrees.
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
     rec: &Rec,
@@ -498,13 +501,18 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     let n = rec.len();
     let nb = lanes.tau.len();
     let pv = P / W;
-    debug_assert!(DB * W <= 128 && DB * pv <= ACC);
+    const {
+        assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
+    }
     debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
     debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
     let fp = ft.as_mut_ptr();
-    // Prefetch hints: the lines of `lanes.prefetch`, one or two per vector and block.
-    // (Issued in bursts at each block start they stalled the core when the miss buffers
-    // ran full: 9% of the 8-column kernel's time in the real forward at B = 256.)
+    // Prefetch hints: the lines of `lanes.prefetch`, a few per vector and block. (Issued in
+    // bursts at each block start they stalled the core when the miss buffers ran full: 9%
+    // of the 8-column kernel's time in the real forward at B = 256.) The (block, vector)
+    // pairs of skipped prefixes issue nothing, so the end of the list (8-16% of the lines,
+    // the last coefficient rows) is left to demand loads; issuing twice as fast was 3%
+    // slower at B = 128.
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
     let xrows = |s0: usize| {
@@ -732,7 +740,8 @@ use crate::simd::{Avx2, Avx512};
 entry!(fwd_avx512_16, "avx512f,fma", forward_body, Avx512, 8, 16, 8);
 // 16 degrees per block would keep 16 sums in flight with 8 columns: 41% of the peak
 // against 39% for one cluster in cache, but 7% slower in the real forward's DWT stage at
-// B = 128 (shorter clusters, more partial blocks).
+// B = 128 (shorter clusters, more partial blocks); it would also need `ft` sized for
+// `n + 16` degrees.
 entry!(fwd_avx512_8, "avx512f,fma", forward_body, Avx512, 8, 8, 8);
 entry!(fwd_avx2_16, "avx2,fma", forward_body, Avx2, 4, 16, 2);
 entry!(fwd_avx2_8, "avx2,fma", forward_body, Avx2, 4, 8, 4);
@@ -907,6 +916,86 @@ mod tests {
             skip: true,
             interleaved: true,
             prefetch: Prefetch::none(),
+        }
+    }
+
+    /// The forward kernel is the transpose of the inverse one: `<y, x> = <fin, f>` for
+    /// `f = forward(x)` and `y = inverse(fin)`, on every path, with and without skipping,
+    /// for odd and even numbers of vectors (the 8-column inverse pairs vectors), halves of
+    /// unequal size, and clusters of 1 to 67 degrees. Skipping changes nothing beyond
+    /// rounding.
+    #[test]
+    fn forward_is_the_adjoint_of_inverse() {
+        let b = 67;
+        for &(m, mp) in &[
+            (0usize, 0usize),
+            (5, 2),
+            (30, 30),
+            (41, 0),
+            (65, 12),
+            (66, 66),
+        ] {
+            let n = b - m;
+            for nbs in [24usize, 40, 56, 72] {
+                let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+                let rec = Rec::new(&rc, n);
+                for pw in [8usize, 16] {
+                    let x = pseudo(nbs * pw, 3 + nbs as u64);
+                    let fin = pseudo(n * pw, 5 + m as u64);
+                    let mut runs = Vec::new();
+                    for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                        if !isa.is_supported() {
+                            continue;
+                        }
+                        for skip in [true, false] {
+                            let lanes = Lanes {
+                                tau: &tau,
+                                p: &p,
+                                sc: &sc,
+                                // Vectors below this lane are the lower half.
+                                upper_from: 8 * (nbs / 16),
+                                big: crate::wigner::big(test_skip_bits()),
+                                skip,
+                                interleaved: false,
+                                prefetch: Prefetch::none(),
+                            };
+                            let mut f = vec![0.0; (n + 8) * pw];
+                            let mut y = vec![f64::NAN; nbs * pw];
+                            forward(isa, pw, &rec, &lanes, &x, &mut f);
+                            inverse(isa, pw, &rec, &lanes, &fin, &mut y);
+                            let dot = |a: &[f64], b: &[f64]| {
+                                a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>()
+                            };
+                            let norm = |a: &[f64]| dot(a, a).sqrt();
+                            let (lhs, rhs) = (dot(&y, &x), dot(&fin, &f[..n * pw]));
+                            let scale = norm(&y) * norm(&x) + norm(&fin) * norm(&f);
+                            assert!(
+                                (lhs - rhs).abs() <= 1e-13 * scale,
+                                "{isa:?} skip={skip} m={m} mp={mp} nbs={nbs} P={pw}: {lhs} {rhs}"
+                            );
+                            assert!(f[n * pw..].iter().all(|&v| v == 0.0));
+                            runs.push((f, y));
+                        }
+                    }
+                    let (f0, y0) = &runs[0];
+                    let fs = f0.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+                    let ys = y0.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+                    for (f, y) in &runs[1..] {
+                        for (u, v) in f.iter().zip(f0) {
+                            assert!(
+                                (u - v).abs() <= 1e-13 * fs,
+                                "m={m} mp={mp} nbs={nbs} P={pw}"
+                            );
+                        }
+                        for (u, v) in y.iter().zip(y0) {
+                            assert!(
+                                (u - v).abs() <= 1e-13 * ys,
+                                "m={m} mp={mp} nbs={nbs} P={pw}"
+                            );
+                        }
+                    }
+                }
+            }
         }
     }
 

@@ -105,6 +105,7 @@ impl Plan {
             fin.fill(0.0);
         }
         let n = self.b - cl.l0();
+        assert!(2 * members.len() <= p && fin.len() == n * p);
         let scale = 1.0 / (2.0 * PI);
         for (q, mem) in members.iter().enumerate() {
             let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
@@ -218,6 +219,7 @@ impl Plan {
         let next = self.next_cluster(t, buf, c, ch, true, coef.get(), members);
         self.run_forward(sc, ch, p, n, blk, next);
         let (mem, nm) = members(cl);
+        assert!(2 * nm <= p && sc.out.len() >= n * p);
         for (q, mem) in mem[..nm].iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
             let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];

@@ -185,7 +185,7 @@ impl Plan {
 }
 
 /// Clusters ahead whose slice values [`prefetch_slots`] requests.
-const PREFETCH_SLOTS: usize = 32;
+const PREFETCH_SLOTS: usize = 8;
 
 /// Prefetch the slice values of cluster `c`'s slots in the slices `sp` (into L2 for
 /// reading, into L1 for writing with `write`): the slots of a cluster lie in different
