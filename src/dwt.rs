@@ -4,7 +4,7 @@
 //! recurrence runs in registers, vectorised over `W` betas; nothing of size
 //! `(B - m) x 2B` is ever stored.
 //!
-//! * forward: `f[i][q] += sum_s dt_{l0+i}(beta_s) * xin[row(s)][q]` (`P` real columns `q`)
+//! * forward: `f[i][q] = sum_s dt_{l0+i}(beta_s) * xin[row(s)][q]` (`P` real columns `q`)
 //! * inverse: `y[row(s)][q] = sum_i dt_{l0+i}(beta_s) * fin[i][q]`
 //!
 //! where `row(s)` is `s` or, for the chunk buffer's blocks, interleaves each beta with its
@@ -472,7 +472,7 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     }
 }
 
-/// Forward kernel body: `ft[i][q] += sum_s dt_i(beta_s) x[s][q]`, a reduction over the
+/// Forward kernel body: `ft[i][q] = sum_s dt_i(beta_s) x[s][q]`, a reduction over the
 /// betas for each degree.
 ///
 /// The loops run degree blocks (`DB` degrees) outer and beta vectors inner, so that the
@@ -540,12 +540,20 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let st = std::slice::from_raw_parts_mut(st_mem.as_mut_ptr() as *mut State<S>, nv);
         let first = st.iter().map(|s| s.i).min().unwrap_or(n);
         let mut i0 = first - first % DB;
+        // The first group of vectors writes the sums (zeros below its first block), the
+        // others add to them: `ft` needs no clearing beforehand.
+        let assign = v0 == 0;
+        if assign {
+            std::ptr::write_bytes(fp, 0, i0 * P);
+        }
         let mut fast = [0usize; FWD_VECTORS];
         while i0 < n {
             let mut acc = [S::zero(); ACC];
-            for j in 0..DB {
-                for h in 0..pv {
-                    acc[j * pv + h] = S::load(fp.add((i0 + j) * P + h * W));
+            if !assign {
+                for j in 0..DB {
+                    for h in 0..pv {
+                        acc[j * pv + h] = S::load(fp.add((i0 + j) * P + h * W));
+                    }
                 }
             }
             // Vectors that start inside this block, still have inactive lanes or end in
@@ -750,10 +758,10 @@ entry!(inv_avx512_8, "avx512f,fma", inverse_body, Avx512, 8, 8);
 entry!(inv_avx2_16, "avx2,fma", inverse_body, Avx2, 4, 16);
 entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 
-/// Forward kernel: `ft[i*P + q] += sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]`, `P` = 8 or
-/// 16 (`row` see [`Lanes::interleaved`]): degree-major, the inverse kernel's input layout.
-/// `ft` holds at least `(n + W) * P` values, `W = isa.lanes()` (the rows from `n` on may
-/// be written with zeros added).
+/// Forward kernel: `ft[i*P + q] = sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]` for `i < n`,
+/// `P` = 8 or 16 (`row` see [`Lanes::interleaved`]): degree-major, the inverse kernel's
+/// input layout; what `ft` held before is ignored. `ft` holds at least `(n + W) * P`
+/// values, `W = isa.lanes()` (rows from `n` on may be written with zeros).
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
@@ -959,7 +967,9 @@ mod tests {
                                 interleaved: false,
                                 prefetch: Prefetch::none(),
                             };
+                            // Stale values in every row the kernel must write.
                             let mut f = vec![0.0; (n + 8) * pw];
+                            f[..n * pw].fill(f64::NAN);
                             let mut y = vec![f64::NAN; nbs * pw];
                             forward(isa, pw, &rec, &lanes, &x, &mut f);
                             inverse(isa, pw, &rec, &lanes, &fin, &mut y);
@@ -1013,7 +1023,7 @@ mod tests {
             for pw in [8usize, 16] {
                 let xin = pseudo(nb * pw, 7 + m as u64);
                 let fin = pseudo(n * pw, 11 + mp as u64);
-                let mut f_ref = vec![0.0; (n + 8) * pw];
+                let mut f_ref = vec![f64::NAN; (n + 8) * pw];
                 let mut y_ref = vec![0.0; nb * pw];
                 forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref);
                 inverse(Isa::Scalar, pw, &rec, &lanes, &fin, &mut y_ref);
@@ -1021,7 +1031,7 @@ mod tests {
                     if !isa.is_supported() {
                         continue;
                     }
-                    let mut f = vec![0.0; (n + 8) * pw];
+                    let mut f = vec![f64::NAN; (n + 8) * pw];
                     let mut y = vec![0.0; nb * pw];
                     forward(isa, pw, &rec, &lanes, &xin, &mut f);
                     inverse(isa, pw, &rec, &lanes, &fin, &mut y);
@@ -1035,7 +1045,11 @@ mod tests {
                             .fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
                         e / scale
                     };
-                    let (ef, ey) = (rel(&f, &f_ref), rel(&y, &y_ref));
+                    // Rows from n on are not part of the result; every row below is
+                    // written (f starts out NaN, which `max` would otherwise skip).
+                    let nf = n * pw;
+                    assert!(f[..nf].iter().chain(&f_ref[..nf]).all(|v| v.is_finite()));
+                    let (ef, ey) = (rel(&f[..nf], &f_ref[..nf]), rel(&y, &y_ref));
                     assert!(
                         ef < 1e-12 && ey < 1e-12,
                         "{isa:?} m={m} mp={mp} P={pw}: {ef} {ey}"

@@ -193,6 +193,15 @@ pub struct Plan {
     buf_bytes: usize,
 }
 
+/// A cluster of the processing order for the DWT stage: its index, the cluster, and the
+/// one after it (whose memory its kernel prefetches), if any.
+#[derive(Clone, Copy)]
+struct At {
+    c: usize,
+    cl: Cluster,
+    next: Option<Cluster>,
+}
+
 /// Shared mutable pointer for disjoint parallel writes.
 #[derive(Clone, Copy)]
 struct SyncPtr<T>(*mut T);
@@ -695,8 +704,8 @@ impl Plan {
             true,
             &self.blocks,
             |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
-            |sc, c, cl, ch, buf, first| unsafe {
-                self.forward_cluster(sc, &self.blocks, all_members, c, cl, ch, buf, coef, first);
+            |sc, at, ch, buf, first| unsafe {
+                self.forward_cluster(sc, &self.blocks, all_members, at, ch, buf, coef, first);
             },
         )
     }
@@ -713,8 +722,8 @@ impl Plan {
             false,
             &self.blocks,
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
-            |sc, c, cl, ch, buf, _| unsafe {
-                self.inverse_cluster(sc, &self.blocks, all_members, c, cl, ch, buf, coeffs)
+            |sc, at, ch, buf, _| unsafe {
+                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs)
             },
         )
     }
@@ -729,7 +738,7 @@ impl Plan {
         forward: bool,
         t: &Blocks,
         fft: impl Fn(&Chunk, *mut f64) -> Result<()> + Sync,
-        cluster: impl Fn(&mut Scratch, usize, &Cluster, &Chunk, *mut f64, bool) + Sync,
+        cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, bool) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
@@ -747,9 +756,7 @@ impl Plan {
                         fft_stage()?;
                     }
                     let t1 = Instant::now();
-                    self.for_each_cluster(t, |sc, c, cl| {
-                        cluster(sc, c, cl, &ch, bp.get(), ci == 0)
-                    });
+                    self.for_each_cluster(t, |sc, at| cluster(sc, at, &ch, bp.get(), ci == 0));
                     times.dwt += t1.elapsed().as_secs_f64();
                     if !forward {
                         fft_stage()?;
@@ -762,11 +769,11 @@ impl Plan {
         Ok(times)
     }
 
-    /// Run `f(scratch, index, cluster)` on every cluster in parallel (work stealing over
-    /// runs of consecutive clusters, whose blocks are consecutive in the chunk buffer).
-    /// While a cluster's kernel runs it prefetches what the next one will touch (see
-    /// `Plan::next_cluster`).
-    fn for_each_cluster(&self, t: &Blocks, f: impl Fn(&mut Scratch, usize, &Cluster) + Sync) {
+    /// Run `f(scratch, at)` on every cluster in parallel (work stealing over runs of
+    /// consecutive clusters, whose blocks are consecutive in the chunk buffer). While a
+    /// cluster's kernel runs it prefetches what the next one will touch (see
+    /// `Plan::next_cluster`), so `at` carries that one too; each cluster is built once.
+    fn for_each_cluster(&self, t: &Blocks, f: impl Fn(&mut Scratch, &At) + Sync) {
         let nc = t.len();
         const RUN: usize = 8;
         (0..nc.div_ceil(RUN)).into_par_iter().for_each(|r| {
@@ -786,8 +793,13 @@ impl Plan {
                 let (m, mp) = self.clusters[c];
                 Cluster::new(m as usize, mp as usize)
             };
+            let mut cl = pair(c0);
             for c in c0..c1 {
-                f(sc, c, &pair(c));
+                let next = (c + 1 < nc).then(|| pair(c + 1));
+                f(sc, &At { c, cl, next });
+                if let Some(n) = next {
+                    cl = n;
+                }
             }
         });
     }

@@ -138,8 +138,8 @@ impl Plan {
         blk[2 * ch.h * p..2 * ch.hp * p].fill(0.0);
     }
 
-    /// The forward kernel on `xin` (a block) into `sc.out`, zeroed first: degree `i` of
-    /// column `q` (the real or imaginary part of a slot) at `i * p + q`.
+    /// The forward kernel on `xin` (a block) into `sc.out`: degree `i` of column `q` (the
+    /// real or imaginary part of a slot) at `i * p + q`.
     /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
     pub(super) fn run_forward(
         &self,
@@ -152,7 +152,6 @@ impl Plan {
     ) {
         let mut out = std::mem::take(&mut sc.out);
         let f = &mut out[..(n + 8) * p];
-        f.fill(0.0);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.prefetch = next;
@@ -160,7 +159,7 @@ impl Plan {
         sc.out = out;
     }
 
-    /// What the cluster after `c` in layout `t` will touch: its block of the chunk buffer
+    /// What the cluster after `at` in layout `t` will touch: its block of the chunk buffer
     /// (with `block`) and its coefficient rows (`members` of it), as prefetch hints (never
     /// read through these pointers).
     #[allow(clippy::too_many_arguments)]
@@ -168,22 +167,20 @@ impl Plan {
         &self,
         t: &Blocks,
         buf: *mut f64,
-        c: usize,
+        at: &At,
         ch: &Chunk,
         block: bool,
         coef: *const Complex64,
         members: Members,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
-        if c + 1 < t.len() {
+        if let Some(cl) = &at.next {
             if block {
-                let lanes = ch.lanes() * t.p(c + 1);
-                pf.push(buf.wrapping_add(t.offset(c + 1)) as *const f64, lanes);
+                let lanes = ch.lanes() * t.p(at.c + 1);
+                pf.push(buf.wrapping_add(t.offset(at.c + 1)) as *const f64, lanes);
             }
-            let (m, mp) = self.clusters[c + 1];
-            let cl = Cluster::new(m as usize, mp as usize);
             let n = self.b - cl.l0();
-            let (mem, nm) = members(&cl);
+            let (mem, nm) = members(cl);
             for mem in &mem[..nm] {
                 let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
                 pf.push(row as *const f64, 2 * n);
@@ -192,7 +189,7 @@ impl Plan {
         pf
     }
 
-    /// Forward DWT of cluster `c` of layout `t` over one chunk, accumulated into `coef`
+    /// Forward DWT of cluster `at` of layout `t` over one chunk, accumulated into `coef`
     /// for the order pairs `members` gives (the real forward fills the other half of the
     /// coefficients afterwards, see `Plan::fill_partners`).
     ///
@@ -205,18 +202,18 @@ impl Plan {
         sc: &mut Scratch,
         t: &Blocks,
         members: Members,
-        c: usize,
-        cl: &Cluster,
+        at: &At,
         ch: &Chunk,
         buf: *mut f64,
         coef: SyncPtr<Complex64>,
         first: bool,
     ) {
+        let (c, cl) = (at.c, &at.cl);
         let n = self.setup(sc, cl, ch);
         let p = t.p(c);
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        let next = self.next_cluster(t, buf, c, ch, true, coef.get(), members);
+        let next = self.next_cluster(t, buf, at, ch, true, coef.get(), members);
         self.run_forward(sc, ch, p, n, blk, next);
         let (mem, nm) = members(cl);
         assert!(2 * nm <= p && sc.out.len() >= n * p);
@@ -227,7 +224,7 @@ impl Plan {
         }
     }
 
-    /// Inverse DWT of cluster `c` of layout `t` over one chunk (the order pairs `members`
+    /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
     /// gives), written into its block.
     ///
     /// # Safety
@@ -238,12 +235,12 @@ impl Plan {
         sc: &mut Scratch,
         t: &Blocks,
         members: Members,
-        c: usize,
-        cl: &Cluster,
+        at: &At,
         ch: &Chunk,
         buf: *mut f64,
         coef: &[Complex64],
     ) {
+        let (c, cl) = (at.c, &at.cl);
         let n = self.setup(sc, cl, ch);
         let p = t.p(c);
         let (mem, nm) = members(cl);
@@ -252,7 +249,7 @@ impl Plan {
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
-        lanes.prefetch = self.next_cluster(t, buf, c, ch, false, coef.as_ptr(), members);
+        lanes.prefetch = self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members);
         dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
         sc.data = data;
     }

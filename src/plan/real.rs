@@ -117,13 +117,13 @@ impl Plan {
         self.real_fft()?;
         let input = SyncInput(input);
         let coef = SyncPtr(coeffs.as_mut_ptr());
+        let t = self.real_blocks()?;
         let mut times = self.run_chunks(
             true,
-            self.real_blocks()?,
+            t,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
-            |sc, c, cl, ch, buf, first| unsafe {
-                let t = self.blocks_real.as_ref().expect("real layout");
-                self.forward_cluster(sc, t, representatives, c, cl, ch, buf, coef, first);
+            |sc, at, ch, buf, first| unsafe {
+                self.forward_cluster(sc, t, representatives, at, ch, buf, coef, first);
             },
         )?;
         // The chunks accumulated the representatives only (half the coefficient traffic per
@@ -174,13 +174,13 @@ impl Plan {
         self.check(false, samples.len(), coeffs.len())?;
         self.real_fft()?;
         let out = SyncPtr(samples.as_mut_ptr());
+        let t = self.real_blocks()?;
         self.run_chunks(
             false,
-            self.real_blocks()?,
+            t,
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
-            |sc, c, cl, ch, buf, _| unsafe {
-                let t = self.blocks_real.as_ref().expect("real layout");
-                self.inverse_cluster(sc, t, representatives, c, cl, ch, buf, coeffs)
+            |sc, at, ch, buf, _| unsafe {
+                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs)
             },
         )
     }
