@@ -490,14 +490,15 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 /// instruction first, so the latency-bound chain of steps never waits behind a block of
 /// independent multiply-adds.
 ///
-/// `DB <= W`: callers size `ft` for `n + W` degrees.
+/// `DB <= W`: callers size `ft` for `n + W` degrees. Returns the lowest degree index any
+/// lane reached active (rows below it are zero).
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
     rec: &Rec,
     lanes: &Lanes,
     xin: &[f64],
     ft: &mut [f64],
-) {
+) -> usize {
     let n = rec.len();
     let nb = lanes.tau.len();
     let pv = P / W;
@@ -520,6 +521,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         (xin.as_ptr().add(r0 * P), step * P)
     };
     let mut dbuf = [DBlock([0.0; 128]); 2];
+    let mut lo = n;
     let mut v0 = 0;
     while v0 < nb {
         // Up to FWD_VECTORS vectors, each through its negligible prefix.
@@ -539,6 +541,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
         let st = std::slice::from_raw_parts_mut(st_mem.as_mut_ptr() as *mut State<S>, nv);
         let first = st.iter().map(|s| s.i).min().unwrap_or(n);
+        lo = lo.min(first);
         let mut i0 = first - first % DB;
         // The first group of vectors writes the sums (zeros below its first block), the
         // others add to them: `ft` needs no clearing beforehand.
@@ -642,6 +645,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         }
         v0 += nv * W;
     }
+    lo
 }
 
 /// `acc[q] += v * row[q]` (the inverse kernel's accumulation of one degree).
@@ -652,30 +656,61 @@ unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *c
     }
 }
 
+/// Fills rows `from..to` of the inverse kernel's input (see [`inverse`]).
+pub(crate) type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
+
+/// Vectors of betas whose states the inverse kernel sets up before it needs their input
+/// rows.
+const INV_VECTORS: usize = 16;
+
 #[inline(always)]
 unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
     rec: &Rec,
     lanes: &Lanes,
-    fin: &[f64],
+    fin: &mut [f64],
+    fill: Fill,
     y: &mut [f64],
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
-    let fp = fin.as_ptr();
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
-    let mut g0 = 0;
-    while g0 < nb {
-        let (g, group) = group_states::<S, W>(rec, lanes, g0, nb, n);
+    // Rows `have..n` of `fin` are filled.
+    let mut have = n;
+    let mut v0 = 0;
+    while v0 < nb {
+        // Up to INV_VECTORS vectors through their negligible prefixes, then the rows from
+        // the first degree any of them needs.
+        let nv = ((nb - v0) / W).min(INV_VECTORS);
+        // Only the first `nv` entries are used; they are written below before any read.
+        let mut st_mem = [const { std::mem::MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
+        let mut g = 0;
+        while g < nv {
+            let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
+            for (k, s) in group.iter().enumerate().take(gn) {
+                let mut s = *s;
+                s.finish_prefix(rec, n);
+                st_mem[g + k].write(s);
+            }
+            g += gn;
+        }
+        // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
+        let states = std::slice::from_raw_parts(st_mem.as_ptr() as *const State<S>, nv);
+        let first = states.iter().map(|s| s.i).min().unwrap_or(n);
+        if first < have {
+            fill(fin, first, have);
+            have = first;
+        }
+        let fp = fin.as_ptr();
         let mut gi = 0;
-        while gi < g {
+        while gi < nv {
             // With 8 columns, two vectors run together once both are fully active: each
             // data broadcast then feeds two multiply-adds, and the two recurrences are
             // independent chains (one vector's step and 8 multiply-adds per degree leave
             // the pipes half idle).
-            let pair = P <= 8 && gi + 1 < g;
-            let mut st = [group[gi], group[(gi + 1).min(g - 1)]];
+            let pair = P <= 8 && gi + 1 < nv;
+            let mut st = [states[gi], states[(gi + 1).min(nv - 1)]];
             let mut acc = [[S::zero(); P]; 2];
             pf.issue(pf_per_vector * (1 + pair as usize));
             if pair {
@@ -713,7 +748,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
             // lines first (the chunk buffer is far larger than the caches, and read back
             // only by the FFT stage).
             for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
-                let (r0, step) = lanes.rows(g0 + (gi + k) * W);
+                let (r0, step) = lanes.rows(v0 + (gi + k) * W);
                 for q0 in (0..P).step_by(W) {
                     let dst = y.as_mut_ptr().add(r0 * P + q0);
                     S::stream_transposed(&a[q0..q0 + W], dst, step * P);
@@ -721,7 +756,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
             }
             gi += 1 + pair as usize;
         }
-        g0 += g * W;
+        v0 += nv * W;
     }
 }
 
@@ -729,14 +764,14 @@ macro_rules! entry {
     ($name:ident, $feat:literal, inverse_body, $S:ty, $W:literal, $N:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) {
-            inverse_body::<$S, $W, $N>(rec, lanes, a, b)
+        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &mut [f64], f: Fill, b: &mut [f64]) {
+            inverse_body::<$S, $W, $N>(rec, lanes, a, f, b)
         }
     };
     ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal, $DB:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) {
+        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) -> usize {
             forward_body::<$S, $W, $N, $DB>(rec, lanes, a, b)
         }
     };
@@ -763,9 +798,20 @@ entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 /// input layout; what `ft` held before is ignored. `ft` holds at least `(n + W) * P`
 /// values, `W = isa.lanes()` (rows from `n` on may be written with zeros).
 ///
+/// Returns `lo <= n`: rows `0..lo` are zero because every lane of every beta is still in
+/// its negligible prefix there (see [`Lanes::skip`]). Callers that accumulate the sums
+/// elsewhere need only add rows `lo..n`.
+///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
-pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) {
+pub(crate) fn forward(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    xin: &[f64],
+    ft: &mut [f64],
+) -> usize {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
@@ -792,7 +838,21 @@ pub(crate) fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64],
 
 /// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
 /// (the layout of the forward kernel's input, see `plan/blocks.rs`).
-pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
+///
+/// The input rows are filled on demand: before it reads them, the kernel calls
+/// `fill(fin, from, to)` to fill rows `from..to` (the calls cover the rows from the first
+/// degree where some lane is past its negligible prefix up to `n`, top down, each row
+/// once; rows below are never read). A chunked inverse thus reads only the coefficients
+/// its betas need.
+pub(crate) fn inverse(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: &mut [f64],
+) {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
@@ -802,15 +862,15 @@ pub(crate) fn inverse(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, fin: &[f64],
     unsafe {
         match (isa, p) {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 16) => inv_avx512_16(rec, lanes, fin, y),
+            (Isa::Avx512, 16) => inv_avx512_16(rec, lanes, fin, fill, y),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 8) => inv_avx512_8(rec, lanes, fin, y),
+            (Isa::Avx512, 8) => inv_avx512_8(rec, lanes, fin, fill, y),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 16) => inv_avx2_16(rec, lanes, fin, y),
+            (Isa::Avx2, 16) => inv_avx2_16(rec, lanes, fin, fill, y),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 8) => inv_avx2_8(rec, lanes, fin, y),
-            (_, 16) => inverse_body::<Scalar, 1, 16>(rec, lanes, fin, y),
-            (_, 8) => inverse_body::<Scalar, 1, 8>(rec, lanes, fin, y),
+            (Isa::Avx2, 8) => inv_avx2_8(rec, lanes, fin, fill, y),
+            (_, 16) => inverse_body::<Scalar, 1, 16>(rec, lanes, fin, fill, y),
+            (_, 8) => inverse_body::<Scalar, 1, 8>(rec, lanes, fin, fill, y),
             _ => unreachable!("P must be 8 or 16"),
         }
     }
@@ -867,6 +927,39 @@ pub(crate) fn column(
 mod tests {
     use super::*;
 
+    /// [`inverse`] with its input rows filled on demand from `fin`: rows start as NaN, so
+    /// a read before the fill shows in `y`. Checks the fill contract (top down, each row
+    /// once, down to a contiguous end at `n`) and returns the lowest row filled.
+    pub(super) fn inverse_from(
+        isa: Isa,
+        pw: usize,
+        rec: &Rec,
+        lanes: &Lanes,
+        fin: &[f64],
+        y: &mut [f64],
+    ) -> usize {
+        let n = rec.len();
+        let mut buf = vec![f64::NAN; n * pw];
+        let mut have = n;
+        inverse(
+            isa,
+            pw,
+            rec,
+            lanes,
+            &mut buf,
+            &mut |b: &mut [f64], from: usize, to: usize| {
+                assert!(
+                    from < to && to == have,
+                    "fill {from}..{to} with rows {have}.. filled"
+                );
+                b[from * pw..to * pw].copy_from_slice(&fin[from * pw..to * pw]);
+                have = from;
+            },
+            y,
+        );
+        have
+    }
+
     fn pseudo(n: usize, seed: u64) -> Vec<f64> {
         let mut s = seed;
         (0..n)
@@ -895,13 +988,24 @@ mod tests {
         mp: usize,
         nbs: usize,
     ) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let ks: Vec<usize> = (0..nbs).map(|s| s * (2 * b) / nbs).collect();
+        cluster_setup_at(b, m, mp, &ks)
+    }
+
+    /// As [`cluster_setup`], for the grid betas `ks`.
+    pub(super) fn cluster_setup_at(
+        b: usize,
+        m: usize,
+        mp: usize,
+        ks: &[usize],
+    ) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let nbs = ks.len();
         let bt = BetaTables::grid(b);
         let norm = crate::wigner::start_norms(b)[m * (m + 1) / 2 + mp];
         let mut rc = RecCoeffs::new(b - m);
         RecTables::new(b).coeffs(m, mp, &mut rc);
         let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
-        for s in 0..nbs {
-            let k = s * (2 * b) / nbs;
+        for (s, &k) in ks.iter().enumerate() {
             tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
             (p[s], sc[s]) = bt.start(k, m, mp, norm, 1.0, test_skip_bits());
         }
@@ -935,6 +1039,8 @@ mod tests {
     #[test]
     fn forward_is_the_adjoint_of_inverse() {
         let b = 67;
+        // Rows below `lo` summed over the runs: the skipped rows must occur here.
+        let mut rows_below_lo = 0;
         for &(m, mp) in &[
             (0usize, 0usize),
             (5, 2),
@@ -944,8 +1050,15 @@ mod tests {
             (66, 66),
         ] {
             let n = b - m;
-            for nbs in [24usize, 40, 56, 72] {
-                let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+            // Spread over the grid, and (16) the 8 betas nearest each pole, where the
+            // kernels skip the first degrees of every lane.
+            for nbs in [24usize, 40, 56, 72, 16] {
+                let (rc, tau, p, sc) = if nbs == 16 {
+                    let ks: Vec<usize> = (0..8).chain(2 * b - 8..2 * b).collect();
+                    cluster_setup_at(b, m, mp, &ks)
+                } else {
+                    cluster_setup(b, m, mp, nbs)
+                };
                 let rec = Rec::new(&rc, n);
                 for pw in [8usize, 16] {
                     let x = pseudo(nbs * pw, 3 + nbs as u64);
@@ -971,8 +1084,12 @@ mod tests {
                             let mut f = vec![0.0; (n + 8) * pw];
                             f[..n * pw].fill(f64::NAN);
                             let mut y = vec![f64::NAN; nbs * pw];
-                            forward(isa, pw, &rec, &lanes, &x, &mut f);
-                            inverse(isa, pw, &rec, &lanes, &fin, &mut y);
+                            let lo = forward(isa, pw, &rec, &lanes, &x, &mut f);
+                            assert!(f[..lo * pw].iter().all(|&v| v == 0.0), "rows below lo");
+                            let filled = inverse_from(isa, pw, &rec, &lanes, &fin, &mut y);
+                            // Both kernels find the same first degree any lane needs.
+                            assert_eq!(filled, lo, "first row read by the inverse");
+                            rows_below_lo += lo;
                             let dot = |a: &[f64], b: &[f64]| {
                                 a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>()
                             };
@@ -1007,6 +1124,7 @@ mod tests {
                 }
             }
         }
+        assert!(rows_below_lo > 0, "no run skipped a row");
     }
 
     /// Every SIMD path agrees with the portable scalar one, forward and inverse,
@@ -1026,7 +1144,7 @@ mod tests {
                 let mut f_ref = vec![f64::NAN; (n + 8) * pw];
                 let mut y_ref = vec![0.0; nb * pw];
                 forward(Isa::Scalar, pw, &rec, &lanes, &xin, &mut f_ref);
-                inverse(Isa::Scalar, pw, &rec, &lanes, &fin, &mut y_ref);
+                inverse_from(Isa::Scalar, pw, &rec, &lanes, &fin, &mut y_ref);
                 for isa in [Isa::Avx512, Isa::Avx2] {
                     if !isa.is_supported() {
                         continue;
@@ -1034,7 +1152,7 @@ mod tests {
                     let mut f = vec![f64::NAN; (n + 8) * pw];
                     let mut y = vec![0.0; nb * pw];
                     forward(isa, pw, &rec, &lanes, &xin, &mut f);
-                    inverse(isa, pw, &rec, &lanes, &fin, &mut y);
+                    inverse_from(isa, pw, &rec, &lanes, &fin, &mut y);
                     // FMA and plain multiply-add round differently; the recurrence error
                     // grows like l * eps (l <= 200 here), so compare relative to the largest value.
                     let rel = |u: &[f64], r: &[f64]| {
@@ -1132,9 +1250,19 @@ mod kernel_speed {
             };
             let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
             for _ in 0..7 {
-                tf = tf.min(batch(&mut || forward(isa, pw, &rec, &lanes, &xin, &mut f)));
+                tf = tf.min(batch(&mut || {
+                    forward(isa, pw, &rec, &lanes, &xin, &mut f);
+                }));
                 ti = ti.min(batch(&mut || {
-                    inverse(isa, pw, &rec, &lanes, &f[..n * pw], &mut y)
+                    inverse(
+                        isa,
+                        pw,
+                        &rec,
+                        &lanes,
+                        &mut f[..n * pw],
+                        &mut |_, _, _| {},
+                        &mut y,
+                    )
                 }));
                 peak = peak.max(fma_peak());
             }
@@ -1182,7 +1310,16 @@ mod stage_speed {
                 tf += dt;
                 qtf[4 * m / b] += dt;
                 let t = std::time::Instant::now();
-                inverse(isa, pw, &rec, &lanes, &f[..n * pw], &mut y[..nbs * pw]);
+                let y = &mut y[..nbs * pw];
+                inverse(
+                    isa,
+                    pw,
+                    &rec,
+                    &lanes,
+                    &mut f[..n * pw],
+                    &mut |_, _, _| {},
+                    y,
+                );
                 let dt = t.elapsed().as_secs_f64();
                 ti += dt;
                 qt[4 * m / b] += dt;

@@ -25,6 +25,9 @@ pub(super) struct Scratch {
     pub data: Vec<f64>,
     /// Forward: the kernel's sums (`n + 8` degrees x `P`, see [`Plan::run_forward`]).
     pub out: Vec<f64>,
+    /// The lowest degree `l` the worker's last cluster needed in this chunk: the guess
+    /// for where the next cluster's coefficient rows start to matter (prefetch only).
+    pub from_l: usize,
 }
 
 impl Scratch {
@@ -36,6 +39,7 @@ impl Scratch {
             sc: vec![0.0; lanes],
             data: vec![0.0; b * 16],
             out: vec![0.0; (b + 8) * 16],
+            from_l: 0,
         }
     }
 
@@ -91,27 +95,36 @@ impl Plan {
         n
     }
 
-    /// Inverse DWT input: `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree
-    /// `l0 + i`, times the member's sign and `1/(2 pi)`; unused columns zero.
+    /// Inverse DWT input, rows `from..to` of `fin` (`n` rows of `p` values):
+    /// `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree `l0 + i`, times the
+    /// member's sign and `1/(2 pi)`; unused columns zero.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn gather_coeffs(
         &self,
         fin: &mut [f64],
         cl: &Cluster,
         members: &[Member],
         coef: &[Complex64],
+        from: usize,
+        to: usize,
     ) {
-        let p = fin.len() / (self.b - cl.l0());
-        if members.len() * 2 < p {
-            fin.fill(0.0);
-        }
         let n = self.b - cl.l0();
-        assert!(2 * members.len() <= p && fin.len() == n * p);
+        let p = fin.len() / n;
+        assert!(2 * members.len() <= p && fin.len() == n * p && from <= to && to <= n);
+        let rows = &mut fin[from * p..to * p];
+        if members.len() * 2 < p {
+            rows.fill(0.0);
+        }
         let scale = 1.0 / (2.0 * PI);
         for (q, mem) in members.iter().enumerate() {
-            let src = &coef[block_start(self.b, mem.m, mem.mp)..][..n];
-            let sg = [mem.sign_at(cl.m) * scale, mem.sign_at(cl.m + 1) * scale];
-            // SAFETY: `fin` has `n` rows of `p >= 2 members.len()` values.
-            unsafe { coeffs::gather(fin[2 * q..].as_mut_ptr(), src.as_ptr(), p, n, sg) };
+            let src = &coef[block_start(self.b, mem.m, mem.mp) + from..][..to - from];
+            // Degree `l0 + from` has the parity of `cl.m + from`.
+            let sg = [
+                mem.sign_at(cl.m + from) * scale,
+                mem.sign_at(cl.m + from + 1) * scale,
+            ];
+            // SAFETY: `rows` has `to - from` rows of `p >= 2 members.len()` values.
+            unsafe { coeffs::gather(rows[2 * q..].as_mut_ptr(), src.as_ptr(), p, to - from, sg) };
         }
     }
 
@@ -141,6 +154,7 @@ impl Plan {
     /// The forward kernel on `xin` (a block) into `sc.out`: degree `i` of column `q` (the
     /// real or imaginary part of a slot) at `i * p + q`.
     /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
+    /// Returns the kernel's `lo`: rows below it are zero.
     pub(super) fn run_forward(
         &self,
         sc: &mut Scratch,
@@ -149,19 +163,22 @@ impl Plan {
         n: usize,
         xin: &[f64],
         next: Prefetch,
-    ) {
+    ) -> usize {
         let mut out = std::mem::take(&mut sc.out);
         let f = &mut out[..(n + 8) * p];
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.prefetch = next;
-        dwt::forward(self.isa, p, &rec, &lanes, xin, f);
+        let lo = dwt::forward(self.isa, p, &rec, &lanes, xin, f);
         sc.out = out;
+        lo
     }
 
     /// What the cluster after `at` in layout `t` will touch: its block of the chunk buffer
-    /// (with `block`) and its coefficient rows (`members` of it), as prefetch hints (never
-    /// read through these pointers).
+    /// (with `block`) and its coefficient rows (`members` of it) from degree `from_l`
+    /// less a margin, as prefetch hints (never read through these pointers). Rows below
+    /// the first degree some beta of the chunk needs are not touched (see
+    /// [`dwt::forward`]); `from_l` guesses that degree from the previous cluster.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn next_cluster(
         &self,
@@ -172,6 +189,7 @@ impl Plan {
         block: bool,
         coef: *const Complex64,
         members: Members,
+        from_l: usize,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
         if let Some(cl) = &at.next {
@@ -179,11 +197,14 @@ impl Plan {
                 let lanes = ch.lanes() * t.p(at.c + 1);
                 pf.push(buf.wrapping_add(t.offset(at.c + 1)) as *const f64, lanes);
             }
+            // Neighbouring clusters need similar degrees; a few below the guess cover
+            // the drift from one to the next.
+            let lo = from_l.saturating_sub(8).max(cl.l0()).min(self.b) - cl.l0();
             let n = self.b - cl.l0();
             let (mem, nm) = members(cl);
             for mem in &mem[..nm] {
-                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp));
-                pf.push(row as *const f64, 2 * n);
+                let row = coef.wrapping_add(block_start(self.b, mem.m, mem.mp) + lo);
+                pf.push(row as *const f64, 2 * (n - lo));
             }
         }
         pf
@@ -213,14 +234,24 @@ impl Plan {
         let p = t.p(c);
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        let next = self.next_cluster(t, buf, at, ch, true, coef.get(), members);
-        self.run_forward(sc, ch, p, n, blk, next);
+        // The first chunk writes every row of the coefficients.
+        let from_l = if first { 0 } else { sc.from_l };
+        let next = self.next_cluster(t, buf, at, ch, true, coef.get(), members, from_l);
+        let lo = self.run_forward(sc, ch, p, n, blk, next);
+        sc.from_l = cl.l0() + lo;
+        // Later chunks add only the degrees where some beta of the chunk is past its
+        // negligible prefix: the coefficient array's read-modify-write per chunk is the
+        // main memory traffic of a chunked forward (B = 512), and near the poles most
+        // clusters contribute nothing to most degrees.
+        let lo = if first { 0 } else { lo.min(n) };
         let (mem, nm) = members(cl);
         assert!(2 * nm <= p && sc.out.len() >= n * p);
         for (q, mem) in mem[..nm].iter().enumerate() {
-            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
-            let sg = [mem.sign_at(cl.m), mem.sign_at(cl.m + 1)];
-            coeffs::scatter(dst, sc.out.as_ptr().add(2 * q), p, n, sg, !first);
+            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp) + lo);
+            // Degree `l0 + lo` has the parity of `cl.m + lo`.
+            let sg = [mem.sign_at(cl.m + lo), mem.sign_at(cl.m + lo + 1)];
+            let src = sc.out.as_ptr().add(lo * p + 2 * q);
+            coeffs::scatter(dst, src, p, n - lo, sg, !first);
         }
     }
 
@@ -245,12 +276,29 @@ impl Plan {
         let p = t.p(c);
         let (mem, nm) = members(cl);
         let mut data = std::mem::take(&mut sc.data);
-        self.gather_coeffs(&mut data[..n * p], cl, &mem[..nm], coef);
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
-        lanes.prefetch = self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members);
-        dwt::inverse(self.isa, p, &rec, &lanes, &data[..n * p], blk);
+        let from_l = sc.from_l;
+        lanes.prefetch = self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members, from_l);
+        let mut lo = n;
+        // Only the degrees some beta of the chunk needs are read from the coefficients
+        // (near the poles most clusters need few or none): a chunked inverse reads the
+        // coefficient array once per chunk.
+        let mut fill = |fin: &mut [f64], from: usize, to: usize| {
+            self.gather_coeffs(fin, cl, &mem[..nm], coef, from, to);
+            lo = from;
+        };
+        dwt::inverse(
+            self.isa,
+            p,
+            &rec,
+            &lanes,
+            &mut data[..n * p],
+            &mut fill,
+            blk,
+        );
         sc.data = data;
+        sc.from_l = cl.l0() + lo;
     }
 }
