@@ -223,6 +223,7 @@ impl<T> SyncPtr<T> {
 /// down). In the blocks of the chunk buffer the two are adjacent rows `2j` and `2j+1`
 /// (`dwt::Lanes::interleaved`), so the FFT stage moves each mirrored pair of slices in
 /// and out of one contiguous piece of every block.
+#[derive(Clone, Copy)]
 struct Chunk {
     lo: usize,
     h: usize,
@@ -245,6 +246,36 @@ impl Chunk {
     /// `2j + 1`): `lo + j` and `2B-1-lo-j`.
     fn pair_betas(&self, b: usize, j: usize) -> (usize, usize) {
         (self.lo + j, 2 * b - 1 - self.lo - j)
+    }
+}
+
+/// The output array of an inverse as room for chunk buffers. The inverse's FFT stage
+/// writes the output slice of a beta only when that beta's chunk is done, so the slices of
+/// the betas of later chunks are free until then: a group of chunks whose buffers (all
+/// but the first, which uses the plan's buffer) fit there runs its DWT stage as one pass,
+/// reading each cluster's coefficients once for the whole group instead of once per
+/// chunk. At B = 512 the 22 chunks of the 5% memory rule become 6 groups.
+struct Spare {
+    /// Start of the output (`2B` slices of `slice_bytes`, beta slowest).
+    base: *mut u8,
+    slice_bytes: usize,
+}
+
+impl Spare {
+    /// Buffers of `bytes` each (a multiple of 64) for `g` chunks in the slices of the
+    /// betas `hi..2B-hi`, 64-byte aligned; `None` if they do not fit.
+    fn room(&self, b: usize, hi: usize, g: usize, bytes: usize) -> Option<Vec<*mut f64>> {
+        let (from, to) = (
+            hi * self.slice_bytes,
+            (2 * b).checked_sub(hi)? * self.slice_bytes,
+        );
+        let start = self.base.wrapping_add(from);
+        let from = from + start.align_offset(64);
+        (to >= from && to - from >= g * bytes).then(|| {
+            (0..g)
+                .map(|k| self.base.wrapping_add(from + k * bytes) as *mut f64)
+                .collect()
+        })
     }
 }
 
@@ -682,6 +713,48 @@ impl Plan {
         f(g.as_ref().expect("plan buffer present"))
     }
 
+    /// The chunks of layout `t` in groups that share one pass of the DWT stage, each with
+    /// its buffer: `None` for the plan's chunk buffer, else a part of the inverse's output
+    /// (see [`Spare`]). Without `spare` every group is one chunk.
+    fn chunk_groups(
+        &self,
+        t: &Blocks,
+        spare: Option<&Spare>,
+    ) -> Vec<Vec<(Chunk, Option<*mut f64>)>> {
+        let chunks: Vec<Chunk> = self.chunks(t).collect();
+        let bytes = (t.total() * 8).next_multiple_of(64);
+        let mut groups = Vec::new();
+        let mut i = 0;
+        while i < chunks.len() {
+            let mut g = 1;
+            let mut at = Vec::new();
+            if let Some(sp) = spare {
+                // Add chunks while the buffers of all but the first fit in the output
+                // slices of the betas after the group's (written only by later groups).
+                while i + g < chunks.len() {
+                    let hi = chunks[i + g].lo + chunks[i + g].h;
+                    match sp.room(self.b, hi, g, bytes) {
+                        Some(ptrs) => {
+                            at = ptrs;
+                            g += 1;
+                        }
+                        None => break,
+                    }
+                }
+            }
+            let mut group = vec![(chunks[i], None)];
+            group.extend(
+                chunks[i + 1..i + g]
+                    .iter()
+                    .zip(at)
+                    .map(|(c, p)| (*c, Some(p))),
+            );
+            groups.push(group);
+            i += g;
+        }
+        groups
+    }
+
     /// The chunks of layout `t`.
     fn chunks(&self, t: &Blocks) -> impl Iterator<Item = Chunk> + '_ {
         let (b, chunk) = (self.b, t.chunk);
@@ -703,8 +776,9 @@ impl Plan {
         self.run_chunks(
             true,
             &self.blocks,
+            None,
             |ch, buf| self.fft_chunk(ch, true, samples.as_ptr() as *mut Complex64, buf),
-            |sc, at, ch, buf, first| unsafe {
+            |sc, at, ch, buf, first, _| unsafe {
                 self.forward_cluster(sc, &self.blocks, all_members, at, ch, buf, coef, first);
             },
         )
@@ -718,37 +792,56 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
         let out = SyncPtr(samples.as_mut_ptr());
+        let spare = Spare {
+            base: samples.as_mut_ptr() as *mut u8,
+            slice_bytes: 4 * self.b * self.b * 16,
+        };
         self.run_chunks(
             false,
             &self.blocks,
+            Some(spare),
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
-            |sc, at, ch, buf, _| unsafe {
-                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs)
+            |sc, at, ch, buf, _, k| unsafe {
+                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, k)
             },
         )
     }
 
-    /// The chunk loop shared by every transform: for each chunk, the FFT stage and the DWT
-    /// of every cluster of layout `t`, in the order of the direction (forward: FFT then
-    /// DWT), timed. `first` tells the cluster stage whether this is the first chunk (the
-    /// forward assigns rather than accumulates then).
+    /// The chunk loop shared by every transform: for each group of chunks (see
+    /// [`Plan::chunk_groups`]), the FFT stage of each chunk and the DWT of every cluster of
+    /// layout `t` over the group's chunks, in the order of the direction (forward: FFT
+    /// then DWT), timed. The cluster stage gets `first` (the first chunk: the forward
+    /// assigns rather than accumulates then) and the chunk's position in its group (the
+    /// inverse reuses a cluster's coefficient rows within a group).
     #[allow(clippy::type_complexity)]
     fn run_chunks(
         &self,
         forward: bool,
         t: &Blocks,
+        spare: Option<Spare>,
         fft: impl Fn(&Chunk, *mut f64) -> Result<()> + Sync,
-        cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, bool) + Sync,
+        cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, bool, usize) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
+        let groups = self.chunk_groups(t, spare.as_ref());
         self.with_buf(|buf| {
-            let bp = SyncPtr(buf.as_mut_ptr() as *mut f64);
+            let bp = buf.as_mut_ptr() as *mut f64;
+            let groups: Vec<Vec<(Chunk, SyncPtr<f64>)>> = groups
+                .iter()
+                .map(|g| {
+                    g.iter()
+                        .map(|(c, p)| (*c, SyncPtr(p.unwrap_or(bp))))
+                        .collect()
+                })
+                .collect();
             self.pool().install(|| {
-                for (ci, ch) in self.chunks(t).enumerate() {
+                for (gi, group) in groups.iter().enumerate() {
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
-                        fft(&ch, bp.get())?;
+                        for (ch, buf) in group {
+                            fft(ch, buf.get())?;
+                        }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
                     };
@@ -756,7 +849,11 @@ impl Plan {
                         fft_stage()?;
                     }
                     let t1 = Instant::now();
-                    self.for_each_cluster(t, |sc, at| cluster(sc, at, &ch, bp.get(), ci == 0));
+                    self.for_each_cluster(t, |sc, at| {
+                        for (k, (ch, buf)) in group.iter().enumerate() {
+                            cluster(sc, at, ch, buf.get(), gi == 0 && k == 0, k);
+                        }
+                    });
                     times.dwt += t1.elapsed().as_secs_f64();
                     if !forward {
                         fft_stage()?;
@@ -839,6 +936,56 @@ impl Drop for Plan {
 
 #[cfg(test)]
 mod tests {
+    /// The chunk groups of an inverse with its output as room: in order, covering every
+    /// chunk once; every spare buffer 64-byte aligned, inside the output, clear of the
+    /// other buffers and of the output slices of its own and all earlier groups (which the
+    /// FFT stage writes before the buffer is read); fewer groups than chunks.
+    #[test]
+    fn chunk_groups_keep_clear_of_written_slices() {
+        for (b, real) in [(64usize, false), (64, true), (40, false), (37, true)] {
+            let opts = super::PlanOptions {
+                max_workspace_bytes: Some(1 << 20),
+                real,
+                ..Default::default()
+            };
+            let plan = super::Plan::new(b, &opts).unwrap();
+            let t = if real {
+                plan.blocks_real.as_ref().unwrap()
+            } else {
+                &plan.blocks
+            };
+            let slice_bytes = 4 * b * b * if real { 8 } else { 16 };
+            let total = 2 * b * slice_bytes;
+            let out = vec![0u8; total + 64];
+            let spare = super::Spare {
+                base: out.as_ptr().wrapping_add(8) as *mut u8,
+                slice_bytes,
+            };
+            let groups = plan.chunk_groups(t, Some(&spare));
+            let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
+            let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
+            assert_eq!(flat, chunks, "B={b} real={real}");
+            assert!(groups.len() < chunks.len(), "B={b} real={real}: no group");
+            let bytes = t.total() * 8;
+            for g in &groups {
+                assert!(g[0].1.is_none());
+                let written = g.last().map(|(c, _)| c.lo + c.h).unwrap();
+                let mut ranges: Vec<(usize, usize)> = Vec::new();
+                for (_, p) in &g[1..] {
+                    let a = (p.unwrap() as usize) - (spare.base as usize);
+                    assert_eq!((spare.base as usize + a) % 64, 0);
+                    assert!(
+                        a >= written * slice_bytes,
+                        "B={b}: buffer below the free slices"
+                    );
+                    assert!(a + bytes <= (2 * b - written) * slice_bytes, "B={b}: above");
+                    assert!(ranges.iter().all(|&(x, y)| a + bytes <= x || a >= y));
+                    ranges.push((a, a + bytes));
+                }
+            }
+        }
+    }
+
     /// After a plan is dropped none of its worker threads is still doing work: every one
     /// has run its exit handler (counted in `live`), which the drop waits for.
     #[test]

@@ -159,7 +159,6 @@ impl Blocks {
     }
 
     /// Doubles of the whole buffer.
-    #[cfg(test)]
     pub fn total(&self) -> usize {
         self.pofs[self.len()] * self.lanes
     }

@@ -28,6 +28,9 @@ pub(super) struct Scratch {
     /// The lowest degree `l` the worker's last cluster needed in this chunk: the guess
     /// for where the next cluster's coefficient rows start to matter (prefetch only).
     pub from_l: usize,
+    /// Inverse: rows `have..` of `data` hold the current cluster's coefficients (kept
+    /// over the chunks of a group, see `Plan::run_chunks`).
+    pub have: usize,
 }
 
 impl Scratch {
@@ -40,6 +43,7 @@ impl Scratch {
             data: vec![0.0; b * 16],
             out: vec![0.0; (b + 8) * 16],
             from_l: 0,
+            have: 0,
         }
     }
 
@@ -68,10 +72,14 @@ impl Plan {
     /// Recurrence coefficients and per-lane inputs (recurrence argument, scaled starting
     /// value) of a cluster for one chunk; returns the number of degrees. Padding lanes get
     /// zeros (a zero starting value keeps them at exactly 0).
-    pub(super) fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk) -> usize {
+    /// With `rec` false the recurrence coefficients are kept from the previous call (the
+    /// same cluster in another chunk).
+    pub(super) fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk, rec: bool) -> usize {
         let n = self.b - cl.l0();
-        sc.rec.resize(n);
-        self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
+        if rec {
+            sc.rec.resize(n);
+            self.rt.coeffs(cl.m, cl.mp, &mut sc.rec);
+        }
         let norm = self.norms[cl.m * (cl.m + 1) / 2 + cl.mp];
         let nl = ch.lanes();
         for (half, (u0, k0)) in ch.halves(self.b).into_iter().enumerate() {
@@ -230,7 +238,7 @@ impl Plan {
         first: bool,
     ) {
         let (c, cl) = (at.c, &at.cl);
-        let n = self.setup(sc, cl, ch);
+        let n = self.setup(sc, cl, ch, true);
         let p = t.p(c);
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
@@ -256,7 +264,9 @@ impl Plan {
     }
 
     /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
-    /// gives), written into its block.
+    /// gives), written into its block. `k`: the chunk's position in its group; for `k > 0`
+    /// the previous call was this cluster on the group's previous chunk, whose recurrence
+    /// coefficients and coefficient rows are reused.
     ///
     /// # Safety
     /// `buf` is the chunk buffer; no other task writes this cluster's block.
@@ -270,9 +280,10 @@ impl Plan {
         ch: &Chunk,
         buf: *mut f64,
         coef: &[Complex64],
+        k: usize,
     ) {
         let (c, cl) = (at.c, &at.cl);
-        let n = self.setup(sc, cl, ch);
+        let n = self.setup(sc, cl, ch, k == 0);
         let p = t.p(c);
         let (mem, nm) = members(cl);
         let mut data = std::mem::take(&mut sc.data);
@@ -282,11 +293,14 @@ impl Plan {
         let from_l = sc.from_l;
         lanes.prefetch = self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members, from_l);
         let mut lo = n;
+        let mut have = if k == 0 { n } else { sc.have };
         // Only the degrees some beta of the chunk needs are read from the coefficients
-        // (near the poles most clusters need few or none): a chunked inverse reads the
-        // coefficient array once per chunk.
+        // (near the poles most clusters need few or none), and each once per group.
         let mut fill = |fin: &mut [f64], from: usize, to: usize| {
-            self.gather_coeffs(fin, cl, &mem[..nm], coef, from, to);
+            if from < have {
+                self.gather_coeffs(fin, cl, &mem[..nm], coef, from, to.min(have));
+                have = from;
+            }
             lo = from;
         };
         dwt::inverse(
@@ -299,6 +313,9 @@ impl Plan {
             blk,
         );
         sc.data = data;
-        sc.from_l = cl.l0() + lo;
+        sc.have = have;
+        if k == 0 || lo < n {
+            sc.from_l = cl.l0() + lo;
+        }
     }
 }

@@ -121,8 +121,9 @@ impl Plan {
         let mut times = self.run_chunks(
             true,
             t,
+            None,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
-            |sc, at, ch, buf, first| unsafe {
+            |sc, at, ch, buf, first, _| unsafe {
                 self.forward_cluster(sc, t, representatives, at, ch, buf, coef, first);
             },
         )?;
@@ -175,12 +176,17 @@ impl Plan {
         self.real_fft()?;
         let out = SyncPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
+        let spare = Spare {
+            base: samples.as_mut_ptr() as *mut u8,
+            slice_bytes: 4 * self.b * self.b * 8,
+        };
         self.run_chunks(
             false,
             t,
+            Some(spare),
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
-            |sc, at, ch, buf, _| unsafe {
-                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs)
+            |sc, at, ch, buf, _, k| unsafe {
+                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, k)
             },
         )
     }
