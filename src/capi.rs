@@ -35,6 +35,8 @@ pub struct so3fft_plan_s {
     output: *mut so3fft_complex,
     /// Made with `SO3FFT_REAL`: transforms take the real-signal path.
     real: bool,
+    /// Made with `SO3FFT_DESTROY_INPUT`: the forward may overwrite its samples.
+    destroy_input: bool,
 }
 
 /// A plan: a pointer to an opaque object (like `fftw_plan`).
@@ -60,9 +62,14 @@ pub const SO3FFT_PATIENT: c_uint = 2;
 /// Planner flag: FFTW measures every candidate (`FFTW_EXHAUSTIVE`).
 /// When several rigour flags are given, the most rigorous one applies.
 pub const SO3FFT_EXHAUSTIVE: c_uint = 4;
-/// Planner flag: the transform may overwrite its input array (like
-/// `FFTW_DESTROY_INPUT`). Accepted; the current implementation never modifies its input
-/// arrays, with or without this flag.
+/// Planner flag: the forward transform may overwrite its input (sample) array, like
+/// `FFTW_DESTROY_INPUT`; its contents afterwards are unspecified. When the plan's chunk
+/// buffer holds fewer betas than the grid (large bandwidths, see `so3fft_plan_memory`),
+/// the forward then keeps its later chunk buffers in the sample slices it has already
+/// read and adds to the coefficients once per group of chunks instead of once per chunk
+/// (at B = 512 under the default memory rule: 6 passes over the coefficients instead of
+/// 22). No extra memory; the same results up to rounding. The inverse never reads its
+/// output and never modifies its input.
 pub const SO3FFT_DESTROY_INPUT: c_uint = 16;
 /// Planner flag: the signal is real-valued. The array layouts do not change, and about
 /// half the work is done (r2c/c2r FFTs, one order pair of each `(m,m')`, `(-m,-m')`).
@@ -371,8 +378,20 @@ unsafe fn run_forward(
     check_arrays(samples, ns, "samples", coeffs, nc, "coefficients")?;
     // SAFETY: non-NULL, aligned, non-overlapping; sizes are the caller's contract.
     // Complex64 is #[repr(C)] { re: f64, im: f64 }, the layout of double[2].
-    let s = std::slice::from_raw_parts(samples as *const Complex64, ns);
     let c = std::slice::from_raw_parts_mut(coeffs as *mut Complex64, nc);
+    if ps.destroy_input {
+        // SAFETY: as above; the caller allowed the samples to be overwritten.
+        let s = std::slice::from_raw_parts_mut(samples as *mut Complex64, ns);
+        return if ps.real {
+            ps.plan
+                .forward_real_parts_destroying_input(s, c)
+                .map(|_| ())
+        } else {
+            ps.plan.forward_destroying_input(s, c)
+        }
+        .map_err(CErr::from);
+    }
+    let s = std::slice::from_raw_parts(samples as *const Complex64, ns);
     if ps.real {
         return ps
             .plan
@@ -499,6 +518,7 @@ fn make_plan(
             input,
             output,
             real,
+            destroy_input: flags & SO3FFT_DESTROY_INPUT != 0,
         })))
     })
 }

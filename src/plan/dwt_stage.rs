@@ -31,6 +31,10 @@ pub(super) struct Scratch {
     /// Inverse: rows `have..` of `data` hold the current cluster's coefficients (kept
     /// over the chunks of a group, see `Plan::run_chunks`).
     pub have: usize,
+    /// Forward: a cluster's sums over the chunks of a group so far (layout of `out`),
+    /// zero below row `sum_lo`.
+    pub sum: Vec<f64>,
+    pub sum_lo: usize,
 }
 
 impl Scratch {
@@ -44,6 +48,8 @@ impl Scratch {
             out: vec![0.0; (b + 8) * 16],
             from_l: 0,
             have: 0,
+            sum: vec![0.0; b * 16],
+            sum_lo: 0,
         }
     }
 
@@ -220,7 +226,8 @@ impl Plan {
 
     /// Forward DWT of cluster `at` of layout `t` over one chunk, accumulated into `coef`
     /// for the order pairs `members` gives (the real forward fills the other half of the
-    /// coefficients afterwards, see `Plan::fill_partners`).
+    /// coefficients afterwards, see `Plan::fill_partners`). Within a group of chunks the
+    /// sums are collected in `sc.sum` and added to `coef` at the group's last chunk.
     ///
     /// # Safety
     /// `buf` holds the chunk's blocks; `coef` has `num_coeffs` entries and no other task
@@ -235,31 +242,58 @@ impl Plan {
         ch: &Chunk,
         buf: *mut f64,
         coef: SyncPtr<Complex64>,
-        first: bool,
+        pass: Pass,
     ) {
         let (c, cl) = (at.c, &at.cl);
-        let n = self.setup(sc, cl, ch, true);
+        let n = self.setup(sc, cl, ch, pass.k == 0);
         let p = t.p(c);
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        // The first chunk writes every row of the coefficients.
-        let from_l = if first { 0 } else { sc.from_l };
+        // The first group writes every row of the coefficients.
+        let from_l = if pass.first { 0 } else { sc.from_l };
         let next = self.next_cluster(t, buf, at, ch, true, coef.get(), members, from_l);
-        let lo = self.run_forward(sc, ch, p, n, blk, next);
+        let lo = self.run_forward(sc, ch, p, n, blk, next).min(n);
         sc.from_l = cl.l0() + lo;
-        // Later chunks add only the degrees where some beta of the chunk is past its
-        // negligible prefix: the coefficient array's read-modify-write per chunk is the
-        // main memory traffic of a chunked forward (B = 512), and near the poles most
-        // clusters contribute nothing to most degrees.
-        let lo = if first { 0 } else { lo.min(n) };
+        let (sums, lo) = if pass.k == 0 && pass.last {
+            (&sc.out, lo)
+        } else {
+            if sc.sum.len() < n * p {
+                sc.sum.resize(n * p, 0.0);
+            }
+            let (sum, out) = (&mut sc.sum[..n * p], &sc.out[..n * p]);
+            if pass.k == 0 {
+                sum[lo * p..].copy_from_slice(&out[lo * p..]);
+                sc.sum_lo = lo;
+            } else {
+                if lo < sc.sum_lo {
+                    sum[lo * p..sc.sum_lo * p].fill(0.0);
+                    sc.sum_lo = lo;
+                }
+                for (s, o) in sum[lo * p..].iter_mut().zip(&out[lo * p..]) {
+                    *s += o;
+                }
+            }
+            if !pass.last {
+                return;
+            }
+            if pass.first {
+                sum[..sc.sum_lo * p].fill(0.0);
+            }
+            (&sc.sum, sc.sum_lo)
+        };
+        // Later groups add only the degrees where some beta is past its negligible
+        // prefix: the coefficient array's read-modify-write per group is the main memory
+        // traffic of a chunked forward (B = 512), and near the poles most clusters
+        // contribute nothing to most degrees.
+        let lo = if pass.first { 0 } else { lo };
         let (mem, nm) = members(cl);
-        assert!(2 * nm <= p && sc.out.len() >= n * p);
+        assert!(2 * nm <= p && sums.len() >= n * p);
         for (q, mem) in mem[..nm].iter().enumerate() {
             let dst = coef.get().add(block_start(self.b, mem.m, mem.mp) + lo);
             // Degree `l0 + lo` has the parity of `cl.m + lo`.
             let sg = [mem.sign_at(cl.m + lo), mem.sign_at(cl.m + lo + 1)];
-            let src = sc.out.as_ptr().add(lo * p + 2 * q);
-            coeffs::scatter(dst, src, p, n - lo, sg, !first);
+            let src = sums.as_ptr().add(lo * p + 2 * q);
+            coeffs::scatter(dst, src, p, n - lo, sg, !pass.first);
         }
     }
 

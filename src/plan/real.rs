@@ -99,7 +99,34 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::Real(samples.as_ptr()), coeffs)
+        self.forward_real_impl(RealInput::Real(samples.as_ptr()), coeffs, None)
+    }
+
+    /// [`Plan::forward_real`] that may overwrite `samples`, for fewer passes over the
+    /// coefficients when the plan works in chunks (see [`Plan::forward_destroying_input`]).
+    pub fn forward_real_destroying_input(
+        &self,
+        samples: &mut [f64],
+        coeffs: &mut [Complex64],
+    ) -> Result<()> {
+        self.forward_real_destroying_input_timed(samples, coeffs)
+            .map(|_| ())
+    }
+
+    /// Like [`Plan::forward_real_destroying_input`], also returning the time of each stage.
+    pub fn forward_real_destroying_input_timed(
+        &self,
+        samples: &mut [f64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        // One raw pointer for reading the slices and for the buffers in the read ones.
+        let base = samples.as_mut_ptr();
+        let spare = Spare {
+            base: base as *mut u8,
+            slice_bytes: 4 * self.b * self.b * 8,
+        };
+        self.forward_real_impl(RealInput::Real(base), coeffs, Some(spare))
     }
 
     /// Forward transform of the real parts of complex samples (the imaginary parts are not
@@ -110,10 +137,30 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::RealParts(samples.as_ptr()), coeffs)
+        self.forward_real_impl(RealInput::RealParts(samples.as_ptr()), coeffs, None)
     }
 
-    fn forward_real_impl(&self, input: RealInput, coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    /// [`Plan::forward_real_parts`] that may overwrite `samples`.
+    pub(crate) fn forward_real_parts_destroying_input(
+        &self,
+        samples: &mut [Complex64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        let base = samples.as_mut_ptr();
+        let spare = Spare {
+            base: base as *mut u8,
+            slice_bytes: 4 * self.b * self.b * 16,
+        };
+        self.forward_real_impl(RealInput::RealParts(base), coeffs, Some(spare))
+    }
+
+    fn forward_real_impl(
+        &self,
+        input: RealInput,
+        coeffs: &mut [Complex64],
+        spare: Option<Spare>,
+    ) -> Result<StageTimes> {
         self.real_fft()?;
         let input = SyncInput(input);
         let coef = SyncPtr(coeffs.as_mut_ptr());
@@ -121,10 +168,10 @@ impl Plan {
         let mut times = self.run_chunks(
             true,
             t,
-            None,
+            spare,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
-            |sc, at, ch, buf, first, _| unsafe {
-                self.forward_cluster(sc, t, representatives, at, ch, buf, coef, first);
+            |sc, at, ch, buf, pass| unsafe {
+                self.forward_cluster(sc, t, representatives, at, ch, buf, coef, pass);
             },
         )?;
         // The chunks accumulated the representatives only (half the coefficient traffic per
@@ -185,8 +232,8 @@ impl Plan {
             t,
             Some(spare),
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
-            |sc, at, ch, buf, _, k| unsafe {
-                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, k)
+            |sc, at, ch, buf, pass| unsafe {
+                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass.k)
             },
         )
     }

@@ -14,6 +14,10 @@
 //!    coefficients with the real-signal symmetry, also regenerated for the comparison; its
 //!    times are related to the complex ones of step 1.
 //!
+//! Steps 1 and 3 are each followed by the forward that may overwrite its input
+//! (`forward_destroying_input`, `forward_real_destroying_input`) on the inverse's samples,
+//! with its time, error and peak memory printed (not in the CSV).
+//!
 //! Each plan is dropped before the next is made (a plan holds a chunk buffer of about 1 GB
 //! here). Before each step the memory it needs is checked against `MemAvailable`; a step
 //! that does not fit is skipped with a message. Everything runs once (a run takes minutes).
@@ -51,6 +55,7 @@ pub fn run(b: usize, threads: usize, opts: &crate::cli::Options, peak_1core: f64
         opts,
         peak_1core,
         coeffs: None,
+        destroy_complex: None,
         rows: Vec::new(),
     };
     let noskip_missing = lean.complex_steps();
@@ -68,6 +73,8 @@ struct Lean<'a> {
     peak_1core: f64,
     /// The coefficient array, shared by all steps once allocated.
     coeffs: Option<Vec<Complex64>>,
+    /// Time of the complex forward that may overwrite its input (step 1).
+    destroy_complex: Option<f64>,
     rows: Vec<Row>,
 }
 
@@ -161,6 +168,21 @@ impl Lean<'_> {
         );
 
         let skip = self.complex_round_trip(&plan, Variant::Complex, &mut coeffs, &mut grid);
+        if let Ok(row) = &skip {
+            // The grid still holds the inverse's samples: the forward that may overwrite
+            // them, on the same plan (the grid is rewritten by the next step's inverse).
+            let arrays = 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64;
+            let (d, mem) =
+                timed_phase(|| plan.forward_destroying_input_timed(&mut grid, &mut coeffs));
+            match d.2 {
+                Ok(t) => {
+                    let e = seeded::compare_complex(self.seed(), &coeffs);
+                    self.destroy_complex = Some(d.0);
+                    destroy_line("complex", d.0, t, e, row.fwd_median, mem, arrays);
+                }
+                Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
+            }
+        }
         // The no-skip plan gets the same chunk buffer: the default depends on MemAvailable,
         // which the grid has just used up, and a smaller chunk makes the DWT stage slower.
         let workspace = plan.workspace_bytes();
@@ -269,7 +291,23 @@ impl Lean<'_> {
             t.elapsed().as_secs_f64()
         );
         match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
-            Ok(row) => self.rows.push(row),
+            Ok(row) => {
+                let arrays = (8 * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64;
+                let (d, mem) = timed_phase(|| {
+                    plan.forward_real_destroying_input_timed(&mut grid, &mut coeffs)
+                });
+                match d.2 {
+                    Ok(t) => {
+                        let e = seeded::compare_real(self.real_seed(), b, &coeffs);
+                        destroy_line("real", d.0, t, e, row.fwd_median, mem, arrays);
+                        if let Some(c) = self.destroy_complex {
+                            println!("  destroying forwards, real over complex: {:.3}", d.0 / c);
+                        }
+                    }
+                    Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
+                }
+                self.rows.push(row)
+            }
             Err(e) => eprintln!("so3fft-bench: B = {b}: real round trip failed: {e}"),
         }
         self.coeffs = Some(coeffs);
@@ -345,6 +383,32 @@ impl Lean<'_> {
             cpu: Some((fwd.1, inv.1)),
         }
     }
+}
+
+/// Prints the result of a forward that may overwrite its input (`what`: complex or real):
+/// time, stages, error against the seeded coefficients, ratio to the preserving forward
+/// `fwd` of the same plan, and its peak memory against input + output.
+fn destroy_line(
+    what: &str,
+    wall: f64,
+    t: StageTimes,
+    e: RoundTripError,
+    fwd: f64,
+    mem: Option<memory::Phase>,
+    arrays: u64,
+) {
+    let peak = mem.map_or("n/a".into(), |p| {
+        format!("{:.4}", p.peak as f64 / arrays as f64)
+    });
+    println!(
+        "  {what} forward destroying its input: {wall:.3e} s (FFT {:.3e} / DWT {:.3e}), \
+         {:.3} x the preserving forward; errors {:.2e} / {:.2e}; peak {peak} x (input + output)",
+        t.fft,
+        t.dwt,
+        wall / fwd,
+        e.max_abs,
+        e.rel_l2,
+    );
 }
 
 /// Wall and process CPU time of one transform, and the library's stage times.
