@@ -93,8 +93,9 @@
  * the forward then keeps its later chunk buffers in the sample slices it has already
  * read and adds to the coefficients once per group of chunks instead of once per chunk
  * (at B = 512 under the default memory rule: 6 passes over the coefficients instead of
- * 22). No extra memory; the same results up to rounding. The inverse never reads its
- * output and never modifies its input.
+ * 22). No extra memory; the same results up to rounding. Concurrent forwards with such
+ * a plan need distinct input arrays. The inverse never reads its output and never
+ * modifies its input. (Earlier builds accepted this flag and ignored it.)
  */
 #define SO3FFT_DESTROY_INPUT 16
 
@@ -305,13 +306,15 @@ void so3fft_destroy_plan(so3fft_plan p);
 
 /**
  * Executes a plan on the arrays given at planning: the forward transform for a
- * forward plan, the inverse for an inverse plan. The input array is not modified.
+ * forward plan, the inverse for an inverse plan. The input array is not modified,
+ * except by the forward of a plan made with `SO3FFT_DESTROY_INPUT`.
  *
  * Returns `SO3FFT_OK`, or an error code with `so3fft_last_error()` set:
  * `SO3FFT_ENULL` (NULL plan, or a plan made without arrays, such as every
  * `so3fft_plan_both` plan), `SO3FFT_ENOMEM` (a concurrent execution of the same plan
  * could not allocate its temporary buffer), `SO3FFT_EFFTW`, `SO3FFT_EPANIC`. On error
- * the output array may have been partly written; nothing outside it is.
+ * the output array (and, with `SO3FFT_DESTROY_INPUT`, the forward's input) may have
+ * been partly written; nothing outside them is.
  *
  * Thread safety: a plan may be executed by several threads at the same time (each
  * call uses the plan's worker pool; a call that finds the plan's buffer in use
@@ -326,7 +329,8 @@ int so3fft_execute(so3fft_plan p);
  * New-array execute of the forward transform: samples `in` (`(2B)^3` values) to
  * coefficients `out` (`(4B^3-B)/3` values) with a plan made by `so3fft_plan_forward`,
  * `so3fft_plan_both` or `so3fft_plan_general` (with or without arrays; the arrays
- * given at planning are ignored). `in` is not modified.
+ * given at planning are ignored). `in` is not modified, unless the plan was made with
+ * `SO3FFT_DESTROY_INPUT`: then its contents afterwards are unspecified (and on error too).
  *
  * The arrays need no particular alignment beyond that of `double` (unlike FFTW's
  * new-array execute), must not overlap, and are not retained after the call.
@@ -337,7 +341,8 @@ int so3fft_execute(so3fft_plan p);
  * Nothing is written on argument errors.
  *
  * Thread safety: one plan may be executed from several threads at the same time on
- * different output arrays (inputs may be shared). A call that finds the plan's chunk
+ * different output arrays (inputs may be shared, except with `SO3FFT_DESTROY_INPUT`,
+ * where each call needs its own input). A call that finds the plan's chunk
  * buffer in use by another call allocates a temporary one of `so3fft`'s workspace
  * size (may fail with `SO3FFT_ENOMEM`).
  *

@@ -68,8 +68,9 @@ pub const SO3FFT_EXHAUSTIVE: c_uint = 4;
 /// the forward then keeps its later chunk buffers in the sample slices it has already
 /// read and adds to the coefficients once per group of chunks instead of once per chunk
 /// (at B = 512 under the default memory rule: 6 passes over the coefficients instead of
-/// 22). No extra memory; the same results up to rounding. The inverse never reads its
-/// output and never modifies its input.
+/// 22). No extra memory; the same results up to rounding. Concurrent forwards with such
+/// a plan need distinct input arrays. The inverse never reads its output and never
+/// modifies its input. (Earlier builds accepted this flag and ignored it.)
 pub const SO3FFT_DESTROY_INPUT: c_uint = 16;
 /// Planner flag: the signal is real-valued. The array layouts do not change, and about
 /// half the work is done (r2c/c2r FFTs, one order pair of each `(m,m')`, `(-m,-m')`).
@@ -656,13 +657,15 @@ pub unsafe extern "C" fn so3fft_destroy_plan(p: so3fft_plan) {
 // ---------------------------------------------------------------------------------------
 
 /// Executes a plan on the arrays given at planning: the forward transform for a
-/// forward plan, the inverse for an inverse plan. The input array is not modified.
+/// forward plan, the inverse for an inverse plan. The input array is not modified,
+/// except by the forward of a plan made with `SO3FFT_DESTROY_INPUT`.
 ///
 /// Returns `SO3FFT_OK`, or an error code with `so3fft_last_error()` set:
 /// `SO3FFT_ENULL` (NULL plan, or a plan made without arrays, such as every
 /// `so3fft_plan_both` plan), `SO3FFT_ENOMEM` (a concurrent execution of the same plan
 /// could not allocate its temporary buffer), `SO3FFT_EFFTW`, `SO3FFT_EPANIC`. On error
-/// the output array may have been partly written; nothing outside it is.
+/// the output array (and, with `SO3FFT_DESTROY_INPUT`, the forward's input) may have
+/// been partly written; nothing outside them is.
 ///
 /// Thread safety: a plan may be executed by several threads at the same time (each
 /// call uses the plan's worker pool; a call that finds the plan's buffer in use
@@ -697,7 +700,8 @@ pub unsafe extern "C" fn so3fft_execute(p: so3fft_plan) -> c_int {
 /// New-array execute of the forward transform: samples `in` (`(2B)^3` values) to
 /// coefficients `out` (`(4B^3-B)/3` values) with a plan made by `so3fft_plan_forward`,
 /// `so3fft_plan_both` or `so3fft_plan_general` (with or without arrays; the arrays
-/// given at planning are ignored). `in` is not modified.
+/// given at planning are ignored). `in` is not modified, unless the plan was made with
+/// `SO3FFT_DESTROY_INPUT`: then its contents afterwards are unspecified (and on error too).
 ///
 /// The arrays need no particular alignment beyond that of `double` (unlike FFTW's
 /// new-array execute), must not overlap, and are not retained after the call.
@@ -708,7 +712,8 @@ pub unsafe extern "C" fn so3fft_execute(p: so3fft_plan) -> c_int {
 /// Nothing is written on argument errors.
 ///
 /// Thread safety: one plan may be executed from several threads at the same time on
-/// different output arrays (inputs may be shared). A call that finds the plan's chunk
+/// different output arrays (inputs may be shared, except with `SO3FFT_DESTROY_INPUT`,
+/// where each call needs its own input). A call that finds the plan's chunk
 /// buffer in use by another call allocates a temporary one of `so3fft`'s workspace
 /// size (may fail with `SO3FFT_ENOMEM`).
 ///

@@ -747,8 +747,9 @@ impl Plan {
     }
 
     /// The chunks of layout `t` in groups that share one pass of the DWT stage, each with
-    /// its buffer: `None` for the plan's chunk buffer, else a part of the inverse's output
-    /// (see [`Spare`]). Without `spare` every group is one chunk.
+    /// its buffer: `None` for the plan's chunk buffer, else a part of `spare` (the
+    /// inverse's output, or the input of a forward that may overwrite it, see [`Spare`]).
+    /// Without `spare` every group is one chunk.
     fn chunk_groups(
         &self,
         t: &Blocks,
@@ -870,9 +871,10 @@ impl Plan {
         samples: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
+        // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SyncPtr(samples.as_mut_ptr());
         let spare = Spare {
-            base: samples.as_mut_ptr() as *mut u8,
+            base: out.get() as *mut u8,
             slice_bytes: 4 * self.b * self.b * 16,
         };
         self.run_chunks(

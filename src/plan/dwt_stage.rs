@@ -25,14 +25,15 @@ pub(super) struct Scratch {
     pub data: Vec<f64>,
     /// Forward: the kernel's sums (`n + 8` degrees x `P`, see [`Plan::run_forward`]).
     pub out: Vec<f64>,
-    /// The lowest degree `l` the worker's last cluster needed in this chunk: the guess
-    /// for where the next cluster's coefficient rows start to matter (prefetch only).
+    /// The lowest degree `l` the worker's last call needed (the previous cluster, or the
+    /// same cluster on the group's previous chunk): the guess for where the next
+    /// cluster's coefficient rows start to matter (prefetch only).
     pub from_l: usize,
     /// Inverse: rows `have..` of `data` hold the current cluster's coefficients (kept
     /// over the chunks of a group, see `Plan::run_chunks`).
     pub have: usize,
-    /// Forward: a cluster's sums over the chunks of a group so far (layout of `out`),
-    /// zero below row `sum_lo`.
+    /// Forward: a cluster's sums over the chunks of a group so far (layout of `out`);
+    /// rows below `sum_lo` are zero by definition (not stored: stale values there).
     pub sum: Vec<f64>,
     pub sum_lo: usize,
 }
@@ -179,6 +180,10 @@ impl Plan {
         next: Prefetch,
     ) -> usize {
         let mut out = std::mem::take(&mut sc.out);
+        if out.len() < (n + 8) * p {
+            // Only after a panic left the scratch without its buffer.
+            out = vec![0.0; (self.b + 8) * 16];
+        }
         let f = &mut out[..(n + 8) * p];
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
@@ -321,6 +326,10 @@ impl Plan {
         let p = t.p(c);
         let (mem, nm) = members(cl);
         let mut data = std::mem::take(&mut sc.data);
+        if data.len() < n * p {
+            // Only after a panic left the scratch without its buffer.
+            data = vec![0.0; self.b * 16];
+        }
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);

@@ -45,10 +45,12 @@ enum RealInput {
     RealParts(*const Complex64),
 }
 
-/// `RealInput` shared by the FFT workers (read only).
+/// `RealInput` shared by the FFT workers (read only through it).
 #[derive(Clone, Copy)]
 struct SyncInput(RealInput);
-// SAFETY: the pointed-to samples are only read, by all workers, during one execution.
+// SAFETY: the pointed-to samples are only read through it, by all workers, during one
+// execution; a forward destroying its input writes chunk buffers only into slices whose
+// reads are finished (see `Spare::consumed`).
 unsafe impl Send for SyncInput {}
 unsafe impl Sync for SyncInput {}
 
@@ -221,10 +223,11 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
         self.real_fft()?;
+        // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SyncPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
         let spare = Spare {
-            base: samples.as_mut_ptr() as *mut u8,
+            base: out.get() as *mut u8,
             slice_bytes: 4 * self.b * self.b * 8,
         };
         self.run_chunks(
