@@ -214,6 +214,10 @@ struct Pass {
     k: usize,
     /// The group's last chunk (the forward writes the cluster's sums then).
     last: bool,
+    /// The buffer of the group's next chunk, if any: the next call is this cluster on it,
+    /// so that is what to prefetch (forward: this cluster's block there; inverse:
+    /// nothing, its coefficient rows are kept).
+    next_buf: Option<SyncPtr<f64>>,
 }
 
 /// Shared mutable pointer for disjoint parallel writes.
@@ -883,7 +887,7 @@ impl Plan {
             Some(spare),
             |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
             |sc, at, ch, buf, pass| unsafe {
-                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass.k)
+                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
             },
         )
     }
@@ -934,6 +938,7 @@ impl Plan {
                                 first: gi == 0,
                                 k,
                                 last: k + 1 == group.len(),
+                                next_buf: group.get(k + 1).map(|g| g.1),
                             };
                             cluster(sc, at, ch, buf.get(), pass);
                         }

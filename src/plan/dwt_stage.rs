@@ -254,9 +254,22 @@ impl Plan {
         let p = t.p(c);
         let blk = self.block(t, buf, c, ch);
         Self::zero_padding(blk, p, ch);
-        // The first group writes every row of the coefficients.
-        let from_l = if pass.first { 0 } else { sc.from_l };
-        let next = self.next_cluster(t, buf, at, ch, true, coef.get(), members, from_l);
+        let next = match pass.next_buf {
+            // Within a group: this cluster's block in the next chunk.
+            Some(nb) => {
+                let mut pf = Prefetch::none();
+                pf.push(
+                    nb.get().wrapping_add(t.offset(c)) as *const f64,
+                    ch.lanes() * p,
+                );
+                pf
+            }
+            None => {
+                // The first group writes every row of the coefficients.
+                let from_l = if pass.first { 0 } else { sc.from_l };
+                self.next_cluster(t, buf, at, ch, true, coef.get(), members, from_l)
+            }
+        };
         let lo = self.run_forward(sc, ch, p, n, blk, next).min(n);
         sc.from_l = cl.l0() + lo;
         let (sums, lo) = if pass.k == 0 && pass.last {
@@ -303,9 +316,9 @@ impl Plan {
     }
 
     /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
-    /// gives), written into its block. `k`: the chunk's position in its group; for `k > 0`
-    /// the previous call was this cluster on the group's previous chunk, whose recurrence
-    /// coefficients and coefficient rows are reused.
+    /// gives), written into its block. For `pass.k > 0` the previous call was this
+    /// cluster on the group's previous chunk, whose recurrence coefficients and
+    /// coefficient rows are reused.
     ///
     /// # Safety
     /// `buf` is the chunk buffer; no other task writes this cluster's block.
@@ -319,8 +332,9 @@ impl Plan {
         ch: &Chunk,
         buf: *mut f64,
         coef: &[Complex64],
-        k: usize,
+        pass: Pass,
     ) {
+        let k = pass.k;
         let (c, cl) = (at.c, &at.cl);
         let n = self.setup(sc, cl, ch, k == 0);
         let p = t.p(c);
@@ -333,8 +347,14 @@ impl Plan {
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
-        let from_l = sc.from_l;
-        lanes.prefetch = self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members, from_l);
+        // Within a group the next call needs nothing new (its rows are kept here, its
+        // block is written with non-temporal stores): prefetch for the next cluster only
+        // on the group's last chunk.
+        if pass.next_buf.is_none() {
+            let from_l = sc.from_l;
+            lanes.prefetch =
+                self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members, from_l);
+        }
         let mut lo = n;
         let mut have = if k == 0 { n } else { sc.have };
         // Only the degrees some beta of the chunk needs are read from the coefficients

@@ -236,7 +236,7 @@ impl Plan {
             Some(spare),
             |ch, buf| self.fft_chunk_real(ch, None, out.get(), buf),
             |sc, at, ch, buf, pass| unsafe {
-                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass.k)
+                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
             },
         )
     }
