@@ -16,6 +16,7 @@
 
 use crate::simd::{Isa, Scalar, Simd};
 use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, SKIP_BITS_RANGE, TINY};
+use std::mem::MaybeUninit;
 
 /// Recurrence coefficients of one cluster, index `i = l - l0` (see `RecTables::coeffs`).
 pub(crate) struct Rec<'a> {
@@ -434,6 +435,35 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
     (g, st)
 }
 
+/// The states of the `mem.len()` vectors of lanes from `v0`, each advanced through its
+/// negligible prefix, written into `mem`; returns the lowest degree index any of them
+/// reached (`n` if none) and the states. Both kernels set up their vectors this way
+/// before touching data, so they agree on the first degree a set of betas needs.
+#[inline(always)]
+unsafe fn prefix_states<'m, 'r, S: Simd, const W: usize>(
+    rec: &Rec<'r>,
+    lanes: &Lanes,
+    v0: usize,
+    n: usize,
+    mem: &'m mut [MaybeUninit<State<'r, S>>],
+) -> (usize, &'m mut [State<'r, S>]) {
+    let nv = mem.len();
+    let mut g = 0;
+    while g < nv {
+        let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
+        for (k, s) in group.iter().enumerate().take(gn) {
+            let mut s = *s;
+            s.finish_prefix(rec, n);
+            mem[g + k].write(s);
+        }
+        g += gn;
+    }
+    // SAFETY: every entry was written above (`gn >= 1` per round).
+    let st = std::slice::from_raw_parts_mut(mem.as_mut_ptr() as *mut State<'r, S>, nv);
+    let first = st.iter().map(|s| s.i).min().unwrap_or(n);
+    (first, st)
+}
+
 /// Vectors of betas whose states the forward kernel keeps at once.
 const FWD_VECTORS: usize = 16;
 
@@ -526,21 +556,8 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     while v0 < nb {
         // Up to FWD_VECTORS vectors, each through its negligible prefix.
         let nv = ((nb - v0) / W).min(FWD_VECTORS);
-        // Only the first `nv` entries are used; they are written below before any read.
-        let mut st_mem = [const { std::mem::MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
-        let mut g = 0;
-        while g < nv {
-            let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
-            for (k, s) in group.iter().enumerate().take(gn) {
-                let mut s = *s;
-                s.finish_prefix(rec, n);
-                st_mem[g + k].write(s);
-            }
-            g += gn;
-        }
-        // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
-        let st = std::slice::from_raw_parts_mut(st_mem.as_mut_ptr() as *mut State<S>, nv);
-        let first = st.iter().map(|s| s.i).min().unwrap_or(n);
+        let mut st_mem = [const { MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
+        let (first, st) = prefix_states::<S, W>(rec, lanes, v0, n, &mut st_mem[..nv]);
         lo = lo.min(first);
         let mut i0 = first - first % DB;
         // The first group of vectors writes the sums (zeros below its first block), the
@@ -683,21 +700,8 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
         // Up to INV_VECTORS vectors through their negligible prefixes, then the rows from
         // the first degree any of them needs.
         let nv = ((nb - v0) / W).min(INV_VECTORS);
-        // Only the first `nv` entries are used; they are written below before any read.
-        let mut st_mem = [const { std::mem::MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
-        let mut g = 0;
-        while g < nv {
-            let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
-            for (k, s) in group.iter().enumerate().take(gn) {
-                let mut s = *s;
-                s.finish_prefix(rec, n);
-                st_mem[g + k].write(s);
-            }
-            g += gn;
-        }
-        // SAFETY: entries 0..nv were initialised above (`gn >= 1` per round).
-        let states = std::slice::from_raw_parts(st_mem.as_ptr() as *const State<S>, nv);
-        let first = states.iter().map(|s| s.i).min().unwrap_or(n);
+        let mut st_mem = [const { MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
+        let (first, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut st_mem[..nv]);
         if first < have {
             fill(fin, first, have);
             have = first;

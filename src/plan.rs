@@ -283,6 +283,14 @@ struct Spare {
 }
 
 impl Spare {
+    /// The `2B` beta slices of a sample array at `base` (`4B^2` values of `T` each).
+    fn over<T>(base: *mut T, b: usize) -> Spare {
+        Spare {
+            base: base as *mut u8,
+            slice_bytes: 4 * b * b * std::mem::size_of::<T>(),
+        }
+    }
+
     /// Forward: buffers of `bytes` each (a multiple of 64), 64-byte aligned, as many as
     /// fit (up to `g`) in the input slices of the betas before `lo` and from `2B-lo` on,
     /// which the FFT stage has read already.
@@ -842,10 +850,7 @@ impl Plan {
         self.check(true, samples.len(), coeffs.len())?;
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
-        let spare = Spare {
-            base: base as *mut u8,
-            slice_bytes: 4 * self.b * self.b * 16,
-        };
+        let spare = Spare::over(base, self.b);
         self.forward_impl(base, coeffs, Some(spare))
     }
 
@@ -877,10 +882,7 @@ impl Plan {
         self.check(false, samples.len(), coeffs.len())?;
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SyncPtr(samples.as_mut_ptr());
-        let spare = Spare {
-            base: out.get() as *mut u8,
-            slice_bytes: 4 * self.b * self.b * 16,
-        };
+        let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             &self.blocks,

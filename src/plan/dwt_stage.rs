@@ -275,9 +275,6 @@ impl Plan {
         let (sums, lo) = if pass.k == 0 && pass.last {
             (&sc.out, lo)
         } else {
-            if sc.sum.len() < n * p {
-                sc.sum.resize(n * p, 0.0);
-            }
             let (sum, out) = (&mut sc.sum[..n * p], &sc.out[..n * p]);
             if pass.k == 0 {
                 sum[lo * p..].copy_from_slice(&out[lo * p..]);

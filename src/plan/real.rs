@@ -124,10 +124,7 @@ impl Plan {
         self.check(true, samples.len(), coeffs.len())?;
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
-        let spare = Spare {
-            base: base as *mut u8,
-            slice_bytes: 4 * self.b * self.b * 8,
-        };
+        let spare = Spare::over(base, self.b);
         self.forward_real_impl(RealInput::Real(base), coeffs, Some(spare))
     }
 
@@ -150,10 +147,7 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
         let base = samples.as_mut_ptr();
-        let spare = Spare {
-            base: base as *mut u8,
-            slice_bytes: 4 * self.b * self.b * 16,
-        };
+        let spare = Spare::over(base, self.b);
         self.forward_real_impl(RealInput::RealParts(base), coeffs, Some(spare))
     }
 
@@ -226,10 +220,7 @@ impl Plan {
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SyncPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
-        let spare = Spare {
-            base: out.get() as *mut u8,
-            slice_bytes: 4 * self.b * self.b * 8,
-        };
+        let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             t,
