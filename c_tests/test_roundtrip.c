@@ -161,16 +161,10 @@ static void several_plans(void) {
     }
 }
 
-/* Real-valued signal: the inverse of coefficients with the real symmetry is real. */
-static void real_signal(void) {
-    const int B = 6;
-    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B), i;
-    so3fft_complex *c = alloc_cx(nc), *s = alloc_cx(ns), *back = alloc_cx(nc);
-    unsigned long long seed = 99;
+/* Random coefficients of a real signal: f^l_{-m,-m'} = (-1)^(m-m') conj(f^l_{m,m'}). */
+static void fill_real_coeffs(so3fft_complex *c, int B, unsigned long long seed) {
     int l, m, mp;
-    double im = 0.0;
-    so3fft_plan p = so3fft_plan_both(B, SO3FFT_REAL);
-    memset(c, 0, nc * sizeof *c);
+    memset(c, 0, so3fft_num_coeffs(B) * sizeof *c);
     for (l = 0; l < B; l++)
         for (m = -l; m <= l; m++)
             for (mp = -l; mp <= l; mp++) {
@@ -182,6 +176,17 @@ static void real_signal(void) {
                 c[kk][0] = sign * c[k][0];
                 c[kk][1] = -sign * c[k][1];
             }
+}
+
+/* Real-valued signal: the inverse of coefficients with the real symmetry is real. */
+static void real_signal(void) {
+    const int B = 6;
+    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B), i;
+    so3fft_complex *c = alloc_cx(nc), *s = alloc_cx(ns), *back = alloc_cx(nc);
+    int l, m, mp;
+    double im = 0.0;
+    so3fft_plan p = so3fft_plan_both(B, SO3FFT_REAL);
+    fill_real_coeffs(c, B, 99);
     CHECK(p != NULL);
     if (p) {
         so3fft_complex *poisoned = alloc_cx(nc), *s2 = alloc_cx(ns);
@@ -235,6 +240,55 @@ static void memory_estimate(void) {
     CHECK_NO_ERR();
 }
 
+/* A workspace cap of 1 byte gives the smallest chunks (8 beta pairs, 5 chunks at B = 36):
+ * the transforms then run chunk groups that keep their buffers in the caller's arrays
+ * (inverse: in output slices not yet written; forward with SO3FFT_DESTROY_INPUT: in input
+ * slices already read; the Rust unit test chunk_groups_keep_clear_of_written_slices checks
+ * that this B and cap form such groups). The round trip must still give the coefficients
+ * back, complex and real, and the forward without the flag must leave its input alone. */
+static void capped_workspace(void) {
+    const int B = 36;
+    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B);
+    so3fft_complex *c = alloc_cx(nc), *s = alloc_cx(ns), *s0 = alloc_cx(ns), *back = alloc_cx(nc);
+    unsigned k;
+    ptrdiff_t est_default = so3fft_plan_memory(B, 0, 1), est_capped;
+    CHECK(so3fft_planner_max_workspace() == 0);
+    CHECK(so3fft_plan_with_max_workspace(1) == SO3FFT_OK);
+    CHECK(so3fft_planner_max_workspace() == 1);
+    est_capped = so3fft_plan_memory(B, 0, 1);
+    printf("capped workspace B=%d: plan memory %ld bytes (default %ld)\n", B, (long)est_capped,
+           (long)est_default);
+    CHECK(est_capped > 0 && est_capped < est_default);
+    for (k = 0; k < 4; k++) {
+        unsigned flags = (k & 1 ? SO3FFT_DESTROY_INPUT : 0u) | (k & 2 ? SO3FFT_REAL : 0u);
+        so3fft_plan p = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, flags, k == 3 ? 2 : 1);
+        double e;
+        CHECK(p != NULL);
+        if (!p) continue;
+        CHECK(so3fft_get_memory(p) == so3fft_plan_memory(B, flags, k == 3 ? 2 : 1));
+        if (flags & SO3FFT_REAL)
+            fill_real_coeffs(c, B, 500u + k);
+        else
+            fill_random(c, nc, 500u + k);
+        CHECK(so3fft_execute_inverse(p, c, s) == SO3FFT_OK);
+        memcpy(s0, s, ns * sizeof *s);
+        CHECK(so3fft_execute_forward(p, s, back) == SO3FFT_OK);
+        e = max_abs_diff(back, c, nc);
+        printf("capped workspace B=%d flags=0x%x: round-trip error %.3g\n", B, flags, e);
+        CHECK(e <= 1e-12);
+        if (!(flags & SO3FFT_DESTROY_INPUT)) CHECK(memcmp(s, s0, ns * sizeof *s) == 0);
+        so3fft_destroy_plan(p);
+    }
+    CHECK(so3fft_plan_with_max_workspace(0) == SO3FFT_OK);
+    CHECK(so3fft_planner_max_workspace() == 0);
+    CHECK(so3fft_plan_memory(B, 0, 1) == est_default);
+    CHECK_NO_ERR();
+    free(c);
+    free(s);
+    free(s0);
+    free(back);
+}
+
 static void threads_setting(void) {
     so3fft_plan p;
     CHECK(so3fft_planner_nthreads() == 0);
@@ -260,6 +314,7 @@ int main(void) {
     several_plans();
     real_signal();
     memory_estimate();
+    capped_workspace();
     threads_setting();
     return finish("test_roundtrip");
 }

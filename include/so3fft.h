@@ -226,6 +226,29 @@ int so3fft_plan_with_nthreads(int nthreads);
 int so3fft_planner_nthreads(void);
 
 /**
+ * Caps the chunk buffer of plans created afterwards by every planner (process-wide, like
+ * `so3fft_plan_with_nthreads`): `bytes` = 0 restores the library default (the initial
+ * setting), any other value is the most the plan's chunk buffer may take.
+ *
+ * The chunk buffer holds the beta slices of one chunk in the DWT's layout; a transform
+ * runs its slices through it a chunk at a time. The default keeps a whole plan within
+ * about 5% of the caller's arrays at large `B` (and within half of the available memory);
+ * a smaller cap means more, smaller chunks: less memory, somewhat more time (each chunk
+ * passes over the coefficients once). The buffer always holds at least one pair of beta
+ * slices, so a tiny cap is not an error. `so3fft_plan_memory` and `so3fft_get_memory`
+ * report the memory with the cap applied. Existing plans are not changed.
+ *
+ * Returns `SO3FFT_OK`. Thread-safe; never fails.
+ */
+int so3fft_plan_with_max_workspace(size_t bytes);
+
+/**
+ * The current process-wide setting of `so3fft_plan_with_max_workspace` (0 = the library
+ * default). Thread-safe; never fails.
+ */
+size_t so3fft_planner_max_workspace(void);
+
+/**
  * Creates a plan for the forward transform (samples to coefficients) of bandwidth `B`.
  *
  * - `B`: bandwidth, 1 .. `SO3FFT_MAX_BANDWIDTH`.
@@ -394,7 +417,7 @@ ptrdiff_t so3fft_get_memory(so3fft_plan p);
  * at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
  * the memory available at the time of the call, so a plan made later may differ if that
  * has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and
- * `Plan::workspace_bytes`.
+ * `Plan::workspace_bytes`. A cap set with `so3fft_plan_with_max_workspace` applies.
  *
  * Returns the byte count, or a negative `SO3FFT_E*` code (`SO3FFT_EBANDWIDTH` for an
  * invalid `B`, `SO3FFT_EINVAL` for unknown flags or `nthreads < 0`). Thread-safe.

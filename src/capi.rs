@@ -15,7 +15,7 @@ use crate::{Complex64, Direction, Plan, PlanOptions, Rigor, MAX_BANDWIDTH};
 use std::cell::RefCell;
 use std::ffi::{c_char, c_double, c_int, c_uint, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicI32, Ordering};
+use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
 
 /// One complex number: `[0]` is the real part, `[1]` the imaginary part.
 ///
@@ -466,6 +466,48 @@ pub extern "C" fn so3fft_planner_nthreads() -> c_int {
 }
 
 // ---------------------------------------------------------------------------------------
+// Workspace
+// ---------------------------------------------------------------------------------------
+
+static PLANNER_MAX_WORKSPACE: AtomicUsize = AtomicUsize::new(0);
+
+/// Caps the chunk buffer of plans created afterwards by every planner (process-wide, like
+/// `so3fft_plan_with_nthreads`): `bytes` = 0 restores the library default (the initial
+/// setting), any other value is the most the plan's chunk buffer may take.
+///
+/// The chunk buffer holds the beta slices of one chunk in the DWT's layout; a transform
+/// runs its slices through it a chunk at a time. The default keeps a whole plan within
+/// about 5% of the caller's arrays at large `B` (and within half of the available memory);
+/// a smaller cap means more, smaller chunks: less memory, somewhat more time (each chunk
+/// passes over the coefficients once). The buffer always holds at least one pair of beta
+/// slices, so a tiny cap is not an error. `so3fft_plan_memory` and `so3fft_get_memory`
+/// report the memory with the cap applied. Existing plans are not changed.
+///
+/// Returns `SO3FFT_OK`. Thread-safe; never fails.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_with_max_workspace(bytes: usize) -> c_int {
+    clear_error();
+    PLANNER_MAX_WORKSPACE.store(bytes, Ordering::Relaxed);
+    SO3FFT_OK
+}
+
+/// The current process-wide setting of `so3fft_plan_with_max_workspace` (0 = the library
+/// default). Thread-safe; never fails.
+#[no_mangle]
+pub extern "C" fn so3fft_planner_max_workspace() -> usize {
+    clear_error();
+    PLANNER_MAX_WORKSPACE.load(Ordering::Relaxed)
+}
+
+/// The workspace cap of plans made now (`None`: the library default).
+fn planner_workspace_cap() -> Option<usize> {
+    match PLANNER_MAX_WORKSPACE.load(Ordering::Relaxed) {
+        0 => None,
+        bytes => Some(bytes),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
 // Planners
 // ---------------------------------------------------------------------------------------
 
@@ -511,6 +553,7 @@ fn make_plan(
             threads,
             rigor,
             real,
+            max_workspace_bytes: planner_workspace_cap(),
             ..PlanOptions::default()
         };
         let plan = Plan::new(b, &options)?;
@@ -786,7 +829,7 @@ pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
 /// at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
 /// the memory available at the time of the call, so a plan made later may differ if that
 /// has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and
-/// `Plan::workspace_bytes`.
+/// `Plan::workspace_bytes`. A cap set with `so3fft_plan_with_max_workspace` applies.
 ///
 /// Returns the byte count, or a negative `SO3FFT_E*` code (`SO3FFT_EBANDWIDTH` for an
 /// invalid `B`, `SO3FFT_EINVAL` for unknown flags or `nthreads < 0`). Thread-safe.
@@ -800,6 +843,7 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
             threads,
             rigor,
             real: flags & SO3FFT_REAL != 0,
+            max_workspace_bytes: planner_workspace_cap(),
             ..PlanOptions::default()
         };
         Ok(Plan::memory_needed(b, &options)? as isize)

@@ -1033,9 +1033,17 @@ mod tests {
     /// FFT stage writes before the buffer is read); fewer groups than chunks.
     #[test]
     fn chunk_groups_keep_clear_of_written_slices() {
-        for (b, real) in [(64usize, false), (64, true), (40, false), (37, true)] {
+        // B = 36 with a 1-byte cap (the smallest chunk, 8 pairs) is the C test's `capped_workspace`.
+        for (b, real, cap) in [
+            (64usize, false, 1usize << 20),
+            (64, true, 1 << 20),
+            (40, false, 1 << 20),
+            (37, true, 1 << 20),
+            (36, false, 1),
+            (36, true, 1),
+        ] {
             let opts = super::PlanOptions {
-                max_workspace_bytes: Some(1 << 20),
+                max_workspace_bytes: Some(cap),
                 real,
                 ..Default::default()
             };
