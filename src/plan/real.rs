@@ -84,7 +84,14 @@ impl Plan {
         let re = unsafe { std::slice::from_raw_parts_mut(samples.as_mut_ptr() as *mut f64, ns) };
         self.inverse_real(coeffs, re)?;
         // SAFETY: `samples` is valid for 2 ns doubles.
-        unsafe { spread_real_in_place(samples.as_mut_ptr() as *mut f64, ns, self.threads) };
+        unsafe {
+            spread_real_in_place(
+                self.pool(),
+                samples.as_mut_ptr() as *mut f64,
+                ns,
+                self.threads,
+            )
+        };
         Ok(())
     }
 
@@ -312,13 +319,15 @@ impl Plan {
 }
 
 /// Turn `n` reals at `base[0..n]` into `n` complex values `(x, 0)` at `base[0..2n]`, in
-/// place. Entry `i` goes to doubles `2i, 2i+1`; the range `[n/2, n)` lands in `[n, 2n)`,
-/// clear of every real still to be read, so it can be done by several threads; then
-/// `[n/4, n/2)` and so on, halving down to the first few entries, done from the top down.
+/// place. Entry `i` goes to doubles `2i, 2i+1`, so going from the top down never
+/// overwrites a real still to be read. With several threads (on the plan's `pool`): the
+/// range `[ceil(n/2), n)` lands in `[2 ceil(n/2), 2n)`, clear of every real still to be
+/// read, so its pieces can be done at once; then the range below, halving down to the
+/// first few entries. One thread does it in a single pass from the top.
 ///
 /// # Safety
 /// `base` is valid for `2n` doubles.
-unsafe fn spread_real_in_place(base: *mut f64, n: usize, threads: usize) {
+unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usize, threads: usize) {
     #[derive(Clone, Copy)]
     struct P(*mut f64);
     // SAFETY: threads write disjoint ranges and read ranges nobody writes in that round.
@@ -332,17 +341,47 @@ unsafe fn spread_real_in_place(base: *mut f64, n: usize, threads: usize) {
         }
     };
     let mut hi = n;
-    while hi > 1 << 16 {
-        let lo = hi / 2;
-        let per = (hi - lo).div_ceil(threads.max(1));
-        std::thread::scope(|s| {
-            for a in (lo..hi).step_by(per) {
-                let b = (a + per).min(hi);
-                let p = P(base);
-                s.spawn(move || spread(p, a, b));
-            }
-        });
-        hi = lo;
+    if threads > 1 {
+        while hi > 1 << 16 {
+            // Rounded up: with `hi` odd, `hi / 2` would write double `hi - 1`, a real
+            // another piece of this round still reads.
+            let lo = hi.div_ceil(2);
+            let per = (hi - lo).div_ceil(threads);
+            let p = P(base);
+            pool.install(|| {
+                (lo..hi)
+                    .step_by(per)
+                    .par_bridge()
+                    .for_each(|a| spread(p, a, (a + per).min(hi)))
+            });
+            hi = lo;
+        }
     }
     spread(P(base), 0, hi);
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every real ends up as `(x, 0)` at its own index, with one thread (one pass) and with
+    /// several (halving rounds, uneven pieces), for sizes around the rounds' threshold.
+    #[test]
+    fn spread_real_in_place_keeps_every_value() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for n in [1usize, 7, 1 << 16, (1 << 16) + 1, 300_001] {
+            for threads in [1usize, 2, 3] {
+                let mut v: Vec<f64> = (0..2 * n)
+                    .map(|i| if i < n { i as f64 + 0.5 } else { f64::NAN })
+                    .collect();
+                // SAFETY: `v` holds 2n doubles.
+                unsafe { super::spread_real_in_place(&pool, v.as_mut_ptr(), n, threads) };
+                assert!(
+                    (0..n).all(|i| v[2 * i] == i as f64 + 0.5 && v[2 * i + 1] == 0.0),
+                    "n={n} threads={threads}"
+                );
+            }
+        }
+    }
 }
