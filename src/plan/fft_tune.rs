@@ -3,8 +3,8 @@
 //! With a measuring rigour (`Rigor::Measure` or stronger), more than one thread and
 //! `FftThreading::Auto`, [`Plan::new`] builds the slice plans of both variants and times
 //! them on a sample of the real work: the FFT stage, for each direction the plan has, of
-//! the first slice groups of a chunk (one group per worker), on a scratch array standing in
-//! for the sample grid and on the plan's own chunk buffer, so the block copies run
+//! the first slice groups of a chunk (up to [`SAMPLE_GROUPS`] groups per worker, within
+//! [`SAMPLE_BYTES`]), on a scratch array standing in for the sample grid and on the plan's own chunk buffer, so the block copies run
 //! with the real stride. FFTW's threads are started by one untimed slice transform first.
 //! Rounds alternate between the variants and each keeps its fastest round (interference
 //! from other processes only ever adds time); after a round that shows a difference of
@@ -16,6 +16,15 @@ use super::*;
 
 /// Timed rounds per variant, at most (the fastest of them counts).
 const ROUNDS: usize = 3;
+
+/// Groups of slice pairs per worker in the timed sample, at most. With one, each worker
+/// had a single group: a worker delayed by another process then doubled the time of the
+/// slices-across-workers variant, and 1 of 4 plans at B = 256 kept FFTW's threads, whose
+/// inverse FFT stage is 15% slower here (forward: equal).
+const SAMPLE_GROUPS: usize = 4;
+
+/// Most bytes of the scratch sample grid (at least one group per worker is timed).
+const SAMPLE_BYTES: usize = 64 << 20;
 
 /// Ratio of the two times beyond which no further round is run.
 const CLEAR: f64 = 1.25;
@@ -74,12 +83,15 @@ impl Plan {
     ) -> Option<[f64; 2]> {
         let n = 2 * self.b;
         let nn = n * n;
-        // One group of pairs per worker and direction, from the first chunk (always a full
-        // one). The sample grid holds the slices the timed pairs write: pair `j` (beta `j`
-        // and its mirror `2B-1-j`) uses slices `2j` and `2j+1`, distinct for the pairs timed
+        // Up to SAMPLE_GROUPS groups of pairs per worker and direction, from the first
+        // chunk (always a full one), within SAMPLE_BYTES of sample grid. The sample grid
+        // holds the slices the timed pairs write: pair `j` (beta `j` and its mirror
+        // `2B-1-j`) uses slices `2j` and `2j+1`, distinct for the pairs timed
         // concurrently. (Mapping fresh memory costs more than the measurement itself when
         // transparent huge pages must be compacted.)
-        let npairs = (self.threads * self.group).min(self.blocks.chunk);
+        let per_group = self.threads * self.group;
+        let fit = SAMPLE_BYTES / (2 * nn * 16) / per_group;
+        let npairs = (per_group * fit.clamp(1, SAMPLE_GROUPS)).min(self.blocks.chunk);
         let slices = 2 * npairs;
         let bytes = slices * nn * 16;
         if mem_available().is_some_and(|a| a / 4 < bytes) {
