@@ -4,8 +4,8 @@
 //! several runs, with the FFT and DWT stages separately), checks the round trip on random
 //! coefficients, relates the DWT stage's flop rate to the machine's FMA peak measured in the
 //! same run, and records the peak resident memory. Per bandwidth it also runs the transforms
-//! without skipping negligible Wigner-d prefixes and, at small B, a plain one-thread DWT
-//! (`naive.rs`) as a yardstick. `--big` adds B = 512 in a memory-lean procedure (`big.rs`).
+//! without skipping negligible Wigner-d prefixes, the real-signal transforms against the
+//! complex ones and, at small B, a plain one-thread DWT (`naive.rs`) as a yardstick. `--big` adds B = 512 in a memory-lean procedure (`big.rs`).
 //! Prints tables, writes a CSV file and an SVG plot.
 //!
 //! `cargo run --release --bin so3fft-bench -- --help` lists the options; `notes/bench.md`
@@ -186,7 +186,7 @@ fn print_header(opts: &Options, peak: &peak::Peak) {
 }
 
 /// All measurements at one bandwidth B <= 256: every thread count, the no-skip run (first
-/// thread count) and the plain DWT. The random coefficients are shared between them.
+/// thread count), the real-signal run (last thread count) and the plain DWT. The random coefficients are shared between them.
 fn bench_bandwidth(
     b: usize,
     opts: &Options,
@@ -214,6 +214,12 @@ fn bench_bandwidth(
             eprintln!("  (B = {b}: no-skip run n/a: {e})");
             noskip_missing.push((b, e.to_string()));
         }
+    }
+
+    let real_threads = *opts.threads.last().expect("at least one thread count");
+    match bench_real(b, real_threads, opts, peak.one_core) {
+        Ok(row) => rows.push(row),
+        Err(e) => eprintln!("so3fft-bench: B = {b}: real-signal run skipped: {e}"),
     }
 
     if b <= opts.naive_max {
@@ -484,6 +490,93 @@ fn bench_noskip(
     let sk = skip.row(b, peak_1core);
     let mut row = noskip.row(b, peak_1core);
     row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
+    Ok(row)
+}
+
+/// The real-signal transforms (`inverse_real` / `forward_real`) against the complex ones at
+/// bandwidth `b` on `threads` threads, on coefficients with the real symmetry
+/// ([`seeded::fill_real`]). First a phase with only the real plan and arrays alive (one
+/// untimed and one timed round trip) gives the peak memory; then `runs` round trips of each
+/// path, interleaved (alternating which goes first) so that the load of the shared machine
+/// hits both alike. The row has the medians of the interleaved real runs and `ratio` =
+/// (real / complex) whole-transform medians of these same runs.
+fn bench_real(
+    b: usize,
+    threads: usize,
+    opts: &Options,
+    peak_1core: f64,
+) -> Result<Row, so3fft::Error> {
+    let seed = 0x5EA1_0000 + b as u64;
+    let (ns, nc) = (so3fft::num_samples(b), so3fft::num_coeffs(b));
+    let mut coeffs = vec![Complex64::default(); nc];
+    seeded::fill_real(seed, b, &mut coeffs);
+    let plan_start = Instant::now();
+    let real = Plan::new(
+        b,
+        &PlanOptions {
+            direction: Direction::Both,
+            threads,
+            rigor: opts.rigor,
+            real: true,
+            ..PlanOptions::default()
+        },
+    )?;
+    eprintln!(
+        "  (B = {b}, threads = {}, real signal: plan created in {:.3} s)",
+        real.threads(),
+        plan_start.elapsed().as_secs_f64()
+    );
+    let mut samples = vec![0.0f64; ns];
+    let mut result = vec![Complex64::default(); nc];
+    real.inverse_real(&coeffs, &mut samples)?;
+    real.forward_real(&samples, &mut result)?;
+    let (measured, phase) = memory::measure(|| {
+        real.inverse_real(&coeffs, &mut samples)?;
+        real.forward_real(&samples, &mut result)
+    });
+    measured?;
+
+    let mut complex = Config::new(b, threads, Variant::Complex, opts)?;
+    let mut arrays = Arrays::new(b);
+    complex.warm_up(&coeffs, &mut arrays)?;
+    let mut times = RunTimes::default();
+    let mut error = RoundTripError::default();
+    let mut real_run = |times: &mut RunTimes| -> Result<(), so3fft::Error> {
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        times
+            .inv
+            .push(real.inverse_real_timed(&coeffs, &mut samples)?);
+        times.inv_wall.push(start.elapsed().as_secs_f64());
+        times.inv_cpu.push(cpu_seconds() - cpu);
+        let (cpu, start) = (cpu_seconds(), Instant::now());
+        times
+            .fwd
+            .push(real.forward_real_timed(&samples, &mut result)?);
+        times.fwd_wall.push(start.elapsed().as_secs_f64());
+        times.fwd_cpu.push(cpu_seconds() - cpu);
+        error = error.worst(seeded::compare_real(seed, b, &result));
+        Ok(())
+    };
+    for run in 0..opts.runs_for(b) {
+        if run % 2 == 0 {
+            real_run(&mut times)?;
+            complex.run(&coeffs, &mut arrays)?;
+        } else {
+            complex.run(&coeffs, &mut arrays)?;
+            real_run(&mut times)?;
+        }
+    }
+    let c = complex.row(b, peak_1core);
+    let mut row = summarise(b, real.threads(), &times, error, peak_1core);
+    row.variant = Variant::Real;
+    row.dwt_flops = workload::dwt_flops_real(b);
+    row.ratio = Some((row.fwd_median / c.fwd_median, row.inv_median / c.inv_median));
+    row.memory = phase.map(|p| Memory {
+        peak: p.peak,
+        start: p.start,
+        plan: real.memory_bytes() as u64,
+        arrays: (8 * ns + 16 * nc) as u64,
+    });
     Ok(row)
 }
 
