@@ -695,13 +695,25 @@ pub unsafe extern "C" fn makeweights2(bw: c_int, w: *mut c_double) {
 // ----------------------------------------------------------------------------------------
 
 /// Number of doubles in a `genWigAll` / `genWigAllTrans` table: the normalised Wigner d
-/// values `dt^l_{m1,m2}(beta_k)` for `0 <= m1 <= m2 < bw`, `l = m2..bw-1`, `k < 2bw`:
-/// `bw^2 (bw+1) (bw+2) / 3` (the size SOFT's clients allocate).
+/// values `dt^l_{m1,m2}(beta_k)` for the order pairs of [`wig_blocks`],
+/// `l = max(m1, m2)..bw-1`, `k < 2bw`: `bw^2 (bw+1) (bw+2) / 3` (the size SOFT's clients
+/// allocate).
 fn wig_table_len(b: usize) -> Option<usize> {
     b.checked_mul(b)?
         .checked_mul(b + 1)?
         .checked_mul(b + 2)
         .map(|v| v / 3)
+}
+
+/// The order pairs `(m1, m2)` of a `genWigAll` table's blocks, in SOFT's order: `(0, 0)`;
+/// `(m, m)` for `m = 1..bw-1`; `(m, 0)` for `m = 1..bw-1`; `(m1, m2)` for `m1 = 1..bw-1`,
+/// `m2 = m1+1..bw-1`. (Every pair `0 <= min <= max < bw` once; the symmetries of `d` give
+/// the others.)
+fn wig_blocks(b: usize) -> impl Iterator<Item = (usize, usize)> {
+    std::iter::once((0, 0))
+        .chain((1..b).map(|m| (m, m)))
+        .chain((1..b).map(|m| (m, 0)))
+        .chain((1..b).flat_map(move |m1| (m1 + 1..b).map(move |m2| (m1, m2))))
 }
 
 /// Shared body of the two table generators.
@@ -713,22 +725,20 @@ unsafe fn gen_wig(bw: c_int, table: *mut c_double, transposed: bool) -> SoftResu
     let out = std::slice::from_raw_parts_mut(table, len);
     let n = 2 * b;
     let mut pos = 0;
-    for m2 in 0..b {
-        for m1 in 0..=m2 {
-            let d = crate::wigner::dt_on_grid(b, m1 as isize, m2 as isize);
-            let rows = b - m2;
-            let blk = &mut out[pos..pos + rows * n];
-            if transposed {
-                for k in 0..n {
-                    for r in 0..rows {
-                        blk[k * rows + r] = d[r * n + k];
-                    }
+    for (m1, m2) in wig_blocks(b) {
+        let d = crate::wigner::dt_on_grid(b, m1 as isize, m2 as isize);
+        let rows = b - m1.max(m2);
+        let blk = &mut out[pos..pos + rows * n];
+        if transposed {
+            for k in 0..n {
+                for r in 0..rows {
+                    blk[k * rows + r] = d[r * n + k];
                 }
-            } else {
-                blk.copy_from_slice(&d);
             }
-            pos += rows * n;
+        } else {
+            blk.copy_from_slice(&d);
         }
+        pos += rows * n;
     }
     debug_assert_eq!(pos, len);
     // Set-up time belongs here: build (and cache) the transform plan of this bandwidth.
@@ -739,8 +749,9 @@ unsafe fn gen_wig(bw: c_int, table: *mut c_double, transposed: bool) -> SoftResu
 
 /// Table for the `_pc` forward transform (`makeWigner.h`): writes exactly
 /// `bw^2 (bw+1)(bw+2)/3` doubles, the normalised Wigner d values
-/// `sqrt((2l+1)/2) d^l_{m1,m2}(beta_k)` for `0 <= m1 <= m2 < bw` (blocks in order `m2`
-/// outer, `m1` inner; rows `l = m2..bw-1`, each of the `2bw` values `k`), and creates the
+/// `sqrt((2l+1)/2) d^l_{m1,m2}(beta_k)`, blocks in SOFT's order: `(0, 0)`, `(m, m)` for
+/// `m = 1..bw-1`, `(m, 0)` for `m = 1..bw-1`, then `(m1, m2)` for `m1 = 1..bw-1`,
+/// `m2 = m1+1..bw-1`; rows `l = max(m1, m2)..bw-1`, each of the `2bw` values `k`), and creates the
 /// cached transform plan of `bw`. The `_pc` transforms accept but do not read the table.
 /// `workspace` is not used.
 ///

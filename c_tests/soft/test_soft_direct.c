@@ -80,29 +80,39 @@ static void direct_checks(int bw, int flag) {
     fftw_free(c);
 }
 
+/* One block of the tables at `pos` against sqrt((2l+1)/2) d^l_{m1,m2}(beta_k): rows l (the
+ * 2bw betas each) in `t`, the transpose in `tt`. Returns the position of the next block. */
+static size_t check_block(int bw, const double *t, const double *tt, size_t pos, int m1, int m2,
+                          double *worst) {
+    int n = 2 * bw, lo = m1 > m2 ? m1 : m2, rows = bw - lo, l, k;
+    for (l = lo; l < bw; l++)
+        for (k = 0; k < n; k++) {
+            double beta = M_PI * (2 * k + 1) / (4.0 * bw);
+            double want = sqrt((2 * l + 1) / 2.0) * wigner_d(l, m1, m2, beta);
+            double a = t[pos + (size_t)(l - lo) * n + k];
+            double b = tt[pos + (size_t)k * rows + (l - lo)];
+            if (fabs(a - want) > *worst) *worst = fabs(a - want);
+            CHECK(a == b);
+        }
+    return pos + (size_t)rows * n;
+}
+
 /* genWigAll / genWigAllTrans write exactly bw^2 (bw+1)(bw+2)/3 doubles (allocated exactly,
- * so valgrind catches any overrun) holding sqrt((2l+1)/2) d^l_{m1,m2}(beta_k). */
+ * so valgrind catches any overrun) holding sqrt((2l+1)/2) d^l_{m1,m2}(beta_k), in blocks
+ * ordered as SOFT's makeWigner: (0,0); (m,m) for m = 1..bw-1; (m,0) for m = 1..bw-1; then
+ * (m1,m2) for m1 = 1..bw-1, m2 = m1+1..bw-1. */
 static void table_checks(int bw) {
-    int n = 2 * bw, m1, m2, l, k;
+    int m1, m2;
     size_t len = (size_t)(bw * bw * (bw * bw + 3 * bw + 2)) / 3, pos = 0;
     double *t = alloc_re(len), *tt = alloc_re(len), *ws = alloc_re((size_t)(24 * bw + 2 * bw * bw));
     double worst = 0.0;
     genWigAll(bw, t, ws);
     genWigAllTrans(bw, tt, ws);
-    for (m2 = 0; m2 < bw; m2++)
-        for (m1 = 0; m1 <= m2; m1++) {
-            int rows = bw - m2;
-            for (l = m2; l < bw; l++)
-                for (k = 0; k < n; k++) {
-                    double beta = M_PI * (2 * k + 1) / (4.0 * bw);
-                    double want = sqrt((2 * l + 1) / 2.0) * wigner_d(l, m1, m2, beta);
-                    double a = t[pos + (size_t)(l - m2) * n + k];
-                    double b = tt[pos + (size_t)k * rows + (l - m2)];
-                    if (fabs(a - want) > worst) worst = fabs(a - want);
-                    CHECK(a == b);
-                }
-            pos += (size_t)rows * n;
-        }
+    pos = check_block(bw, t, tt, pos, 0, 0, &worst);
+    for (m1 = 1; m1 < bw; m1++) pos = check_block(bw, t, tt, pos, m1, m1, &worst);
+    for (m1 = 1; m1 < bw; m1++) pos = check_block(bw, t, tt, pos, m1, 0, &worst);
+    for (m1 = 1; m1 < bw; m1++)
+        for (m2 = m1 + 1; m2 < bw; m2++) pos = check_block(bw, t, tt, pos, m1, m2, &worst);
     CHECK(pos == len);
     CHECK_CLOSE(worst, 1e-13, "genWigAll table values");
     fftw_free(ws);
