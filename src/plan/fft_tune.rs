@@ -4,8 +4,8 @@
 //! `FftThreading::Auto`, [`Plan::new`] builds the slice plans of both variants and times
 //! them on a sample of the real work: the FFT stage, for each direction the plan has, of
 //! the first slice groups of a chunk (up to [`SAMPLE_GROUPS`] groups per worker, within
-//! [`SAMPLE_BYTES`]), on a scratch array standing in for the sample grid and on the plan's own chunk buffer, so the block copies run
-//! with the real stride. FFTW's threads are started by one untimed slice transform first.
+//! [`SAMPLE_BYTES`]), on a scratch array standing in for the sample grid and on the plan's
+//! own chunk buffer, so the block copies run with the real stride. FFTW's threads are started by one untimed slice transform first.
 //! Rounds alternate between the variants and each keeps its fastest round (interference
 //! from other processes only ever adds time); after a round that shows a difference of
 //! more than [`CLEAR`], no more are run, else up to [`ROUNDS`]. The faster variant is kept
@@ -19,8 +19,8 @@ const ROUNDS: usize = 3;
 
 /// Groups of slice pairs per worker in the timed sample, at most. With one, each worker
 /// had a single group: a worker delayed by another process then doubled the time of the
-/// slices-across-workers variant, and 1 of 4 plans at B = 256 kept FFTW's threads, whose
-/// inverse FFT stage is 15% slower here (forward: equal).
+/// slices-across-workers variant, and 3 of 10 plans at B = 256 kept FFTW's threads, whose
+/// inverse FFT stage is 15% slower here (forward: equal); none of 14 with four groups.
 const SAMPLE_GROUPS: usize = 4;
 
 /// Most bytes of the scratch sample grid (at least one group per worker is timed).
