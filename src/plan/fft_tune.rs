@@ -5,12 +5,12 @@
 //! them on a sample of the real work: the FFT stage, for each direction the plan has, of
 //! the first slice groups of a chunk (up to [`SAMPLE_GROUPS`] groups per worker, within
 //! [`SAMPLE_BYTES`]), on a scratch array standing in for the sample grid and on the plan's
-//! own chunk buffer, so the block copies run with the real stride. FFTW's threads are started by one untimed slice transform first.
-//! Rounds alternate between the variants and each keeps its fastest round (interference
-//! from other processes only ever adds time); after a round that shows a difference of
-//! more than [`CLEAR`], no more are run, else up to [`ROUNDS`]. The faster variant is kept
-//! (FFTW's threads need a margin of [`FFTW_MARGIN`]) and the other's FFTW plans are
-//! destroyed.
+//! own chunk buffer, so the block copies run with the real stride. FFTW's threads are
+//! started by one untimed slice transform first. Rounds alternate between the variants and
+//! each keeps its fastest round (interference from other processes only ever adds time);
+//! after a round that shows a difference of more than [`CLEAR`], no more are run, else up
+//! to [`ROUNDS`]. The faster variant is kept (FFTW's threads need a margin of
+//! [`FFTW_MARGIN`]) and the other's FFTW plans are destroyed.
 
 use super::*;
 
