@@ -5,7 +5,8 @@
 //! coefficients, relates the DWT stage's flop rate to the machine's FMA peak measured in the
 //! same run, and records the peak resident memory. Per bandwidth it also runs the transforms
 //! without skipping negligible Wigner-d prefixes, the real-signal transforms against the
-//! complex ones and, at small B, a plain one-thread DWT (`naive.rs`) as a yardstick. `--big` adds B = 512 in a memory-lean procedure (`big.rs`).
+//! complex ones and, at small B, a plain one-thread DWT (`naive.rs`) as a yardstick. `--big`
+//! adds B = 512 in a memory-lean procedure (`big.rs`).
 //! Prints tables, writes a CSV file and an SVG plot.
 //!
 //! `cargo run --release --bin so3fft-bench -- --help` lists the options; `notes/bench.md`
@@ -186,7 +187,8 @@ fn print_header(opts: &Options, peak: &peak::Peak) {
 }
 
 /// All measurements at one bandwidth B <= 256: every thread count, the no-skip run (first
-/// thread count), the real-signal run (last thread count) and the plain DWT. The random coefficients are shared between them.
+/// thread count), the real-signal run (last thread count) and the plain DWT. The random
+/// coefficients are shared between the complex runs and the plain DWT.
 fn bench_bandwidth(
     b: usize,
     opts: &Options,
