@@ -98,9 +98,9 @@ pub enum FftThreading {
     ///   one thread: both variants are planned and timed, and the faster one is kept
     ///   ([`Plan::fft_threading`] tells which). The timed work is the FFT stage, for every
     ///   direction the plan has, of the first groups of a chunk (up to 4 groups of up to 4
-    ///   mirrored pairs of slices per worker, within 64 MiB), on a scratch array standing in for the
-    ///   samples and on the plan's own chunk buffer, so the block copies run with their real
-    ///   strides. The variants alternate for up to three rounds (one when they differ by
+    ///   mirrored pairs of slices per worker, within 64 MiB), on a scratch array standing
+    ///   in for the samples and on the plan's own chunk buffer, so the block copies run
+    ///   with their real strides. The variants alternate for up to three rounds (one when they differ by
     ///   more than 25%) and each is judged by its fastest round (interference from other
     ///   processes only adds time); FFTW's threads are kept only when at least 10% faster,
     ///   as slices across workers balance their load dynamically and suffer less from other
@@ -1073,18 +1073,25 @@ mod tests {
                 groups.len() < flat.len(),
                 "B={b} real={real}: no forward group"
             );
-            for g in &groups {
-                let lo = g[0].0.lo;
+            let bytes = t.total() * 8;
+            // The spare buffers of a group (all but its first chunk's): offsets into the
+            // array, each 64-byte aligned and clear of the group's other buffers.
+            let offsets = |g: &[(super::Chunk, Option<*mut f64>)]| -> Vec<usize> {
                 let mut ranges: Vec<(usize, usize)> = Vec::new();
                 for (_, p) in &g[1..] {
                     let a = (p.unwrap() as usize) - (spare.base as usize);
-                    let bytes = t.total() * 8;
                     assert_eq!((spare.base as usize + a) % 64, 0);
+                    assert!(ranges.iter().all(|&(x, y)| a + bytes <= x || a >= y));
+                    ranges.push((a, a + bytes));
+                }
+                ranges.iter().map(|r| r.0).collect()
+            };
+            for g in &groups {
+                let lo = g[0].0.lo;
+                for a in offsets(g) {
                     let low = a + bytes <= lo * slice_bytes;
                     let high = a >= (2 * b - lo) * slice_bytes && a + bytes <= total;
                     assert!(low || high, "B={b}: forward buffer outside the read slices");
-                    assert!(ranges.iter().all(|&(x, y)| a + bytes <= x || a >= y));
-                    ranges.push((a, a + bytes));
                 }
             }
             let groups = plan.chunk_groups(t, false, Some(&spare));
@@ -1092,21 +1099,15 @@ mod tests {
             let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
             assert_eq!(flat, chunks, "B={b} real={real}");
             assert!(groups.len() < chunks.len(), "B={b} real={real}: no group");
-            let bytes = t.total() * 8;
             for g in &groups {
                 assert!(g[0].1.is_none());
                 let written = g.last().map(|(c, _)| c.lo + c.h).unwrap();
-                let mut ranges: Vec<(usize, usize)> = Vec::new();
-                for (_, p) in &g[1..] {
-                    let a = (p.unwrap() as usize) - (spare.base as usize);
-                    assert_eq!((spare.base as usize + a) % 64, 0);
+                for a in offsets(g) {
                     assert!(
                         a >= written * slice_bytes,
                         "B={b}: buffer below the free slices"
                     );
                     assert!(a + bytes <= (2 * b - written) * slice_bytes, "B={b}: above");
-                    assert!(ranges.iter().all(|&(x, y)| a + bytes <= x || a >= y));
-                    ranges.push((a, a + bytes));
                 }
             }
         }

@@ -137,22 +137,11 @@ fn real_inverse_into_complex_at_odd_b() {
         let mut got = zeros(ns);
         // SAFETY: plans and arrays as the C API documents; sizes from the same B.
         unsafe {
-            let pc = so3fft_plan_general(
-                bi,
-                SO3FFT_BOTH,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                0,
-                threads,
-            );
-            let pr = so3fft_plan_general(
-                bi,
-                SO3FFT_BOTH,
-                std::ptr::null_mut(),
-                std::ptr::null_mut(),
-                SO3FFT_REAL,
-                threads,
-            );
+            let plan = |flags| {
+                let null = std::ptr::null_mut();
+                so3fft_plan_general(bi, SO3FFT_BOTH, null, null, flags, threads)
+            };
+            let (pc, pr) = (plan(0), plan(SO3FFT_REAL));
             assert!(!pc.is_null() && !pr.is_null());
             let wp = want.as_mut_ptr() as *mut so3fft_complex;
             assert_eq!(so3fft_execute_inverse(pc, cp, wp), SO3FFT_OK);

@@ -289,7 +289,7 @@ fn bench_naive(b: usize, opts: &Options, coeffs: &[Complex64], peak_1core: f64) 
             peak: p.peak,
             start: p.start,
             plan: 0,
-            arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
+            arrays: workload::array_bytes(b, false),
         }),
         ratio: None,
         cpu: Some((median(&times.fwd_cpu), median(&times.inv_cpu))),
@@ -331,6 +331,66 @@ struct RunTimes {
     inv: Vec<StageTimes>,
 }
 
+impl RunTimes {
+    /// Times one inverse `f` (wall and process CPU time, and the library's stages).
+    fn inverse(&mut self, f: impl FnOnce() -> so3fft::Result<StageTimes>) -> so3fft::Result<()> {
+        timed_call(&mut self.inv, &mut self.inv_wall, &mut self.inv_cpu, f)
+    }
+
+    /// Times one forward `f`, as [`RunTimes::inverse`].
+    fn forward(&mut self, f: impl FnOnce() -> so3fft::Result<StageTimes>) -> so3fft::Result<()> {
+        timed_call(&mut self.fwd, &mut self.fwd_wall, &mut self.fwd_cpu, f)
+    }
+}
+
+/// Runs `f` and records its stage times, wall time and process CPU time.
+fn timed_call(
+    stages: &mut Vec<StageTimes>,
+    wall: &mut Vec<f64>,
+    cpu: &mut Vec<f64>,
+    f: impl FnOnce() -> so3fft::Result<StageTimes>,
+) -> so3fft::Result<()> {
+    let (c, start) = (cpu_seconds(), Instant::now());
+    stages.push(f()?);
+    wall.push(start.elapsed().as_secs_f64());
+    cpu.push(cpu_seconds() - c);
+    Ok(())
+}
+
+/// A `Direction::Both` plan for `variant` (`Complex`: default options; `NoSkip`:
+/// `skip_bits: Some(0)`; `Real`: the real-signal transforms) with the bench's rigour; the
+/// planning time goes to stderr.
+fn bench_plan(
+    b: usize,
+    threads: usize,
+    variant: Variant,
+    opts: &Options,
+) -> Result<Plan, so3fft::Error> {
+    let plan_start = Instant::now();
+    let plan = Plan::new(
+        b,
+        &PlanOptions {
+            direction: Direction::Both,
+            threads,
+            rigor: opts.rigor,
+            skip_bits: (variant == Variant::NoSkip).then_some(0),
+            real: variant == Variant::Real,
+            ..PlanOptions::default()
+        },
+    )?;
+    let what = match variant {
+        Variant::NoSkip => ", no skipping",
+        Variant::Real => ", real signal",
+        _ => "",
+    };
+    eprintln!(
+        "  (B = {b}, threads = {}{what}: plan created in {:.3} s)",
+        plan.threads(),
+        plan_start.elapsed().as_secs_f64()
+    );
+    Ok(plan)
+}
+
 /// A plan being measured: its times and worst error so far.
 struct Config {
     plan: Plan,
@@ -348,27 +408,7 @@ impl Config {
         variant: Variant,
         opts: &Options,
     ) -> Result<Config, so3fft::Error> {
-        let plan_start = Instant::now();
-        let plan = Plan::new(
-            b,
-            &PlanOptions {
-                direction: Direction::Both,
-                threads,
-                rigor: opts.rigor,
-                skip_bits: (variant == Variant::NoSkip).then_some(0),
-                ..PlanOptions::default()
-            },
-        )?;
-        eprintln!(
-            "  (B = {b}, threads = {}{}: plan created in {:.3} s)",
-            plan.threads(),
-            if variant == Variant::NoSkip {
-                ", no skipping"
-            } else {
-                ""
-            },
-            plan_start.elapsed().as_secs_f64()
-        );
+        let plan = bench_plan(b, threads, variant, opts)?;
         Ok(Config {
             plan,
             variant,
@@ -385,20 +425,11 @@ impl Config {
 
     /// One timed inverse-then-forward round trip, checked against `coeffs`.
     fn run(&mut self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
-        let t = &mut self.times;
-        let (cpu, start) = (cpu_seconds(), Instant::now());
-        t.inv
-            .push(self.plan.inverse_timed(coeffs, &mut arrays.samples)?);
-        t.inv_wall.push(start.elapsed().as_secs_f64());
-        t.inv_cpu.push(cpu_seconds() - cpu);
-
-        let (cpu, start) = (cpu_seconds(), Instant::now());
-        t.fwd.push(
-            self.plan
-                .forward_timed(&arrays.samples, &mut arrays.result)?,
-        );
-        t.fwd_wall.push(start.elapsed().as_secs_f64());
-        t.fwd_cpu.push(cpu_seconds() - cpu);
+        let plan = &self.plan;
+        self.times
+            .inverse(|| plan.inverse_timed(coeffs, &mut arrays.samples))?;
+        self.times
+            .forward(|| plan.forward_timed(&arrays.samples, &mut arrays.result))?;
         let error = workload::roundtrip_error(coeffs, &arrays.result);
         self.error = self.error.worst(error);
         Ok(())
@@ -459,7 +490,7 @@ fn bench_config(
         peak: p.peak,
         start: p.start,
         plan: config.plan.memory_bytes() as u64,
-        arrays: 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64,
+        arrays: workload::array_bytes(b, false),
     });
     Ok(row)
 }
@@ -512,22 +543,7 @@ fn bench_real(
     let (ns, nc) = (so3fft::num_samples(b), so3fft::num_coeffs(b));
     let mut coeffs = vec![Complex64::default(); nc];
     seeded::fill_real(seed, b, &mut coeffs);
-    let plan_start = Instant::now();
-    let real = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Both,
-            threads,
-            rigor: opts.rigor,
-            real: true,
-            ..PlanOptions::default()
-        },
-    )?;
-    eprintln!(
-        "  (B = {b}, threads = {}, real signal: plan created in {:.3} s)",
-        real.threads(),
-        plan_start.elapsed().as_secs_f64()
-    );
+    let real = bench_plan(b, threads, Variant::Real, opts)?;
     let mut samples = vec![0.0f64; ns];
     let mut result = vec![Complex64::default(); nc];
     real.inverse_real(&coeffs, &mut samples)?;
@@ -544,18 +560,8 @@ fn bench_real(
     let mut times = RunTimes::default();
     let mut error = RoundTripError::default();
     let mut real_run = |times: &mut RunTimes| -> Result<(), so3fft::Error> {
-        let (cpu, start) = (cpu_seconds(), Instant::now());
-        times
-            .inv
-            .push(real.inverse_real_timed(&coeffs, &mut samples)?);
-        times.inv_wall.push(start.elapsed().as_secs_f64());
-        times.inv_cpu.push(cpu_seconds() - cpu);
-        let (cpu, start) = (cpu_seconds(), Instant::now());
-        times
-            .fwd
-            .push(real.forward_real_timed(&samples, &mut result)?);
-        times.fwd_wall.push(start.elapsed().as_secs_f64());
-        times.fwd_cpu.push(cpu_seconds() - cpu);
+        times.inverse(|| real.inverse_real_timed(&coeffs, &mut samples))?;
+        times.forward(|| real.forward_real_timed(&samples, &mut result))?;
         error = error.worst(seeded::compare_real(seed, b, &result));
         Ok(())
     };
@@ -577,7 +583,7 @@ fn bench_real(
         peak: p.peak,
         start: p.start,
         plan: real.memory_bytes() as u64,
-        arrays: (8 * ns + 16 * nc) as u64,
+        arrays: workload::array_bytes(b, true),
     });
     Ok(row)
 }

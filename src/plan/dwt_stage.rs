@@ -54,6 +54,18 @@ impl Scratch {
         }
     }
 
+    /// `buf` taken out of the scratch for a kernel call (put back afterwards). Only after a
+    /// panic left the scratch without it is it shorter than `need`: then a fresh one of
+    /// `full` values.
+    fn take(buf: &mut Vec<f64>, need: usize, full: usize) -> Vec<f64> {
+        let v = std::mem::take(buf);
+        if v.len() < need {
+            vec![0.0; full]
+        } else {
+            v
+        }
+    }
+
     /// Scratch for the chunks of the complex layout and, if present, the real one.
     pub fn for_layouts(b: usize, complex: &Blocks, real: Option<&Blocks>) -> Scratch {
         Scratch::new(b, complex.lanes.max(real.map_or(0, |t| t.lanes)))
@@ -179,11 +191,7 @@ impl Plan {
         xin: &[f64],
         next: Prefetch,
     ) -> usize {
-        let mut out = std::mem::take(&mut sc.out);
-        if out.len() < (n + 8) * p {
-            // Only after a panic left the scratch without its buffer.
-            out = vec![0.0; (self.b + 8) * 16];
-        }
+        let mut out = Scratch::take(&mut sc.out, (n + 8) * p, (self.b + 8) * 16);
         let f = &mut out[..(n + 8) * p];
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
@@ -336,11 +344,7 @@ impl Plan {
         let n = self.setup(sc, cl, ch, k == 0);
         let p = t.p(c);
         let (mem, nm) = members(cl);
-        let mut data = std::mem::take(&mut sc.data);
-        if data.len() < n * p {
-            // Only after a panic left the scratch without its buffer.
-            data = vec![0.0; self.b * 16];
-        }
+        let mut data = Scratch::take(&mut sc.data, n * p, self.b * 16);
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);

@@ -171,7 +171,7 @@ impl Lean<'_> {
         if let Ok(row) = &skip {
             // The grid still holds the inverse's samples: the forward that may overwrite
             // them, on the same plan (the grid is rewritten by the next step's inverse).
-            let arrays = 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64;
+            let arrays = workload::array_bytes(b, false);
             let (d, mem) =
                 timed_phase(|| plan.forward_destroying_input_timed(&mut grid, &mut coeffs));
             match d.2 {
@@ -237,7 +237,7 @@ impl Lean<'_> {
         let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
         let t = Instant::now();
         let error = seeded::compare_complex(self.seed(), coeffs);
-        let arrays = 16 * (so3fft::num_samples(b) + so3fft::num_coeffs(b)) as u64;
+        let arrays = workload::array_bytes(b, false);
         let row = self.row(
             variant,
             inv,
@@ -292,7 +292,7 @@ impl Lean<'_> {
         );
         match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
             Ok(row) => {
-                let arrays = (8 * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64;
+                let arrays = workload::array_bytes(b, true);
                 let (d, mem) = timed_phase(|| {
                     plan.forward_real_destroying_input_timed(&mut grid, &mut coeffs)
                 });
@@ -326,7 +326,7 @@ impl Lean<'_> {
         let (fwd, fwd_mem) = timed_phase(|| plan.forward_real_timed(grid, coeffs));
         let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
         let error = seeded::compare_real(self.real_seed(), b, coeffs);
-        let arrays = (8 * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64;
+        let arrays = workload::array_bytes(b, true);
         let mut row = self.row(
             Variant::Real,
             inv,

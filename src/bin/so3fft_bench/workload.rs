@@ -122,6 +122,13 @@ pub fn estimated_bytes(b: usize) -> usize {
     elem * (2 * so3fft::num_samples(b) + 2 * so3fft::num_coeffs(b))
 }
 
+/// Bytes of a transform's input and output at bandwidth `b`: complex samples, or real ones
+/// with `real`, plus the complex coefficients (the "in+out" of the memory figures).
+pub fn array_bytes(b: usize, real: bool) -> u64 {
+    let sample = if real { 8 } else { 16 };
+    (sample * so3fft::num_samples(b) + 16 * so3fft::num_coeffs(b)) as u64
+}
+
 /// `MemAvailable` from /proc/meminfo in bytes, or `None` where it cannot be read.
 pub fn mem_available_bytes() -> Option<usize> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
