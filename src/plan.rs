@@ -216,6 +216,9 @@ struct Pass {
     k: usize,
     /// The group's last chunk (the forward writes the cluster's sums then).
     last: bool,
+    /// The last chunk of the transform's last group: after this call the forward's
+    /// coefficients of the cluster are final.
+    done: bool,
     /// The buffer of the group's next chunk, if any: the next call is this cluster on it,
     /// so that is what to prefetch (forward: this cluster's block there; inverse:
     /// nothing, its coefficient rows are kept).
@@ -870,7 +873,17 @@ impl Plan {
             spare,
             |ch, buf| self.fft_chunk(ch, true, input.get(), buf),
             |sc, at, ch, buf, pass| unsafe {
-                self.forward_cluster(sc, &self.blocks, all_members, at, ch, buf, coef, pass);
+                self.forward_cluster(
+                    sc,
+                    &self.blocks,
+                    all_members,
+                    false,
+                    at,
+                    ch,
+                    buf,
+                    coef,
+                    pass,
+                );
             },
         )
     }
@@ -942,6 +955,7 @@ impl Plan {
                                 first: gi == 0,
                                 k,
                                 last: k + 1 == group.len(),
+                                done: gi + 1 == groups.len() && k + 1 == group.len(),
                                 next_buf: group.get(k + 1).map(|g| g.1),
                             };
                             cluster(sc, at, ch, buf.get(), pass);

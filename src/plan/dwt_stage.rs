@@ -238,8 +238,10 @@ impl Plan {
     }
 
     /// Forward DWT of cluster `at` of layout `t` over one chunk, accumulated into `coef`
-    /// for the order pairs `members` gives (the real forward fills the other half of the
-    /// coefficients afterwards, see `Plan::fill_partners`). Within a group of chunks the
+    /// for the order pairs `members` gives; with `partners` (the real forward, whose
+    /// members are the representatives) the last chunk also writes each member's partner
+    /// `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))` (not for `(0,0)`, its own
+    /// partner). Within a group of chunks the
     /// sums are collected in `sc.sum` and added to `coef` at the group's last chunk.
     ///
     /// # Safety
@@ -251,6 +253,7 @@ impl Plan {
         sc: &mut Scratch,
         t: &Blocks,
         members: Members,
+        partners: bool,
         at: &At,
         ch: &Chunk,
         buf: *mut f64,
@@ -312,11 +315,21 @@ impl Plan {
         let (mem, nm) = members(cl);
         assert!(2 * nm <= p && sums.len() >= n * p);
         for (q, mem) in mem[..nm].iter().enumerate() {
-            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp) + lo);
+            let dst = coef.get().add(block_start(self.b, mem.m, mem.mp));
+            // The real forward's partner `(-M, -M')`, from the final values; the degrees
+            // below `lo` (not touched by this group) are final already.
+            let partner = if partners && pass.done && (mem.m, mem.mp) != (0, 0) {
+                let d2 = coef.get().add(block_start(self.b, -mem.m, -mem.mp));
+                let ps = real::neg_sign(mem.m, mem.mp);
+                coeffs::partner_copy(d2, dst, lo, ps);
+                Some((d2.add(lo), ps))
+            } else {
+                None
+            };
             // Degree `l0 + lo` has the parity of `cl.m + lo`.
             let sg = [mem.sign_at(cl.m + lo), mem.sign_at(cl.m + lo + 1)];
             let src = sums.as_ptr().add(lo * p + 2 * q);
-            coeffs::scatter(dst, src, p, n - lo, sg, !pass.first);
+            coeffs::scatter(dst.add(lo), src, p, n - lo, sg, !pass.first, partner);
         }
     }
 

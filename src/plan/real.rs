@@ -28,7 +28,7 @@ pub(super) fn representatives(cl: &Cluster) -> ([Member; 8], usize) {
 }
 
 /// `(-1)^(M - M')`.
-fn neg_sign(m: isize, mp: isize) -> f64 {
+pub(super) fn neg_sign(m: isize, mp: isize) -> f64 {
     if (m - mp).rem_euclid(2) == 0 {
         1.0
     } else {
@@ -168,52 +168,17 @@ impl Plan {
         let input = SyncInput(input);
         let coef = SyncPtr(coeffs.as_mut_ptr());
         let t = self.real_blocks()?;
-        let mut times = self.run_chunks(
+        self.run_chunks(
             true,
             t,
             spare,
             |ch, buf| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf),
             |sc, at, ch, buf, pass| unsafe {
-                self.forward_cluster(sc, t, representatives, at, ch, buf, coef, pass);
+                // The chunks accumulate the representatives only (half the coefficient
+                // traffic per chunk); the last one also writes their partners.
+                self.forward_cluster(sc, t, representatives, true, at, ch, buf, coef, pass);
             },
-        )?;
-        // The chunks accumulated the representatives only (half the coefficient traffic per
-        // chunk); their partners follow once, by symmetry.
-        let t = Instant::now();
-        self.pool().install(|| {
-            self.clusters.par_chunks(16).for_each(|run| {
-                for &(m, mp) in run {
-                    let cl = Cluster::new(m as usize, mp as usize);
-                    // SAFETY: each cluster's partner blocks belong to it alone.
-                    unsafe { self.fill_partners(&cl, coef) };
-                }
-            })
-        });
-        let dt = t.elapsed().as_secs_f64();
-        times.dwt += dt;
-        times.total += dt;
-        Ok(times)
-    }
-
-    /// `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))` for the representatives `(M,M')` of
-    /// `cl` (nothing for `(0,0)`, its own partner).
-    ///
-    /// # Safety
-    /// `coef` has `num_coeffs` entries; no other task writes these partner blocks.
-    unsafe fn fill_partners(&self, cl: &Cluster, coef: SyncPtr<Complex64>) {
-        let (reps, nr) = representatives(cl);
-        let n = self.b - cl.l0();
-        for mem in &reps[..nr] {
-            if mem.m == 0 && mem.mp == 0 {
-                continue;
-            }
-            let src = coef.get().add(block_start(self.b, mem.m, mem.mp));
-            let dst = coef.get().add(block_start(self.b, -mem.m, -mem.mp));
-            let ps = neg_sign(mem.m, mem.mp);
-            for i in 0..n {
-                *dst.add(i) = (*src.add(i)).conj() * ps;
-            }
-        }
+        )
     }
 
     /// Like [`Plan::inverse_real`], also returning the time of each stage.
