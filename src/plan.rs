@@ -171,8 +171,8 @@ pub struct Plan {
     inv_fft: Option<SliceFft>,
     /// Real-data slice FFTs (with `PlanOptions::real`).
     real_fft: Option<SliceFftReal>,
-    /// Per-worker buffers of `2 group + 1` slices: a group of mirrored pairs of beta slices
-    /// in the FFT stage and a spare one.
+    /// Per-worker buffers of `2 group` padded slices (see [`fft::slice_stride`]): a group
+    /// of mirrored pairs of beta slices in the FFT stage.
     fft_scratch: Vec<Mutex<AlignedBuf>>,
     /// Per-worker DWT scratch.
     dwt_scratch: Vec<Mutex<Scratch>>,
@@ -411,10 +411,11 @@ impl Layout {
             chunk,
             chunk_real,
             chunk_bytes,
-            // A group of pairs of slices and a spare one per worker.
+            // A group of pairs of padded slices per worker.
             fft_scratch_bytes: threads
-                * (2 * fft_stage::pairs_per_group(slice_bytes) + 1)
-                * slice_bytes,
+                * 2
+                * fft_stage::pairs_per_group(slice_bytes)
+                * (2 * b * fft::slice_stride(2 * b) * 16),
             table_bytes,
         }
     }
@@ -543,30 +544,15 @@ impl Plan {
                 FftThreading::FftwThreads => true,
             };
         let fftw_threads = if fftw_threaded { threads } else { 1 };
-        let fwd_fft = if want_fwd {
-            let p = SliceFft::new(n, SIGN_PLUS, options.rigor, fftw_threads, true)?;
-            // Slices across workers copy each slice into their cache-resident scratch and
-            // transform it there (see `Plan::fft_group`).
-            Some(if fftw_threaded {
-                p
+        let slice_fft = |want: bool, sign: i32| -> Result<Option<SliceFft>> {
+            Ok(if want {
+                Some(SliceFft::new(n, sign, options.rigor, fftw_threads)?)
             } else {
-                p.with_in_place(n, SIGN_PLUS, options.rigor)?
+                None
             })
-        } else {
-            None
         };
-        let inv_fft = if want_inv {
-            // The inverse transforms the per-worker scratch, which it may overwrite.
-            Some(SliceFft::new(
-                n,
-                SIGN_MINUS,
-                options.rigor,
-                fftw_threads,
-                false,
-            )?)
-        } else {
-            None
-        };
+        let fwd_fft = slice_fft(want_fwd, SIGN_PLUS)?;
+        let inv_fft = slice_fft(want_inv, SIGN_MINUS)?;
         let clusters = cluster_pairs(b);
         let blocks = Blocks::complex(b, &clusters, layout.chunk);
         // The real layout is about half as large per beta: its chunks take twice the betas.
@@ -581,7 +567,7 @@ impl Plan {
         };
         let group = fft_stage::pairs_per_group(16 * n * n);
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new((2 * group + 1) * n * n).map(Mutex::new))
+            .map(|_| AlignedBuf::new(2 * group * n * fft::slice_stride(n)).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -675,9 +661,10 @@ impl Plan {
 
     /// Bytes of memory the plan holds (chunk buffer, per-worker FFT buffers, tables),
     /// computed before allocating: the chunk buffer ([`Plan::workspace_bytes`]) plus
-    /// `threads * (2g + 1) * (2B)^2 * 16` for the per-worker FFT buffers (a group of `g`
-    /// pairs of beta slices and a spare one; `g = clamp(512 KiB / (2 (2B)^2 16), 1, 4)`,
-    /// i.e. 4 for B <= 32 and 1 from B = 64 on) plus `O(B^2)` tables. A transform needs the
+    /// `threads * 2g * 2B (2B + 4) * 16` for the per-worker FFT buffers (a group of `g`
+    /// pairs of beta slices, each row padded by 4 values;
+    /// `g = clamp(512 KiB / (2 (2B)^2 16), 1, 4)`, i.e. 4 for B <= 32 and 1 from B = 64 on)
+    /// plus `O(B^2)` tables. A transform needs the
     /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
     /// large. [`Plan::memory_needed`] gives the same number before planning.
     /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
@@ -1008,7 +995,7 @@ impl Plan {
         });
     }
 
-    /// Run `f` with a per-worker FFT scratch buffer (`2 group + 1` slices). A worker may
+    /// Run `f` with a per-worker FFT scratch buffer (`2 group` padded slices). A worker may
     /// take on another execution's group while it waits inside a parallel copy, so buffers
     /// are taken by try_lock, never by blocking; when all are busy a private one is
     /// allocated.
@@ -1016,7 +1003,7 @@ impl Plan {
         match lock_free(&self.fft_scratch) {
             Some(g) => f(&g),
             None => f(&AlignedBuf::new(
-                (2 * self.group + 1) * 4 * self.b * self.b,
+                2 * self.group * 2 * self.b * fft::slice_stride(2 * self.b),
             )?),
         }
     }

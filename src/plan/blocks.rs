@@ -52,14 +52,16 @@ const PREFETCH_ABOVE: usize = 2 << 20;
 
 impl Blocks {
     /// Layout of the complex transforms: every member of every cluster, in member order.
-    /// Slices are `2B x 2B`, `(M, M')` at `(M mod 2B) 2B + (M' mod 2B)`.
+    /// Slices are `2B x 2B` in the FFT scratch, rows `rs = slice_stride(2B)` apart, with
+    /// `(M, M')` at `(M mod 2B) rs + (M' mod 2B)`.
     pub fn complex(b: usize, clusters: &[(u32, u32)], chunk: usize) -> Blocks {
         let n = 2 * b as isize;
+        let rs = crate::fft::slice_stride(2 * b) as isize;
         let pair_bytes = 2 * (2 * b) * (2 * b) * 16;
         Blocks::build(clusters, chunk, pair_bytes, |cl| {
             let mut out = [(NONE, NONE, false); 8];
             for (q, mem) in cl.members().iter().enumerate() {
-                let fi = mem.m.rem_euclid(n) * n + mem.mp.rem_euclid(n);
+                let fi = mem.m.rem_euclid(n) * rs + mem.mp.rem_euclid(n);
                 out[q] = (fi as u32, NONE, mem.reversed);
             }
             (out, cl.members().len())
@@ -190,6 +192,7 @@ mod tests {
             let cl = cluster_pairs(b);
             let t = Blocks::complex(b, &cl, 1);
             let n = 2 * b;
+            let rs = crate::fft::slice_stride(n);
             let mut seen = HashSet::new();
             for c in 0..t.len() {
                 for q in 0..8 {
@@ -197,7 +200,8 @@ mod tests {
                     if fi != NONE {
                         assert!(2 * q < t.p(c));
                         assert!(seen.insert(fi));
-                        let (a, g) = (fi as usize / n, fi as usize % n);
+                        let (a, g) = (fi as usize / rs, fi as usize % rs);
+                        assert!(a < n && g < n, "outside the slice or in its padding");
                         assert!(a != b && g != b, "frequency B is out of band");
                     }
                 }

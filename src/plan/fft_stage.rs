@@ -78,7 +78,7 @@ impl Plan {
                 (w[2 * jj], w[2 * jj + 1]) = (self.wq[k0], self.wq[k1]);
             }
             self.with_fft_scratch(|scratch| unsafe {
-                // SAFETY: the scratch holds 2g + 1 slices; the group owns its rows of every
+                // SAFETY: the scratch holds 2g padded slices; the group owns its rows of every
                 // block and its sample slices.
                 self.fft_group(
                     fft,
@@ -101,10 +101,10 @@ impl Plan {
         }
     }
 
-    /// One group of pairs of a chunk through the scratch `sp` (`2g + 1` slices): `grid` are
-    /// the group's sample slices (beta, mirror, beta, mirror, ...), `w` their forward
-    /// weights, `j0` its first pair; `parallel_copy` spreads the block copies over the
-    /// workers.
+    /// One group of pairs of a chunk through the scratch `sp` (`2g` padded slices, see
+    /// [`fft::slice_stride`]): `grid` are the group's sample slices (beta, mirror, beta,
+    /// mirror, ...), `w` their forward weights, `j0` its first pair; `parallel_copy`
+    /// spreads the block copies over the workers.
     #[allow(clippy::too_many_arguments)]
     unsafe fn fft_group(
         &self,
@@ -118,25 +118,20 @@ impl Plan {
         parallel_copy: bool,
     ) {
         let n = 2 * self.b;
-        let nn = n * n;
+        let rs = fft::slice_stride(n);
         let ns = grid.len();
         let mut s = [SyncPtr(std::ptr::null_mut()); 2 * MAX_GROUP];
         for (i, si) in s.iter_mut().enumerate().take(ns) {
-            *si = SyncPtr(sp.add(i * nn));
+            *si = SyncPtr(sp.add(i * n * rs));
         }
         let s = &s[..ns];
-        let spare = sp.add(ns * nn);
         let b = SyncPtr(buf);
         if forward {
             for (dst, &src) in s.iter().zip(grid) {
-                if fft.has_in_place() {
-                    // Copied first (a sequential read the prefetchers follow), then
-                    // transformed in the cache: faster than FFTW reading the samples.
-                    std::ptr::copy_nonoverlapping(src, dst.get(), nn);
-                    fft.in_place(dst.get(), spare, n);
-                } else {
-                    fft.execute(src, dst.get());
-                }
+                // Copied first (a sequential read the prefetchers follow), then
+                // transformed in the cache: faster than FFTW reading the samples.
+                fft::copy_rows(src, n, dst.get(), rs, n, false);
+                fft.in_place(dst.get());
             }
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
                 scatter_group(&self.blocks, s, w, false, b.get(), j0, c0..c1)
@@ -149,17 +144,13 @@ impl Plan {
                 let src = src.get();
                 // Frequency B (alpha or gamma) is outside the band limit.
                 for i in 0..n {
-                    *src.add(self.b * n + i) = Complex64::new(0.0, 0.0);
-                    *src.add(i * n + self.b) = Complex64::new(0.0, 0.0);
+                    *src.add(self.b * rs + i) = Complex64::new(0.0, 0.0);
+                    *src.add(i * rs + self.b) = Complex64::new(0.0, 0.0);
                 }
-                if (dst as usize).is_multiple_of(16) {
-                    // Into the cache-resident spare slice, then streamed to the samples:
-                    // FFTW's own stores would first read every line of `dst` from memory.
-                    fft.execute(src, spare);
-                    fft::stream_copy(spare, dst, nn);
-                } else {
-                    fft.execute(src, dst);
-                }
+                // In place in the cache, then streamed to the samples: FFTW's own stores
+                // would first read every line of `dst` from memory.
+                fft.in_place(src);
+                fft::copy_rows(src, rs, dst, n, n, true);
             }
         }
     }
@@ -460,9 +451,10 @@ mod speed {
                 .unwrap_or(pairs_per_group(16 * nn));
             let t = Blocks::complex(b, &crate::symmetry::cluster_pairs(b), 8);
             let buf = AlignedBuf::new(t.total() / 2 + 8).unwrap();
-            let sl = AlignedBuf::new(2 * g * nn).unwrap();
+            let ps = n * crate::fft::slice_stride(n);
+            let sl = AlignedBuf::new(2 * g * ps).unwrap();
             let s: Vec<SyncPtr<Complex64>> = (0..2 * g)
-                .map(|i| SyncPtr(unsafe { sl.as_mut_ptr().add(i * nn) }))
+                .map(|i| SyncPtr(unsafe { sl.as_mut_ptr().add(i * ps) }))
                 .collect();
             let w = vec![1.0; 2 * g];
             let reps = 20;

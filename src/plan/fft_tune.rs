@@ -52,7 +52,7 @@ impl Plan {
         let n = 2 * self.b;
         let plan_threaded = |have: bool, sign: i32| -> Result<Option<SliceFft>> {
             if have {
-                SliceFft::new(n, sign, options.rigor, self.threads, sign == SIGN_PLUS).map(Some)
+                SliceFft::new(n, sign, options.rigor, self.threads).map(Some)
             } else {
                 Ok(None)
             }
@@ -97,7 +97,8 @@ impl Plan {
         if mem_available().is_some_and(|a| a / 4 < bytes) {
             return None;
         }
-        let grid = AlignedBuf::new(slices * nn).ok()?;
+        // (At least one padded slice, for the warm-up below.)
+        let grid = AlignedBuf::new((slices * nn).max(n * fft::slice_stride(n))).ok()?;
         let h = self.blocks.chunk;
         let ch = Chunk {
             lo: 0,
@@ -119,9 +120,8 @@ impl Plan {
             self.pool().install(|| {
                 // Start FFTW's threads (created on a plan's first execution) untimed.
                 if let Some(fft) = fwd.or(inv) {
-                    let sp = buf.as_mut_ptr();
-                    // SAFETY: the sample grid and the chunk buffer hold at least one slice.
-                    unsafe { fft.execute(sp, g.get()) };
+                    // SAFETY: the sample grid holds at least one padded slice.
+                    unsafe { fft.in_place(g.get()) };
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
                 for round in 0..ROUNDS {

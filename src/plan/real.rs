@@ -230,9 +230,10 @@ impl Plan {
             let (k0, k1) = ch.pair_betas(b, j);
             self.with_fft_scratch(|scratch| {
                 let sp = scratch.as_mut_ptr();
-                // SAFETY: the scratch holds three slices of n^2 complex values: two half
-                // spectra (nh <= n^2/2 + n each) and n^2 packed reals fit; pair `j` owns
-                // its two rows of every block and its two sample slices (n^2 reals each).
+                // SAFETY: the scratch holds at least two padded slices, 2n(n + 4) complex
+                // values: two half spectra (nh = n^2/2 + n each) and n^2 packed reals
+                // (n^2/2 values) fit; pair `j` owns its two rows of every block and its two
+                // sample slices (n^2 reals each).
                 unsafe {
                     let s = [sp, sp.add(nh)];
                     if let Some(SyncInput(input)) = input {
