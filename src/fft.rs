@@ -216,7 +216,8 @@ pub(crate) const SIGN_MINUS: i32 = ffi::FFTW_FORWARD;
 pub(crate) struct SliceFft {
     aligned: RawPlan,
     /// Plan for arrays not aligned as FFTW's SIMD code wants (FFTW_UNALIGNED, planned
-    /// with FFTW_ESTIMATE). The scratch slices always are aligned; this is a safety net.
+    /// with FFTW_ESTIMATE, on as many threads). The scratch slices always are aligned;
+    /// this is a safety net.
     unaligned: RawPlan,
 }
 
@@ -328,34 +329,37 @@ impl SliceFftReal {
     }
 }
 
-/// Copy an `n x n` slice from rows `ss` apart at `src` to rows `ds` apart at `dst`,
-/// with non-temporal stores when `dst` is 16-byte aligned (the slice goes to memory the
-/// transform does not read again; ordinary stores would first read every line).
+/// Copy `rows` rows of `len` doubles from rows `ss` doubles apart at `src` to rows `ds`
+/// apart at `dst`; with `stream`, by non-temporal stores where `dst` and its rows are
+/// 16-byte aligned (for memory the transform does not read again: ordinary stores would
+/// first read every line).
 ///
 /// # Safety
 /// Both valid for those extents, no overlap.
 pub(crate) unsafe fn copy_rows(
-    src: *const Complex64,
+    src: *const f64,
     ss: usize,
-    dst: *mut Complex64,
+    dst: *mut f64,
     ds: usize,
-    n: usize,
+    rows: usize,
+    len: usize,
     stream: bool,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if stream && (dst as usize).is_multiple_of(16) {
+    if stream && (dst as usize).is_multiple_of(16) && ds.is_multiple_of(2) && len.is_multiple_of(2)
+    {
         use std::arch::x86_64::{_mm_loadu_pd, _mm_sfence, _mm_stream_pd};
-        for r in 0..n {
-            let (s, d) = (src.add(r * ss) as *const f64, dst.add(r * ds) as *mut f64);
-            for i in 0..n {
-                _mm_stream_pd(d.add(2 * i), _mm_loadu_pd(s.add(2 * i)));
+        for r in 0..rows {
+            let (s, d) = (src.add(r * ss), dst.add(r * ds));
+            for i in (0..len).step_by(2) {
+                _mm_stream_pd(d.add(i), _mm_loadu_pd(s.add(i)));
             }
         }
         _mm_sfence();
         return;
     }
     let _ = stream;
-    for r in 0..n {
-        std::ptr::copy_nonoverlapping(src.add(r * ss), dst.add(r * ds), n);
+    for r in 0..rows {
+        std::ptr::copy_nonoverlapping(src.add(r * ss), dst.add(r * ds), len);
     }
 }

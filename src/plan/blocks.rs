@@ -41,7 +41,8 @@ pub(super) struct Blocks {
     /// `2 * chunk` rounded up to a multiple of 16.
     pub lanes: usize,
     /// Whether the block copies prefetch slice values ahead: only when a pair of
-    /// transformed slices is larger than a core's L2 cache (assumed 2 MiB); below that
+    /// transformed slices (unpadded) is larger than a core's L2 cache (assumed 2 MiB);
+    /// below that
     /// the prefetches only cost instructions (measured: +10% in the real forward's FFT
     /// stage at B = 128).
     pub prefetch_slices: bool,

@@ -46,8 +46,8 @@ pub(super) unsafe fn gather(
 /// here, where the coefficients fit in the (large, shared) L3 cache.
 ///
 /// # Safety
-/// `dst` (and `d2`) valid for `n` reads and writes, `src` for reads at `i * p` and
-/// `i * p + 1`, `i < n`; no overlap.
+/// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
+/// `i * p` and `i * p + 1`, `i < n`; no overlap.
 pub(super) unsafe fn scatter(
     dst: *mut Complex64,
     src: *const f64,

@@ -241,8 +241,8 @@ impl Plan {
     /// for the order pairs `members` gives; with `partners` (the real forward, whose
     /// members are the representatives) the last chunk also writes each member's partner
     /// `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))` (not for `(0,0)`, its own
-    /// partner). Within a group of chunks the
-    /// sums are collected in `sc.sum` and added to `coef` at the group's last chunk.
+    /// partner). Within a group of chunks the sums are collected in `sc.sum` and added to
+    /// `coef` at the group's last chunk.
     ///
     /// # Safety
     /// `buf` holds the chunk's blocks; `coef` has `num_coeffs` entries and no other task

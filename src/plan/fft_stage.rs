@@ -2,14 +2,15 @@
 //! time.
 //!
 //! Forward: the slices of a group of pairs (`beta` and `pi - beta`) are copied into the
-//! worker's cache-resident scratch, transformed in place, and moved, weighted, into the
-//! rows of every cluster's block (`blocks.rs`): the group fills `2g` adjacent rows of each
-//! block completely, written as whole cache lines with non-temporal stores. Inverse: those
-//! rows of every block are read back into the slices, which are transformed into a spare
-//! slice and streamed to the samples. Small slices move in groups of up to 4 pairs (one
-//! longer piece of each block per group), larger ones a pair at a time, which keeps the
-//! slices' random accesses in L2. The groups are spread over the workers, or, with FFTW's threads, run one
-//! after another with the block copies spread over the workers.
+//! worker's cache-resident scratch (rows padded, see [`fft::slice_stride`]), transformed in
+//! place, and moved, weighted, into the rows of every cluster's block (`blocks.rs`): the
+//! group fills `2g` adjacent rows of each block completely, written as whole cache lines
+//! with non-temporal stores. Inverse: those rows of every block are read back into the
+//! slices, which are transformed in place and streamed to the samples. Small slices move
+//! in groups of up to 4 pairs (one longer piece of each block per group), larger ones a
+//! pair at a time, which keeps the slices' random accesses in L2. The groups are spread
+//! over the workers, or, with FFTW's threads, run one after another with the copies spread
+//! over the workers.
 
 use super::blocks::{Blocks, NONE};
 use super::*;
@@ -20,8 +21,9 @@ const PREFETCH_CLUSTERS: usize = 16;
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
 pub(super) const MAX_GROUP: usize = 4;
 
-/// Pairs per group for slices of `slice_bytes`: up to [`MAX_GROUP`], as many as keep the
-/// group's slices within 512 KiB, about half of a core's L2 (B <= 32: 4, from B = 64 on: 1).
+/// Pairs per group for slices of `slice_bytes` (unpadded): up to [`MAX_GROUP`], as many as
+/// keep the group's slices within about 512 KiB, half of a core's L2 (B <= 32: 4, from
+/// B = 64 on: 1).
 /// The copies between slices and blocks are bound by the slice side's cache misses: one
 /// pair at B = 64 copies twice as fast per pair as a group of four (`copy_speed` test).
 pub(super) fn pairs_per_group(slice_bytes: usize) -> usize {
@@ -126,11 +128,37 @@ impl Plan {
         }
         let s = &s[..ns];
         let b = SyncPtr(buf);
+        // Rows of a slice between the samples (rows `2n` doubles apart) and the scratch
+        // (`2 rs`), spread over the workers with `parallel_copy` (FFTW's threads wait).
+        let copy = |from: *const Complex64, to: *mut Complex64, forward: bool| {
+            let (from, to) = (SyncPtr(from as *mut f64), SyncPtr(to as *mut f64));
+            let (ss, ds) = if forward {
+                (2 * n, 2 * rs)
+            } else {
+                (2 * rs, 2 * n)
+            };
+            let rows = |r0: usize, r1: usize| {
+                let (f, t) = (
+                    from.get().wrapping_add(r0 * ss),
+                    to.get().wrapping_add(r0 * ds),
+                );
+                // SAFETY: rows r0..r1 of both slices, disjoint between the pieces.
+                unsafe { fft::copy_rows(f, ss, t, ds, r1 - r0, 2 * n, !forward) };
+            };
+            if parallel_copy {
+                let step = n.div_ceil(4 * self.threads).max(1);
+                (0..n.div_ceil(step))
+                    .into_par_iter()
+                    .for_each(|i| rows(i * step, ((i + 1) * step).min(n)));
+            } else {
+                rows(0, n);
+            }
+        };
         if forward {
             for (dst, &src) in s.iter().zip(grid) {
                 // Copied first (a sequential read the prefetchers follow), then
                 // transformed in the cache: faster than FFTW reading the samples.
-                fft::copy_rows(src, n, dst.get(), rs, n, false);
+                copy(src, dst.get(), true);
                 fft.in_place(dst.get());
             }
             self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
@@ -150,7 +178,7 @@ impl Plan {
                 // In place in the cache, then streamed to the samples: FFTW's own stores
                 // would first read every line of `dst` from memory.
                 fft.in_place(src);
-                fft::copy_rows(src, rs, dst, n, n, true);
+                copy(src, dst, false);
             }
         }
     }
