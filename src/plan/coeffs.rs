@@ -127,34 +127,25 @@ mod tests {
             }
         }
         let mut back = vec![Complex64::new(1.0, 1.0); n];
-        unsafe {
+        let back_from_rows = |back: &mut [Complex64], add: bool| unsafe {
             scatter(
                 back.as_mut_ptr(),
                 rows[4..].as_ptr(),
                 p,
                 n - 1,
                 sg,
-                false,
+                add,
                 None,
             )
         };
+        back_from_rows(&mut back, false);
         for i in 0..n - 1 {
             // Signs squared: 2.25 and 4.
             let s2 = sg[i % 2] * sg[i % 2];
             assert_eq!(back[i], z[i] * s2);
         }
         assert_eq!(back[n - 1], Complex64::new(1.0, 1.0));
-        unsafe {
-            scatter(
-                back.as_mut_ptr(),
-                rows[4..].as_ptr(),
-                p,
-                n - 1,
-                sg,
-                true,
-                None,
-            )
-        };
+        back_from_rows(&mut back, true);
         for i in 0..n - 1 {
             let s2 = sg[i % 2] * sg[i % 2];
             assert_eq!(back[i], z[i] * (2.0 * s2));

@@ -145,14 +145,7 @@ impl Plan {
                 // SAFETY: rows r0..r1 of both slices, disjoint between the pieces.
                 unsafe { fft::copy_rows(f, ss, t, ds, r1 - r0, 2 * n, !forward) };
             };
-            if parallel_copy {
-                let step = n.div_ceil(4 * self.threads).max(1);
-                (0..n.div_ceil(step))
-                    .into_par_iter()
-                    .for_each(|i| rows(i * step, ((i + 1) * step).min(n)));
-            } else {
-                rows(0, n);
-            }
+            self.for_ranges(n, parallel_copy, rows);
         };
         if forward {
             for (dst, &src) in s.iter().zip(grid) {
@@ -161,11 +154,11 @@ impl Plan {
                 copy(src, dst.get(), true);
                 fft.in_place(dst.get());
             }
-            self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
+            self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
                 scatter_group(&self.blocks, s, w, false, b.get(), j0, c0..c1)
             });
         } else {
-            self.for_cluster_ranges(&self.blocks, parallel_copy, |c0, c1| {
+            self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
                 gather_group(&self.blocks, s, false, b.get(), j0, c0..c1)
             });
             for (src, &dst) in s.iter().zip(grid) {
@@ -183,22 +176,16 @@ impl Plan {
         }
     }
 
-    /// Run `f(c0, c1)` over all clusters of `t`: in one piece, or, with `parallel`, in
-    /// pieces spread over the workers.
-    pub(super) fn for_cluster_ranges(
-        &self,
-        t: &Blocks,
-        parallel: bool,
-        f: impl Fn(usize, usize) + Sync,
-    ) {
-        let nc = t.len();
+    /// Run `f(i0, i1)` over `0..len`: in one piece, or, with `parallel`, in pieces spread
+    /// over the workers.
+    pub(super) fn for_ranges(&self, len: usize, parallel: bool, f: impl Fn(usize, usize) + Sync) {
         if parallel {
-            let step = nc.div_ceil(4 * self.threads).max(1);
-            (0..nc.div_ceil(step))
+            let step = len.div_ceil(4 * self.threads).max(1);
+            (0..len.div_ceil(step))
                 .into_par_iter()
-                .for_each(|i| f(i * step, ((i + 1) * step).min(nc)));
+                .for_each(|i| f(i * step, ((i + 1) * step).min(len)));
         } else {
-            f(0, nc);
+            f(0, len);
         }
     }
 }
