@@ -384,9 +384,10 @@ fn bench_plan(
         _ => "",
     };
     eprintln!(
-        "  (B = {b}, threads = {}{what}: plan created in {:.3} s)",
+        "  (B = {b}, threads = {}{what}: plan created in {:.3} s, FFT stage {:?})",
         plan.threads(),
-        plan_start.elapsed().as_secs_f64()
+        plan_start.elapsed().as_secs_f64(),
+        plan.fft_threading()
     );
     Ok(plan)
 }
