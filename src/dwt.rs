@@ -72,6 +72,9 @@ pub(crate) struct Lanes<'a> {
     /// Memory to prefetch into L2 while the kernel runs, a few lines at a time (the next
     /// cluster's block and coefficient rows); hints only, never read.
     pub prefetch: Prefetch,
+    /// Inverse: write the output with non-temporal stores (for outputs far larger than
+    /// the caches, read back only later; ordinary stores would first read every line).
+    pub stream: bool,
 }
 
 /// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
@@ -748,15 +751,22 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
                 s.run(rec, n, |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
             }
             // Rows of the output are lanes: each W x W block of (order column, lane) is
-            // transposed in registers on the way out, and written without reading the
-            // lines first (the chunk buffer is far larger than the caches, and read back
-            // only by the FFT stage).
-            for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
-                let (r0, step) = lanes.rows(v0 + (gi + k) * W);
-                for q0 in (0..P).step_by(W) {
-                    let dst = y.as_mut_ptr().add(r0 * P + q0);
-                    S::stream_transposed(&a[q0..q0 + W], dst, step * P);
+            // transposed in registers on the way out, and with `lanes.stream` written
+            // without reading the lines first (see `Lanes::stream`).
+            let mut out = |stream: bool| {
+                for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
+                    let (r0, step) = lanes.rows(v0 + (gi + k) * W);
+                    for q0 in (0..P).step_by(W) {
+                        let dst = y.as_mut_ptr().add(r0 * P + q0);
+                        S::store_transposed(&a[q0..q0 + W], dst, step * P, stream);
+                    }
                 }
+            };
+            // One branch per vector, each arm with its own store instructions.
+            if lanes.stream {
+                out(true)
+            } else {
+                out(false)
             }
             gi += 1 + pair as usize;
         }
@@ -922,6 +932,7 @@ pub(crate) fn column(
         skip: false,
         interleaved: false,
         prefetch: Prefetch::none(),
+        stream: false,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     f.iter().step_by(8).take(n).copied().collect()
@@ -1032,6 +1043,7 @@ mod tests {
             skip: true,
             interleaved: true,
             prefetch: Prefetch::none(),
+            stream: true,
         }
     }
 
@@ -1083,6 +1095,8 @@ mod tests {
                                 skip,
                                 interleaved: false,
                                 prefetch: Prefetch::none(),
+                                // Both ways of storing the inverse's output.
+                                stream: skip,
                             };
                             // Stale values in every row the kernel must write.
                             let mut f = vec![0.0; (n + 8) * pw];

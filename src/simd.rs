@@ -98,15 +98,19 @@ pub(crate) trait Simd: Copy {
     }
     /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
     /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j` (with
-    /// [`Simd::stream`]).
+    /// [`Simd::stream`] if `stream`, else ordinary stores).
     #[inline(always)]
-    unsafe fn stream_transposed(v: &[Self::V], dst: *mut f64, stride: usize) {
+    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize, stream: bool) {
         let mut t = [Self::zero(); 8];
         let w = v.len();
         t[..w].copy_from_slice(v);
         Self::transpose(&mut t[..w]);
         for (r, x) in t[..w].iter().enumerate() {
-            Self::stream(dst.add(r * stride), *x);
+            if stream {
+                Self::stream(dst.add(r * stride), *x);
+            } else {
+                Self::store(dst.add(r * stride), *x);
+            }
         }
     }
     /// `v` unchanged, through an empty `asm!` the compiler may not move code across:

@@ -83,6 +83,7 @@ impl Scratch {
             skip: plan.skip,
             interleaved: true,
             prefetch: Prefetch::none(),
+            stream: true,
         }
     }
 }
@@ -361,6 +362,7 @@ impl Plan {
         let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
+        lanes.stream = pass.stream;
         // Within a group the next call needs nothing new (its rows are kept here, its
         // block is written with non-temporal stores): prefetch for the next cluster only
         // on the group's last chunk.
