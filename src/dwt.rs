@@ -684,7 +684,7 @@ pub(crate) type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
 const INV_VECTORS: usize = 16;
 
 #[inline(always)]
-unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
+unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     rec: &Rec,
     lanes: &Lanes,
     fin: &mut [f64],
@@ -753,20 +753,14 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize>(
             // Rows of the output are lanes: each W x W block of (order column, lane) is
             // transposed in registers on the way out, and with `lanes.stream` written
             // without reading the lines first (see `Lanes::stream`).
-            let mut out = |stream: bool| {
-                for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
-                    let (r0, step) = lanes.rows(v0 + (gi + k) * W);
-                    for q0 in (0..P).step_by(W) {
-                        let dst = y.as_mut_ptr().add(r0 * P + q0);
-                        S::store_transposed(&a[q0..q0 + W], dst, step * P, stream);
-                    }
+            // `NT` is a parameter of the kernel: a run-time branch here cost the 8-column
+            // kernel a third of its speed (its register allocation changed).
+            for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
+                let (r0, step) = lanes.rows(v0 + (gi + k) * W);
+                for q0 in (0..P).step_by(W) {
+                    let dst = y.as_mut_ptr().add(r0 * P + q0);
+                    S::store_transposed(&a[q0..q0 + W], dst, step * P, NT);
                 }
-            };
-            // One branch per vector, each arm with its own store instructions.
-            if lanes.stream {
-                out(true)
-            } else {
-                out(false)
             }
             gi += 1 + pair as usize;
         }
@@ -778,8 +772,14 @@ macro_rules! entry {
     ($name:ident, $feat:literal, inverse_body, $S:ty, $W:literal, $N:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &mut [f64], f: Fill, b: &mut [f64]) {
-            inverse_body::<$S, $W, $N>(rec, lanes, a, f, b)
+        unsafe fn $name<const NT: bool>(
+            rec: &Rec,
+            lanes: &Lanes,
+            a: &mut [f64],
+            f: Fill,
+            b: &mut [f64],
+        ) {
+            inverse_body::<$S, $W, $N, NT>(rec, lanes, a, f, b)
         }
     };
     ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal, $DB:literal) => {
@@ -874,21 +874,31 @@ pub(crate) fn inverse(
     assert!(fin.len() >= n * p && y.len() >= nb * p && isa.is_supported());
     // SAFETY: lengths checked above, instruction set checked by is_supported.
     unsafe {
+        // The kernel for the store mode `lanes.stream`.
+        macro_rules! nt {
+            ($f:ident $(::<$($g:tt),*>)?) => {
+                if lanes.stream {
+                    $f::<$($($g,)*)? true>(rec, lanes, fin, fill, y)
+                } else {
+                    $f::<$($($g,)*)? false>(rec, lanes, fin, fill, y)
+                }
+            };
+        }
         match (isa, p) {
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 16) => inv_avx512_16(rec, lanes, fin, fill, y),
+            (Isa::Avx512, 16) => nt!(inv_avx512_16),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 8) => inv_avx512_8(rec, lanes, fin, fill, y),
+            (Isa::Avx512, 8) => nt!(inv_avx512_8),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 16) => inv_avx2_16(rec, lanes, fin, fill, y),
+            (Isa::Avx2, 16) => nt!(inv_avx2_16),
             #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 8) => inv_avx2_8(rec, lanes, fin, fill, y),
-            (_, 16) => inverse_body::<Scalar, 1, 16>(rec, lanes, fin, fill, y),
-            (_, 8) => inverse_body::<Scalar, 1, 8>(rec, lanes, fin, fill, y),
+            (Isa::Avx2, 8) => nt!(inv_avx2_8),
+            (_, 16) => nt!(inverse_body::<Scalar, 1, 16>),
+            (_, 8) => nt!(inverse_body::<Scalar, 1, 8>),
             _ => unreachable!("P must be 8 or 16"),
         }
     }
-    // The output rows were written with non-temporal stores.
+    // The output rows may have been written with non-temporal stores.
     crate::simd::sfence();
 }
 
