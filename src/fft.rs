@@ -79,13 +79,9 @@ impl AlignedBuf {
             want
         };
         // Room to move the start to a 2 MiB boundary.
-        let map = if huge {
-            bytes
-                .checked_add(HUGE)
-                .ok_or(Error::OutOfMemory { bytes: usize::MAX })?
-        } else {
-            bytes
-        };
+        let map = bytes
+            .checked_add(if huge { HUGE } else { 0 })
+            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?;
         // SAFETY: anonymous private mapping; checked for failure below.
         let raw = unsafe {
             libc::mmap(

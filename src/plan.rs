@@ -380,8 +380,8 @@ fn default_workspace(b: usize, real: bool) -> usize {
 /// non-temporal ones: a quarter of the last-level cache (from Linux's sysfs; the cache is
 /// shared with the other cores), 0 (always non-temporal) where unknown. Blocks that stay
 /// in the cache are read back by the FFT stage much faster: at B = 64 (34 MiB of blocks,
-/// 480 MiB of L3 on the development machine) the complex inverse took 7% less time and the
-/// real one 13% less; at B = 128 (254 MiB) non-temporal stores were faster (DWT stage
+/// 480 MiB of L3 on the development machine) the complex inverse took 8% less time and the
+/// real one 17% less; at B = 128 (254 MiB) non-temporal stores were faster (DWT stage
 /// 0.062 against 0.069 s), and with the blocks capped at 64-128 MiB the two were even.
 fn plain_store_limit() -> usize {
     let size = |dir: &std::path::Path| -> Option<usize> {
@@ -425,7 +425,6 @@ impl Layout {
     /// pair): each chunk layout gets the largest chunk that fits, and the buffer is the
     /// larger of the two.
     fn new(b: usize, threads: usize, budget: usize, real: bool) -> Layout {
-        let slice_bytes = 64 * b * b;
         let (cdpl, rdpl) = (
             Blocks::doubles_per_lane(b, false),
             Blocks::doubles_per_lane(b, true),
@@ -451,10 +450,7 @@ impl Layout {
             chunk_real,
             chunk_bytes,
             // A group of pairs of padded slices per worker.
-            fft_scratch_bytes: threads
-                * 2
-                * fft_stage::pairs_per_group(slice_bytes)
-                * (2 * b * fft::slice_stride(2 * b) * 16),
+            fft_scratch_bytes: threads * fft_stage::scratch_len(b) * 16,
             table_bytes,
         }
     }
@@ -606,7 +602,7 @@ impl Plan {
         };
         let group = fft_stage::pairs_per_group(16 * n * n);
         let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new(2 * group * n * fft::slice_stride(n)).map(Mutex::new))
+            .map(|_| AlignedBuf::new(fft_stage::scratch_len(b)).map(Mutex::new))
             .collect::<Result<Vec<_>>>()?;
         let norm = PI / (2.0 * (b * b) as f64);
         let wq = weights(b).iter().map(|w| w * norm).collect();
@@ -1044,9 +1040,7 @@ impl Plan {
     fn with_fft_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
         match lock_free(&self.fft_scratch) {
             Some(g) => f(&g),
-            None => f(&AlignedBuf::new(
-                2 * self.group * 2 * self.b * fft::slice_stride(2 * self.b),
-            )?),
+            None => f(&AlignedBuf::new(fft_stage::scratch_len(self.b))?),
         }
     }
 }
@@ -1204,11 +1198,10 @@ mod tests {
                             for mp in -l..=l {
                                 let i = crate::grid::coef_index(b, l as usize, m, mp);
                                 let j = crate::grid::coef_index(b, l as usize, -m, -mp);
-                                let s = if (m - mp) % 2 == 0 { 1.0 } else { -1.0 };
                                 if (m, mp) == (0, 0) {
                                     coefs[i].im = 0.0;
                                 } else if i < j {
-                                    coefs[j] = coefs[i].conj() * s;
+                                    coefs[j] = coefs[i].conj() * super::real::neg_sign(m, mp);
                                 }
                             }
                         }

@@ -30,6 +30,13 @@ pub(super) fn pairs_per_group(slice_bytes: usize) -> usize {
     ((512usize << 10) / (2 * slice_bytes)).clamp(1, MAX_GROUP)
 }
 
+/// Complex values of a worker's FFT scratch at bandwidth `b`: a group of pairs of padded
+/// slices (see [`fft::slice_stride`]).
+pub(super) fn scratch_len(b: usize) -> usize {
+    let n = 2 * b;
+    2 * pairs_per_group(16 * n * n) * n * fft::slice_stride(n)
+}
+
 impl Plan {
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
     /// from `buf` into `grid`.
@@ -130,7 +137,7 @@ impl Plan {
         let b = SyncPtr(buf);
         // Rows of a slice between the samples (rows `2n` doubles apart) and the scratch
         // (`2 rs`), spread over the workers with `parallel_copy` (FFTW's threads wait).
-        let copy = |from: *const Complex64, to: *mut Complex64, forward: bool| {
+        let copy = |from: *const Complex64, to: *mut Complex64| {
             let (from, to) = (SyncPtr(from as *mut f64), SyncPtr(to as *mut f64));
             let (ss, ds) = if forward {
                 (2 * n, 2 * rs)
@@ -151,7 +158,7 @@ impl Plan {
             for (dst, &src) in s.iter().zip(grid) {
                 // Copied first (a sequential read the prefetchers follow), then
                 // transformed in the cache: faster than FFTW reading the samples.
-                copy(src, dst.get(), true);
+                copy(src, dst.get());
                 fft.in_place(dst.get());
             }
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
@@ -171,7 +178,7 @@ impl Plan {
                 // In place in the cache, then streamed to the samples: FFTW's own stores
                 // would first read every line of `dst` from memory.
                 fft.in_place(src);
-                copy(src, dst, false);
+                copy(src, dst);
             }
         }
     }
