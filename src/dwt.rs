@@ -75,6 +75,10 @@ pub(crate) struct Lanes<'a> {
     /// Inverse: write the output with non-temporal stores (for outputs far larger than
     /// the caches, read back only later; ordinary stores would first read every line).
     pub stream: bool,
+    /// Inverse, interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the
+    /// output to the next; row `r` is at `(r / 2) * pair_stride + (r % 2) * P`. 0 means
+    /// `2P`, rows one after another (see `plan/blocks.rs` for the pair-major layout).
+    pub pair_stride: usize,
 }
 
 /// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
@@ -689,11 +693,16 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     lanes: &Lanes,
     fin: &mut [f64],
     fill: Fill,
-    y: &mut [f64],
+    y: *mut f64,
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P && y.len() >= nb * P);
+    debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P);
+    let ps = if lanes.pair_stride == 0 {
+        2 * P
+    } else {
+        lanes.pair_stride
+    };
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
     // Rows `have..n` of `fin` are filled.
@@ -756,10 +765,11 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
             // `NT` is a parameter of the kernel: a run-time branch here cost the 8-column
             // kernel a third of its speed (its register allocation changed).
             for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
+                // Interleaved rows step by 2: one pair of rows to the next.
                 let (r0, step) = lanes.rows(v0 + (gi + k) * W);
+                let (at, stride) = ((r0 / 2) * ps + (r0 % 2) * P, if step == 2 { ps } else { P });
                 for q0 in (0..P).step_by(W) {
-                    let dst = y.as_mut_ptr().add(r0 * P + q0);
-                    S::store_transposed(&a[q0..q0 + W], dst, step * P, NT);
+                    S::store_transposed(&a[q0..q0 + W], y.add(at + q0), stride, NT);
                 }
             }
             gi += 1 + pair as usize;
@@ -777,7 +787,7 @@ macro_rules! entry {
             lanes: &Lanes,
             a: &mut [f64],
             f: Fill,
-            b: &mut [f64],
+            b: *mut f64,
         ) {
             inverse_body::<$S, $W, $N, NT>(rec, lanes, a, f, b)
         }
@@ -858,6 +868,7 @@ pub(crate) fn forward(
 /// degree where some lane is past its negligible prefix up to `n`, top down, each row
 /// once; rows below are never read). A chunked inverse thus reads only the coefficients
 /// its betas need.
+#[cfg(test)]
 pub(crate) fn inverse(
     isa: Isa,
     p: usize,
@@ -867,12 +878,34 @@ pub(crate) fn inverse(
     fill: Fill,
     y: &mut [f64],
 ) {
+    assert!(lanes.pair_stride == 0 && y.len() >= lanes.tau.len() * p);
+    // SAFETY: `y` holds every row (consecutive rows of `p` values).
+    unsafe { inverse_raw(isa, p, rec, lanes, fin, fill, y.as_mut_ptr()) }
+}
+
+/// [`inverse`] into rows anywhere: row `r` of the output at
+/// `y + (r / 2) * lanes.pair_stride + (r % 2) * p` (with `pair_stride` 0: `y + r * p`).
+///
+/// # Safety
+/// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for writes and
+/// written by no one else meanwhile; a nonzero `pair_stride` needs interleaved lanes.
+pub(crate) unsafe fn inverse_raw(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: *mut f64,
+) {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(fin.len() >= n * p && y.len() >= nb * p && isa.is_supported());
-    // SAFETY: lengths checked above, instruction set checked by is_supported.
+    assert!(fin.len() >= n * p && isa.is_supported());
+    assert!(lanes.pair_stride == 0 || (lanes.interleaved && lanes.pair_stride >= 2 * p));
+    // SAFETY: lengths checked above, rows by the caller, instruction set checked by
+    // is_supported.
     unsafe {
         // The kernel for the store mode `lanes.stream`.
         macro_rules! nt {
@@ -943,6 +976,7 @@ pub(crate) fn column(
         interleaved: false,
         prefetch: Prefetch::none(),
         stream: false,
+        pair_stride: 0,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
     f.iter().step_by(8).take(n).copied().collect()
@@ -1054,6 +1088,7 @@ mod tests {
             interleaved: true,
             prefetch: Prefetch::none(),
             stream: true,
+            pair_stride: 0,
         }
     }
 
@@ -1062,6 +1097,72 @@ mod tests {
     /// for odd and even numbers of vectors (the 8-column inverse pairs vectors), halves of
     /// unequal size, and clusters of 1 to 67 degrees. Skipping changes nothing beyond
     /// rounding.
+    /// The inverse into pair-major rows (`Lanes::pair_stride`, the plan's inverse layout)
+    /// writes exactly what it writes into consecutive rows, each row at its pair's place,
+    /// and nothing between the pairs: every instruction set, both store modes.
+    #[test]
+    fn pair_major_rows_hold_the_consecutive_rows() {
+        let b = 40;
+        for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
+            let n = b - m;
+            let nbs = 48;
+            let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+            let rec = Rec::new(&rc, n);
+            for pw in [8usize, 16] {
+                let fin = pseudo(n * pw, 7 + m as u64);
+                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                    if !isa.is_supported() {
+                        continue;
+                    }
+                    for stream in [true, false] {
+                        let mut lanes = Lanes {
+                            tau: &tau,
+                            p: &p,
+                            sc: &sc,
+                            upper_from: nbs / 2,
+                            big: crate::wigner::big(test_skip_bits()),
+                            skip: true,
+                            interleaved: true,
+                            prefetch: Prefetch::none(),
+                            stream,
+                            pair_stride: 0,
+                        };
+                        let mut y = vec![f64::NAN; nbs * pw];
+                        inverse_from(isa, pw, &rec, &lanes, &fin, &mut y);
+                        // Pairs 2p + 8 values apart, 5 values into the buffer.
+                        let ps = 2 * pw + 8;
+                        lanes.pair_stride = ps;
+                        let mut z = vec![f64::NAN; 5 + nbs / 2 * ps];
+                        let mut buf = fin.clone();
+                        // SAFETY: z holds nbs / 2 pairs of two rows after offset 5.
+                        unsafe {
+                            inverse_raw(
+                                isa,
+                                pw,
+                                &rec,
+                                &lanes,
+                                &mut buf,
+                                &mut |_, _, _| {},
+                                z.as_mut_ptr().add(5),
+                            )
+                        };
+                        for (i, v) in z.iter().enumerate() {
+                            let k = i.wrapping_sub(5);
+                            let (j, q) = (k / ps, k % ps);
+                            if i < 5 || q >= 2 * pw {
+                                assert!(v.is_nan(), "{isa:?} P={pw}: wrote {i} between pairs");
+                            } else {
+                                let r = 2 * j + q / pw;
+                                let want = y[r * pw + q % pw];
+                                assert_eq!(v.to_bits(), want.to_bits(), "{isa:?} P={pw} row {r}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn forward_is_the_adjoint_of_inverse() {
         let b = 67;
@@ -1107,6 +1208,7 @@ mod tests {
                                 prefetch: Prefetch::none(),
                                 // Both ways of storing the inverse's output.
                                 stream: skip,
+                                pair_stride: 0,
                             };
                             // Stale values in every row the kernel must write.
                             let mut f = vec![0.0; (n + 8) * pw];

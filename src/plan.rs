@@ -226,8 +226,9 @@ struct Pass {
     /// so that is what to prefetch (forward: this cluster's block there; inverse:
     /// nothing, its coefficient rows are kept).
     next_buf: Option<SyncPtr<f64>>,
-    /// Inverse: write the blocks with non-temporal stores (the group's blocks are too large
-    /// to stay in the cache until the FFT stage reads them, see [`plain_store_limit`]).
+    /// Inverse: write the blocks with non-temporal stores and pair-major (the group's
+    /// blocks are too large to stay in the cache until the FFT stage reads them, see
+    /// [`plain_store_limit`] and `plan/blocks.rs`).
     stream: bool,
 }
 
@@ -376,13 +377,16 @@ fn default_workspace(b: usize, real: bool) -> usize {
     }
 }
 
-/// Most bytes of blocks an inverse group writes with ordinary stores rather than
-/// non-temporal ones: a quarter of the last-level cache (from Linux's sysfs; the cache is
+/// Most bytes of blocks an inverse group writes with ordinary stores into cluster-major
+/// blocks rather than with non-temporal ones into the pair-major layout (see
+/// `plan/blocks.rs`): a quarter of the last-level cache (from Linux's sysfs; the cache is
 /// shared with the other cores), 0 (always non-temporal) where unknown. Blocks that stay
 /// in the cache are read back by the FFT stage much faster: at B = 64 (34 MiB of blocks,
 /// 480 MiB of L3 on the development machine) the complex inverse took 8% less time and the
 /// real one 17% less; at B = 128 (254 MiB) non-temporal stores were faster (DWT stage
 /// 0.062 against 0.069 s), and with the blocks capped at 64-128 MiB the two were even.
+/// Pair-major blocks in the cache are slower still (B = 64 complex inverse DWT stage
+/// 0.0084 against 0.0053 s: each row on its own page).
 fn plain_store_limit() -> usize {
     let size = |dir: &std::path::Path| -> Option<usize> {
         let level = std::fs::read_to_string(dir.join("level")).ok()?;
@@ -894,7 +898,7 @@ impl Plan {
             true,
             &self.blocks,
             spare,
-            |ch, buf| self.fft_chunk(ch, true, input.get(), buf),
+            |ch, buf, _| self.fft_chunk(ch, true, input.get(), buf, false),
             |sc, at, ch, buf, pass| unsafe {
                 self.forward_cluster(
                     sc,
@@ -925,7 +929,7 @@ impl Plan {
             false,
             &self.blocks,
             Some(spare),
-            |ch, buf| self.fft_chunk(ch, false, out.get(), buf),
+            |ch, buf, pair_major| self.fft_chunk(ch, false, out.get(), buf, pair_major),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
             },
@@ -942,7 +946,7 @@ impl Plan {
         forward: bool,
         t: &Blocks,
         spare: Option<Spare>,
-        fft: impl Fn(&Chunk, *mut f64) -> Result<()> + Sync,
+        fft: impl Fn(&Chunk, *mut f64, bool) -> Result<()> + Sync,
         cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
@@ -960,10 +964,13 @@ impl Plan {
                 .collect();
             self.pool().install(|| {
                 for (gi, group) in groups.iter().enumerate() {
+                    // Inverse: blocks too large to stay in the cache are written with
+                    // non-temporal stores, pair-major (see `plan/blocks.rs`).
+                    let stream = !forward && group.len() * self.buf_bytes > self.plain_store_limit;
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
                         for (ch, buf) in group {
-                            fft(ch, buf.get())?;
+                            fft(ch, buf.get(), stream)?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
@@ -971,7 +978,6 @@ impl Plan {
                     if forward {
                         fft_stage()?;
                     }
-                    let stream = group.len() * self.buf_bytes > self.plain_store_limit;
                     let t1 = Instant::now();
                     self.for_each_cluster(t, |sc, at| {
                         for (k, (ch, buf)) in group.iter().enumerate() {
@@ -1169,18 +1175,26 @@ mod tests {
         }
     }
 
-    /// The inverse's two ways of writing the blocks (non-temporal stores for groups larger
-    /// than `plain_store_limit`, ordinary ones below) give the same samples, bit for bit,
-    /// complex and real, with one chunk and with chunk groups; the forward brings the
-    /// coefficients back.
+    /// The inverse's two ways of writing the blocks (non-temporal stores into the
+    /// pair-major layout for groups larger than `plain_store_limit`, ordinary ones into
+    /// cluster-major blocks below) give the same samples, bit for bit,
+    /// complex and real, with one chunk and with chunk groups, with either FFT threading;
+    /// the forward brings the coefficients back.
     #[test]
     fn block_stores_do_not_change_results() {
+        use super::FftThreading::{FftwThreads, SlicesAcrossWorkers};
         use num_complex::Complex64;
-        for (b, cap) in [(24usize, None), (36, Some(1usize))] {
+        for (b, cap, fft_threading) in [
+            (24usize, None, SlicesAcrossWorkers),
+            (36, Some(1usize), SlicesAcrossWorkers),
+            (36, Some(1usize), FftwThreads),
+        ] {
             for real in [false, true] {
                 let opts = super::PlanOptions {
                     max_workspace_bytes: cap,
                     real,
+                    threads: 2,
+                    fft_threading,
                     ..Default::default()
                 };
                 let mut plan = super::Plan::new(b, &opts).unwrap();

@@ -84,6 +84,7 @@ impl Scratch {
             interleaved: true,
             prefetch: Prefetch::none(),
             stream: true,
+            pair_stride: 0,
         }
     }
 }
@@ -335,7 +336,8 @@ impl Plan {
     }
 
     /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
-    /// gives), written into its block. For `pass.k > 0` the previous call was this
+    /// gives), written into its block, or with `pass.stream` into its rows of the
+    /// pair-major buffer (see `plan/blocks.rs`). For `pass.k > 0` the previous call was this
     /// cluster on the group's previous chunk, whose recurrence coefficients and
     /// coefficient rows are reused.
     ///
@@ -359,10 +361,16 @@ impl Plan {
         let p = t.p(c);
         let (mem, nm) = members(cl);
         let mut data = Scratch::take(&mut sc.data, n * p, self.b * 16);
-        let blk = self.block(t, buf, c, ch);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.stream = pass.stream;
+        // Blocks too large for the cache are pair-major (see `plan/blocks.rs`).
+        let at_c = if pass.stream {
+            lanes.pair_stride = t.pair_stride();
+            t.pair_offset(c)
+        } else {
+            t.offset(c)
+        };
         // Within a group the next call needs nothing new (its rows are kept here, its
         // block is written with non-temporal stores): prefetch for the next cluster only
         // on the group's last chunk.
@@ -382,14 +390,17 @@ impl Plan {
             }
             lo = from;
         };
-        dwt::inverse(
+        // SAFETY: this cluster's `ch.lanes() <= t.lanes` rows: its block, or pair-major
+        // pair `j` at `j * pair_stride + pair_offset(c)` (`2p` values of the
+        // `pair_stride`), within the buffer's `t.lanes / 2` pairs; the caller owns them.
+        dwt::inverse_raw(
             self.isa,
             p,
             &rec,
             &lanes,
             &mut data[..n * p],
             &mut fill,
-            blk,
+            buf.add(at_c),
         );
         sc.data = data;
         sc.have = have;

@@ -124,6 +124,8 @@ impl Plan {
                     unsafe { fft.in_place(g.get()) };
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
+                // The inverse's layout of a chunk this large (see `plan/blocks.rs`).
+                let pm = self.buf_bytes > self.plain_store_limit;
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -132,7 +134,9 @@ impl Plan {
                         let t = Instant::now();
                         for (fft, forward) in [(f, true), (iv, false)] {
                             if let Some(fft) = fft {
-                                self.fft_pairs(&ch, fft, threaded, forward, &slice, bp, npairs)?;
+                                self.fft_pairs(
+                                    &ch, fft, threaded, forward, &slice, bp, pm, npairs,
+                                )?;
                             }
                         }
                         best[v] = best[v].min(t.elapsed().as_secs_f64());
@@ -189,8 +193,9 @@ mod tests {
         let t = Instant::now();
         plan.with_buf(|buf| {
             plan.pool().install(|| {
+                let pm = !forward && plan.buf_bytes > plan.plain_store_limit;
                 for ch in plan.chunks(&plan.blocks) {
-                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64)?;
+                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, pm)?;
                 }
                 Ok(())
             })
