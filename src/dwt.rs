@@ -1092,11 +1092,6 @@ mod tests {
         }
     }
 
-    /// The forward kernel is the transpose of the inverse one: `<y, x> = <fin, f>` for
-    /// `f = forward(x)` and `y = inverse(fin)`, on every path, with and without skipping,
-    /// for odd and even numbers of vectors (the 8-column inverse pairs vectors), halves of
-    /// unequal size, and clusters of 1 to 67 degrees. Skipping changes nothing beyond
-    /// rounding.
     /// The inverse into pair-major rows (`Lanes::pair_stride`, the plan's inverse layout)
     /// writes exactly what it writes into consecutive rows, each row at its pair's place,
     /// and nothing between the pairs: every instruction set, both store modes.
@@ -1163,6 +1158,11 @@ mod tests {
         }
     }
 
+    /// The forward kernel is the transpose of the inverse one: `<y, x> = <fin, f>` for
+    /// `f = forward(x)` and `y = inverse(fin)`, on every path, with and without skipping,
+    /// for odd and even numbers of vectors (the 8-column inverse pairs vectors), halves of
+    /// unequal size, and clusters of 1 to 67 degrees. Skipping changes nothing beyond
+    /// rounding.
     #[test]
     fn forward_is_the_adjoint_of_inverse() {
         let b = 67;

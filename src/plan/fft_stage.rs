@@ -349,13 +349,21 @@ pub(super) unsafe fn gather_group(
             // rows of a cluster further on.
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
             let ahead = if pair_major {
-                (row as *const i8).wrapping_add(GATHER_AHEAD)
+                Some(((row as *const i8).wrapping_add(GATHER_AHEAD), p))
             } else {
-                let cf = (c + PREFETCH_CLUSTERS).min(end - 1);
-                buf.wrapping_add(t.offset(cf) + 2 * j0 * t.p(cf)) as *const i8
+                let cf = c + PREFETCH_CLUSTERS;
+                (cf < end).then(|| {
+                    let pf = t.p(cf);
+                    (
+                        buf.wrapping_add(t.offset(cf) + 2 * j0 * pf) as *const i8,
+                        pf,
+                    )
+                })
             };
-            for line in 0..ns * p / 8 {
-                _mm_prefetch::<_MM_HINT_T0>(ahead.wrapping_add(64 * line));
+            if let Some((a, pf)) = ahead {
+                for line in 0..ns * pf / 8 {
+                    _mm_prefetch::<_MM_HINT_T0>(a.wrapping_add(64 * line));
+                }
             }
         }
         let rev = t.rev[c];
