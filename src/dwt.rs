@@ -680,7 +680,7 @@ unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *c
     }
 }
 
-/// Fills rows `from..to` of the inverse kernel's input (see [`inverse`]).
+/// Fills rows `from..to` of the inverse kernel's input (see [`inverse_raw`]).
 pub(crate) type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
 
 /// Vectors of betas whose states the inverse kernel sets up before it needs their input
@@ -860,14 +860,7 @@ pub(crate) fn forward(
     }
 }
 
-/// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
-/// (the layout of the forward kernel's input, see `plan/blocks.rs`).
-///
-/// The input rows are filled on demand: before it reads them, the kernel calls
-/// `fill(fin, from, to)` to fill rows `from..to` (the calls cover the rows from the first
-/// degree where some lane is past its negligible prefix up to `n`, top down, each row
-/// once; rows below are never read). A chunked inverse thus reads only the coefficients
-/// its betas need.
+/// [`inverse_raw`] into consecutive rows of `y` (bounds checked).
 #[cfg(test)]
 pub(crate) fn inverse(
     isa: Isa,
@@ -883,8 +876,16 @@ pub(crate) fn inverse(
     unsafe { inverse_raw(isa, p, rec, lanes, fin, fill, y.as_mut_ptr()) }
 }
 
-/// [`inverse`] into rows anywhere: row `r` of the output at
-/// `y + (r / 2) * lanes.pair_stride + (r % 2) * p` (with `pair_stride` 0: `y + r * p`).
+/// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
+/// (the layout of the forward kernel's input, see `plan/blocks.rs`), with row `r` of the
+/// output at `y + r * P`, or, with a nonzero `lanes.pair_stride` (the pair-major layout),
+/// at `y + (r / 2) * lanes.pair_stride + (r % 2) * P`.
+///
+/// The input rows are filled on demand: before it reads them, the kernel calls
+/// `fill(fin, from, to)` to fill rows `from..to` (the calls cover the rows from the first
+/// degree where some lane is past its negligible prefix up to `n`, top down, each row
+/// once; rows below are never read). A chunked inverse thus reads only the coefficients
+/// its betas need.
 ///
 /// # Safety
 /// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for writes and
