@@ -1188,6 +1188,9 @@ mod tests {
             (24usize, None, SlicesAcrossWorkers),
             (36, Some(1usize), SlicesAcrossWorkers),
             (36, Some(1usize), FftwThreads),
+            // Odd: padding lanes in every chunk.
+            (37, Some(1usize), SlicesAcrossWorkers),
+            (41, None, SlicesAcrossWorkers),
         ] {
             for real in [false, true] {
                 let opts = super::PlanOptions {
