@@ -964,9 +964,7 @@ impl Plan {
                 .collect();
             self.pool().install(|| {
                 for (gi, group) in groups.iter().enumerate() {
-                    // Inverse: blocks too large to stay in the cache are written with
-                    // non-temporal stores, pair-major (see `plan/blocks.rs`).
-                    let stream = !forward && group.len() * self.buf_bytes > self.plain_store_limit;
+                    let stream = !forward && self.streams_blocks(group.len());
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
                         for (ch, buf) in group {
@@ -1037,6 +1035,13 @@ impl Plan {
                 }
             }
         });
+    }
+
+    /// Whether an inverse group of `chunks` chunks writes its blocks with non-temporal
+    /// stores, pair-major (see `plan/blocks.rs`): when they are too large to stay in the
+    /// cache until the FFT stage reads them ([`plain_store_limit`]).
+    fn streams_blocks(&self, chunks: usize) -> bool {
+        chunks * self.buf_bytes > self.plain_store_limit
     }
 
     /// Run `f` with a per-worker FFT scratch buffer (`2 group` padded slices). A worker may

@@ -327,6 +327,7 @@ pub(super) unsafe fn gather_group(
         sp[i] = s[i].get();
     }
     let end = cs.end;
+    let pair_stride = t.pair_stride();
     for c in cs {
         if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, s, true);
@@ -336,10 +337,7 @@ pub(super) unsafe fn gather_group(
         // pair to the next: pair-major, a sequential run over the clusters for each pair;
         // else within the cluster's block.
         let (row, ps) = if pair_major {
-            (
-                buf.add(j0 * t.pair_stride() + t.pair_offset(c)),
-                t.pair_stride(),
-            )
+            (buf.add(j0 * pair_stride + t.pair_offset(c)), pair_stride)
         } else {
             (buf.add(t.offset(c) + 2 * j0 * p), 2 * p)
         };
@@ -531,6 +529,8 @@ mod speed {
             };
             let bp = buf.as_mut_ptr() as *mut f64;
             let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, 0, 0..t.len()) });
+            // The gather as a large inverse runs it (pair-major); the scatter's blocks are
+            // only a source of values here.
             let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, true, 0, 0..t.len()) });
             let bytes = 2 * g * nn * 16;
             let src = AlignedBuf::new(bytes / 16).unwrap();

@@ -124,8 +124,8 @@ impl Plan {
                     unsafe { fft.in_place(g.get()) };
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
-                // The inverse's layout of a chunk this large (see `plan/blocks.rs`).
-                let pm = self.buf_bytes > self.plain_store_limit;
+                // The inverse's layout for one chunk (see `plan/blocks.rs`).
+                let pm = self.streams_blocks(1);
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -193,7 +193,7 @@ mod tests {
         let t = Instant::now();
         plan.with_buf(|buf| {
             plan.pool().install(|| {
-                let pm = !forward && plan.buf_bytes > plan.plain_store_limit;
+                let pm = !forward && plan.streams_blocks(1);
                 for ch in plan.chunks(&plan.blocks) {
                     plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, pm)?;
                 }
