@@ -18,18 +18,17 @@ use crate::simd::{Isa, Scalar, Simd};
 use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, SKIP_BITS_RANGE, TINY};
 use std::mem::MaybeUninit;
 
-/// Recurrence coefficients of one cluster, index `i = l - l0` (see `RecTables::coeffs`).
+/// Recurrence coefficients of one cluster, index `i = l - l0`, for the scaled values
+/// `e_i` of `RecTables::coeffs`: `e_{i+1} = (A'_i x + C'_i) e_i - e_{i-1}`.
 pub(crate) struct Rec<'a> {
-    /// `A_l`
+    /// `A'_i`
     pub a: &'a [f64],
-    /// `-A_l`
+    /// `-A'_i`
     pub an: &'a [f64],
-    /// `A_l + C_l`
+    /// `A'_i + C'_i`
     pub d: &'a [f64],
-    /// `C_l - A_l`
+    /// `C'_i - A'_i`
     pub e: &'a [f64],
-    /// `Bc_l`
-    pub bb: &'a [f64],
 }
 
 impl<'a> Rec<'a> {
@@ -40,7 +39,6 @@ impl<'a> Rec<'a> {
             an: &r.an[..n],
             d: &r.d[..n],
             e: &r.e[..n],
-            bb: &r.bb[..n],
         }
     }
 
@@ -245,13 +243,13 @@ impl<'r, S: Simd> State<'r, S> {
     /// Step without accumulating until some lane is active (or degree `n`): the rest of
     /// the negligible prefix after [`skip_inactive`], one vector at a time.
     #[inline(always)]
-    unsafe fn finish_prefix(&mut self, rec: &Rec, n: usize) {
+    unsafe fn finish_prefix(&mut self, n: usize) {
         if !self.skip {
             return;
         }
         let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
         while i < n && self.none_active() {
-            let p2 = self.step(rec, p0, p1, i);
+            let p2 = self.step(p0, p1, i);
             (p0, p1) = (p1, p2);
             i += 1;
             if S::any_ge(S::abs(p1), self.big) {
@@ -266,13 +264,13 @@ impl<'r, S: Simd> State<'r, S> {
     /// `min(i0 + D, n)`. For the blocks where not all lanes are active yet, or which start
     /// before the state does, or end past `n`.
     #[inline(always)]
-    unsafe fn masked_block<const D: usize>(&mut self, rec: &Rec, i0: usize, n: usize) -> [S::V; D] {
+    unsafe fn masked_block<const D: usize>(&mut self, i0: usize, n: usize) -> [S::V; D] {
         let mut d = [S::zero(); D];
         let (mut p0, mut p1, mut i) = (self.p0, self.p1, self.i);
         let end = (i0 + D).min(n);
         while i < end {
             d[i - i0] = S::mul(p1, self.mask);
-            let p2 = self.step(rec, p0, p1, i);
+            let p2 = self.step(p0, p1, i);
             (p0, p1) = (p1, p2);
             i += 1;
             if S::any_ge(S::abs(p1), self.big) {
@@ -285,28 +283,28 @@ impl<'r, S: Simd> State<'r, S> {
 
     /// One recurrence step from `(p0, p1)` at degree index `i`: the next value.
     #[inline(always)]
-    unsafe fn step(&self, rec: &Rec, p0: S::V, p1: S::V, i: usize) -> S::V {
+    unsafe fn step(&self, p0: S::V, p1: S::V, i: usize) -> S::V {
         let t = S::fma(
             S::splat(*self.ka.get_unchecked(i)),
             self.tau,
             S::splat(*self.kc.get_unchecked(i)),
         );
-        S::fms(t, p1, S::mul(S::splat(*rec.bb.get_unchecked(i)), p0))
+        S::fms(t, p1, p0)
     }
 
     /// Run the remaining degrees up to `n`, calling `acc(v, i)` with the value vector at
     /// each degree from the first one where some lane is active. The recurrence values
     /// live in locals (registers) throughout.
     #[inline(always)]
-    unsafe fn run(&mut self, rec: &Rec, n: usize, mut acc: impl FnMut(S::V, usize)) {
-        self.run_slow(rec, n, &mut acc);
-        self.run_fast(rec, n, &mut acc);
+    unsafe fn run(&mut self, n: usize, mut acc: impl FnMut(S::V, usize)) {
+        self.run_slow(n, &mut acc);
+        self.run_fast(n, &mut acc);
     }
 
     /// The slow phase of [`State::run`]: while some lanes are still scaled down (and
     /// masked to zero), up to degree `n`.
     #[inline(always)]
-    unsafe fn run_slow(&mut self, rec: &Rec, n: usize, acc: &mut impl FnMut(S::V, usize)) {
+    unsafe fn run_slow(&mut self, n: usize, acc: &mut impl FnMut(S::V, usize)) {
         if self.all_active() {
             return;
         }
@@ -315,7 +313,7 @@ impl<'r, S: Simd> State<'r, S> {
         let mut accumulate = !self.none_active() || !self.skip;
         while i < n {
             let v = S::mul(p1, self.mask);
-            let p2 = S::fence(self.step(rec, p0, p1, i));
+            let p2 = S::fence(self.step(p0, p1, i));
             (p0, p1) = (p1, p2);
             if accumulate {
                 acc(v, i);
@@ -338,12 +336,12 @@ impl<'r, S: Simd> State<'r, S> {
     /// it and put its latency on the critical path at every degree (measured: 13.4 against
     /// 10.7 cycles per degree).
     #[inline(always)]
-    unsafe fn run_fast(&mut self, rec: &Rec, end: usize, acc: &mut impl FnMut(S::V, usize)) {
+    unsafe fn run_fast(&mut self, end: usize, acc: &mut impl FnMut(S::V, usize)) {
         let mut i = self.i;
         let (mut p0, mut p1) = (self.p0, self.p1);
         while i < end {
             let v = p1;
-            let p2 = S::fence(self.step(rec, p0, p1, i));
+            let p2 = S::fence(self.step(p0, p1, i));
             (p0, p1) = (p1, p2);
             acc(v, i);
             i += 1;
@@ -380,7 +378,6 @@ unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: u
     loop {
         let mut hit = false;
         while i < n {
-            let b = S::splat(*rec.bb.get_unchecked(i));
             let mut m = S::zero();
             for k in 0..GROUP {
                 let t = S::fma(
@@ -388,7 +385,7 @@ unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: u
                     tau[k],
                     S::splat(*kc[k].get_unchecked(i)),
                 );
-                let p2 = S::fms(t, p1[k], S::mul(b, p0[k]));
+                let p2 = S::fms(t, p1[k], p0[k]);
                 p0[k] = p1[k];
                 p1[k] = p2;
                 m = S::max(m, S::abs(p2));
@@ -460,7 +457,7 @@ unsafe fn prefix_states<'m, 'r, S: Simd, const W: usize>(
         let (gn, group) = group_states::<S, W>(rec, lanes, v0 + g * W, v0 + nv * W, n);
         for (k, s) in group.iter().enumerate().take(gn) {
             let mut s = *s;
-            s.finish_prefix(rec, n);
+            s.finish_prefix(n);
             mem[g + k].write(s);
         }
         g += gn;
@@ -596,7 +593,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     continue;
                 }
                 pf.issue(pf_per_vector);
-                let d = s.masked_block::<DB>(rec, i0, n);
+                let d = s.masked_block::<DB>(i0, n);
                 let db = dbuf[0].0.as_mut_ptr();
                 for (j, dj) in d.iter().enumerate() {
                     S::store(db.add(j * W), *dj);
@@ -615,7 +612,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 let db = dbuf[cur].0.as_mut_ptr();
                 for j in 0..DB {
                     S::store(db.add(j * W), p1);
-                    let p2 = S::fence(s.step(rec, p0, p1, i0 + j));
+                    let p2 = S::fence(s.step(p0, p1, i0 + j));
                     (p0, p1) = (p1, p2);
                 }
                 (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
@@ -634,7 +631,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                                 // This lane's share of the next vector's steps.
                                 for k in $w * DB / W..($w + 1) * DB / W {
                                     S::store(dn.add(k * W), p1);
-                                    let p2 = S::fence(s.step(rec, p0, p1, i0 + k));
+                                    let p2 = S::fence(s.step(p0, p1, i0 + k));
                                     (p0, p1) = (p1, p2);
                                 }
                                 beta_fmas::<S, W, P, DB>(&mut acc, dc, $w, x.add($w * xs));
@@ -732,19 +729,19 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
             if pair {
                 let [a0, a1] = &mut acc;
                 for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
-                    s.run_slow(rec, n, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    s.run_slow(n, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
                 }
                 // The one behind catches up alone, then both run together.
                 let i0 = st[0].i.max(st[1].i);
                 for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
-                    s.run_fast(rec, i0, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    s.run_fast(i0, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
                 }
                 let [s0, s1] = &mut st;
                 let (mut p0, mut p1, mut r0, mut r1) = (s0.p0, s0.p1, s1.p0, s1.p1);
                 for i in i0..n {
                     let (v, u) = (p1, r1);
-                    let p2 = S::fence(s0.step(rec, p0, p1, i));
-                    let r2 = S::fence(s1.step(rec, r0, r1, i));
+                    let p2 = S::fence(s0.step(p0, p1, i));
+                    let r2 = S::fence(s1.step(r0, r1, i));
                     (p0, p1, r0, r1) = (p1, p2, r1, r2);
                     let row = fp.add(i * P);
                     for q in 0..P {
@@ -757,7 +754,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                 // A local copy, so the state lives in registers during the run.
                 let mut s = st[0];
                 let a = &mut acc[0];
-                s.run(rec, n, |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                s.run(n, |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
             }
             // Rows of the output are lanes: each W x W block of (order column, lane) is
             // transposed in registers on the way out, and with `lanes.stream` written
@@ -838,7 +835,7 @@ pub(crate) fn forward(
 ) -> usize {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(xin.len() >= nb * p && ft.len() >= (n + isa.lanes()) * p);
     assert!(isa.is_supported());
@@ -901,7 +898,7 @@ pub(crate) unsafe fn inverse_raw(
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n && rec.bb.len() == n);
+    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n);
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && isa.is_supported());
     assert!(lanes.pair_stride == 0 || (lanes.interleaved && lanes.pair_stride >= 2 * p));
@@ -980,7 +977,7 @@ pub(crate) fn column(
         pair_stride: 0,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
-    f.iter().step_by(8).take(n).copied().collect()
+    f.iter().step_by(8).zip(&rc.s).map(|(v, s)| v * s).collect()
 }
 
 #[cfg(test)]

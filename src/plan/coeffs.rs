@@ -9,7 +9,8 @@
 
 use num_complex::Complex64;
 
-/// `dst[i * p .. i * p + 2] = src[i] * sg[i % 2]` for `i < n`.
+/// `dst[i * p .. i * p + 2] = src[i] * sg[i % 2] * s[i]` for `i < n` (`s`: the kernels'
+/// value scales, see `RecTables::coeffs`).
 ///
 /// # Safety
 /// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
@@ -19,26 +20,28 @@ pub(super) unsafe fn gather(
     p: usize,
     n: usize,
     sg: [f64; 2],
+    s: &[f64],
 ) {
+    let s = &s[..n];
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::*;
-        let g = [_mm_set1_pd(sg[0]), _mm_set1_pd(sg[1])];
-        for i in 0..n {
+        for (i, &si) in s.iter().enumerate() {
             let z = _mm_loadu_pd(src.add(i) as *const f64);
-            _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, g[i & 1]));
+            _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, _mm_set1_pd(sg[i & 1] * si)));
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    for i in 0..n {
+    for (i, &si) in s.iter().enumerate() {
         let z = *src.add(i);
-        let g = sg[i & 1];
+        let g = sg[i & 1] * si;
         *dst.add(i * p) = z.re * g;
         *dst.add(i * p + 1) = z.im * g;
     }
 }
 
-/// `dst[i] = src[i * p .. i * p + 2] * sg[i % 2]` (or `+=` if `add`) for `i < n`; with
+/// `dst[i] = src[i * p .. i * p + 2] * sg[i % 2] * s[i]` (or `+=` if `add`) for `i < n`
+/// (`s` as for [`gather`]); with
 /// `partner = Some((d2, ps))` also `d2[i] = ps * conj(dst[i])` (the real forward's partner
 /// pair, from the value in a register: no second pass over the coefficients).
 ///
@@ -48,26 +51,29 @@ pub(super) unsafe fn gather(
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
 /// `i * p` and `i * p + 1`, `i < n`; no overlap.
+#[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter(
     dst: *mut Complex64,
     src: *const f64,
     p: usize,
     n: usize,
     sg: [f64; 2],
+    s: &[f64],
     add: bool,
     partner: Option<(*mut Complex64, f64)>,
 ) {
+    let s = &s[..n];
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::*;
-        let g = [_mm_set1_pd(sg[0]), _mm_set1_pd(sg[1])];
         let d = dst as *mut f64;
         let (d2, conj) = match partner {
             Some((d2, ps)) => (d2 as *mut f64, _mm_set_pd(-ps, ps)),
             None => (std::ptr::null_mut(), _mm_setzero_pd()),
         };
-        for i in 0..n {
-            let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g[i & 1]);
+        for (i, &si) in s.iter().enumerate() {
+            let g = _mm_set1_pd(sg[i & 1] * si);
+            let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g);
             if add {
                 z = _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z);
             }
@@ -78,8 +84,8 @@ pub(super) unsafe fn scatter(
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    for i in 0..n {
-        let g = sg[i & 1];
+    for (i, &si) in s.iter().enumerate() {
+        let g = sg[i & 1] * si;
         let mut z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
         if add {
             z += *dst.add(i);
@@ -114,13 +120,15 @@ mod tests {
             .map(|i| Complex64::new(i as f64 + 0.5, -(i as f64) * 0.25))
             .collect();
         let sg = [-1.5, 2.0];
+        // Scales that are powers of two keep every product exact.
+        let sc: Vec<f64> = (0..n).map(|i| [1.0, 0.5, 4.0][i % 3]).collect();
         let mut rows = vec![7.0; n * p];
-        unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg) };
+        unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg, &sc) };
         for i in 0..n {
             for q in 0..p {
                 let want = match q {
-                    4 if i < n - 1 => z[i].re * sg[i % 2],
-                    5 if i < n - 1 => z[i].im * sg[i % 2],
+                    4 if i < n - 1 => z[i].re * sg[i % 2] * sc[i],
+                    5 if i < n - 1 => z[i].im * sg[i % 2] * sc[i],
                     _ => 7.0,
                 };
                 assert_eq!(rows[i * p + q], want, "i={i} q={q}");
@@ -134,20 +142,21 @@ mod tests {
                 p,
                 n - 1,
                 sg,
+                &sc,
                 add,
                 None,
             )
         };
         back_from_rows(&mut back, false);
         for i in 0..n - 1 {
-            // Signs squared: 2.25 and 4.
-            let s2 = sg[i % 2] * sg[i % 2];
+            // Signs and scales squared.
+            let s2 = (sg[i % 2] * sc[i]).powi(2);
             assert_eq!(back[i], z[i] * s2);
         }
         assert_eq!(back[n - 1], Complex64::new(1.0, 1.0));
         back_from_rows(&mut back, true);
         for i in 0..n - 1 {
-            let s2 = sg[i % 2] * sg[i % 2];
+            let s2 = (sg[i % 2] * sc[i]).powi(2);
             assert_eq!(back[i], z[i] * (2.0 * s2));
         }
         // Assigned or added, with partners, at both alignments of 16 bytes (offsets of 0
@@ -162,14 +171,25 @@ mod tests {
                         b.as_mut_ptr().add(off) as *mut Complex64,
                     )
                 };
-                unsafe { scatter(pa, rows[4..].as_ptr(), p, n - 1, sg, add, Some((pb, -2.0))) };
+                unsafe {
+                    scatter(
+                        pa,
+                        rows[4..].as_ptr(),
+                        p,
+                        n - 1,
+                        sg,
+                        &sc,
+                        add,
+                        Some((pb, -2.0)),
+                    )
+                };
                 for i in 0..n {
                     let (x, y) = unsafe { (*pa.add(i), *pb.add(i)) };
                     if i == n - 1 {
                         assert_eq!((x, y), (Complex64::new(3.0, 3.0), Complex64::new(5.0, 5.0)));
                         continue;
                     }
-                    let mut want = z[i] * (sg[i % 2] * sg[i % 2]);
+                    let mut want = z[i] * (sg[i % 2] * sc[i]).powi(2);
                     if add {
                         want += Complex64::new(3.0, 3.0);
                     }

@@ -126,7 +126,8 @@ impl Plan {
 
     /// Inverse DWT input, rows `from..to` of `fin` (`n` rows of `p` values):
     /// `fin[i][2q..2q+2]` = coefficient of `members[q]` at degree `l0 + i`, times the
-    /// member's sign and `1/(2 pi)`; unused columns zero.
+    /// member's sign, `1/(2 pi)` and the kernels' value scale `vscale[i]` (see
+    /// `RecTables::coeffs`); unused columns zero.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn gather_coeffs(
         &self,
@@ -134,6 +135,7 @@ impl Plan {
         cl: &Cluster,
         members: &[Member],
         coef: &[Complex64],
+        vscale: &[f64],
         from: usize,
         to: usize,
     ) {
@@ -153,7 +155,8 @@ impl Plan {
                 mem.sign_at(cl.m + from + 1) * scale,
             ];
             // SAFETY: `rows` has `to - from` rows of `p >= 2 members.len()` values.
-            unsafe { coeffs::gather(rows[2 * q..].as_mut_ptr(), src.as_ptr(), p, to - from, sg) };
+            let (dst, s) = (rows[2 * q..].as_mut_ptr(), &vscale[from..to]);
+            unsafe { coeffs::gather(dst, src.as_ptr(), p, to - from, sg, s) };
         }
     }
 
@@ -331,7 +334,8 @@ impl Plan {
             // Degree `l0 + lo` has the parity of `cl.m + lo`.
             let sg = [mem.sign_at(cl.m + lo), mem.sign_at(cl.m + lo + 1)];
             let src = sums.as_ptr().add(lo * p + 2 * q);
-            coeffs::scatter(dst.add(lo), src, p, n - lo, sg, !pass.first, partner);
+            let s = &sc.rec.s[lo..n];
+            coeffs::scatter(dst.add(lo), src, p, n - lo, sg, s, !pass.first, partner);
         }
     }
 
@@ -383,9 +387,10 @@ impl Plan {
         let mut have = if k == 0 { n } else { sc.have };
         // Only the degrees some beta of the chunk needs are read from the coefficients
         // (near the poles most clusters need few or none), and each once per group.
+        let scale = &sc.rec.s[..n];
         let mut fill = |fin: &mut [f64], from: usize, to: usize| {
             if from < have {
-                self.gather_coeffs(fin, cl, &mem[..nm], coef, from, to.min(have));
+                self.gather_coeffs(fin, cl, &mem[..nm], coef, scale, from, to.min(have));
                 have = from;
             }
             lo = from;
