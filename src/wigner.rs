@@ -356,23 +356,22 @@ unsafe fn starts_avx512(
 }
 
 /// Tables from which the recurrence coefficients of any base pair follow by a few
-/// double-double multiplications (no square root or division of tabulated values per
-/// cluster), so that every coefficient the kernels use is the double nearest to its exact
-/// value (to within a few units in the 30th decimal place).
+/// double-double multiplications per degree (no square root per cluster), so that every
+/// coefficient the kernels use is the double nearest to its exact value (to within a few
+/// units in the 30th decimal place). At B = 256 the coefficients of all clusters take
+/// about 9 ms per chunk (`coeffs_speed` test), 1-2% of the DWT stage.
 ///
 /// Correct rounding matters: with the coefficients formed by products of rounded table
 /// values (3-5 roundings each), the mean maximum round-trip error over 40 seeds was 74%
 /// larger at B = 64 (2.66e-14 against 1.53e-14) and the relative L2 error 17% larger.
 pub(crate) struct RecTables {
     stride: usize,
-    /// `1 / sqrt(l^2 - m^2)` at `[m * stride + l]` (`l > m`, 0 at `l = m`).
-    r: DdVec,
-    /// `sqrt((l^2 - m^2) / ((l+1)^2 - m^2))` at `[m * stride + l]` (`l >= m`).
-    rho: DdVec,
-    /// `(l+1) sqrt((2l+3)(2l+1))`.
-    k1: DdVec,
-    /// `sqrt((2l+3)/(2l-1)) (l+1)/l` (0 at `l = 0`).
-    k2: DdVec,
+    /// `sqrt((l+1) sqrt((2l+3)(2l+1)) / ((l+1)^2 - m^2))` at `[m * stride + l]` (`l >= m`):
+    /// `A_l = ga[m][l] ga[m'][l]`.
+    ga: DdVec,
+    /// `sqrt(sqrt((2l+3)/(2l-1)) (l+1)/l (l^2 - m^2) / ((l+1)^2 - m^2))` (`l >= m`, 0 at
+    /// `l = 0`): `Bc_l = gb[m][l] gb[m'][l]`.
+    gb: DdVec,
     /// `1 / (l(l+1))` (0 at `l = 0`).
     k3: DdVec,
     /// Hardware FMA available (the double-double products need fused multiply-adds; without
@@ -434,38 +433,35 @@ impl RecTables {
         let stride = lmax + 2;
         // `l^2 - m^2` and `(l+1)^2 - m^2` are exact integers in a double (l < 2^26).
         let sq = |k: usize| (k * k) as f64;
-        let r = DdVec::from_fn((lmax + 1) * stride, |k| {
+        let k1 = |l: usize| {
+            let l = l as f64;
+            Dd::prod(2.0 * l + 3.0, 2.0 * l + 1.0).sqrt().mul_f(l + 1.0)
+        };
+        let k2 = |l: usize| {
+            let l = l as f64;
+            Dd::new(2.0 * l + 3.0)
+                .div(Dd::new(2.0 * l - 1.0))
+                .sqrt()
+                .mul_f(l + 1.0)
+                .div(Dd::new(l))
+        };
+        let ga = DdVec::from_fn((lmax + 1) * stride, |k| {
             let (m, l) = (k / stride, k % stride);
-            if l > m {
-                Dd::new(1.0).div(Dd::new(sq(l) - sq(m)).sqrt())
+            if l >= m && l <= lmax {
+                k1(l).div(Dd::new(sq(l + 1) - sq(m))).sqrt()
             } else {
                 Dd::new(0.0)
             }
         });
-        let rho = DdVec::from_fn((lmax + 1) * stride, |k| {
+        let gb = DdVec::from_fn((lmax + 1) * stride, |k| {
             let (m, l) = (k / stride, k % stride);
-            if l >= m {
-                Dd::new(sq(l) - sq(m))
+            if l >= m && l <= lmax && l > 0 {
+                k2(l)
+                    .mul_f(sq(l) - sq(m))
                     .div(Dd::new(sq(l + 1) - sq(m)))
                     .sqrt()
             } else {
                 Dd::new(0.0)
-            }
-        });
-        let k1 = DdVec::from_fn(lmax + 1, |l| {
-            let l = l as f64;
-            Dd::prod(2.0 * l + 3.0, 2.0 * l + 1.0).sqrt().mul_f(l + 1.0)
-        });
-        let k2 = DdVec::from_fn(lmax + 1, |l| {
-            let l = l as f64;
-            if l == 0.0 {
-                Dd::new(0.0)
-            } else {
-                Dd::new(2.0 * l + 3.0)
-                    .div(Dd::new(2.0 * l - 1.0))
-                    .sqrt()
-                    .mul_f(l + 1.0)
-                    .div(Dd::new(l))
             }
         });
         let k3 = DdVec::from_fn(lmax + 1, |l| {
@@ -478,10 +474,8 @@ impl RecTables {
         });
         RecTables {
             stride,
-            r,
-            rho,
-            k1,
-            k2,
+            ga,
+            gb,
             k3,
             fma,
         }
@@ -539,21 +533,18 @@ impl RecTables {
         }
         let st = self.stride;
         let mm = (m * mp) as f64;
-        // Table runs for `l = m .. m + n` (`r` at `l + 1`), as slices of length `n` so
-        // that the loops below have no bounds checks and vectorise.
-        let (k1h, k1l) = self.k1.run(m, n);
-        let (k2h, k2l) = self.k2.run(m, n);
+        // Table runs for `l = m .. m + n`, as slices of length `n` so that the loops below
+        // have no bounds checks and vectorise.
         let (k3h, k3l) = self.k3.run(m, n);
-        let (rmh, rml) = self.r.run(m * st + m + 1, n);
-        let (rph, rpl) = self.r.run(mp * st + m + 1, n);
-        let (omh, oml) = self.rho.run(m * st + m, n);
-        let (oph, opl) = self.rho.run(mp * st + m, n);
+        let (amh, aml) = self.ga.run(m * st + m, n);
+        let (aph, apl) = self.ga.run(mp * st + m, n);
+        let (bmh, bml) = self.gb.run(m * st + m, n);
+        let (bph, bpl) = self.gb.run(mp * st + m, n);
         let dd = |h: &[f64], l: &[f64], i: usize| Dd { hi: h[i], lo: l[i] };
         // `Bc` rounded (into `r.e` for now), then the scales `S_i`.
         let bc = &mut r.e[..n];
         for (i, b) in bc.iter_mut().enumerate() {
-            let rho = dd(omh, oml, i).mul(dd(oph, opl, i));
-            *b = dd(k2h, k2l, i).mul(rho).to_f64();
+            *b = dd(bmh, bml, i).mul(dd(bph, bpl, i)).to_f64();
         }
         let sc = &mut r.s[..n];
         let (mut s0, mut s1) = (1.0, 1.0);
@@ -565,30 +556,35 @@ impl RecTables {
         }
         let (ra, ran, rd, re) = (&mut r.a[..n], &mut r.an[..n], &mut r.d[..n], &mut r.e[..n]);
         let sc = &r.s[..n];
-        let one = Dd::new(1.0);
         // Written out twice (a closure would not be inlined into this `target_feature`
         // function, and would then neither vectorise nor use FMA instructions).
         macro_rules! coeff {
-            ($i:expr, $f:expr) => {{
+            ($i:expr, $s_next:expr) => {{
                 let i = $i;
-                let a = dd(k1h, k1l, i)
-                    .mul(dd(rmh, rml, i))
-                    .mul(dd(rph, rpl, i))
-                    .mul($f);
-                // `C / A = -m m' / (l(l+1))`, below 1 in magnitude.
-                let c = dd(k3h, k3l, i).mul_f(mm);
+                // `A' = A S_i / S_{i+1}`.
+                let f = Dd::quot(sc[i], $s_next);
+                let a = dd(amh, aml, i).mul(dd(aph, apl, i)).mul(f);
+                // `A + C = A (ll - mm) / ll`, `C - A = -A (ll + mm) / ll`: exact integers
+                // times `1 / ll`, no cancellation.
+                let l = (m + i) as f64;
+                let ll = l * (l + 1.0);
+                let d = a.mul(dd(k3h, k3l, i).mul_f(ll - mm));
                 ra[i] = a.to_f64();
                 ran[i] = -ra[i];
-                rd[i] = a.mul(one.sub_small(c)).to_f64();
-                re[i] = -a.mul(one.add_small(c)).to_f64();
+                rd[i] = d.to_f64();
+                re[i] = -a.mul(dd(k3h, k3l, i).mul_f(ll + mm)).to_f64();
             }};
         }
-        // `f = S_i / S_{i+1}`; the last degree's coefficient is never used (it would
-        // step to degree `m + n`), so any `f` does there.
         for i in 0..n - 1 {
-            coeff!(i, Dd::quot(sc[i], sc[i + 1]));
+            coeff!(i, sc[i + 1]);
         }
-        coeff!(n - 1, one);
+        // The last degree's coefficient is never used (it would step to degree `m + n`),
+        // so any scale does there.
+        coeff!(n - 1, sc[n - 1]);
+        if m == 0 {
+            // `l = 0`: `C = 0` (`1 / ll` is stored as 0).
+            (rd[0], re[0]) = (ra[0], -ra[0]);
+        }
     }
 }
 
@@ -644,23 +640,6 @@ impl Dd {
     fn mul(self, b: Dd) -> Dd {
         let p = Dd::prod(self.hi, b.hi);
         Dd::fast_sum(p.hi, self.hi.mul_add(b.lo, self.lo.mul_add(b.hi, p.lo)))
-    }
-
-    /// `self + b` for `|b.hi| <= |self.hi|`.
-    #[inline(always)]
-    fn add_small(self, b: Dd) -> Dd {
-        let s = self.hi + b.hi;
-        let err = (self.hi - s) + b.hi;
-        Dd::fast_sum(s, err + self.lo + b.lo)
-    }
-
-    /// `self - b` for `|b.hi| <= |self.hi|`.
-    #[inline(always)]
-    fn sub_small(self, b: Dd) -> Dd {
-        self.add_small(Dd {
-            hi: -b.hi,
-            lo: -b.lo,
-        })
     }
 
     #[inline(always)]
@@ -843,6 +822,28 @@ mod tests {
             checked.iter().all(|&c| c >= 20),
             "too few exact checks: {checked:?}"
         );
+    }
+
+    /// Time of the coefficients of every cluster at B = 256 (one chunk's worth).
+    #[test]
+    #[ignore]
+    fn coeffs_speed() {
+        let b = 256;
+        let rt = RecTables::new(b);
+        let mut r = RecCoeffs::new(b);
+        let mut best = f64::MAX;
+        for _ in 0..7 {
+            let t = std::time::Instant::now();
+            for m in 0..b {
+                for mp in 0..=m {
+                    r.resize(b - m);
+                    rt.coeffs(m, mp, &mut r);
+                }
+            }
+            best = best.min(t.elapsed().as_secs_f64());
+            std::hint::black_box(&r);
+        }
+        println!("coeffs for all clusters of B = {b}: {:.2} ms", best * 1e3);
     }
 
     /// The scaled coefficients undo their scales: `A'_i S_{i+1} / S_i = A_i` and
