@@ -1058,7 +1058,7 @@ mod tests {
     ) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
         let nbs = ks.len();
         let bt = BetaTables::grid(b);
-        let norm = crate::wigner::start_norms(b)[m * (m + 1) / 2 + mp];
+        let norm = crate::wigner::start_norm(m, mp);
         let mut rc = RecCoeffs::new(b - m);
         RecTables::new(b).coeffs(m, mp, &mut rc);
         let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);

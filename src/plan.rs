@@ -441,10 +441,11 @@ impl Layout {
         }
         let block_lanes = Blocks::lanes_for(chunk.max(chunk_real.unwrap_or(0)));
         let clusters = crate::symmetry::num_generic(b) + 2 * b;
-        // Recurrence tables (2 (B+1)(B+2) doubles), starting-value norms (B(B+1)/2 Ext),
-        // power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list and slot tables
-        // (8 + 8 * 9 bytes per cluster, twice with the real layout), per-worker DWT scratch.
-        let table_bytes = 16 * (b + 1) * (b + 2)
+        // Recurrence tables (2 double-double tables of (B+1)(B+2) entries), starting-value
+        // norms (B(B+1)/2 Ext), power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list
+        // and slot tables (8 + 8 * 9 bytes per cluster, twice with the real layout),
+        // per-worker DWT scratch.
+        let table_bytes = 32 * (b + 1) * (b + 2)
             + 8 * b * (b + 1)
             + 64 * b * (66 + b / 32)
             + 2 * 80 * clusters

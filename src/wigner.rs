@@ -71,38 +71,6 @@ pub(crate) fn ldexp(mut x: f64, mut n: i64) -> f64 {
 impl Ext {
     pub const ONE: Ext = Ext { mant: 0.5, exp: 1 };
 
-    pub fn new(x: f64) -> Ext {
-        let (mant, exp) = frexp(x);
-        Ext { mant, exp }
-    }
-
-    #[inline]
-    pub fn mul(self, o: Ext) -> Ext {
-        let (mant, e) = frexp(self.mant * o.mant);
-        Ext {
-            mant,
-            exp: self.exp + o.exp + e,
-        }
-    }
-
-    pub fn mul_f64(self, x: f64) -> Ext {
-        self.mul(Ext::new(x))
-    }
-
-    pub fn sqrt(self) -> Ext {
-        if self.exp % 2 == 0 {
-            Ext::new(self.mant.sqrt()).mul(Ext {
-                mant: 0.5,
-                exp: self.exp / 2 + 1,
-            })
-        } else {
-            Ext::new((2.0 * self.mant).sqrt()).mul(Ext {
-                mant: 0.5,
-                exp: (self.exp - 1) / 2 + 1,
-            })
-        }
-    }
-
     /// The kernels' scaled form `(p, sc)` for skip threshold `2^-bits`: true value
     /// `= p * 2^(SCALE_STEP * sc)`, `sc = 0` if the value is at least `2^-bits`, else `p` in
     /// `[2^(-bits-1), big(bits))`.
@@ -121,22 +89,112 @@ impl Ext {
     }
 }
 
-/// `sqrt((2m+1)/2 * binom(2m, m-m'))` for every `0 <= m' <= m < b`, index `m(m+1)/2 + m'`.
+/// `sqrt((2m+1)/2 * binom(2m, m-m'))` for every `0 <= m' <= m < b`, index `m(m+1)/2 + m'`,
+/// each the nearest double (times a power of two): the binomials are built in
+/// double-double arithmetic, whose rounding errors over the `m` steps stay far below one
+/// double ulp.
 pub(crate) fn start_norms(b: usize) -> Vec<Ext> {
     let mut out = vec![Ext::ONE; b * (b + 1) / 2];
     for m in 0..b {
         // binom(2m, j) for j = m - m' = 0..m, built up by the ratio (2m-j+1)/j.
-        let mut bin = Ext::ONE;
+        let mut bin = Xd::from_dd(Dd::new(1.0));
         for j in 0..=m {
             if j > 0 {
-                bin = bin.mul_f64((2 * m - j + 1) as f64 / j as f64);
+                bin = Xd::from_dd(bin.m.mul_f((2 * m - j + 1) as f64).div(Dd::new(j as f64)))
+                    .shift(bin.e);
             }
             let mp = m - j;
-            out[m * (m + 1) / 2 + mp] = bin.mul_f64((2 * m + 1) as f64 / 2.0).sqrt();
+            let v = Xd::from_dd(bin.m.mul_f((2 * m + 1) as f64)).shift(bin.e - 1);
+            out[m * (m + 1) / 2 + mp] = v.sqrt().to_ext();
         }
     }
     out
 }
+
+/// One entry of [`start_norms`]: `sqrt((2m+1)/2 * binom(2m, m-m'))` for `m' <= m`.
+pub(crate) fn start_norm(m: usize, mp: usize) -> Ext {
+    assert!(mp <= m);
+    let mut bin = Xd::from_dd(Dd::new(1.0));
+    for j in 1..=m - mp {
+        bin = Xd::from_dd(bin.m.mul_f((2 * m - j + 1) as f64).div(Dd::new(j as f64))).shift(bin.e);
+    }
+    Xd::from_dd(bin.m.mul_f((2 * m + 1) as f64))
+        .shift(bin.e - 1)
+        .sqrt()
+        .to_ext()
+}
+
+/// A double-double mantissa with an extended exponent, `(m.hi + m.lo) 2^e`, `m.hi` in
+/// `[0.5, 1)` (or zero): products of hundreds of factors without overflow and with
+/// rounding errors far below one double ulp.
+#[derive(Clone, Copy, Debug)]
+struct Xd {
+    m: Dd,
+    e: i64,
+}
+
+impl Xd {
+    fn from_dd(d: Dd) -> Xd {
+        let (hi, e) = frexp(d.hi);
+        Xd {
+            m: Dd {
+                hi,
+                lo: ldexp(d.lo, -e),
+            },
+            e,
+        }
+    }
+
+    /// Times `2^k`.
+    fn shift(self, k: i64) -> Xd {
+        Xd {
+            m: self.m,
+            e: self.e + k,
+        }
+    }
+
+    fn mul(self, o: Xd) -> Xd {
+        Xd::from_dd(self.m.mul(o.m)).shift(self.e + o.e)
+    }
+
+    fn sqrt(self) -> Xd {
+        // An even exponent: sqrt(m 2^(2k)) = sqrt(m) 2^k.
+        let (m, e) = if self.e % 2 == 0 {
+            (self.m, self.e)
+        } else {
+            (self.m.mul_f(2.0), self.e - 1)
+        };
+        Xd::from_dd(m.sqrt()).shift(e / 2)
+    }
+
+    /// The nearest double, as an [`Ext`].
+    fn to_ext(self) -> Ext {
+        let (mant, e) = frexp(self.m.to_f64());
+        Ext {
+            mant,
+            exp: e + self.e,
+        }
+    }
+}
+
+/// `(sin x, cos x)` in double-double for `0 <= x <= pi/2` (Taylor series in `x^2`).
+fn sin_cos_dd(x: Dd) -> (Dd, Dd) {
+    let x2 = x.mul(x);
+    // Horner from the term of x^40 (below 1e-38 of the sum here) down.
+    let (mut s, mut c) = (Dd::new(1.0), Dd::new(1.0));
+    for n in (1..=20).rev() {
+        let k = (2 * n) as f64;
+        s = Dd::new(1.0).sub(x2.mul(s).div(Dd::new(k * (k + 1.0))));
+        c = Dd::new(1.0).sub(x2.mul(c).div(Dd::new((k - 1.0) * k)));
+    }
+    (x.mul(s), c)
+}
+
+/// `pi` in double-double.
+const PI_DD: Dd = Dd {
+    hi: std::f64::consts::PI,
+    lo: 1.2246467991473532e-16,
+};
 
 /// Powers `base^a`, `0 <= a <= maxpow`, for a list of bases, stored in two levels
 /// (`a mod 64` and `64 * (a div 64)`) so one power costs one multiplication. Mantissas
@@ -152,19 +210,27 @@ pub(crate) struct PowTable {
 }
 
 impl PowTable {
-    fn new(bases: &[f64], maxpow: usize) -> PowTable {
+    /// Tables for the given bases (in double-double): every power is built in
+    /// double-double arithmetic and rounded once, so that its error does not grow with the
+    /// exponent (rounding the base alone to a double would give `base^a` a relative error
+    /// of up to `a/2` ulps).
+    fn new(bases: &[Dd], maxpow: usize) -> PowTable {
         let nb = bases.len();
         let nhi = maxpow / 64 + 1;
         let mut lo = vec![Ext::ONE; 64 * nb];
         let mut hi = vec![Ext::ONE; nhi * nb];
         for (k, &c) in bases.iter().enumerate() {
-            let ce = Ext::new(c);
+            let ce = Xd::from_dd(c);
+            let mut p = Xd::from_dd(Dd::new(1.0));
             for j in 1..64 {
-                lo[j * nb + k] = lo[(j - 1) * nb + k].mul(ce);
+                p = p.mul(ce);
+                lo[j * nb + k] = p.to_ext();
             }
-            let c64 = lo[63 * nb + k].mul(ce);
+            let c64 = p.mul(ce);
+            let mut p = Xd::from_dd(Dd::new(1.0));
             for j in 1..nhi {
-                hi[j * nb + k] = hi[(j - 1) * nb + k].mul(c64);
+                p = p.mul(c64);
+                hi[j * nb + k] = p.to_ext();
             }
         }
         PowTable {
@@ -204,24 +270,28 @@ pub(crate) struct BetaTables {
 }
 
 impl BetaTables {
-    /// Tables for points given as `(cos(beta/2), sin(beta/2))`, powers up to `maxpow`.
-    pub fn new(points: &[(f64, f64)], maxpow: usize) -> BetaTables {
-        let c: Vec<f64> = points.iter().map(|p| p.0).collect();
-        let s: Vec<f64> = points.iter().map(|p| p.1).collect();
+    /// Tables for points given as `(cos(beta/2), sin(beta/2))` in double-double, powers up
+    /// to `maxpow`. Each table value is the double nearest to its exact value.
+    fn new(points: &[(Dd, Dd)], maxpow: usize) -> BetaTables {
+        let c: Vec<Dd> = points.iter().map(|p| p.0).collect();
+        let s: Vec<Dd> = points.iter().map(|p| p.1).collect();
+        let tau = |x: &Dd| x.mul(*x).mul_f(2.0).to_f64();
         BetaTables {
-            tau_lo: s.iter().map(|s| 2.0 * s * s).collect(),
-            tau_hi: c.iter().map(|c| 2.0 * c * c).collect(),
+            tau_lo: s.iter().map(tau).collect(),
+            tau_hi: c.iter().map(tau).collect(),
             cpow: PowTable::new(&c, maxpow),
             spow: PowTable::new(&s, maxpow),
         }
     }
 
-    /// Tables for the `2B` grid betas of bandwidth `b`.
+    /// Tables for the `2B` grid betas of bandwidth `b`: `beta_k / 2 = pi (2k+1) / (8B)`,
+    /// its cosine and sine in double-double.
     pub fn grid(b: usize) -> BetaTables {
-        let pts: Vec<(f64, f64)> = (0..2 * b)
+        let pts: Vec<(Dd, Dd)> = (0..2 * b)
             .map(|k| {
-                let bk = crate::grid::beta(b, k);
-                ((bk / 2.0).cos(), (bk / 2.0).sin())
+                let x = PI_DD.mul_f((2 * k + 1) as f64).div(Dd::new((8 * b) as f64));
+                let (s, c) = sin_cos_dd(x);
+                (c, s)
             })
             .collect();
         BetaTables::new(&pts, 2 * b)
@@ -642,6 +712,24 @@ impl Dd {
         Dd::fast_sum(p.hi, self.hi.mul_add(b.lo, self.lo.mul_add(b.hi, p.lo)))
     }
 
+    /// `self + b` (two-sum of the high parts: any magnitudes).
+    #[cfg(test)]
+    fn add_dd(self, b: Dd) -> Dd {
+        self.sub(Dd {
+            hi: -b.hi,
+            lo: -b.lo,
+        })
+    }
+
+    /// `self - b` (two-sum of the high parts: any magnitudes).
+    #[inline(always)]
+    fn sub(self, b: Dd) -> Dd {
+        let s = self.hi - b.hi;
+        let bb = s - self.hi;
+        let err = (self.hi - (s - bb)) - (b.hi + bb);
+        Dd::fast_sum(s, err + (self.lo - b.lo))
+    }
+
     #[inline(always)]
     fn div(self, b: Dd) -> Dd {
         let q1 = self.hi / b.hi;
@@ -726,10 +814,15 @@ pub(crate) fn wigner_d_column_isa(
         return Vec::new();
     }
     // pi - beta for reversed members, without rounding: swap the half-angle cos and sin.
-    let (c, s) = ((beta / 2.0).cos(), (beta / 2.0).sin());
+    // (`beta / 2` is exact; outside [0, pi] the half-angle functions take their signs.)
+    let (s, c) = if (0.0..=std::f64::consts::PI).contains(&beta) {
+        sin_cos_dd(Dd::new(beta / 2.0))
+    } else {
+        (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
+    };
     let pt = if mem.reversed { (s, c) } else { (c, s) };
     let bt = BetaTables::new(&[pt], 2 * bm);
-    let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
+    let norm = start_norm(bm, bmp);
     let rt = RecTables::new(lmax + 1);
     let col = crate::dwt::column(isa, &bt, &rt, 0, bm, bmp, norm, lmax + 1);
     col.iter()
@@ -748,7 +841,7 @@ pub fn dt_on_grid(b: usize, m: isize, mp: isize) -> Vec<f64> {
     assert!(bm < b, "order ({m},{mp}) out of range for bandwidth {b}");
     let n = 2 * b;
     let bt = BetaTables::grid(b);
-    let norm = start_norms(bm + 1)[bm * (bm + 1) / 2 + bmp];
+    let norm = start_norm(bm, bmp);
     let rt = RecTables::new(b);
     let isa = Isa::detect();
     let rows = b - bm;
@@ -822,6 +915,27 @@ mod tests {
             checked.iter().all(|&c| c >= 20),
             "too few exact checks: {checked:?}"
         );
+    }
+
+    /// Time of the plan's tables at large bandwidths.
+    #[test]
+    #[ignore]
+    fn table_build_speed() {
+        for b in [512usize, 2048] {
+            let t = std::time::Instant::now();
+            let n = start_norms(b);
+            let t1 = t.elapsed().as_secs_f64();
+            let bt = BetaTables::grid(b);
+            let t2 = t.elapsed().as_secs_f64();
+            let rt = RecTables::new(b);
+            let t3 = t.elapsed().as_secs_f64();
+            std::hint::black_box((&n, &bt, &rt));
+            println!(
+                "B = {b}: start_norms {t1:.3} s, BetaTables {:.3} s, RecTables {:.3} s",
+                t2 - t1,
+                t3 - t2
+            );
+        }
     }
 
     /// Time of the coefficients of every cluster at B = 256 (one chunk's worth).
@@ -912,22 +1026,56 @@ mod tests {
     }
 
     #[test]
-    fn ext_handles_huge_and_tiny() {
+    fn extended_double_double_handles_huge_and_tiny() {
         // 2^-3000 * 2^2000 = 2^-1000
-        let a = Ext {
-            mant: 0.5,
-            exp: -2999,
-        };
-        let b = Ext {
-            mant: 0.5,
-            exp: 2001,
-        };
-        let p = a.mul(b);
+        let a = Xd::from_dd(Dd::new(0.5)).shift(-2999);
+        let b = Xd::from_dd(Dd::new(0.5)).shift(2001);
+        let p = a.mul(b).to_ext();
         assert_eq!(ldexp(p.mant, p.exp), ldexp(1.0, -1000));
-        let s = Ext { mant: 0.5, exp: 3 }.sqrt(); // sqrt(4) = 2
+        let s = Xd::from_dd(Dd::new(0.5)).shift(3).sqrt().to_ext(); // sqrt(4) = 2
         assert_eq!(ldexp(s.mant, s.exp), 2.0);
-        let s = Ext { mant: 0.5, exp: 4 }.sqrt(); // sqrt(8)
-        assert!((ldexp(s.mant, s.exp) - 8f64.sqrt()).abs() < 1e-15);
+        let s = Xd::from_dd(Dd::new(0.5)).shift(4).sqrt().to_ext(); // sqrt(8)
+        assert_eq!(ldexp(s.mant, s.exp), 8f64.sqrt());
+        let s = Xd::from_dd(Dd::new(0.5)).shift(-2001).sqrt().to_ext(); // sqrt(2^-2002)
+        assert_eq!((s.mant, s.exp), (0.5, -1000));
+    }
+
+    /// Double-double sine and cosine at angles with known values, to far below a double
+    /// ulp.
+    #[test]
+    fn sin_cos_dd_known_values() {
+        let at = |num: f64, den: f64| sin_cos_dd(PI_DD.mul_f(num).div(Dd::new(den)));
+        let close = |x: Dd, want: f64| (x.sub(Dd::new(want)).to_f64()).abs() < 1e-30;
+        let (s, c) = at(1.0, 6.0);
+        assert!(close(s, 0.5) && close(c.mul(c), 0.75), "pi/6: {s:?} {c:?}");
+        let (s, c) = at(1.0, 4.0);
+        assert!(close(s.mul(s), 0.5) && close(c.mul(c), 0.5), "pi/4");
+        let (s, c) = at(1.0, 2.0);
+        assert!(close(s, 1.0) && c.to_f64().abs() < 1e-30, "pi/2: {c:?}");
+        let (s, c) = at(0.0, 1.0);
+        assert!(close(s, 0.0) && close(c, 1.0));
+        for k in 0..50 {
+            let (s, c) = at((2 * k + 1) as f64, 200.0);
+            assert!(close(s.mul(s).add_dd(c.mul(c)), 1.0), "k={k}");
+        }
+    }
+
+    /// The starting-value norms are the nearest doubles to their exact values.
+    #[test]
+    fn start_norms_are_correctly_rounded() {
+        let norms = start_norms(31);
+        for m in 0..31u128 {
+            for mp in 0..=m {
+                // norm^2 = (2m+1) binom(2m, m-m') / 2
+                let j = m - mp;
+                let bin = (1..=j).fold(1u128, |b, i| b * (2 * m - i + 1) / i);
+                let e = norms[(m * (m + 1) / 2 + mp) as usize];
+                assert_eq!(e, start_norm(m as usize, mp as usize));
+                let x = ldexp(e.mant, e.exp);
+                let ok = tests::is_rounded_sqrt(x, (2 * m + 1) * bin, 2);
+                assert_eq!(ok, Some(true), "m={m} mp={mp}: {x:e}");
+            }
+        }
     }
 
     #[test]
