@@ -39,15 +39,38 @@ pub fn gamma(b: usize, j: usize) -> f64 {
 ///
 /// They integrate band-limited functions against `sin(beta) dbeta` exactly.
 pub fn weights(b: usize) -> Vec<f64> {
+    use crate::wigner::{sin_cos_dd, Dd, PI_DD};
+    // sin(pi j / (4B)) for j = 0..8B in double-double: every angle of the sums is such a
+    // multiple of pi / (4B), `(2i+1) beta_k = pi (2i+1)(2k+1) / (4B)`, reduced exactly
+    // in integers; forming it in doubles instead would put an error of up to
+    // `(2i+1) ulp(beta_k)` into the argument.
+    let n = 8 * b;
+    let quarter: Vec<Dd> = (0..=2 * b)
+        .map(|j| sin_cos_dd(PI_DD.mul_f(j as f64).div(Dd::new((4 * b) as f64))).0)
+        .collect();
+    // sin(pi j / (4B)) from the first quadrant.
+    let sin_at = |j: usize| {
+        let j = j % n;
+        let (half, r) = (j / (4 * b), j % (4 * b));
+        let v = quarter[if r <= 2 * b { r } else { 4 * b - r }];
+        if half == 0 {
+            v
+        } else {
+            Dd::new(0.0).sub(v)
+        }
+    };
     (0..2 * b)
         .map(|k| {
-            let bk = beta(b, k);
-            // Sum small terms first for accuracy.
-            let s: f64 = (0..b)
-                .rev()
-                .map(|i| ((2 * i + 1) as f64 * bk).sin() / (2 * i + 1) as f64)
-                .sum();
-            2.0 / b as f64 * bk.sin() * s
+            // Small terms first.
+            let s = (0..b).rev().fold(Dd::new(0.0), |acc, i| {
+                let t = sin_at((2 * i + 1) * (2 * k + 1)).div(Dd::new((2 * i + 1) as f64));
+                acc.add_dd(t)
+            });
+            sin_at(2 * k + 1)
+                .mul(s)
+                .mul_f(2.0)
+                .div(Dd::new(b as f64))
+                .to_f64()
         })
         .collect()
 }

@@ -178,7 +178,7 @@ impl Xd {
 }
 
 /// `(sin x, cos x)` in double-double for `0 <= x <= pi/2` (Taylor series in `x^2`).
-fn sin_cos_dd(x: Dd) -> (Dd, Dd) {
+pub(crate) fn sin_cos_dd(x: Dd) -> (Dd, Dd) {
     let x2 = x.mul(x);
     // Horner from the term of x^40 (below 1e-38 of the sum here) down.
     let (mut s, mut c) = (Dd::new(1.0), Dd::new(1.0));
@@ -191,7 +191,7 @@ fn sin_cos_dd(x: Dd) -> (Dd, Dd) {
 }
 
 /// `pi` in double-double.
-const PI_DD: Dd = Dd {
+pub(crate) const PI_DD: Dd = Dd {
     hi: std::f64::consts::PI,
     lo: 1.2246467991473532e-16,
 };
@@ -661,14 +661,14 @@ impl RecTables {
 /// Double-double number `hi + lo` (`|lo| <= ulp(hi) / 2`): about 106 bits, enough to
 /// round the recurrence coefficients to the nearest double.
 #[derive(Clone, Copy, Debug)]
-struct Dd {
-    hi: f64,
-    lo: f64,
+pub(crate) struct Dd {
+    pub hi: f64,
+    pub lo: f64,
 }
 
 impl Dd {
     #[inline(always)]
-    fn new(x: f64) -> Dd {
+    pub fn new(x: f64) -> Dd {
         Dd { hi: x, lo: 0.0 }
     }
 
@@ -701,20 +701,19 @@ impl Dd {
     }
 
     #[inline(always)]
-    fn mul_f(self, b: f64) -> Dd {
+    pub fn mul_f(self, b: f64) -> Dd {
         let p = Dd::prod(self.hi, b);
         Dd::fast_sum(p.hi, self.lo.mul_add(b, p.lo))
     }
 
     #[inline(always)]
-    fn mul(self, b: Dd) -> Dd {
+    pub fn mul(self, b: Dd) -> Dd {
         let p = Dd::prod(self.hi, b.hi);
         Dd::fast_sum(p.hi, self.hi.mul_add(b.lo, self.lo.mul_add(b.hi, p.lo)))
     }
 
     /// `self + b` (two-sum of the high parts: any magnitudes).
-    #[cfg(test)]
-    fn add_dd(self, b: Dd) -> Dd {
+    pub fn add_dd(self, b: Dd) -> Dd {
         self.sub(Dd {
             hi: -b.hi,
             lo: -b.lo,
@@ -723,7 +722,7 @@ impl Dd {
 
     /// `self - b` (two-sum of the high parts: any magnitudes).
     #[inline(always)]
-    fn sub(self, b: Dd) -> Dd {
+    pub fn sub(self, b: Dd) -> Dd {
         let s = self.hi - b.hi;
         let bb = s - self.hi;
         let err = (self.hi - (s - bb)) - (b.hi + bb);
@@ -731,7 +730,7 @@ impl Dd {
     }
 
     #[inline(always)]
-    fn div(self, b: Dd) -> Dd {
+    pub fn div(self, b: Dd) -> Dd {
         let q1 = self.hi / b.hi;
         // The remainder `self - q1 b`; its high part cancels exactly.
         let p = b.mul_f(q1);
@@ -752,7 +751,7 @@ impl Dd {
 
     /// The nearest double.
     #[inline(always)]
-    fn to_f64(self) -> f64 {
+    pub fn to_f64(self) -> f64 {
         self.hi + self.lo
     }
 }
@@ -929,11 +928,15 @@ mod tests {
             let t2 = t.elapsed().as_secs_f64();
             let rt = RecTables::new(b);
             let t3 = t.elapsed().as_secs_f64();
-            std::hint::black_box((&n, &bt, &rt));
+            let w = crate::grid::weights(b);
+            let t4 = t.elapsed().as_secs_f64();
+            std::hint::black_box((&n, &bt, &rt, &w));
             println!(
-                "B = {b}: start_norms {t1:.3} s, BetaTables {:.3} s, RecTables {:.3} s",
+                "B = {b}: start_norms {t1:.3} s, BetaTables {:.3} s, RecTables {:.3} s, \
+                 weights {:.3} s",
                 t2 - t1,
-                t3 - t2
+                t3 - t2,
+                t4 - t3
             );
         }
     }
