@@ -429,7 +429,9 @@ unsafe fn starts_avx512(
 /// double-double multiplications per degree (no square root per cluster), so that every
 /// coefficient the kernels use is the double nearest to its exact value (to within a few
 /// units in the 30th decimal place). At B = 256 the coefficients of all clusters take
-/// about 9 ms per chunk (`coeffs_speed` test), 1-2% of the DWT stage.
+/// about 8 ms per chunk (`coeffs_speed` test; 5 ms for the earlier products of rounded
+/// values): about 4% of the forward's DWT stage with its 5 chunks, less for the inverse,
+/// which computes them once per group of chunks.
 ///
 /// Correct rounding matters: with the coefficients formed by products of rounded table
 /// values (3-5 roundings each), the mean maximum round-trip error over 40 seeds was 74%
@@ -444,8 +446,13 @@ pub(crate) struct RecTables {
     gb: DdVec,
     /// `1 / (l(l+1))` (0 at `l = 0`).
     k3: DdVec,
-    /// Hardware FMA available (the double-double products need fused multiply-adds; without
-    /// them `f64::mul_add` is a library call, equally exact but slow).
+    /// `l(l+1)` (a table, so that the coefficient loop converts no integers and vectorises).
+    ll: Vec<f64>,
+    /// Row of order `m` in `ga` and `gb` (`usize::MAX`: not tabulated).
+    row: Vec<usize>,
+    /// x86-64 with FMA and AVX2: the coefficients are computed in a function compiled for
+    /// them (the double-double products need fused multiply-adds; without the feature
+    /// `f64::mul_add` is a library call there, equally exact but slow).
     fma: bool,
 }
 
@@ -483,24 +490,40 @@ fn fma_available() -> bool {
 impl RecTables {
     /// Tables for degrees up to `lmax` (coefficients for `l <= lmax`).
     pub fn new(lmax: usize) -> RecTables {
+        let orders: Vec<usize> = (0..=lmax).collect();
+        Self::for_orders(lmax, &orders)
+    }
+
+    /// Tables for degrees up to `lmax` holding only the rows of the orders `orders`
+    /// (`O(lmax)` per order): enough for the base pairs made of them.
+    pub fn for_orders(lmax: usize, orders: &[usize]) -> RecTables {
         let fma = fma_available();
         #[cfg(target_arch = "x86_64")]
         if fma {
             // SAFETY: FMA and AVX2 are available.
-            return unsafe { Self::new_fma(lmax) };
+            return unsafe { Self::new_fma(lmax, orders) };
         }
-        Self::new_body(lmax, fma)
+        Self::new_body(lmax, orders, fma)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
-    unsafe fn new_fma(lmax: usize) -> RecTables {
-        Self::new_body(lmax, true)
+    unsafe fn new_fma(lmax: usize, orders: &[usize]) -> RecTables {
+        Self::new_body(lmax, orders, true)
     }
 
     #[inline(always)]
-    fn new_body(lmax: usize, fma: bool) -> RecTables {
+    fn new_body(lmax: usize, orders: &[usize], fma: bool) -> RecTables {
         let stride = lmax + 2;
+        let mut row = vec![usize::MAX; lmax + 1];
+        let mut ms = Vec::new();
+        for &m in orders {
+            assert!(m <= lmax, "order {m} above lmax {lmax}");
+            if row[m] == usize::MAX {
+                row[m] = ms.len();
+                ms.push(m);
+            }
+        }
         // `l^2 - m^2` and `(l+1)^2 - m^2` are exact integers in a double (l < 2^26).
         let sq = |k: usize| (k * k) as f64;
         let k1 = |l: usize| {
@@ -515,16 +538,16 @@ impl RecTables {
                 .mul_f(l + 1.0)
                 .div(Dd::new(l))
         };
-        let ga = DdVec::from_fn((lmax + 1) * stride, |k| {
-            let (m, l) = (k / stride, k % stride);
+        let ga = DdVec::from_fn(ms.len() * stride, |k| {
+            let (m, l) = (ms[k / stride], k % stride);
             if l >= m && l <= lmax {
                 k1(l).div(Dd::new(sq(l + 1) - sq(m))).sqrt()
             } else {
                 Dd::new(0.0)
             }
         });
-        let gb = DdVec::from_fn((lmax + 1) * stride, |k| {
-            let (m, l) = (k / stride, k % stride);
+        let gb = DdVec::from_fn(ms.len() * stride, |k| {
+            let (m, l) = (ms[k / stride], k % stride);
             if l >= m && l <= lmax && l > 0 {
                 k2(l)
                     .mul_f(sq(l) - sq(m))
@@ -547,6 +570,8 @@ impl RecTables {
             ga,
             gb,
             k3,
+            ll: (0..=lmax).map(|l| (l * (l + 1)) as f64).collect(),
+            row,
             fma,
         }
     }
@@ -581,6 +606,10 @@ impl RecTables {
             "coefficient arrays of unequal length"
         );
         assert!(m + n < self.stride && mp <= m);
+        assert!(
+            self.row[m] != usize::MAX && self.row[mp] != usize::MAX,
+            "orders ({m}, {mp}) not tabulated"
+        );
         #[cfg(target_arch = "x86_64")]
         if self.fma {
             // SAFETY: `new` found FMA and AVX2.
@@ -606,10 +635,12 @@ impl RecTables {
         // Table runs for `l = m .. m + n`, as slices of length `n` so that the loops below
         // have no bounds checks and vectorise.
         let (k3h, k3l) = self.k3.run(m, n);
-        let (amh, aml) = self.ga.run(m * st + m, n);
-        let (aph, apl) = self.ga.run(mp * st + m, n);
-        let (bmh, bml) = self.gb.run(m * st + m, n);
-        let (bph, bpl) = self.gb.run(mp * st + m, n);
+        let (rm, rp) = (self.row[m] * st, self.row[mp] * st);
+        let (amh, aml) = self.ga.run(rm + m, n);
+        let (aph, apl) = self.ga.run(rp + m, n);
+        let (bmh, bml) = self.gb.run(rm + m, n);
+        let (bph, bpl) = self.gb.run(rp + m, n);
+        let llv = &self.ll[m..m + n];
         let dd = |h: &[f64], l: &[f64], i: usize| Dd { hi: h[i], lo: l[i] };
         // `Bc` rounded (into `r.e` for now), then the scales `S_i`.
         let bc = &mut r.e[..n];
@@ -636,8 +667,7 @@ impl RecTables {
                 let a = dd(amh, aml, i).mul(dd(aph, apl, i)).mul(f);
                 // `A + C = A (ll - mm) / ll`, `C - A = -A (ll + mm) / ll`: exact integers
                 // times `1 / ll`, no cancellation.
-                let l = (m + i) as f64;
-                let ll = l * (l + 1.0);
+                let ll = llv[i];
                 let d = a.mul(dd(k3h, k3l, i).mul_f(ll - mm));
                 ra[i] = a.to_f64();
                 ran[i] = -ra[i];
@@ -712,7 +742,8 @@ impl Dd {
         Dd::fast_sum(p.hi, self.hi.mul_add(b.lo, self.lo.mul_add(b.hi, p.lo)))
     }
 
-    /// `self + b` (two-sum of the high parts: any magnitudes).
+    /// `self + b` (two-sum of the high parts, so any order of the magnitudes; where the
+    /// high parts cancel, the result keeps the absolute, not the relative, accuracy).
     pub fn add_dd(self, b: Dd) -> Dd {
         self.sub(Dd {
             hi: -b.hi,
@@ -720,7 +751,7 @@ impl Dd {
         })
     }
 
-    /// `self - b` (two-sum of the high parts: any magnitudes).
+    /// `self - b` (as [`Dd::add_dd`]).
     #[inline(always)]
     pub fn sub(self, b: Dd) -> Dd {
         let s = self.hi - b.hi;
@@ -822,7 +853,7 @@ pub(crate) fn wigner_d_column_isa(
     let pt = if mem.reversed { (s, c) } else { (c, s) };
     let bt = BetaTables::new(&[pt], 2 * bm);
     let norm = start_norm(bm, bmp);
-    let rt = RecTables::new(lmax + 1);
+    let rt = RecTables::for_orders(lmax + 1, &[bm, bmp]);
     let col = crate::dwt::column(isa, &bt, &rt, 0, bm, bmp, norm, lmax + 1);
     col.iter()
         .enumerate()
@@ -865,12 +896,18 @@ mod tests {
         let bits = x.to_bits();
         let e = ((bits >> 52) & 0x7ff) as i64 - 1075;
         let m = ((bits & ((1 << 52) - 1)) | (1 << 52)) as u128;
-        // x -+ ulp/2 = (2m -+ 1) 2^(e-1); squared, times 2^k with k = 2 - 2e.
+        // x + ulp/2 = (2m + 1) 2^(e-1); squared, times 2^k with k = 2 - 2e. Below a power
+        // of two the gap to the next double is half as large: x - ulp/4 = (4m - 1) 2^(e-2).
         let k = u32::try_from(2 - 2 * e).ok()?;
         let mid = n.checked_mul(1u128.checked_shl(k)?)?;
-        let lo = (2 * m - 1).checked_pow(2)?.checked_mul(d)?;
         let hi = (2 * m + 1).checked_pow(2)?.checked_mul(d)?;
-        Some(lo <= mid && mid <= hi)
+        let lo_ok = if m == 1 << 52 {
+            let mid4 = n.checked_mul(1u128.checked_shl(k + 2)?)?;
+            (4 * m - 1).checked_pow(2)?.checked_mul(d)? <= mid4
+        } else {
+            (2 * m - 1).checked_pow(2)?.checked_mul(d)? <= mid
+        };
+        Some(lo_ok && mid <= hi)
     }
 
     /// The first coefficients of each base pair (where the scale is 1) against their
@@ -1060,6 +1097,33 @@ mod tests {
         for k in 0..50 {
             let (s, c) = at((2 * k + 1) as f64, 200.0);
             assert!(close(s.mul(s).add_dd(c.mul(c)), 1.0), "k={k}");
+        }
+    }
+
+    /// Power tables at `beta = pi/2`, where `cos(beta/2) = sin(beta/2) = sqrt(2)/2`: even
+    /// powers are exact powers of two and odd ones `sqrt(2)/2` (rounded once) times a
+    /// power of two, however high the exponent. Powers of the base rounded to a double,
+    /// or products that drop the low parts, drift by up to `a/2` ulps.
+    #[test]
+    fn power_tables_are_correctly_rounded() {
+        let (s, c) = sin_cos_dd(PI_DD.div(Dd::new(4.0)));
+        let maxpow = 1000;
+        let bt = BetaTables::new(&[(c, s)], maxpow);
+        let half_sqrt2 = std::f64::consts::FRAC_1_SQRT_2;
+        for t in [&bt.cpow, &bt.spow] {
+            let value = |m: f64, e: f64| ldexp(m, e as i64);
+            for a in 0..64usize {
+                let want = if a % 2 == 0 {
+                    ldexp(1.0, -(a as i64 / 2))
+                } else {
+                    ldexp(half_sqrt2, -(a as i64 / 2))
+                };
+                assert_eq!(value(t.lo_m[a], t.lo_e[a]), want, "a={a}");
+            }
+            for j in 0..=maxpow / 64 {
+                let want = ldexp(1.0, -32 * j as i64);
+                assert_eq!(value(t.hi_m[j], t.hi_e[j]), want, "a={}", 64 * j);
+            }
         }
     }
 
