@@ -56,14 +56,18 @@ pub fn weights(b: usize) -> Vec<f64> {
         if half == 0 {
             v
         } else {
-            Dd::new(0.0).sub(v)
+            v.neg()
         }
     };
+    // 1 / (2i + 1), shared by every beta.
+    let inv_odd: Vec<Dd> = (0..b)
+        .map(|i| Dd::new(1.0).div(Dd::new((2 * i + 1) as f64)))
+        .collect();
     (0..2 * b)
         .map(|k| {
             // Small terms first.
             let s = (0..b).rev().fold(Dd::new(0.0), |acc, i| {
-                let t = sin_at((2 * i + 1) * (2 * k + 1)).div(Dd::new((2 * i + 1) as f64));
+                let t = sin_at((2 * i + 1) * (2 * k + 1)).mul(inv_odd[i]);
                 acc.add_dd(t)
             });
             sin_at(2 * k + 1)

@@ -96,16 +96,12 @@ impl Ext {
 pub(crate) fn start_norms(b: usize) -> Vec<Ext> {
     let mut out = vec![Ext::ONE; b * (b + 1) / 2];
     for m in 0..b {
-        // binom(2m, j) for j = m - m' = 0..m, built up by the ratio (2m-j+1)/j.
-        let mut bin = Xd::from_dd(Dd::new(1.0));
+        let mut bin = Xd::ONE;
         for j in 0..=m {
             if j > 0 {
-                bin = Xd::from_dd(bin.m.mul_f((2 * m - j + 1) as f64).div(Dd::new(j as f64)))
-                    .shift(bin.e);
+                bin = binom_step(bin, m, j);
             }
-            let mp = m - j;
-            let v = Xd::from_dd(bin.m.mul_f((2 * m + 1) as f64)).shift(bin.e - 1);
-            out[m * (m + 1) / 2 + mp] = v.sqrt().to_ext();
+            out[m * (m + 1) / 2 + m - j] = norm_from_binom(bin, m);
         }
     }
     out
@@ -114,10 +110,17 @@ pub(crate) fn start_norms(b: usize) -> Vec<Ext> {
 /// One entry of [`start_norms`]: `sqrt((2m+1)/2 * binom(2m, m-m'))` for `m' <= m`.
 pub(crate) fn start_norm(m: usize, mp: usize) -> Ext {
     assert!(mp <= m);
-    let mut bin = Xd::from_dd(Dd::new(1.0));
-    for j in 1..=m - mp {
-        bin = Xd::from_dd(bin.m.mul_f((2 * m - j + 1) as f64).div(Dd::new(j as f64))).shift(bin.e);
-    }
+    let bin = (1..=m - mp).fold(Xd::ONE, |bin, j| binom_step(bin, m, j));
+    norm_from_binom(bin, m)
+}
+
+/// `binom(2m, j)` from `binom(2m, j - 1)`: times `(2m - j + 1) / j`.
+fn binom_step(bin: Xd, m: usize, j: usize) -> Xd {
+    Xd::from_dd(bin.m.mul_f((2 * m - j + 1) as f64).div(Dd::new(j as f64))).shift(bin.e)
+}
+
+/// `sqrt((2m+1)/2 * bin)`, rounded once.
+fn norm_from_binom(bin: Xd, m: usize) -> Ext {
     Xd::from_dd(bin.m.mul_f((2 * m + 1) as f64))
         .shift(bin.e - 1)
         .sqrt()
@@ -134,6 +137,11 @@ struct Xd {
 }
 
 impl Xd {
+    const ONE: Xd = Xd {
+        m: Dd { hi: 0.5, lo: 0.0 },
+        e: 1,
+    };
+
     fn from_dd(d: Dd) -> Xd {
         let (hi, e) = frexp(d.hi);
         Xd {
@@ -221,13 +229,13 @@ impl PowTable {
         let mut hi = vec![Ext::ONE; nhi * nb];
         for (k, &c) in bases.iter().enumerate() {
             let ce = Xd::from_dd(c);
-            let mut p = Xd::from_dd(Dd::new(1.0));
+            let mut p = Xd::ONE;
             for j in 1..64 {
                 p = p.mul(ce);
                 lo[j * nb + k] = p.to_ext();
             }
             let c64 = p.mul(ce);
-            let mut p = Xd::from_dd(Dd::new(1.0));
+            let mut p = Xd::ONE;
             for j in 1..nhi {
                 p = p.mul(c64);
                 hi[j * nb + k] = p.to_ext();
@@ -742,13 +750,18 @@ impl Dd {
         Dd::fast_sum(p.hi, self.hi.mul_add(b.lo, self.lo.mul_add(b.hi, p.lo)))
     }
 
+    /// `-self`.
+    pub fn neg(self) -> Dd {
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+
     /// `self + b` (two-sum of the high parts, so any order of the magnitudes; where the
     /// high parts cancel, the result keeps the absolute, not the relative, accuracy).
     pub fn add_dd(self, b: Dd) -> Dd {
-        self.sub(Dd {
-            hi: -b.hi,
-            lo: -b.lo,
-        })
+        self.sub(b.neg())
     }
 
     /// `self - b` (as [`Dd::add_dd`]).
