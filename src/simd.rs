@@ -89,6 +89,12 @@ pub(crate) trait Simd: Copy {
     /// Transpose the `W x W` block `v` (vector `j`, lane `w`) in registers: afterwards
     /// vector `w` holds lane `w` of every former vector.
     unsafe fn transpose(v: &mut [Self::V]);
+    /// `[p[0], p[1]]` repeated in every pair of lanes (`W >= 2` only).
+    unsafe fn splat2(p: *const f64) -> Self::V;
+    /// The even lanes of `a` and `b` interleaved, `[a0, b0, a2, b2, ...]` (`W >= 2` only).
+    unsafe fn unpack_even(a: Self::V, b: Self::V) -> Self::V;
+    /// The odd lanes of `a` and `b` interleaved, `[a1, b1, a3, b3, ...]` (`W >= 2` only).
+    unsafe fn unpack_odd(a: Self::V, b: Self::V) -> Self::V;
     /// Store `v` at `p` without reading the cache line first (a non-temporal store) where
     /// `p` is aligned to the vector size, else an ordinary store. Callers end a run of these
     /// with [`sfence`].
@@ -191,6 +197,16 @@ impl Simd for Scalar {
     }
     #[inline(always)]
     unsafe fn transpose(_v: &mut [f64]) {}
+    // One lane has no pairs: the kernels never pair betas with `W = 1`.
+    unsafe fn splat2(_p: *const f64) -> f64 {
+        unreachable!("no lane pairs with W = 1")
+    }
+    unsafe fn unpack_even(_a: f64, _b: f64) -> f64 {
+        unreachable!("no lane pairs with W = 1")
+    }
+    unsafe fn unpack_odd(_a: f64, _b: f64) -> f64 {
+        unreachable!("no lane pairs with W = 1")
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -267,6 +283,19 @@ mod x86 {
         #[inline(always)]
         unsafe fn max(a: __m512d, b: __m512d) -> __m512d {
             _mm512_max_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn splat2(p: *const f64) -> __m512d {
+            // vbroadcastf32x4 moves the same 128 bits and needs only AVX-512F (f64x2 is DQ).
+            _mm512_castps_pd(_mm512_broadcast_f32x4(_mm_castpd_ps(_mm_loadu_pd(p))))
+        }
+        #[inline(always)]
+        unsafe fn unpack_even(a: __m512d, b: __m512d) -> __m512d {
+            _mm512_unpacklo_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn unpack_odd(a: __m512d, b: __m512d) -> __m512d {
+            _mm512_unpackhi_pd(a, b)
         }
         #[inline(always)]
         unsafe fn transpose(v: &mut [__m512d]) {
@@ -373,6 +402,18 @@ mod x86 {
             _mm256_max_pd(a, b)
         }
         #[inline(always)]
+        unsafe fn splat2(p: *const f64) -> __m256d {
+            _mm256_broadcast_pd(&_mm_loadu_pd(p))
+        }
+        #[inline(always)]
+        unsafe fn unpack_even(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_unpacklo_pd(a, b)
+        }
+        #[inline(always)]
+        unsafe fn unpack_odd(a: __m256d, b: __m256d) -> __m256d {
+            _mm256_unpackhi_pd(a, b)
+        }
+        #[inline(always)]
         unsafe fn transpose(v: &mut [__m256d]) {
             let t0 = _mm256_unpacklo_pd(v[0], v[1]); // v0[0] v1[0] v0[2] v1[2]
             let t1 = _mm256_unpackhi_pd(v[0], v[1]); // v0[1] v1[1] v0[3] v1[3]
@@ -382,6 +423,41 @@ mod x86 {
             v[1] = _mm256_permute2f128_pd::<0x20>(t1, t3);
             v[2] = _mm256_permute2f128_pd::<0x31>(t0, t2);
             v[3] = _mm256_permute2f128_pd::<0x31>(t1, t3);
+        }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+
+    /// `splat2`, `unpack_even` and `unpack_odd` against their definitions, lane by lane.
+    fn pair_ops<S: Simd, const W: usize>() {
+        let a: Vec<f64> = (0..W).map(|k| 1.0 + k as f64).collect();
+        let b: Vec<f64> = (0..W).map(|k| -10.0 - k as f64).collect();
+        let mut out = [[0.0; W]; 3];
+        // SAFETY: callers check the instruction set; every pointer covers W doubles.
+        unsafe {
+            let (va, vb) = (S::load(a.as_ptr()), S::load(b.as_ptr()));
+            S::store(out[0].as_mut_ptr(), S::splat2(a[2..].as_ptr()));
+            S::store(out[1].as_mut_ptr(), S::unpack_even(va, vb));
+            S::store(out[2].as_mut_ptr(), S::unpack_odd(va, vb));
+        }
+        for k in 0..W {
+            assert_eq!(out[0][k], a[2 + k % 2]);
+            let (src, lane) = (if k % 2 == 0 { &a } else { &b }, k - k % 2);
+            assert_eq!(out[1][k], src[lane]);
+            assert_eq!(out[2][k], src[lane + 1]);
+        }
+    }
+
+    #[test]
+    fn pair_operations() {
+        if Isa::Avx512.is_supported() {
+            pair_ops::<Avx512, 8>();
+        }
+        if Isa::Avx2.is_supported() {
+            pair_ops::<Avx2, 4>();
         }
     }
 }
