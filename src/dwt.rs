@@ -544,8 +544,25 @@ unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
     S::add(S::unpack_even(a, b), S::unpack_odd(a, b))
 }
 
-/// All `W` lanes of a stored d block: [`beta_fmas`] per lane, or [`pair_fmas`] per pair of
-/// lanes. `x` is lane 0's data row, `xs` the stride between rows.
+/// Lane `w`'s share of the multiply-adds of a stored d block: [`beta_fmas`], or with
+/// paired betas [`pair_fmas`] for lanes `w - 1` and `w` at each odd `w` (nothing at even
+/// `w`). `x` is lane 0's data row, `xs` the stride between rows.
+#[inline(always)]
+unsafe fn lane_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
+    acc: &mut [S::V; ACC],
+    db: *const f64,
+    w: usize,
+    x: *const f64,
+    xs: usize,
+) {
+    if !paired(W, P) {
+        beta_fmas::<S, W, P, DB>(acc, db, w, x.add(w * xs));
+    } else if w % 2 == 1 {
+        pair_fmas::<S, W, DB>(acc, db, w - 1, x.add((w - 1) * xs), x.add(w * xs));
+    }
+}
+
+/// All `W` lanes of a stored d block ([`lane_fmas`]).
 #[inline(always)]
 unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
@@ -553,14 +570,10 @@ unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     x: *const f64,
     xs: usize,
 ) {
-    if paired(W, P) {
-        for w in (0..W).step_by(2) {
-            pair_fmas::<S, W, DB>(acc, db, w, x.add(w * xs), x.add((w + 1) * xs));
-        }
-    } else {
-        for w in 0..W {
-            beta_fmas::<S, W, P, DB>(acc, db, w, x.add(w * xs));
-        }
+    // Only the lanes that do work (each pair at its odd lane), so the loop unrolls.
+    let step = if paired(W, P) { 2 } else { 1 };
+    for w in (step - 1..W).step_by(step) {
+        lane_fmas::<S, W, P, DB>(acc, db, w, x, xs);
     }
 }
 
@@ -693,13 +706,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                                     let p2 = S::fence(s.step(p0, p1, i0 + k));
                                     (p0, p1) = (p1, p2);
                                 }
-                                if !pair {
-                                    beta_fmas::<S, W, P, DB>(&mut acc, dc, $w, x.add($w * xs));
-                                } else if $w % 2 == 1 {
-                                    let w0 = $w - 1;
-                                    let (x0, x1) = (x.add(w0 * xs), x.add($w * xs));
-                                    pair_fmas::<S, W, DB>(&mut acc, dc, w0, x0, x1);
-                                }
+                                lane_fmas::<S, W, P, DB>(&mut acc, dc, $w, x, xs);
                             }
                         };
                     }
@@ -1140,6 +1147,12 @@ mod tests {
         (rc, tau, p, sc)
     }
 
+    /// `len` values of `buf` from its first 64-byte boundary (as the plan's chunk
+    /// buffers); `buf` holds at least `len + 7`.
+    pub(super) fn aligned(buf: &[f64], len: usize) -> &[f64] {
+        &buf[buf.as_ptr().align_offset(64)..][..len]
+    }
+
     /// Kernel lanes over `cluster_setup`'s arrays, default skip threshold.
     pub(super) fn grid_lanes<'a>(
         tau: &'a [f64],
@@ -1379,7 +1392,7 @@ mod tests {
 
 #[cfg(test)]
 mod kernel_speed {
-    use super::tests::{cluster_setup, grid_lanes};
+    use super::tests::{aligned, cluster_setup, grid_lanes};
     use super::*;
 
     /// FMA peak of one core, GFLOP/s: 16 independent chains of AVX-512 FMAs (AVX2 or
@@ -1440,9 +1453,8 @@ mod kernel_speed {
             let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
             let rec = Rec::new(&rc, n);
             let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
-            // 64-byte aligned rows, as the plan's chunk buffers.
             let xbuf = vec![0.5; nbs * 16 + 8];
-            let xin = &xbuf[xbuf.as_ptr().align_offset(64)..][..nbs * 16];
+            let xin = aligned(&xbuf, nbs * 16);
             let mut f = vec![0.0; (n + 8) * 16];
             let mut y = vec![0.0; nbs * 16];
             let isa = Isa::detect();
@@ -1484,7 +1496,7 @@ mod kernel_speed {
 
 #[cfg(test)]
 mod stage_speed {
-    use super::tests::{cluster_setup, grid_lanes};
+    use super::tests::{aligned, cluster_setup, grid_lanes};
     use super::*;
 
     /// Kernel time summed over every cluster of a bandwidth (all 2B betas as one chunk),
@@ -1499,9 +1511,8 @@ mod stage_speed {
             let mut qt = [0.0f64; 4];
             let mut qtf = [0.0f64; 4];
             let mut qf = [0.0f64; 4];
-            // 64-byte aligned rows, as the plan's chunk buffers.
             let xbuf = vec![0.5; nbs * 16 + 8];
-            let xin = &xbuf[xbuf.as_ptr().align_offset(64)..][..nbs * 16];
+            let xin = aligned(&xbuf, nbs * 16);
             let mut f = vec![0.0; (b + 8) * 16];
             let mut y = vec![0.0; nbs * 16];
             for (m, mp) in crate::symmetry::cluster_pairs(b) {
