@@ -15,11 +15,13 @@
 //! of a vector is active only the recurrence runs (the negligible prefix in `l` is skipped).
 
 use crate::simd::{Isa, Scalar, Simd};
-use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, SKIP_BITS_RANGE, TINY};
+use crate::wigner::{BetaTables, Ext, RecCoeffs, RecTables, REC_PAD, SKIP_BITS_RANGE, TINY};
 use std::mem::MaybeUninit;
 
 /// Recurrence coefficients of one cluster, index `i = l - l0`, for the scaled values
-/// `e_i` of `RecTables::coeffs`: `e_{i+1} = (A'_i x + C'_i) e_i - e_{i-1}`.
+/// `e_i` of `RecTables::coeffs`: `e_{i+1} = (A'_i x + C'_i) e_i - e_{i-1}`. Each slice
+/// holds [`REC_PAD`] finite values past the `n` degrees (what the forward kernel's last
+/// block steps through).
 pub(crate) struct Rec<'a> {
     /// `A'_i`
     pub a: &'a [f64],
@@ -29,21 +31,32 @@ pub(crate) struct Rec<'a> {
     pub d: &'a [f64],
     /// `C'_i - A'_i`
     pub e: &'a [f64],
+    n: usize,
 }
 
 impl<'a> Rec<'a> {
     /// The first `n` degrees of `r`.
     pub fn new(r: &'a RecCoeffs, n: usize) -> Rec<'a> {
+        assert!(n <= r.len());
+        let end = n + REC_PAD;
         Rec {
-            a: &r.a[..n],
-            an: &r.an[..n],
-            d: &r.d[..n],
-            e: &r.e[..n],
+            a: &r.a[..end],
+            an: &r.an[..end],
+            d: &r.d[..end],
+            e: &r.e[..end],
+            n,
         }
     }
 
     fn len(&self) -> usize {
-        self.a.len()
+        self.n
+    }
+
+    /// Whether every slice holds the `n` degrees and the padding.
+    fn padded(&self) -> bool {
+        [self.a, self.an, self.d, self.e]
+            .iter()
+            .all(|v| v.len() == self.n + REC_PAD)
     }
 }
 
@@ -74,9 +87,13 @@ pub(crate) struct Lanes<'a> {
     /// the caches, read back only later; ordinary stores would first read every line).
     pub stream: bool,
     /// Inverse, interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the
-    /// output to the next; row `r` is at `(r / 2) * pair_stride + (r % 2) * P`. 0 means
-    /// `2P`, rows one after another (see `plan/blocks.rs` for the pair-major layout).
+    /// output to the next; row `r` is at `(r / 2) * pair_stride + (r % 2) * row_gap`. 0
+    /// means `2P`, rows one after another.
     pub pair_stride: usize,
+    /// Inverse, with `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`,
+    /// side by side). Far larger in the half-major layout of `plan/blocks.rs`, where the
+    /// low-beta rows and the mirror rows are in two separate halves.
+    pub row_gap: usize,
 }
 
 /// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
@@ -609,6 +626,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     let pv = P / W;
     const {
         assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
+        assert!(DB <= REC_PAD);
         assert!(!paired(W, P) || (2 * DB <= ACC && W.is_multiple_of(2)));
     }
     let pair = paired(W, P);
@@ -661,7 +679,9 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 if s.i >= i0 + DB || s.i >= n {
                     continue;
                 }
-                if s.i == i0 && i0 + DB <= n && s.all_active() {
+                // A last block that ends past `n` runs in full too: its steps read the
+                // zero padding of the coefficients, and its rows from `n` on are scratch.
+                if s.i == i0 && s.all_active() {
                     fast[nf] = v;
                     nf += 1;
                     continue;
@@ -778,6 +798,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     } else {
         lanes.pair_stride
     };
+    let gap = if lanes.row_gap == 0 { P } else { lanes.row_gap };
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
     // Rows `have..n` of `fin` are filled.
@@ -842,7 +863,10 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
             for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
                 // Interleaved rows step by 2: one pair of rows to the next.
                 let (r0, step) = lanes.rows(v0 + (gi + k) * W);
-                let (at, stride) = ((r0 / 2) * ps + (r0 % 2) * P, if step == 2 { ps } else { P });
+                let (at, stride) = (
+                    (r0 / 2) * ps + (r0 % 2) * gap,
+                    if step == 2 { ps } else { P },
+                );
                 for q0 in (0..P).step_by(W) {
                     S::store_transposed(&a[q0..q0 + W], y.add(at + q0), stride, NT);
                 }
@@ -895,7 +919,7 @@ entry!(inv_avx2_8, "avx2,fma", inverse_body, Avx2, 4, 8);
 /// Forward kernel: `ft[i*P + q] = sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]` for `i < n`,
 /// `P` = 8 or 16 (`row` see [`Lanes::interleaved`]): degree-major, the inverse kernel's
 /// input layout; what `ft` held before is ignored. `ft` holds at least `(n + W) * P`
-/// values, `W = isa.lanes()` (rows from `n` on may be written with zeros).
+/// values, `W = isa.lanes()` (rows from `n` on are scratch: the last block of degrees runs in full).
 ///
 /// Returns `lo <= n`: rows `0..lo` are zero because every lane of every beta is still in
 /// its negligible prefix there (see [`Lanes::skip`]). Callers that accumulate the sums
@@ -913,7 +937,7 @@ pub(crate) fn forward(
 ) -> usize {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n);
+    assert!(rec.padded());
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(xin.len() >= nb * p && ft.len() >= (n + isa.lanes()) * p);
     assert!(isa.is_supported());
@@ -953,8 +977,8 @@ pub(crate) fn inverse(
 
 /// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
 /// (the layout of the forward kernel's input, see `plan/blocks.rs`), with row `r` of the
-/// output at `y + r * P`, or, with a nonzero `lanes.pair_stride` (the pair-major layout),
-/// at `y + (r / 2) * lanes.pair_stride + (r % 2) * P`.
+/// output at `y + r * P`, or, with a nonzero `lanes.pair_stride` (the half-major layout),
+/// at `y + (r / 2) * lanes.pair_stride + (r % 2) * lanes.row_gap` (`P` if `row_gap` is 0).
 ///
 /// The input rows are filled on demand: before it reads them, the kernel calls
 /// `fill(fin, from, to)` to fill rows `from..to` (the calls cover the rows from the first
@@ -976,10 +1000,13 @@ pub(crate) unsafe fn inverse_raw(
 ) {
     let n = rec.len();
     let nb = lanes.tau.len();
-    assert!(rec.an.len() == n && rec.d.len() == n && rec.e.len() == n);
+    assert!(rec.padded());
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && isa.is_supported());
-    assert!(lanes.pair_stride == 0 || (lanes.interleaved && lanes.pair_stride >= 2 * p));
+    assert!(lanes.pair_stride == 0 || (lanes.interleaved && lanes.pair_stride >= p));
+    // The two rows of a pair side by side or (half-major) in separate halves.
+    assert!(lanes.row_gap == 0 || (lanes.pair_stride > 0 && lanes.row_gap >= p));
+    assert!(lanes.row_gap > 0 || lanes.pair_stride == 0 || lanes.pair_stride >= 2 * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe {
@@ -1053,9 +1080,14 @@ pub(crate) fn column(
         prefetch: Prefetch::none(),
         stream: false,
         pair_stride: 0,
+        row_gap: 0,
     };
     forward(isa, 8, &rec, &lanes, &xin, &mut f);
-    f.iter().step_by(8).zip(&rc.s).map(|(v, s)| v * s).collect()
+    f.iter()
+        .step_by(8)
+        .zip(&rc.s[..n])
+        .map(|(v, s)| v * s)
+        .collect()
 }
 
 #[cfg(test)]
@@ -1171,14 +1203,16 @@ mod tests {
             prefetch: Prefetch::none(),
             stream: true,
             pair_stride: 0,
+            row_gap: 0,
         }
     }
 
-    /// The inverse into pair-major rows (`Lanes::pair_stride`, the plan's inverse layout)
-    /// writes exactly what it writes into consecutive rows, each row at its pair's place,
-    /// and nothing between the pairs: every instruction set, both store modes.
+    /// The inverse into rows a pair stride apart (`Lanes::pair_stride`), the two rows of a
+    /// pair side by side or (`Lanes::row_gap`, the plan's half-major layout) in two
+    /// separate halves, writes exactly what it writes into consecutive rows, each row at
+    /// its place, and nothing elsewhere: every instruction set, both store modes.
     #[test]
-    fn pair_major_rows_hold_the_consecutive_rows() {
+    fn strided_rows_hold_the_consecutive_rows() {
         let b = 40;
         for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
             let n = b - m;
@@ -1191,7 +1225,7 @@ mod tests {
                     if !isa.is_supported() {
                         continue;
                     }
-                    for stream in [true, false] {
+                    for (stream, half) in [(true, false), (false, false), (true, true)] {
                         let mut lanes = Lanes {
                             tau: &tau,
                             p: &p,
@@ -1203,13 +1237,18 @@ mod tests {
                             prefetch: Prefetch::none(),
                             stream,
                             pair_stride: 0,
+                            row_gap: 0,
                         };
                         let mut y = vec![f64::NAN; nbs * pw];
                         inverse_from(isa, pw, &rec, &lanes, &fin, &mut y);
-                        // Pairs 2p + 8 values apart, 5 values into the buffer.
-                        let ps = 2 * pw + 8;
+                        // Pairs 2p + 8 values apart, 5 values into the buffer; half-major:
+                        // rows p + 8 apart in each half, the second half 3 values after the
+                        // first.
+                        let ps = if half { pw + 8 } else { 2 * pw + 8 };
+                        let gap = if half { nbs / 2 * ps + 3 } else { pw };
                         lanes.pair_stride = ps;
-                        let mut z = vec![f64::NAN; 5 + nbs / 2 * ps];
+                        lanes.row_gap = if half { gap } else { 0 };
+                        let mut z = vec![f64::NAN; 5 + nbs / 2 * ps + gap];
                         let mut buf = fin.clone();
                         // SAFETY: z holds nbs / 2 pairs of two rows after offset 5.
                         unsafe {
@@ -1223,16 +1262,17 @@ mod tests {
                                 z.as_mut_ptr().add(5),
                             )
                         };
-                        for (i, v) in z.iter().enumerate() {
-                            let k = i.wrapping_sub(5);
-                            let (j, q) = (k / ps, k % ps);
-                            if i < 5 || q >= 2 * pw {
-                                assert!(v.is_nan(), "{isa:?} P={pw}: wrote {i} between pairs");
-                            } else {
-                                let r = 2 * j + q / pw;
-                                let want = y[r * pw + q % pw];
-                                assert_eq!(v.to_bits(), want.to_bits(), "{isa:?} P={pw} row {r}");
-                            }
+                        let mut want = vec![f64::NAN; z.len()];
+                        for r in 0..nbs {
+                            let at = 5 + (r / 2) * ps + (r % 2) * gap;
+                            want[at..at + pw].copy_from_slice(&y[r * pw..(r + 1) * pw]);
+                        }
+                        for (i, (v, w)) in z.iter().zip(&want).enumerate() {
+                            assert_eq!(
+                                v.to_bits(),
+                                w.to_bits(),
+                                "{isa:?} P={pw} half={half} at {i}"
+                            );
                         }
                     }
                 }
@@ -1291,6 +1331,7 @@ mod tests {
                                 // Both ways of storing the inverse's output.
                                 stream: skip,
                                 pair_stride: 0,
+                                row_gap: 0,
                             };
                             // Stale values in every row the kernel must write.
                             let mut f = vec![0.0; (n + 8) * pw];
@@ -1307,12 +1348,15 @@ mod tests {
                             };
                             let norm = |a: &[f64]| dot(a, a).sqrt();
                             let (lhs, rhs) = (dot(&y, &x), dot(&fin, &f[..n * pw]));
-                            let scale = norm(&y) * norm(&x) + norm(&fin) * norm(&f);
+                            let scale = norm(&y) * norm(&x) + norm(&fin) * norm(&f[..n * pw]);
                             assert!(
                                 (lhs - rhs).abs() <= 1e-13 * scale,
                                 "{isa:?} skip={skip} m={m} mp={mp} nbs={nbs} P={pw}: {lhs} {rhs}"
                             );
-                            assert!(f[n * pw..].iter().all(|&v| v == 0.0));
+                            // Rows from `n` on are scratch (the last block runs in full),
+                            // but never a non-finite value.
+                            assert!(f[n * pw..].iter().all(|v| v.is_finite()));
+                            f.truncate(n * pw);
                             runs.push((f, y));
                         }
                     }

@@ -226,10 +226,12 @@ struct Pass {
     /// so that is what to prefetch (forward: this cluster's block there; inverse:
     /// nothing, its coefficient rows are kept).
     next_buf: Option<SyncPtr<f64>>,
-    /// Inverse: write the blocks with non-temporal stores and pair-major (the group's
+    /// Inverse: write the blocks with non-temporal stores and half-major (the group's
     /// blocks are too large to stay in the cache until the FFT stage reads them, see
     /// [`plain_store_limit`] and `plan/blocks.rs`).
     stream: bool,
+    /// Half-major: doubles from the chunk buffer's low-beta half to its mirror half.
+    gap: usize,
 }
 
 /// Shared mutable pointer for disjoint parallel writes.
@@ -285,9 +287,15 @@ impl Chunk {
 /// the betas of later chunks are free until then: a group of chunks whose buffers (all
 /// but the first, which uses the plan's buffer) fit there runs its DWT stage as one pass,
 /// reading each cluster's coefficients once for the whole group instead of once per
-/// chunk. At B = 512 the 22 chunks of the 5% memory rule become 6 groups. A forward may
+/// chunk (the real inverse; at B = 512 the 22 chunks of the 5% memory rule became 6
+/// groups that way). A forward may
 /// likewise put the buffers of a group in the input slices of earlier groups (already
-/// read), and adds each cluster's sums over the group's chunks to the coefficients once.
+/// read), and adds each cluster's sums over the group's chunks to the coefficients once
+/// (6 groups of the 22 chunks at B = 512).
+///
+/// An inverse of the complex layout goes further: its buffers are half-major (see
+/// `plan/blocks.rs`), so one can live in the low-beta and the mirror slices of another
+/// chunk, and all chunks run as one group (see [`Plan::inverse_chain`]).
 struct Spare {
     /// Start of the array (`2B` slices of `slice_bytes`, beta slowest).
     base: *mut u8,
@@ -317,6 +325,17 @@ impl Spare {
             }
         }
         out
+    }
+
+    /// The two halves of a half-major buffer, `bytes` each, 64-byte aligned: one in the
+    /// low-beta slices of chunk `ch`, one in its mirror slices; `None` if they do not fit.
+    fn halves(&self, b: usize, ch: &Chunk, bytes: usize) -> Option<(*mut f64, *mut f64)> {
+        let region = |first: usize| {
+            let (from, to) = (first * self.slice_bytes, (first + ch.h) * self.slice_bytes);
+            let at = from + self.base.wrapping_add(from).align_offset(64);
+            (at <= to && to - at >= bytes).then(|| self.base.wrapping_add(at) as *mut f64)
+        };
+        Some((region(ch.lo)?, region(2 * b - ch.lo - ch.h)?))
     }
 
     /// Inverse: buffers of `bytes` each (a multiple of 64) for `g` chunks in the slices of the
@@ -378,15 +397,16 @@ fn default_workspace(b: usize, real: bool) -> usize {
 }
 
 /// Most bytes of blocks an inverse group writes with ordinary stores into cluster-major
-/// blocks rather than with non-temporal ones into the pair-major layout (see
+/// blocks rather than with non-temporal ones into the half-major layout (see
 /// `plan/blocks.rs`): a quarter of the last-level cache (from Linux's sysfs; the cache is
 /// shared with the other cores), 0 (always non-temporal) where unknown. Blocks that stay
 /// in the cache are read back by the FFT stage much faster: at B = 64 (34 MiB of blocks,
 /// 480 MiB of L3 on the development machine) the complex inverse took 8% less time and the
 /// real one 17% less; at B = 128 (254 MiB) non-temporal stores were faster (DWT stage
 /// 0.062 against 0.069 s), and with the blocks capped at 64-128 MiB the two were even.
-/// Pair-major blocks in the cache are slower still (B = 64 complex inverse DWT stage
-/// 0.0084 against 0.0053 s: each row on its own page).
+/// Pair-major blocks (the rows of a pair side by side, what the half-major layout replaced)
+/// in the cache were slower still (B = 64 complex inverse DWT stage 0.0084 against
+/// 0.0053 s: each row on its own page).
 fn plain_store_limit() -> usize {
     let size = |dir: &std::path::Path| -> Option<usize> {
         let level = std::fs::read_to_string(dir.join("level")).ok()?;
@@ -794,8 +814,76 @@ impl Plan {
     /// The chunks of layout `t` in groups that share one pass of the DWT stage, each with
     /// its buffer: `None` for the plan's chunk buffer, else a part of `spare` (the
     /// inverse's output, or the input of a forward that may overwrite it, see [`Spare`]).
-    /// Without `spare` every group is one chunk.
+    /// Without `spare` every group is one chunk. With each buffer comes the gap (doubles)
+    /// from its low-beta half to its mirror half in the half-major layout; the plan's
+    /// buffer has its halves `t.total() / 2` apart, and so do the buffers placed whole.
+    /// Also returns whether the groups are the inverse's chain (see
+    /// [`Plan::inverse_chain`]), whose buffers must be half-major.
+    #[allow(clippy::type_complexity)]
     fn chunk_groups(
+        &self,
+        t: &Blocks,
+        forward: bool,
+        spare: Option<&Spare>,
+    ) -> (Vec<Vec<(Chunk, Option<(*mut f64, usize)>)>>, bool) {
+        if let (false, Some(sp)) = (forward, spare) {
+            if let Some(g) = self.inverse_chain(t, sp) {
+                return (vec![g], true);
+            }
+        }
+        let whole = t.total() / 2;
+        let groups = self
+            .chunk_groups_whole(t, forward, spare)
+            .into_iter()
+            .map(|g| {
+                g.into_iter()
+                    .map(|(c, p)| (c, p.map(|p| (p, whole))))
+                    .collect()
+            })
+            .collect();
+        (groups, false)
+    }
+
+    /// The inverse's chunks as one group, the one at the equator first: each chunk's
+    /// buffer (half-major, two halves of `t.half_len(hp)` doubles) goes into the low-beta
+    /// and the mirror slices of the chunk after it, whose FFT stage writes them only once
+    /// this chunk's has read its buffer; the last chunk (at the poles) uses the plan's
+    /// buffer. The DWT stage then reads each cluster's coefficients and computes its
+    /// recurrence coefficients once, not once per group (B = 256 with the default
+    /// workspace, one thread: 4 groups before). `None` with fewer than two chunks, or if
+    /// a half does not fit (the real layout: its rows per lane are larger than a real
+    /// slice).
+    #[allow(clippy::type_complexity)]
+    fn inverse_chain(
+        &self,
+        t: &Blocks,
+        spare: &Spare,
+    ) -> Option<Vec<(Chunk, Option<(*mut f64, usize)>)>> {
+        let order: Vec<Chunk> = self
+            .chunks(t)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        if order.len() < 2 {
+            return None;
+        }
+        let mut group = Vec::with_capacity(order.len());
+        for (i, ch) in order.iter().enumerate() {
+            let place = match order.get(i + 1) {
+                Some(next) => {
+                    let (a, b) = spare.halves(self.b, next, 8 * t.half_len(ch.hp))?;
+                    Some((a, (b as usize - a as usize) / 8))
+                }
+                None => None,
+            };
+            group.push((*ch, place));
+        }
+        Some(group)
+    }
+
+    /// [`Plan::chunk_groups`] without the chain: every buffer in one piece.
+    fn chunk_groups_whole(
         &self,
         t: &Blocks,
         forward: bool,
@@ -899,7 +987,7 @@ impl Plan {
             true,
             &self.blocks,
             spare,
-            |ch, buf, _| self.fft_chunk(ch, true, input.get(), buf, false),
+            |ch, buf, _| self.fft_chunk(ch, true, input.get(), buf, None),
             |sc, at, ch, buf, pass| unsafe {
                 self.forward_cluster(
                     sc,
@@ -930,7 +1018,7 @@ impl Plan {
             false,
             &self.blocks,
             Some(spare),
-            |ch, buf, pair_major| self.fft_chunk(ch, false, out.get(), buf, pair_major),
+            |ch, buf, half| self.fft_chunk(ch, false, out.get(), buf, half),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
             },
@@ -947,29 +1035,34 @@ impl Plan {
         forward: bool,
         t: &Blocks,
         spare: Option<Spare>,
-        fft: impl Fn(&Chunk, *mut f64, bool) -> Result<()> + Sync,
+        fft: impl Fn(&Chunk, *mut f64, Option<usize>) -> Result<()> + Sync,
         cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
-        let groups = self.chunk_groups(t, forward, spare.as_ref());
+        let (groups, chained) = self.chunk_groups(t, forward, spare.as_ref());
         self.with_buf(|buf| {
             let bp = buf.as_mut_ptr() as *mut f64;
-            let groups: Vec<Vec<(Chunk, SyncPtr<f64>)>> = groups
+            let whole = t.total() / 2;
+            let groups: Vec<Vec<(Chunk, SyncPtr<f64>, usize)>> = groups
                 .iter()
                 .map(|g| {
                     g.iter()
-                        .map(|(c, p)| (*c, SyncPtr(p.unwrap_or(bp))))
+                        .map(|(c, p)| {
+                            let (p, gap) = p.unwrap_or((bp, whole));
+                            (*c, SyncPtr(p), gap)
+                        })
                         .collect()
                 })
                 .collect();
             self.pool().install(|| {
                 for (gi, group) in groups.iter().enumerate() {
-                    let stream = !forward && self.streams_blocks(group.len());
+                    // The chain's buffers are in two pieces: half-major only.
+                    let stream = !forward && (chained || self.streams_blocks(group.len()));
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
-                        for (ch, buf) in group {
-                            fft(ch, buf.get(), stream)?;
+                        for (ch, buf, gap) in group {
+                            fft(ch, buf.get(), stream.then_some(*gap))?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
@@ -979,7 +1072,7 @@ impl Plan {
                     }
                     let t1 = Instant::now();
                     self.for_each_cluster(t, |sc, at| {
-                        for (k, (ch, buf)) in group.iter().enumerate() {
+                        for (k, (ch, buf, gap)) in group.iter().enumerate() {
                             let pass = Pass {
                                 first: gi == 0,
                                 k,
@@ -987,6 +1080,7 @@ impl Plan {
                                 done: gi + 1 == groups.len() && k + 1 == group.len(),
                                 next_buf: group.get(k + 1).map(|g| g.1),
                                 stream,
+                                gap: *gap,
                             };
                             cluster(sc, at, ch, buf.get(), pass);
                         }
@@ -1039,7 +1133,7 @@ impl Plan {
     }
 
     /// Whether an inverse group of `chunks` chunks writes its blocks with non-temporal
-    /// stores, pair-major (see `plan/blocks.rs`): when they are too large to stay in the
+    /// stores, half-major (see `plan/blocks.rs`): when they are too large to stay in the
     /// cache until the FFT stage reads them ([`plain_store_limit`]).
     fn streams_blocks(&self, chunks: usize) -> bool {
         chunks * self.buf_bytes > self.plain_store_limit
@@ -1112,7 +1206,10 @@ mod tests {
                 slice_bytes,
             };
             // The forward's groups: buffers in the slices of earlier groups only.
-            let groups = plan.chunk_groups(t, true, Some(&spare));
+            let (split, chained) = plan.chunk_groups(t, true, Some(&spare));
+            assert!(!chained);
+            let groups = plan.chunk_groups_whole(t, true, Some(&spare));
+            assert_eq!(split.len(), groups.len());
             let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
             assert_eq!(
                 flat,
@@ -1143,8 +1240,40 @@ mod tests {
                     assert!(low || high, "B={b}: forward buffer outside the read slices");
                 }
             }
-            let groups = plan.chunk_groups(t, false, Some(&spare));
             let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
+            let (chain, chained) = plan.chunk_groups(t, false, Some(&spare));
+            // The complex inverse: one group, equator first, each buffer's halves in the
+            // low-beta and the mirror slices of the next chunk (written after its own FFT
+            // stage read the buffer), the last one in the plan's buffer.
+            assert_eq!(chained, !real, "B={b} real={real}");
+            if chained {
+                assert_eq!(chain.len(), 1);
+                let g = &chain[0];
+                let order: Vec<_> = g.iter().map(|(c, _)| (c.lo, c.h)).collect();
+                assert_eq!(order, chunks.iter().rev().copied().collect::<Vec<_>>());
+                assert!(g.last().unwrap().1.is_none());
+                for (i, (ch, p)) in g[..g.len() - 1].iter().enumerate() {
+                    let next = g[i + 1].0;
+                    let (a, gap) = p.unwrap();
+                    let half = 8 * t.half_len(ch.hp);
+                    let a = a as usize - spare.base as usize;
+                    let m = a + 8 * gap;
+                    assert_eq!((spare.base as usize + a) % 64, 0);
+                    assert_eq!((spare.base as usize + m) % 64, 0);
+                    assert!(a >= next.lo * slice_bytes);
+                    assert!(
+                        a + half <= (next.lo + next.h) * slice_bytes,
+                        "B={b}: low half"
+                    );
+                    assert!(m >= (2 * b - next.lo - next.h) * slice_bytes);
+                    assert!(
+                        m + half <= (2 * b - next.lo) * slice_bytes,
+                        "B={b}: mirror half"
+                    );
+                }
+                continue;
+            }
+            let groups = plan.chunk_groups_whole(t, false, Some(&spare));
             let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
             assert_eq!(flat, chunks, "B={b} real={real}");
             assert!(groups.len() < chunks.len(), "B={b} real={real}: no group");
@@ -1182,7 +1311,7 @@ mod tests {
     }
 
     /// The inverse's two ways of writing the blocks (non-temporal stores into the
-    /// pair-major layout for groups larger than `plain_store_limit`, ordinary ones into
+    /// half-major layout for groups larger than `plain_store_limit`, ordinary ones into
     /// cluster-major blocks below) give the same samples, bit for bit,
     /// complex and real, with one chunk and with chunk groups, with either FFT threading;
     /// the forward brings the coefficients back.
@@ -1249,6 +1378,33 @@ mod tests {
                     }
                 }
                 assert!(runs[0].0 == runs[1].0, "B={b} real={real}: samples differ");
+                // Chunks, groups and the complex inverse's chain change nothing either:
+                // each lane's sums are its own.
+                if cap.is_some() {
+                    let whole = super::Plan::new(
+                        b,
+                        &super::PlanOptions {
+                            max_workspace_bytes: None,
+                            ..opts
+                        },
+                    )
+                    .unwrap();
+                    let bits: Vec<u64> = if real {
+                        let mut f = vec![0.0; whole.num_samples()];
+                        whole.inverse_real(&coefs, &mut f).unwrap();
+                        f.iter().map(|v| v.to_bits()).collect()
+                    } else {
+                        let mut f = vec![Complex64::new(0.0, 0.0); whole.num_samples()];
+                        whole.inverse(&coefs, &mut f).unwrap();
+                        f.iter()
+                            .flat_map(|v| [v.re.to_bits(), v.im.to_bits()])
+                            .collect()
+                    };
+                    assert!(
+                        bits == runs[0].0,
+                        "B={b} real={real}: chunked samples differ"
+                    );
+                }
                 for (_, c) in &runs {
                     let e = c
                         .iter()

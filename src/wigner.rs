@@ -608,11 +608,7 @@ impl RecTables {
     /// `A x + C = A tau + (C - A)`; `A + C = A (1 - m m' / (l(l+1)))` is formed without
     /// cancellation.
     pub fn coeffs(&self, m: usize, mp: usize, r: &mut RecCoeffs) {
-        let n = r.a.len();
-        assert!(
-            r.an.len() == n && r.d.len() == n && r.e.len() == n && r.s.len() == n,
-            "coefficient arrays of unequal length"
-        );
+        let n = r.len();
         assert!(m + n < self.stride && mp <= m);
         assert!(
             self.row[m] != usize::MAX && self.row[mp] != usize::MAX,
@@ -634,7 +630,7 @@ impl RecTables {
 
     #[inline(always)]
     fn coeffs_body(&self, m: usize, mp: usize, r: &mut RecCoeffs) {
-        let n = r.a.len();
+        let n = r.len();
         if n == 0 {
             return;
         }
@@ -800,7 +796,13 @@ impl Dd {
     }
 }
 
-/// Recurrence coefficients of one cluster (see [`RecTables::coeffs`]), index `i = l - l0`.
+/// Zero entries after the last degree of every [`RecCoeffs`] array: the forward kernel
+/// runs its last block of degrees in full (see `dwt::forward`), stepping up to
+/// `REC_PAD - 1` degrees past the end.
+pub(crate) const REC_PAD: usize = 8;
+
+/// Recurrence coefficients of one cluster (see [`RecTables::coeffs`]), index `i = l - l0`,
+/// for `len()` degrees; each array holds [`REC_PAD`] zeros after them.
 #[derive(Default)]
 pub(crate) struct RecCoeffs {
     pub a: Vec<f64>,
@@ -809,21 +811,23 @@ pub(crate) struct RecCoeffs {
     pub e: Vec<f64>,
     /// The scale `S_i` of the values (see [`RecTables::coeffs`]).
     pub s: Vec<f64>,
+    n: usize,
 }
 
 impl RecCoeffs {
     /// Arrays for `n` degrees.
     pub fn new(n: usize) -> RecCoeffs {
-        RecCoeffs {
-            a: vec![0.0; n],
-            an: vec![0.0; n],
-            d: vec![0.0; n],
-            e: vec![0.0; n],
-            s: vec![0.0; n],
-        }
+        let mut r = RecCoeffs::default();
+        r.resize(n);
+        r
     }
 
-    /// Shorten (or lengthen) every array to `n` degrees.
+    /// Number of degrees.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Shorten (or lengthen) every array to `n` degrees (and the zero padding).
     pub fn resize(&mut self, n: usize) {
         for v in [
             &mut self.a,
@@ -832,8 +836,10 @@ impl RecCoeffs {
             &mut self.e,
             &mut self.s,
         ] {
-            v.resize(n, 0.0);
+            v.resize(n + REC_PAD, 0.0);
+            v[n..].fill(0.0);
         }
+        self.n = n;
     }
 }
 

@@ -12,11 +12,15 @@
 //! inverse's FFT stage instead reads one pair of rows (a beta and its mirror) of every
 //! block at a time, and in that layout those reads are 256 bytes every block (64 KiB at
 //! B = 256), each a few lines from memory. So an inverse whose blocks do not stay in the
-//! cache (see `plain_store_limit` in `plan.rs`) uses the same buffer pair-major: the two
-//! rows of pair `j` of every block, cluster after cluster, then pair `j + 1`
-//! ([`Blocks::pair_stride`], [`Blocks::pair_offset`]); its DWT kernel writes its rows far
-//! apart with non-temporal stores, and its FFT stage reads sequentially. At B = 256 (one
-//! thread) that took the inverse's block reads from 0.6-0.65 s to 0.29-0.31 s.
+//! cache (see `plain_store_limit` in `plan.rs`) uses the buffer "half-major": two halves,
+//! one with the low-beta rows and one with the mirror rows, each holding row `j` of every
+//! block, cluster after cluster, then row `j + 1` ([`Blocks::half_stride`],
+//! [`Blocks::half_offset`]); its DWT kernel writes its rows far apart with non-temporal
+//! stores, and its FFT stage reads two sequential runs. (The rows of a pair side by side,
+//! "pair-major", took the inverse's block reads at B = 256 from 0.6-0.65 s to 0.29-0.31 s
+//! on one thread.) The two halves need not be adjacent: a chunk's buffer can then live in
+//! the low-beta and the mirror slices of another chunk of the output (see `Spare` in
+//! `plan.rs`).
 //!
 //! Slot `q` of cluster `c` holds the value of order pair `(M, M')` at the row's beta, or,
 //! for a "reversed" member (see `symmetry.rs`), at the mirrored beta `pi - beta`: `fi[8c+q]`
@@ -171,15 +175,21 @@ impl Blocks {
         self.pofs[c] * self.lanes
     }
 
-    /// Pair-major layout (the inverse's): doubles from one pair of lanes (rows `2j`,
-    /// `2j + 1` of every block) to the next.
-    pub fn pair_stride(&self) -> usize {
-        2 * self.pofs[self.len()]
+    /// Half-major layout (the large inverse's): doubles from one row of every block to
+    /// the next, within a half.
+    pub fn half_stride(&self) -> usize {
+        self.pofs[self.len()]
     }
 
-    /// Pair-major layout: offset (in doubles) of cluster `c`'s two rows within a pair.
-    pub fn pair_offset(&self, c: usize) -> usize {
-        2 * self.pofs[c]
+    /// Half-major layout: offset (in doubles) of cluster `c`'s row within a row of every
+    /// block.
+    pub fn half_offset(&self, c: usize) -> usize {
+        self.pofs[c]
+    }
+
+    /// Half-major layout: doubles of one half for `pairs` pairs of rows.
+    pub fn half_len(&self, pairs: usize) -> usize {
+        pairs * self.half_stride()
     }
 
     /// Doubles of the whole buffer.

@@ -85,6 +85,7 @@ impl Scratch {
             prefetch: Prefetch::none(),
             stream: true,
             pair_stride: 0,
+            row_gap: 0,
         }
     }
 }
@@ -341,7 +342,7 @@ impl Plan {
 
     /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
     /// gives), written into its block, or with `pass.stream` into its rows of the
-    /// pair-major buffer (see `plan/blocks.rs`). For `pass.k > 0` the previous call was this
+    /// half-major buffer (see `plan/blocks.rs`). For `pass.k > 0` the previous call was this
     /// cluster on the group's previous chunk, whose recurrence coefficients and
     /// coefficient rows are reused.
     ///
@@ -368,10 +369,11 @@ impl Plan {
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.stream = pass.stream;
-        // Blocks too large for the cache are pair-major (see `plan/blocks.rs`).
+        // Blocks too large for the cache are half-major (see `plan/blocks.rs`).
         let at_c = if pass.stream {
-            lanes.pair_stride = t.pair_stride();
-            t.pair_offset(c)
+            lanes.pair_stride = t.half_stride();
+            lanes.row_gap = pass.gap;
+            t.half_offset(c)
         } else {
             t.offset(c)
         };
@@ -395,9 +397,10 @@ impl Plan {
             }
             lo = from;
         };
-        // SAFETY: this cluster's `ch.lanes() <= t.lanes` rows: its block, or pair-major
-        // pair `j` at `j * pair_stride + pair_offset(c)` (`2p` values of the
-        // `pair_stride`), within the buffer's `t.lanes / 2` pairs; the caller owns them.
+        // SAFETY: this cluster's `ch.lanes() <= t.lanes` rows: its block, or half-major
+        // rows `2j` at `j * half_stride + half_offset(c)` and `2j + 1` `pass.gap` further
+        // (`p` values each), `j < ch.hp`, within the buffer's two halves of
+        // `t.half_len(ch.hp)` doubles; the caller owns them.
         dwt::inverse_raw(
             self.isa,
             p,

@@ -36,14 +36,15 @@ pub(super) fn scratch_len(b: usize) -> usize {
 
 impl Plan {
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
-    /// from `buf` (pair-major with `pair_major`, see `plan/blocks.rs`) into `grid`.
+    /// from `buf` (half-major with `half = Some(gap)`, the doubles from its low-beta half
+    /// to its mirror half, see `plan/blocks.rs`) into `grid`.
     pub(super) fn fft_chunk(
         &self,
         ch: &Chunk,
         forward: bool,
         grid: *mut Complex64,
         buf: *mut f64,
-        pair_major: bool,
+        half: Option<usize>,
     ) -> Result<()> {
         let fft = if forward {
             self.fwd_fft.as_ref()
@@ -55,7 +56,7 @@ impl Plan {
         let grid = SyncPtr(grid);
         let slices = move |k: usize| SyncPtr(grid.get().wrapping_add(k * nn));
         let threaded = self.fftw_threaded;
-        self.fft_pairs(ch, fft, threaded, forward, &slices, buf, pair_major, ch.h)
+        self.fft_pairs(ch, fft, threaded, forward, &slices, buf, half, ch.h)
     }
 
     /// The first `npairs` pairs of [`Plan::fft_chunk`] with the slice plan `fft`; `slice(k)`
@@ -71,7 +72,7 @@ impl Plan {
         forward: bool,
         slice: &(dyn Fn(usize) -> SyncPtr<Complex64> + Sync),
         buf: *mut f64,
-        pair_major: bool,
+        half: Option<usize>,
         npairs: usize,
     ) -> Result<()> {
         let buf = SyncPtr(buf);
@@ -96,7 +97,7 @@ impl Plan {
                     &w[..2 * gn],
                     scratch.as_mut_ptr(),
                     buf.get(),
-                    pair_major,
+                    half,
                     j0,
                     fftw_threaded,
                 );
@@ -124,7 +125,7 @@ impl Plan {
         w: &[f64],
         sp: *mut Complex64,
         buf: *mut f64,
-        pair_major: bool,
+        half: Option<usize>,
         j0: usize,
         parallel_copy: bool,
     ) {
@@ -168,7 +169,7 @@ impl Plan {
             });
         } else {
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                gather_group(&self.blocks, s, false, b.get(), pair_major, j0, c0..c1)
+                gather_group(&self.blocks, s, false, b.get(), half, j0, c0..c1)
             });
             for (src, &dst) in s.iter().zip(grid) {
                 let src = src.get();
@@ -298,14 +299,15 @@ pub(super) unsafe fn scatter_group(
 /// (blocks in the cache).
 const PREFETCH_CLUSTERS: usize = 16;
 
-/// Bytes ahead of its reads in the pair-major buffer that [`gather_group`] prefetches.
+/// Bytes ahead of its reads in the half-major buffer that [`gather_group`] prefetches.
 /// The hardware prefetchers follow the sequential reads, but not far enough: at B = 256
 /// (one thread) the gather took 0.29-0.31 s with 2-4 KiB ahead, 0.39-0.42 s with none
 /// (0.6-0.65 s in the cluster-major layout).
 const GATHER_AHEAD: usize = 4096;
 
-/// The reverse of [`scatter_group`] without weights, from blocks or (with `pair_major`)
-/// the pair-major layout of a large inverse (see `plan/blocks.rs`): slots of the rows of
+/// The reverse of [`scatter_group`] without weights, from blocks or (with `half`, the gap
+/// between its halves) the half-major layout of a large inverse (see `plan/blocks.rs`):
+/// slots of the rows of
 /// the pairs `j0 ..` into the slices `s` (conjugated with `conj`; the real layout's
 /// second index `fi2` gets the value itself).
 ///
@@ -316,7 +318,7 @@ pub(super) unsafe fn gather_group(
     s: &[SyncPtr<Complex64>],
     conj: bool,
     buf: *const f64,
-    pair_major: bool,
+    half: Option<usize>,
     j0: usize,
     cs: std::ops::Range<usize>,
 ) {
@@ -327,26 +329,29 @@ pub(super) unsafe fn gather_group(
         sp[i] = s[i].get();
     }
     let end = cs.end;
-    let pair_stride = t.pair_stride();
+    let half_stride = t.half_stride();
     for c in cs {
         if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, s, true);
         }
         let p = t.p(c);
-        // Where this cluster's rows of the group's first pair are, and doubles from one
-        // pair to the next: pair-major, a sequential run over the clusters for each pair;
-        // else within the cluster's block.
-        let (row, ps) = if pair_major {
-            (buf.add(j0 * pair_stride + t.pair_offset(c)), pair_stride)
-        } else {
-            (buf.add(t.offset(c) + 2 * j0 * p), 2 * p)
+        // Where this cluster's low-beta row of the group's first pair is, doubles from one
+        // pair to the next and from the low-beta row to the mirror row: half-major, two
+        // sequential runs over the clusters for each pair; else within the cluster's block.
+        let (row, ps, gap) = match half {
+            Some(gap) => (
+                buf.add(j0 * half_stride + t.half_offset(c)),
+                half_stride,
+                gap,
+            ),
+            None => (buf.add(t.offset(c) + 2 * j0 * p), 2 * p, p),
         };
         #[cfg(target_arch = "x86_64")]
         {
             // Hints only (may point past the buffer): ahead in the sequential run, or the
             // rows of a cluster further on.
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let ahead = if pair_major {
+            let ahead = if half.is_some() {
                 Some(((row as *const i8).wrapping_add(GATHER_AHEAD), p))
             } else {
                 let cf = c + PREFETCH_CLUSTERS;
@@ -359,8 +364,17 @@ pub(super) unsafe fn gather_group(
                 })
             };
             if let Some((a, pf)) = ahead {
-                for line in 0..ns * pf / 8 {
-                    _mm_prefetch::<_MM_HINT_T0>(a.wrapping_add(64 * line));
+                // Half-major: as far ahead in the mirror half.
+                let runs = if half.is_some() { [0, 8 * gap] } else { [0, 0] };
+                let lines = if half.is_some() {
+                    ns * pf / 16
+                } else {
+                    ns * pf / 8
+                };
+                for r in &runs[..1 + half.is_some() as usize] {
+                    for line in 0..lines.max(1) {
+                        _mm_prefetch::<_MM_HINT_T0>(a.wrapping_add(r + 64 * line));
+                    }
                 }
             }
         }
@@ -368,8 +382,8 @@ pub(super) unsafe fn gather_group(
         if t.regular[c] {
             // The common case (`Blocks::regular`), written out.
             match p {
-                16 => gather_regular::<8>(t, c, &sp[..ns], conj, row, ps),
-                _ => gather_regular::<4>(t, c, &sp[..ns], conj, row, ps),
+                16 => gather_regular::<8>(t, c, &sp[..ns], conj, row, ps, gap),
+                _ => gather_regular::<4>(t, c, &sp[..ns], conj, row, ps, gap),
             }
             continue;
         }
@@ -382,7 +396,7 @@ pub(super) unsafe fn gather_group(
             let fi2 = *t.fi2.get_unchecked(8 * c + q);
             let r = ((rev >> q) & 1) as usize;
             for jj in 0..ns / 2 {
-                let (ra, rb) = (jj * ps + r * p + 2 * q, jj * ps + (1 - r) * p + 2 * q);
+                let (ra, rb) = (jj * ps + r * gap + 2 * q, jj * ps + (1 - r) * gap + 2 * q);
                 let a = Complex64::new(*row.add(ra), *row.add(ra + 1));
                 let b = Complex64::new(*row.add(rb), *row.add(rb + 1));
                 let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
@@ -447,6 +461,7 @@ unsafe fn gather_regular<const S: usize>(
     conj: bool,
     row: *const f64,
     ps: usize,
+    gap: usize,
 ) {
     let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
     let h = S / 2;
@@ -454,7 +469,8 @@ unsafe fn gather_regular<const S: usize>(
     let v = |z: Complex64| if conj { z.conj() } else { z };
     for jj in 0..sp.len() / 2 {
         let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
-        let (lo, hi) = (rows.add(jj * ps / 2), rows.add(jj * ps / 2 + S));
+        // `ps` and `gap` are even: whole complex values.
+        let (lo, hi) = (rows.add(jj * ps / 2), rows.add((jj * ps + gap) / 2));
         for q in 0..h {
             *s0.add(f[q]) = v(*lo.add(q));
             *s1.add(f[q]) = v(*hi.add(q));
@@ -529,9 +545,10 @@ mod speed {
             };
             let bp = buf.as_mut_ptr() as *mut f64;
             let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, 0, 0..t.len()) });
-            // The gather as a large inverse runs it (pair-major); the scatter's blocks are
+            // The gather as a large inverse runs it (half-major); the scatter's blocks are
             // only a source of values here.
-            let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, true, 0, 0..t.len()) });
+            let half = Some(t.total() / 2);
+            let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, half, 0, 0..t.len()) });
             let bytes = 2 * g * nn * 16;
             let src = AlignedBuf::new(bytes / 16).unwrap();
             let dst = AlignedBuf::new(bytes / 16).unwrap();

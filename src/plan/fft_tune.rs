@@ -125,7 +125,7 @@ impl Plan {
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
                 // The inverse's layout for one chunk (see `plan/blocks.rs`).
-                let pm = self.streams_blocks(1);
+                let half = self.streams_blocks(1).then_some(self.blocks.total() / 2);
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -135,7 +135,7 @@ impl Plan {
                         for (fft, forward) in [(f, true), (iv, false)] {
                             if let Some(fft) = fft {
                                 self.fft_pairs(
-                                    &ch, fft, threaded, forward, &slice, bp, pm, npairs,
+                                    &ch, fft, threaded, forward, &slice, bp, half, npairs,
                                 )?;
                             }
                         }
@@ -193,9 +193,9 @@ mod tests {
         let t = Instant::now();
         plan.with_buf(|buf| {
             plan.pool().install(|| {
-                let pm = !forward && plan.streams_blocks(1);
+                let half = (!forward && plan.streams_blocks(1)).then_some(plan.blocks.total() / 2);
                 for ch in plan.chunks(&plan.blocks) {
-                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, pm)?;
+                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, half)?;
                 }
                 Ok(())
             })

@@ -172,7 +172,7 @@ impl Plan {
             true,
             t,
             spare,
-            |ch, buf, _| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, false),
+            |ch, buf, _| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, None),
             |sc, at, ch, buf, pass| unsafe {
                 // The chunks accumulate the representatives only (half the coefficient
                 // traffic per chunk); the last one also writes their partners.
@@ -197,7 +197,7 @@ impl Plan {
             false,
             t,
             Some(spare),
-            |ch, buf, pair_major| self.fft_chunk_real(ch, None, out.get(), buf, pair_major),
+            |ch, buf, half| self.fft_chunk_real(ch, None, out.get(), buf, half),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
             },
@@ -213,14 +213,14 @@ impl Plan {
     /// FFT stage of one chunk for real data (see the module documentation), one mirrored
     /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
     /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
-    /// into `grid` (c2r), reading the blocks pair-major with `pair_major`.
+    /// into `grid` (c2r), reading the blocks half-major with `half = Some(gap)` (see `plan/blocks.rs`).
     fn fft_chunk_real(
         &self,
         ch: &Chunk,
         input: Option<SyncInput>,
         grid: *mut f64,
         buf: *mut f64,
-        pair_major: bool,
+        half: Option<usize>,
     ) -> Result<()> {
         let fft = self.real_fft()?;
         let t = self.real_blocks()?;
@@ -266,7 +266,7 @@ impl Plan {
                         );
                     } else {
                         let sc = [SyncPtr(s[0]), SyncPtr(s[1])];
-                        fft_stage::gather_group(t, &sc, true, buf.get(), pair_major, j, 0..t.len());
+                        fft_stage::gather_group(t, &sc, true, buf.get(), half, j, 0..t.len());
                         for (&slot, k) in s.iter().zip([k0, k1]) {
                             // Frequency B (alpha or gamma) is outside the band limit.
                             for i in 0..=b {
