@@ -279,7 +279,7 @@ impl<'r, S: Simd> State<'r, S> {
     /// The values of degrees `i0 .. i0 + D` (the state is at degree `i >= i0`), masked to
     /// the active lanes, zero before `i` and from `n` on; advances the state to
     /// `min(i0 + D, n)`. For the blocks where not all lanes are active yet, or which start
-    /// before the state does, or end past `n`.
+    /// before the state does.
     #[inline(always)]
     unsafe fn masked_block<const D: usize>(&mut self, i0: usize, n: usize) -> [S::V; D] {
         let mut d = [S::zero(); D];
@@ -672,8 +672,8 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     }
                 }
             }
-            // Vectors that start inside this block, still have inactive lanes or end in
-            // it, one at a time; the others are listed for the pipelined loop.
+            // Vectors that start inside this block or still have inactive lanes, one at a
+            // time; the others are listed for the pipelined loop.
             let mut nf = 0;
             for (v, s) in st.iter_mut().enumerate() {
                 if s.i >= i0 + DB || s.i >= n {
@@ -1003,10 +1003,14 @@ pub(crate) unsafe fn inverse_raw(
     assert!(rec.padded());
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && isa.is_supported());
-    assert!(lanes.pair_stride == 0 || (lanes.interleaved && lanes.pair_stride >= p));
-    // The two rows of a pair side by side or (half-major) in separate halves.
-    assert!(lanes.row_gap == 0 || (lanes.pair_stride > 0 && lanes.row_gap >= p));
-    assert!(lanes.row_gap > 0 || lanes.pair_stride == 0 || lanes.pair_stride >= 2 * p);
+    // Rows that never overlap: consecutive, the two rows of a pair side by side, or
+    // (half-major) the second rows of all `nb / 2` pairs after the first rows.
+    let (ps, gap) = (lanes.pair_stride, lanes.row_gap);
+    assert!(ps == 0 || lanes.interleaved);
+    assert!(gap == 0 || ps > 0);
+    assert!(gap > 0 || ps == 0 || ps >= 2 * p);
+    assert!(gap == 0 || (ps >= p && (gap == p || gap >= nb / 2 * ps)));
+    assert!(gap != p || ps >= 2 * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe {

@@ -826,7 +826,10 @@ impl Plan {
         forward: bool,
         spare: Option<&Spare>,
     ) -> (Vec<Vec<(Chunk, Option<(*mut f64, usize)>)>>, bool) {
-        if let (false, Some(sp)) = (forward, spare) {
+        // Only where the blocks would not stay in the cache anyway: the chain's buffers
+        // are half-major, written with non-temporal stores.
+        let chunks = self.chunks(t).count();
+        if let (false, Some(sp), true) = (forward, spare, self.streams_blocks(chunks)) {
             if let Some(g) = self.inverse_chain(t, sp) {
                 return (vec![g], true);
             }
@@ -851,8 +854,9 @@ impl Plan {
     /// buffer. The DWT stage then reads each cluster's coefficients and computes its
     /// recurrence coefficients once, not once per group (B = 256 with the default
     /// workspace, one thread: 4 groups before). `None` with fewer than two chunks, or if
-    /// a half does not fit (the real layout: its rows per lane are larger than a real
-    /// slice).
+    /// a half does not fit: the real layout's row per lane (`4B^2 + 4B` doubles) is longer
+    /// than a real slice (`4B^2`), so a full chunk's buffer never fits in another full
+    /// chunk's slices, and its chain exists only for two chunks, the first one short.
     #[allow(clippy::type_complexity)]
     fn inverse_chain(
         &self,
@@ -1186,13 +1190,17 @@ mod tests {
             (37, true, 1 << 20),
             (36, false, 1),
             (36, true, 1),
+            // Real, two chunks, the second short enough to fit in the first's slices.
+            (20, true, 500_000),
         ] {
             let opts = super::PlanOptions {
                 max_workspace_bytes: Some(cap),
                 real,
                 ..Default::default()
             };
-            let plan = super::Plan::new(b, &opts).unwrap();
+            let mut plan = super::Plan::new(b, &opts).unwrap();
+            // Blocks that would stay in the cache: no chain (ordinary stores, cluster-major).
+            plan.plain_store_limit = usize::MAX;
             let t = if real {
                 plan.blocks_real.as_ref().unwrap()
             } else {
@@ -1216,7 +1224,7 @@ mod tests {
                 plan.chunks(t).map(|c| (c.lo, c.h)).collect::<Vec<_>>()
             );
             assert!(
-                groups.len() < flat.len(),
+                groups.len() < flat.len() || flat.len() < 3,
                 "B={b} real={real}: no forward group"
             );
             let bytes = t.total() * 8;
@@ -1241,11 +1249,22 @@ mod tests {
                 }
             }
             let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
-            let (chain, chained) = plan.chunk_groups(t, false, Some(&spare));
-            // The complex inverse: one group, equator first, each buffer's halves in the
+            assert!(!plan.chunk_groups(t, false, Some(&spare)).1);
+            // Blocks too large for the cache (every limit below theirs): the complex
+            // inverse runs as one group, equator first, each buffer's halves in the
             // low-beta and the mirror slices of the next chunk (written after its own FFT
-            // stage read the buffer), the last one in the plan's buffer.
-            assert_eq!(chained, !real, "B={b} real={real}");
+            // stage read the buffer), the last one in the plan's buffer. The real one's
+            // full buffers do not fit there: only two chunks, the first one short.
+            let mut plan = plan;
+            plan.plain_store_limit = 0;
+            let t = if real {
+                plan.blocks_real.as_ref().unwrap()
+            } else {
+                &plan.blocks
+            };
+            let (chain, chained) = plan.chunk_groups(t, false, Some(&spare));
+            let short_pair = chunks.len() == 2 && chunks[1].1 * 2 <= chunks[0].1;
+            assert_eq!(chained, !real || short_pair, "B={b} real={real}");
             if chained {
                 assert_eq!(chain.len(), 1);
                 let g = &chain[0];
@@ -1325,6 +1344,8 @@ mod tests {
             (36, Some(1usize), FftwThreads),
             // Odd: padding lanes in every chunk.
             (37, Some(1usize), SlicesAcrossWorkers),
+            // The real layout's chain (two chunks, the second short).
+            (20, Some(500_000), SlicesAcrossWorkers),
             (41, None, SlicesAcrossWorkers),
         ] {
             for real in [false, true] {
