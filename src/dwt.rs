@@ -107,7 +107,7 @@ pub(crate) struct Prefetch {
 }
 
 impl Prefetch {
-    const MAX: usize = 9;
+    const MAX: usize = 10;
 
     /// Nothing to prefetch.
     pub fn none() -> Prefetch {
@@ -154,6 +154,30 @@ impl Prefetch {
 }
 
 impl Lanes<'_> {
+    /// Interleaved rows: doubles from one pair of rows to the next and from row `2j` to
+    /// row `2j + 1` (`pair_stride`, `row_gap` with their defaults for `P` doubles a row).
+    #[inline(always)]
+    fn pair_layout(&self, p: usize) -> (usize, usize) {
+        let ps = if self.pair_stride == 0 {
+            2 * p
+        } else {
+            self.pair_stride
+        };
+        (ps, if self.row_gap == 0 { p } else { self.row_gap })
+    }
+
+    /// Panics unless the rows of the `tau.len()` lanes (`p` doubles each) cannot overlap:
+    /// consecutive, the two rows of a pair side by side, or the second rows of all pairs
+    /// after the first rows (the split layouts of `plan/blocks.rs`).
+    fn assert_rows_apart(&self, p: usize) {
+        let (ps, gap, nb) = (self.pair_stride, self.row_gap, self.tau.len());
+        assert!(ps == 0 || self.interleaved);
+        assert!(gap == 0 || ps > 0);
+        assert!(gap > 0 || ps == 0 || ps >= 2 * p);
+        assert!(gap == 0 || (ps >= p && (gap == p || gap >= nb / 2 * ps)));
+        assert!(gap != p || ps >= 2 * p);
+    }
+
     /// First row and row step (in rows) of the vector of lanes starting at `s0`.
     #[inline(always)]
     fn rows(&self, s0: usize) -> (usize, usize) {
@@ -618,7 +642,7 @@ unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
     rec: &Rec,
     lanes: &Lanes,
-    xin: &[f64],
+    xin: *const f64,
     ft: &mut [f64],
 ) -> usize {
     let n = rec.len();
@@ -630,7 +654,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         assert!(!paired(W, P) || (2 * DB <= ACC && W.is_multiple_of(2)));
     }
     let pair = paired(W, P);
-    debug_assert!(nb.is_multiple_of(W) && xin.len() >= nb * P);
+    debug_assert!(nb.is_multiple_of(W));
     debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
     let fp = ft.as_mut_ptr();
     // Prefetch hints: the lines of `lanes.prefetch`, a few per vector and block. (Issued in
@@ -641,9 +665,14 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     // slower at B = 128.
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
+    let (ps, gap) = lanes.pair_layout(P);
     let xrows = |s0: usize| {
         let (r0, step) = lanes.rows(s0);
-        (xin.as_ptr().add(r0 * P), step * P)
+        if step == 2 {
+            (xin.add((r0 / 2) * ps + (r0 % 2) * gap), ps)
+        } else {
+            (xin.add(r0 * P), P)
+        }
     };
     let mut dbuf = [DBlock([0.0; 128]); 2];
     let mut lo = n;
@@ -793,12 +822,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     let n = rec.len();
     let nb = lanes.tau.len();
     debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P);
-    let ps = if lanes.pair_stride == 0 {
-        2 * P
-    } else {
-        lanes.pair_stride
-    };
-    let gap = if lanes.row_gap == 0 { P } else { lanes.row_gap };
+    let (ps, gap) = lanes.pair_layout(P);
     let mut pf = lanes.prefetch;
     let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
     // Rows `have..n` of `fin` are filled.
@@ -894,7 +918,7 @@ macro_rules! entry {
     ($name:ident, $feat:literal, forward_body, $S:ty, $W:literal, $N:literal, $DB:literal) => {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: &[f64], b: &mut [f64]) -> usize {
+        unsafe fn $name(rec: &Rec, lanes: &Lanes, a: *const f64, b: &mut [f64]) -> usize {
             forward_body::<$S, $W, $N, $DB>(rec, lanes, a, b)
         }
     };
@@ -935,13 +959,36 @@ pub(crate) fn forward(
     xin: &[f64],
     ft: &mut [f64],
 ) -> usize {
+    assert!(lanes.pair_stride == 0 && lanes.row_gap == 0);
+    assert!(xin.len() >= lanes.tau.len() * p);
+    // SAFETY: the rows are consecutive, within `xin`.
+    unsafe { forward_raw(isa, p, rec, lanes, xin.as_ptr(), ft) }
+}
+
+/// [`forward`] reading row `r` of the input at `xin + r * P`, or for interleaved lanes at
+/// `xin + (r / 2) * lanes.pair_stride + (r % 2) * lanes.row_gap` (defaults `2P` and `P`:
+/// consecutive rows; see `plan/blocks.rs` for the split layout).
+///
+/// # Safety
+/// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for reads and
+/// written by no one meanwhile.
+pub(crate) unsafe fn forward_raw(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    xin: *const f64,
+    ft: &mut [f64],
+) -> usize {
     let n = rec.len();
     let nb = lanes.tau.len();
     assert!(rec.padded());
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(xin.len() >= nb * p && ft.len() >= (n + isa.lanes()) * p);
+    assert!(ft.len() >= (n + isa.lanes()) * p);
     assert!(isa.is_supported());
-    // SAFETY: lengths checked above, instruction set checked by is_supported.
+    lanes.assert_rows_apart(p);
+    // SAFETY: lengths checked above, rows by the caller, instruction set checked by
+    // is_supported.
     unsafe {
         match (isa, p) {
             #[cfg(target_arch = "x86_64")]
@@ -1003,14 +1050,7 @@ pub(crate) unsafe fn inverse_raw(
     assert!(rec.padded());
     assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
     assert!(fin.len() >= n * p && isa.is_supported());
-    // Rows that never overlap: consecutive, the two rows of a pair side by side, or
-    // (half-major) the second rows of all `nb / 2` pairs after the first rows.
-    let (ps, gap) = (lanes.pair_stride, lanes.row_gap);
-    assert!(ps == 0 || lanes.interleaved);
-    assert!(gap == 0 || ps > 0);
-    assert!(gap > 0 || ps == 0 || ps >= 2 * p);
-    assert!(gap == 0 || (ps >= p && (gap == p || gap >= nb / 2 * ps)));
-    assert!(gap != p || ps >= 2 * p);
+    lanes.assert_rows_apart(p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe {
@@ -1208,6 +1248,47 @@ mod tests {
             stream: true,
             pair_stride: 0,
             row_gap: 0,
+        }
+    }
+
+    /// The forward reading its rows in the split layout (`Lanes::pair_stride` = `P`, the
+    /// mirror rows `Lanes::row_gap` after the low-beta rows; a forward chain's buffers)
+    /// gives the sums it gives from consecutive rows, bit for bit: every instruction set,
+    /// 8 and 16 columns.
+    #[test]
+    fn split_rows_give_the_same_sums() {
+        let b = 40;
+        for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
+            let n = b - m;
+            let nbs = 48;
+            let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+            let rec = Rec::new(&rc, n);
+            for pw in [8usize, 16] {
+                let x = pseudo(nbs * pw, 11 + m as u64);
+                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                    if !isa.is_supported() {
+                        continue;
+                    }
+                    let mut lanes = grid_lanes(&tau, &p, &sc, nbs / 2);
+                    let mut want = vec![0.0; (n + 8) * pw];
+                    forward(isa, pw, &rec, &lanes, &x, &mut want);
+                    // Low-beta rows from 5 values in, mirror rows 3 values after them;
+                    // NaN everywhere else.
+                    let gap = nbs / 2 * pw + 3;
+                    let mut z = vec![f64::NAN; 5 + gap + nbs / 2 * pw];
+                    for r in 0..nbs {
+                        let at = 5 + (r / 2) * pw + (r % 2) * gap;
+                        z[at..at + pw].copy_from_slice(&x[r * pw..(r + 1) * pw]);
+                    }
+                    (lanes.pair_stride, lanes.row_gap) = (pw, gap);
+                    let mut f = vec![0.0; (n + 8) * pw];
+                    // SAFETY: every row of the lanes is inside `z`.
+                    unsafe { forward_raw(isa, pw, &rec, &lanes, z.as_ptr().add(5), &mut f) };
+                    for (i, (u, v)) in f[..n * pw].iter().zip(&want).enumerate() {
+                        assert_eq!(u.to_bits(), v.to_bits(), "{isa:?} P={pw} m={m} at {i}");
+                    }
+                }
+            }
         }
     }
 

@@ -222,15 +222,19 @@ struct Pass {
     /// The last chunk of the transform's last group: after this call the forward's
     /// coefficients of the cluster are final.
     done: bool,
-    /// The buffer of the group's next chunk, if any: the next call is this cluster on it,
-    /// so that is what to prefetch (forward: this cluster's block there; inverse:
-    /// nothing, its coefficient rows are kept).
-    next_buf: Option<SyncPtr<f64>>,
+    /// The buffer of the group's next chunk and its gap (see `gap`), if any: the next
+    /// call is this cluster on it, so that is what to prefetch (forward: this cluster's
+    /// block there; inverse: nothing, its coefficient rows are kept).
+    next_buf: Option<(SyncPtr<f64>, usize)>,
     /// Inverse: write the blocks with non-temporal stores and half-major (the group's
     /// blocks are too large to stay in the cache until the FFT stage reads them, see
     /// [`plain_store_limit`] and `plan/blocks.rs`).
     stream: bool,
-    /// Half-major: doubles from the chunk buffer's low-beta half to its mirror half.
+    /// Forward: the group's buffers are split in two cluster-major halves (the forward's
+    /// chain, see [`Plan::forward_chain`] and `plan/blocks.rs`).
+    split: bool,
+    /// Half-major or split: doubles from the chunk buffer's low-beta half to its mirror
+    /// half.
     gap: usize,
 }
 
@@ -291,11 +295,12 @@ impl Chunk {
 /// groups that way). A forward may
 /// likewise put the buffers of a group in the input slices of earlier groups (already
 /// read), and adds each cluster's sums over the group's chunks to the coefficients once
-/// (6 groups of the 22 chunks at B = 512).
+/// (the real forward of real samples).
 ///
-/// An inverse of the complex layout goes further: its buffers are half-major (see
-/// `plan/blocks.rs`), so one can live in the low-beta and the mirror slices of another
-/// chunk, and all chunks run as one group (see [`Plan::inverse_chain`]).
+/// Where the buffers fit, both go further: a buffer in two halves (half-major for the
+/// inverse, two cluster-major halves for the forward, see `plan/blocks.rs`) can live in
+/// the low-beta and the mirror slices of one other chunk, and all chunks run as one group
+/// (see [`Plan::inverse_chain`], [`Plan::forward_chain`]).
 struct Spare {
     /// Start of the array (`2B` slices of `slice_bytes`, beta slowest).
     base: *mut u8,
@@ -826,6 +831,11 @@ impl Plan {
         forward: bool,
         spare: Option<&Spare>,
     ) -> (Vec<Vec<(Chunk, Option<(*mut f64, usize)>)>>, bool) {
+        if let (true, Some(sp)) = (forward, spare) {
+            if let Some(g) = self.forward_chain(t, sp) {
+                return (vec![g], true);
+            }
+        }
         // Only where the blocks would not stay in the cache anyway: the chain's buffers
         // are half-major, written with non-temporal stores.
         let chunks = self.chunks(t).count();
@@ -882,6 +892,34 @@ impl Plan {
                 None => None,
             };
             group.push((*ch, place));
+        }
+        Some(group)
+    }
+
+    /// The chunks of a forward that may overwrite its input as one group, in their
+    /// order from the poles: chunk 0 in the plan's buffer, each later chunk's buffer
+    /// split in two cluster-major halves (see `plan/blocks.rs`) in the low-beta and the
+    /// mirror input slices of the chunk before it, which that chunk's FFT stage has read
+    /// already. Every cluster's sums then reach the coefficients once (B = 512 under the
+    /// 5% memory rule: 6 groups of the 22 chunks before). `None` with fewer than two
+    /// chunks, or if a half does not fit (the real layout: its rows per lane are longer
+    /// than a real slice).
+    #[allow(clippy::type_complexity)]
+    fn forward_chain(
+        &self,
+        t: &Blocks,
+        spare: &Spare,
+    ) -> Option<Vec<(Chunk, Option<(*mut f64, usize)>)>> {
+        let chunks: Vec<Chunk> = self.chunks(t).collect();
+        if chunks.len() < 2 {
+            return None;
+        }
+        // Every block has room for `t.lanes` rows, the chunk's own or not.
+        let half = 8 * (t.total() / 2);
+        let mut group = vec![(chunks[0], None)];
+        for k in 1..chunks.len() {
+            let (a, b) = spare.halves(self.b, &chunks[k - 1], half)?;
+            group.push((chunks[k], Some((a, (b as usize - a as usize) / 8))));
         }
         Some(group)
     }
@@ -955,8 +993,8 @@ impl Plan {
     /// holds fewer betas than the grid (see [`Plan::workspace_bytes`]) keeps the buffers
     /// of later chunks in the input slices it has read already and adds each cluster's
     /// sums to the coefficients once per group of chunks instead of once per chunk: at
-    /// B = 512 under the 5% memory rule 6 groups instead of 22 chunks. Same memory, same
-    /// results up to rounding.
+    /// B = 512 under the 5% memory rule once instead of 22 times (all chunks in one
+    /// group). Same memory, same results up to rounding.
     pub fn forward_destroying_input(
         &self,
         samples: &mut [Complex64],
@@ -991,7 +1029,7 @@ impl Plan {
             true,
             &self.blocks,
             spare,
-            |ch, buf, _| self.fft_chunk(ch, true, input.get(), buf, None),
+            |ch, buf, half| self.fft_chunk(ch, true, input.get(), buf, half),
             |sc, at, ch, buf, pass| unsafe {
                 self.forward_cluster(
                     sc,
@@ -1061,12 +1099,14 @@ impl Plan {
                 .collect();
             self.pool().install(|| {
                 for (gi, group) in groups.iter().enumerate() {
-                    // The chain's buffers are in two pieces: half-major only.
+                    // The chains' buffers are in two pieces: the inverse's half-major, the
+                    // forward's split.
                     let stream = !forward && (chained || self.streams_blocks(group.len()));
+                    let split = forward && chained;
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
                         for (ch, buf, gap) in group {
-                            fft(ch, buf.get(), stream.then_some(*gap))?;
+                            fft(ch, buf.get(), (stream || split).then_some(*gap))?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
@@ -1082,8 +1122,9 @@ impl Plan {
                                 k,
                                 last: k + 1 == group.len(),
                                 done: gi + 1 == groups.len() && k + 1 == group.len(),
-                                next_buf: group.get(k + 1).map(|g| g.1),
+                                next_buf: group.get(k + 1).map(|g| (g.1, g.2)),
                                 stream,
+                                split,
                                 gap: *gap,
                             };
                             cluster(sc, at, ch, buf.get(), pass);
@@ -1213,11 +1254,38 @@ mod tests {
                 base: out.as_ptr().wrapping_add(8) as *mut u8,
                 slice_bytes,
             };
-            // The forward's groups: buffers in the slices of earlier groups only.
-            let (split, chained) = plan.chunk_groups(t, true, Some(&spare));
-            assert!(!chained);
+            let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
+            // A chain's buffer halves `(a, gap)` of `half` bytes each: 64-byte aligned,
+            // in the low-beta and the mirror slices of chunk `host`.
+            let in_slices = |host: super::Chunk, (a, gap): (*mut f64, usize), half: usize| {
+                let a = a as usize - spare.base as usize;
+                let m = a + 8 * gap;
+                assert_eq!((spare.base as usize + a) % 64, 0);
+                assert_eq!((spare.base as usize + m) % 64, 0);
+                assert!(a >= host.lo * slice_bytes);
+                let low_end = (host.lo + host.h) * slice_bytes;
+                assert!(a + half <= low_end, "B={b}: low half");
+                assert!(m >= (2 * b - host.lo - host.h) * slice_bytes);
+                let mirror_end = (2 * b - host.lo) * slice_bytes;
+                assert!(m + half <= mirror_end, "B={b}: mirror half");
+            };
+            // The complex forward's chain: one group in the chunks' order, chunk 0 in the
+            // plan's buffer, each other buffer's halves in the slices of the chunk before
+            // it (read by then). The real layout's do not fit in real slices.
+            let (chain, chained) = plan.chunk_groups(t, true, Some(&spare));
+            assert_eq!(chained, !real, "B={b} real={real}: forward chain");
+            if chained {
+                assert_eq!(chain.len(), 1);
+                let g = &chain[0];
+                let order: Vec<_> = g.iter().map(|(c, _)| (c.lo, c.h)).collect();
+                assert_eq!(order, chunks);
+                assert!(g[0].1.is_none());
+                for k in 1..g.len() {
+                    in_slices(g[k - 1].0, g[k].1.unwrap(), 8 * (t.total() / 2));
+                }
+            }
+            // Otherwise: buffers in the slices of earlier groups only.
             let groups = plan.chunk_groups_whole(t, true, Some(&spare));
-            assert_eq!(split.len(), groups.len());
             let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
             assert_eq!(
                 flat,
@@ -1248,7 +1316,6 @@ mod tests {
                     assert!(low || high, "B={b}: forward buffer outside the read slices");
                 }
             }
-            let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
             assert!(!plan.chunk_groups(t, false, Some(&spare)).1);
             // Blocks too large for the cache (every limit below theirs): the complex
             // inverse runs as one group, equator first, each buffer's halves in the
@@ -1272,23 +1339,7 @@ mod tests {
                 assert_eq!(order, chunks.iter().rev().copied().collect::<Vec<_>>());
                 assert!(g.last().unwrap().1.is_none());
                 for (i, (ch, p)) in g[..g.len() - 1].iter().enumerate() {
-                    let next = g[i + 1].0;
-                    let (a, gap) = p.unwrap();
-                    let half = 8 * t.half_len(ch.hp);
-                    let a = a as usize - spare.base as usize;
-                    let m = a + 8 * gap;
-                    assert_eq!((spare.base as usize + a) % 64, 0);
-                    assert_eq!((spare.base as usize + m) % 64, 0);
-                    assert!(a >= next.lo * slice_bytes);
-                    assert!(
-                        a + half <= (next.lo + next.h) * slice_bytes,
-                        "B={b}: low half"
-                    );
-                    assert!(m >= (2 * b - next.lo - next.h) * slice_bytes);
-                    assert!(
-                        m + half <= (2 * b - next.lo) * slice_bytes,
-                        "B={b}: mirror half"
-                    );
+                    in_slices(g[i + 1].0, p.unwrap(), 8 * t.half_len(ch.hp));
                 }
                 continue;
             }

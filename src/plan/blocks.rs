@@ -22,6 +22,11 @@
 //! the low-beta and the mirror slices of another chunk of the output (see `Spare` in
 //! `plan.rs`).
 //!
+//! A forward allowed to overwrite its input splits its buffers the same way but keeps
+//! them cluster-major within each half ([`Blocks::split_offset`]): its kernel reads a
+//! block at a time, `P` doubles per row, low-beta rows from one half and mirror rows from
+//! the other.
+//!
 //! Slot `q` of cluster `c` holds the value of order pair `(M, M')` at the row's beta, or,
 //! for a "reversed" member (see `symmetry.rs`), at the mirrored beta `pi - beta`: `fi[8c+q]`
 //! is where that value sits in a transformed slice, and bit `q` of `rev[c]` says whether it
@@ -185,6 +190,13 @@ impl Blocks {
     /// block.
     pub fn half_offset(&self, c: usize) -> usize {
         self.pofs[c]
+    }
+
+    /// Split layout (a chained forward's, see `Plan::forward_chain`): offset (in doubles)
+    /// of cluster `c`'s low-beta rows within the low-beta half, and of its mirror rows
+    /// within the mirror half: each half is cluster-major, `t.total() / 2` doubles.
+    pub fn split_offset(&self, c: usize) -> usize {
+        self.pofs[c] * (self.lanes / 2)
     }
 
     /// Half-major layout: doubles of one half for `pairs` pairs of rows.

@@ -161,40 +161,72 @@ impl Plan {
         }
     }
 
-    /// The block of cluster `c` in the chunk buffer `buf` of layout `t`, as a slice of
-    /// the chunk's lanes.
-    ///
-    /// # Safety
-    /// `buf` is a chunk buffer of layout `t`; the caller owns the block.
-    pub(super) unsafe fn block<'a>(
-        &self,
+    /// Where cluster `c`'s block starts in the chunk buffer `buf` of layout `t`: its rows
+    /// one after another, or in the split layout (`split = Some(gap)`, see
+    /// `plan/blocks.rs`) its low-beta rows, its mirror rows `gap` doubles further.
+    pub(super) fn block_at(t: &Blocks, buf: *mut f64, c: usize, split: Option<usize>) -> *mut f64 {
+        match split {
+            None => buf.wrapping_add(t.offset(c)),
+            Some(_) => buf.wrapping_add(t.split_offset(c)),
+        }
+    }
+
+    /// Prefetch hints for cluster `c`'s block of `lanes` rows in `buf` (see
+    /// [`Plan::block_at`]): one range, or the two halves of the split layout.
+    fn push_block(
+        pf: &mut Prefetch,
         t: &Blocks,
         buf: *mut f64,
         c: usize,
-        ch: &Chunk,
-    ) -> &'a mut [f64] {
-        let p = t.p(c);
-        std::slice::from_raw_parts_mut(buf.add(t.offset(c)), ch.lanes() * p)
+        lanes: usize,
+        split: Option<usize>,
+    ) {
+        let (x, p) = (Self::block_at(t, buf, c, split) as *const f64, t.p(c));
+        match split {
+            None => pf.push(x, lanes * p),
+            Some(gap) => {
+                pf.push(x, lanes / 2 * p);
+                pf.push(x.wrapping_add(gap), lanes / 2 * p);
+            }
+        }
     }
 
-    /// Zero the padding rows of a block (lanes `h..hp` of each half, rows `2h..2hp`),
-    /// which the FFT stage does not write: the forward kernel multiplies them by exact
-    /// zeros, which must not meet a stale non-finite value.
-    pub(super) fn zero_padding(blk: &mut [f64], p: usize, ch: &Chunk) {
-        blk[2 * ch.h * p..2 * ch.hp * p].fill(0.0);
+    /// Zero the padding rows of a block at `x` (lanes `h..hp` of each half: rows
+    /// `2h..2hp`, or in the split layout rows `h..hp` of each half), which the FFT stage
+    /// does not write: the forward kernel multiplies them by exact zeros, which must not
+    /// meet a stale non-finite value.
+    ///
+    /// # Safety
+    /// `x` is a block of `ch.lanes()` rows of `p` doubles (see [`Plan::block_at`]) that
+    /// the caller owns.
+    pub(super) unsafe fn zero_padding(x: *mut f64, p: usize, ch: &Chunk, split: Option<usize>) {
+        let pad = (ch.hp - ch.h) * p;
+        match split {
+            None => std::ptr::write_bytes(x.add(2 * ch.h * p), 0, 2 * pad),
+            Some(gap) => {
+                for half in [x, x.add(gap)] {
+                    std::ptr::write_bytes(half.add(ch.h * p), 0, pad);
+                }
+            }
+        }
     }
 
-    /// The forward kernel on `xin` (a block) into `sc.out`: degree `i` of column `q` (the
-    /// real or imaginary part of a slot) at `i * p + q`.
+    /// The forward kernel on the block at `x` (see [`Plan::block_at`]) into `sc.out`:
+    /// degree `i` of column `q` (the real or imaginary part of a slot) at `i * p + q`.
     /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
     /// Returns the kernel's `lo`: rows below it are zero.
-    pub(super) fn run_forward(
+    ///
+    /// # Safety
+    /// `x` is a block of `ch.lanes()` rows of `p` doubles that no one writes meanwhile.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn run_forward(
         &self,
         sc: &mut Scratch,
         ch: &Chunk,
         p: usize,
         n: usize,
-        xin: &[f64],
+        x: *const f64,
+        split: Option<usize>,
         next: Prefetch,
     ) -> usize {
         let mut out = Scratch::take(&mut sc.out, (n + 8) * p, (self.b + 8) * 16);
@@ -202,13 +234,17 @@ impl Plan {
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.prefetch = next;
-        let lo = dwt::forward(self.isa, p, &rec, &lanes, xin, f);
+        if let Some(gap) = split {
+            (lanes.pair_stride, lanes.row_gap) = (p, gap);
+        }
+        let lo = dwt::forward_raw(self.isa, p, &rec, &lanes, x, f);
         sc.out = out;
         lo
     }
 
     /// What the cluster after `at` in layout `t` will touch: its block of the chunk buffer
-    /// (with `block`) and its coefficient rows (`members` of it) from degree `from_l`
+    /// (with `block = Some(split)`, see [`Plan::block_at`]) and its coefficient rows
+    /// (`members` of it) from degree `from_l`
     /// less a margin, as prefetch hints (never read through these pointers). Rows below
     /// the first degree some beta of the chunk needs are not touched (see
     /// [`dwt::forward`]); `from_l` guesses that degree from the previous cluster.
@@ -219,16 +255,15 @@ impl Plan {
         buf: *mut f64,
         at: &At,
         ch: &Chunk,
-        block: bool,
+        block: Option<Option<usize>>,
         coef: *const Complex64,
         members: Members,
         from_l: usize,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
         if let Some(cl) = &at.next {
-            if block {
-                let lanes = ch.lanes() * t.p(at.c + 1);
-                pf.push(buf.wrapping_add(t.offset(at.c + 1)) as *const f64, lanes);
+            if let Some(split) = block {
+                Self::push_block(&mut pf, t, buf, at.c + 1, ch.lanes(), split);
             }
             // Neighbouring clusters need similar degrees; a few below the guess cover
             // the drift from one to the next.
@@ -269,25 +304,25 @@ impl Plan {
         let (c, cl) = (at.c, &at.cl);
         let n = self.setup(sc, cl, ch, pass.k == 0);
         let p = t.p(c);
-        let blk = self.block(t, buf, c, ch);
-        Self::zero_padding(blk, p, ch);
+        let split = pass.split.then_some(pass.gap);
+        let x = Self::block_at(t, buf, c, split);
+        Self::zero_padding(x, p, ch, split);
         let next = match pass.next_buf {
             // Within a group: this cluster's block in the next chunk.
-            Some(nb) => {
+            Some((nb, gap)) => {
                 let mut pf = Prefetch::none();
-                pf.push(
-                    nb.get().wrapping_add(t.offset(c)) as *const f64,
-                    ch.lanes() * p,
-                );
+                let split = pass.split.then_some(gap);
+                Self::push_block(&mut pf, t, nb.get(), c, ch.lanes(), split);
                 pf
             }
             None => {
                 // The first group writes every row of the coefficients.
                 let from_l = if pass.first { 0 } else { sc.from_l };
-                self.next_cluster(t, buf, at, ch, true, coef.get(), members, from_l)
+                let block = Some(split);
+                self.next_cluster(t, buf, at, ch, block, coef.get(), members, from_l)
             }
         };
-        let lo = self.run_forward(sc, ch, p, n, blk, next).min(n);
+        let lo = self.run_forward(sc, ch, p, n, x, split, next).min(n);
         sc.from_l = cl.l0() + lo;
         let (sums, lo) = if pass.k == 0 && pass.last {
             (&sc.out, lo)
@@ -383,7 +418,7 @@ impl Plan {
         if pass.next_buf.is_none() {
             let from_l = sc.from_l;
             lanes.prefetch =
-                self.next_cluster(t, buf, at, ch, false, coef.as_ptr(), members, from_l);
+                self.next_cluster(t, buf, at, ch, None, coef.as_ptr(), members, from_l);
         }
         let mut lo = n;
         let mut have = if k == 0 { n } else { sc.have };

@@ -36,8 +36,9 @@ pub(super) fn scratch_len(b: usize) -> usize {
 
 impl Plan {
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
-    /// from `buf` (half-major with `half = Some(gap)`, the doubles from its low-beta half
-    /// to its mirror half, see `plan/blocks.rs`) into `grid`.
+    /// from `buf` into `grid`. With `half = Some(gap)` (the doubles from the buffer's
+    /// low-beta half to its mirror half) the buffer is split in two halves, see
+    /// `plan/blocks.rs`: cluster-major halves (forward) or half-major (inverse).
     pub(super) fn fft_chunk(
         &self,
         ch: &Chunk,
@@ -165,7 +166,7 @@ impl Plan {
                 fft.in_place(dst.get());
             }
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                scatter_group(&self.blocks, s, w, false, b.get(), j0, c0..c1)
+                scatter_group(&self.blocks, s, w, false, b.get(), half, j0, c0..c1)
             });
         } else {
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
@@ -240,12 +241,14 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SyncPtr<Complex64>], write:
 /// # Safety
 /// `s` are valid for every index in the slot tables; `buf` holds the blocks of `t`,
 /// 64-byte aligned, and nobody else writes these rows.
+#[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter_group(
     t: &Blocks,
     s: &[SyncPtr<Complex64>],
     w: &[f64],
     conj: bool,
     buf: *mut f64,
+    split: Option<usize>,
     j0: usize,
     cs: std::ops::Range<usize>,
 ) {
@@ -264,12 +267,17 @@ pub(super) unsafe fn scatter_group(
         }
         let p = t.p(c);
         let rev = t.rev[c];
+        // Where the group's first row goes: in the block, or in the split layout's
+        // low-beta half.
+        let dst = match split {
+            None => buf.add(t.offset(c) + 2 * j0 * p),
+            Some(_) => buf.add(t.split_offset(c) + j0 * p),
+        };
         if t.regular[c] {
             // The common case (`Blocks::regular`), written out.
-            let dst = buf.add(t.offset(c) + 2 * j0 * p);
             match p {
-                16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst),
-                _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst),
+                16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst, split),
+                _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst, split),
             }
             continue;
         }
@@ -290,9 +298,24 @@ pub(super) unsafe fn scatter_group(
                 rows[rb + 1] = b.im * wi[2 * jj + 1];
             }
         }
-        stream_rows(buf.add(t.offset(c) + 2 * j0 * p), &rows[..ns * p]);
+        store_rows(dst, &rows[..ns * p], p, split);
     }
     fence();
+}
+
+/// Store the rows of a group of pairs (low-beta row and mirror row of each pair in turn)
+/// at `dst`: consecutive, or with `split = Some(gap)` the low-beta rows one after another
+/// at `dst` and the mirror rows `gap` doubles further.
+#[inline(always)]
+unsafe fn store_rows(dst: *mut f64, rows: &[f64], p: usize, split: Option<usize>) {
+    match split {
+        None => stream_rows(dst, rows),
+        Some(gap) => {
+            for (k, row) in rows.chunks_exact(p).enumerate() {
+                stream_rows(dst.add((k / 2) * p + (k % 2) * gap), row);
+            }
+        }
+    }
 }
 
 /// Clusters ahead whose rows [`gather_group`] prefetches in the cluster-major layout
@@ -426,6 +449,7 @@ unsafe fn scatter_regular<const S: usize>(
     w: &[f64],
     conj: bool,
     dst: *mut f64,
+    split: Option<usize>,
 ) {
     let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
     let (h, ns) = (S / 2, sp.len());
@@ -446,9 +470,11 @@ unsafe fn scatter_regular<const S: usize>(
             *z = z.conj();
         }
     }
-    stream_rows(
+    store_rows(
         dst,
         std::slice::from_raw_parts(rows.as_ptr() as *const f64, ns * 2 * S),
+        2 * S,
+        split,
     );
 }
 
@@ -544,7 +570,7 @@ mod speed {
                     .fold(f64::INFINITY, f64::min)
             };
             let bp = buf.as_mut_ptr() as *mut f64;
-            let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, 0, 0..t.len()) });
+            let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, None, 0, 0..t.len()) });
             // The gather as a large inverse runs it (half-major); the scatter's blocks are
             // only a source of values here.
             let half = Some(t.total() / 2);

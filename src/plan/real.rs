@@ -172,7 +172,7 @@ impl Plan {
             true,
             t,
             spare,
-            |ch, buf, _| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, None),
+            |ch, buf, half| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, half),
             |sc, at, ch, buf, pass| unsafe {
                 // The chunks accumulate the representatives only (half the coefficient
                 // traffic per chunk); the last one also writes their partners.
@@ -213,7 +213,8 @@ impl Plan {
     /// FFT stage of one chunk for real data (see the module documentation), one mirrored
     /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
     /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
-    /// into `grid` (c2r), reading the blocks half-major with `half = Some(gap)` (see `plan/blocks.rs`).
+    /// into `grid` (c2r); with `half = Some(gap)` the buffer is split in two halves (see
+    /// [`Plan::fft_chunk`]).
     fn fft_chunk_real(
         &self,
         ch: &Chunk,
@@ -261,6 +262,7 @@ impl Plan {
                             &[self.wq[k0], self.wq[k1]],
                             true,
                             buf.get(),
+                            half,
                             j,
                             0..t.len(),
                         );
