@@ -243,9 +243,11 @@ static void memory_estimate(void) {
 /* A workspace cap of 1 byte gives the smallest chunks (8 beta pairs, 5 chunks at B = 36):
  * the transforms then run chunk groups that keep their buffers in the caller's arrays
  * (inverse: in output slices not yet written; forward with SO3FFT_DESTROY_INPUT: in input
- * slices already read; the Rust unit test chunk_groups_keep_clear_of_written_slices checks
- * that this B and cap form such groups). The round trip must still give the coefficients
- * back, complex and real, and the forward without the flag must leave its input alone. */
+ * slices already read, complex and real alike chained in one group; the Rust unit tests
+ * chunk_groups_keep_clear_of_written_slices and real_parts_forward_chains_and_matches
+ * check that this B and cap form such groups). The round trip must still give the
+ * coefficients back, complex and real, and the forward without the flag must leave its
+ * input alone. */
 static void capped_workspace(void) {
     const int B = 36;
     size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B);

@@ -93,8 +93,9 @@
  * the forward then keeps its later chunk buffers in the sample slices it has already
  * read and adds to the coefficients once per group of chunks instead of once per chunk
  * (at B = 512 under the default memory rule: one pass over the coefficients instead of
- * 22; with `SO3FFT_REAL` and its real layout in the complex samples as well). No extra memory; the same results up to rounding. Concurrent forwards with such
- * a plan need distinct input arrays. The inverse never reads its output and never
+ * one per chunk: 22 of them, fewer with `SO3FFT_REAL`, whose chunks are larger). No
+ * extra memory; the same results up to rounding. Concurrent forwards with such a plan
+ * need distinct input arrays. The inverse never reads its output and never
  * modifies its input. (Earlier builds accepted this flag and ignored it.)
  */
 #define SO3FFT_DESTROY_INPUT 16

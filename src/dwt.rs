@@ -86,13 +86,13 @@ pub(crate) struct Lanes<'a> {
     /// Inverse: write the output with non-temporal stores (for outputs far larger than
     /// the caches, read back only later; ordinary stores would first read every line).
     pub stream: bool,
-    /// Inverse, interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the
-    /// output to the next; row `r` is at `(r / 2) * pair_stride + (r % 2) * row_gap`. 0
-    /// means `2P`, rows one after another.
+    /// Interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the inverse's
+    /// output or the forward's input (`forward_raw`) to the next; row `r` is at
+    /// `(r / 2) * pair_stride + (r % 2) * row_gap`. 0 means `2P`, rows one after another.
     pub pair_stride: usize,
-    /// Inverse, with `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`,
-    /// side by side). Far larger in the half-major layout of `plan/blocks.rs`, where the
-    /// low-beta rows and the mirror rows are in two separate halves.
+    /// With `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`, side by
+    /// side). Far larger in the half-major and split layouts of `plan/blocks.rs`, where
+    /// the low-beta rows and the mirror rows are in two separate halves.
     pub row_gap: usize,
 }
 

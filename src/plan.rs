@@ -226,6 +226,9 @@ struct Pass {
     /// call is this cluster on it, so that is what to prefetch (forward: this cluster's
     /// block there; inverse: nothing, its coefficient rows are kept).
     next_buf: Option<(SyncPtr<f64>, usize)>,
+    /// The group's first chunk, its buffer and gap: after the group's last chunk the next
+    /// call is the next cluster on that one (the forward prefetches its block there).
+    head: (Chunk, SyncPtr<f64>, usize),
     /// Inverse: write the blocks with non-temporal stores and half-major (the group's
     /// blocks are too large to stay in the cache until the FFT stage reads them, see
     /// [`plain_store_limit`] and `plan/blocks.rs`).
@@ -258,7 +261,8 @@ impl<T> SyncPtr<T> {
 /// `j < h` is beta `lo + j` and lane `hp + j` its mirror `2B-1-lo-j` (the upper half runs
 /// down). In the blocks of the chunk buffer the two are adjacent rows `2j` and `2j+1`
 /// (`dwt::Lanes::interleaved`), so the FFT stage moves each mirrored pair of slices in
-/// and out of one contiguous piece of every block.
+/// and out of one contiguous piece of every block; in the split and half-major layouts
+/// (`plan/blocks.rs`) row `2j` is in one half and row `2j+1` in the other.
 #[derive(Clone, Copy)]
 struct Chunk {
     lo: usize,
@@ -1123,6 +1127,7 @@ impl Plan {
                                 last: k + 1 == group.len(),
                                 done: gi + 1 == groups.len() && k + 1 == group.len(),
                                 next_buf: group.get(k + 1).map(|g| (g.1, g.2)),
+                                head: group[0],
                                 stream,
                                 split,
                                 gap: *gap,
@@ -1485,6 +1490,45 @@ mod tests {
                         .fold(0.0f64, f64::max);
                     assert!(e < 1e-12, "B={b} real={real}: round trip {e:.2e}");
                 }
+            }
+        }
+    }
+
+    /// A real plan's forward on the real parts of complex samples that may overwrite them
+    /// (the C API's `SO3FFT_REAL | SO3FFT_DESTROY_INPUT`): its real layout fits in complex
+    /// slices, so the chunks chain (split buffers in the slices read already); the
+    /// coefficients match the forward that leaves its input alone.
+    #[test]
+    fn real_parts_forward_chains_and_matches() {
+        use num_complex::Complex64;
+        for (b, cap) in [(36usize, 1usize), (37, 1), (20, 500_000)] {
+            let opts = super::PlanOptions {
+                max_workspace_bytes: Some(cap),
+                real: true,
+                threads: 2,
+                ..Default::default()
+            };
+            let plan = super::Plan::new(b, &opts).unwrap();
+            let t = plan.blocks_real.as_ref().unwrap();
+            let mut samples: Vec<Complex64> = (0..plan.num_samples())
+                .map(|i| {
+                    let x = ((i * 7919) % 1009) as f64 / 1009.0 - 0.5;
+                    Complex64::new(x, 0.25 - x)
+                })
+                .collect();
+            let spare = super::Spare::over(samples.as_mut_ptr(), b);
+            assert!(
+                plan.chunk_groups(t, true, Some(&spare)).1,
+                "B={b}: no chain"
+            );
+            let mut want = vec![Complex64::new(f64::NAN, 0.0); plan.num_coeffs()];
+            plan.forward_real_parts(&samples, &mut want).unwrap();
+            let mut got = vec![Complex64::new(f64::NAN, 0.0); plan.num_coeffs()];
+            plan.forward_real_parts_destroying_input(&mut samples, &mut got)
+                .unwrap();
+            let scale = want.iter().map(|z| z.norm()).fold(0.0f64, f64::max);
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).norm() <= 1e-13 * scale, "B={b}: {g} against {w}");
             }
         }
     }

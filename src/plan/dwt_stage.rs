@@ -316,10 +316,13 @@ impl Plan {
                 pf
             }
             None => {
-                // The first group writes every row of the coefficients.
+                // The first group writes every row of the coefficients. The next cluster
+                // starts on the group's first chunk.
                 let from_l = if pass.first { 0 } else { sc.from_l };
-                let block = Some(split);
-                self.next_cluster(t, buf, at, ch, block, coef.get(), members, from_l)
+                let (hch, hbuf, hgap) = pass.head;
+                let block = Some(pass.split.then_some(hgap));
+                let c = coef.get();
+                self.next_cluster(t, hbuf.get(), at, &hch, block, c, members, from_l)
             }
         };
         let lo = self.run_forward(sc, ch, p, n, x, split, next).min(n);

@@ -4,8 +4,8 @@
 //! Forward: the slices of a group of pairs (`beta` and `pi - beta`) are copied into the
 //! worker's cache-resident scratch (rows padded, see [`fft::slice_stride`]), transformed in
 //! place, and moved, weighted, into the rows of every cluster's block (`blocks.rs`): the
-//! group fills `2g` adjacent rows of each block completely, written as whole cache lines
-//! with non-temporal stores. Inverse: those rows of every block are read back into the
+//! group fills `2g` adjacent rows of each block completely (in the split layout `g` rows
+//! of each half), written as whole cache lines with non-temporal stores. Inverse: those rows of every block are read back into the
 //! slices, which are transformed in place and streamed to the samples. Small slices move
 //! in groups of up to 4 pairs (one longer piece of each block per group), larger ones a
 //! pair at a time, which keeps the slices' random accesses in L2. The groups are spread
@@ -232,8 +232,10 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SyncPtr<Complex64>], write:
     let _ = (t, c, sp, write);
 }
 
-/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, adjacent) of the blocks of
-/// clusters `cs` from the transformed slices `s` (beta, then pi - beta, for each pair),
+/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, adjacent, or with
+/// `split = Some(gap)` in the two halves of the split layout, see `plan/blocks.rs`) of the
+/// blocks of clusters `cs` from the transformed slices `s` (beta, then pi - beta, for each
+/// pair),
 /// scaled by their weights `w` (and conjugated with `conj`): the first row of a pair
 /// takes each slot from its own slice, the second from the other one; reversed slots the
 /// other way round. Unused slots are zero.
