@@ -1251,45 +1251,51 @@ mod tests {
         }
     }
 
+    /// The cases of the row-layout tests: B = 40, three base pairs, 48 betas over the
+    /// grid, 8 and 16 columns, every supported instruction set, as
+    /// `f(isa, columns, m, rec, lanes)` (interleaved lanes, default skip threshold).
+    fn layout_cases(mut f: impl FnMut(Isa, usize, usize, &Rec, Lanes)) {
+        let (b, nbs) = (40, 48);
+        for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
+            let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+            let rec = Rec::new(&rc, b - m);
+            for pw in [8usize, 16] {
+                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                    if isa.is_supported() {
+                        f(isa, pw, m, &rec, grid_lanes(&tau, &p, &sc, nbs / 2));
+                    }
+                }
+            }
+        }
+    }
+
     /// The forward reading its rows in the split layout (`Lanes::pair_stride` = `P`, the
     /// mirror rows `Lanes::row_gap` after the low-beta rows; a forward chain's buffers)
     /// gives the sums it gives from consecutive rows, bit for bit: every instruction set,
     /// 8 and 16 columns.
     #[test]
     fn split_rows_give_the_same_sums() {
-        let b = 40;
-        for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
-            let n = b - m;
-            let nbs = 48;
-            let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
-            let rec = Rec::new(&rc, n);
-            for pw in [8usize, 16] {
-                let x = pseudo(nbs * pw, 11 + m as u64);
-                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
-                    if !isa.is_supported() {
-                        continue;
-                    }
-                    let mut lanes = grid_lanes(&tau, &p, &sc, nbs / 2);
-                    let mut want = vec![0.0; (n + 8) * pw];
-                    forward(isa, pw, &rec, &lanes, &x, &mut want);
-                    // Low-beta rows from 5 values in, mirror rows 3 values after them;
-                    // NaN everywhere else.
-                    let gap = nbs / 2 * pw + 3;
-                    let mut z = vec![f64::NAN; 5 + gap + nbs / 2 * pw];
-                    for r in 0..nbs {
-                        let at = 5 + (r / 2) * pw + (r % 2) * gap;
-                        z[at..at + pw].copy_from_slice(&x[r * pw..(r + 1) * pw]);
-                    }
-                    (lanes.pair_stride, lanes.row_gap) = (pw, gap);
-                    let mut f = vec![0.0; (n + 8) * pw];
-                    // SAFETY: every row of the lanes is inside `z`.
-                    unsafe { forward_raw(isa, pw, &rec, &lanes, z.as_ptr().add(5), &mut f) };
-                    for (i, (u, v)) in f[..n * pw].iter().zip(&want).enumerate() {
-                        assert_eq!(u.to_bits(), v.to_bits(), "{isa:?} P={pw} m={m} at {i}");
-                    }
-                }
+        layout_cases(|isa, pw, m, rec, mut lanes| {
+            let (n, nbs) = (rec.len(), lanes.tau.len());
+            let x = pseudo(nbs * pw, 11 + m as u64);
+            let mut want = vec![0.0; (n + 8) * pw];
+            forward(isa, pw, rec, &lanes, &x, &mut want);
+            // Low-beta rows from 5 values in, mirror rows 3 values after them; NaN
+            // everywhere else.
+            let gap = nbs / 2 * pw + 3;
+            let mut z = vec![f64::NAN; 5 + gap + nbs / 2 * pw];
+            for r in 0..nbs {
+                let at = 5 + (r / 2) * pw + (r % 2) * gap;
+                z[at..at + pw].copy_from_slice(&x[r * pw..(r + 1) * pw]);
             }
-        }
+            (lanes.pair_stride, lanes.row_gap) = (pw, gap);
+            let mut f = vec![0.0; (n + 8) * pw];
+            // SAFETY: every row of the lanes is inside `z`.
+            unsafe { forward_raw(isa, pw, rec, &lanes, z.as_ptr().add(5), &mut f) };
+            for (i, (u, v)) in f[..n * pw].iter().zip(&want).enumerate() {
+                assert_eq!(u.to_bits(), v.to_bits(), "{isa:?} P={pw} m={m} at {i}");
+            }
+        });
     }
 
     /// The inverse into rows a pair stride apart (`Lanes::pair_stride`), the two rows of a
@@ -1298,71 +1304,47 @@ mod tests {
     /// its place, and nothing elsewhere: every instruction set, both store modes.
     #[test]
     fn strided_rows_hold_the_consecutive_rows() {
-        let b = 40;
-        for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
-            let n = b - m;
-            let nbs = 48;
-            let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
-            let rec = Rec::new(&rc, n);
-            for pw in [8usize, 16] {
-                let fin = pseudo(n * pw, 7 + m as u64);
-                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
-                    if !isa.is_supported() {
-                        continue;
-                    }
-                    for (stream, half) in [(true, false), (false, false), (true, true)] {
-                        let mut lanes = Lanes {
-                            tau: &tau,
-                            p: &p,
-                            sc: &sc,
-                            upper_from: nbs / 2,
-                            big: crate::wigner::big(test_skip_bits()),
-                            skip: true,
-                            interleaved: true,
-                            prefetch: Prefetch::none(),
-                            stream,
-                            pair_stride: 0,
-                            row_gap: 0,
-                        };
-                        let mut y = vec![f64::NAN; nbs * pw];
-                        inverse_from(isa, pw, &rec, &lanes, &fin, &mut y);
-                        // Pairs 2p + 8 values apart, 5 values into the buffer; half-major:
-                        // rows p + 8 apart in each half, the second half 3 values after the
-                        // first.
-                        let ps = if half { pw + 8 } else { 2 * pw + 8 };
-                        let gap = if half { nbs / 2 * ps + 3 } else { pw };
-                        lanes.pair_stride = ps;
-                        lanes.row_gap = if half { gap } else { 0 };
-                        let mut z = vec![f64::NAN; 5 + nbs / 2 * ps + gap];
-                        let mut buf = fin.clone();
-                        // SAFETY: z holds nbs / 2 pairs of two rows after offset 5.
-                        unsafe {
-                            inverse_raw(
-                                isa,
-                                pw,
-                                &rec,
-                                &lanes,
-                                &mut buf,
-                                &mut |_, _, _| {},
-                                z.as_mut_ptr().add(5),
-                            )
-                        };
-                        let mut want = vec![f64::NAN; z.len()];
-                        for r in 0..nbs {
-                            let at = 5 + (r / 2) * ps + (r % 2) * gap;
-                            want[at..at + pw].copy_from_slice(&y[r * pw..(r + 1) * pw]);
-                        }
-                        for (i, (v, w)) in z.iter().zip(&want).enumerate() {
-                            assert_eq!(
-                                v.to_bits(),
-                                w.to_bits(),
-                                "{isa:?} P={pw} half={half} at {i}"
-                            );
-                        }
-                    }
+        layout_cases(|isa, pw, m, rec, lanes| {
+            let (n, nbs) = (rec.len(), lanes.tau.len());
+            let fin = pseudo(n * pw, 7 + m as u64);
+            for (stream, half) in [(true, false), (false, false), (true, true)] {
+                let mut lanes = Lanes { stream, ..lanes };
+                let mut y = vec![f64::NAN; nbs * pw];
+                inverse_from(isa, pw, rec, &lanes, &fin, &mut y);
+                // Pairs 2p + 8 values apart, 5 values into the buffer; half-major: rows
+                // p + 8 apart in each half, the second half 3 values after the first.
+                let ps = if half { pw + 8 } else { 2 * pw + 8 };
+                let gap = if half { nbs / 2 * ps + 3 } else { pw };
+                lanes.pair_stride = ps;
+                lanes.row_gap = if half { gap } else { 0 };
+                let mut z = vec![f64::NAN; 5 + nbs / 2 * ps + gap];
+                let mut buf = fin.clone();
+                // SAFETY: z holds nbs / 2 pairs of two rows after offset 5.
+                unsafe {
+                    inverse_raw(
+                        isa,
+                        pw,
+                        rec,
+                        &lanes,
+                        &mut buf,
+                        &mut |_, _, _| {},
+                        z.as_mut_ptr().add(5),
+                    )
+                };
+                let mut want = vec![f64::NAN; z.len()];
+                for r in 0..nbs {
+                    let at = 5 + (r / 2) * ps + (r % 2) * gap;
+                    want[at..at + pw].copy_from_slice(&y[r * pw..(r + 1) * pw]);
+                }
+                for (i, (v, w)) in z.iter().zip(&want).enumerate() {
+                    assert_eq!(
+                        v.to_bits(),
+                        w.to_bits(),
+                        "{isa:?} P={pw} half={half} at {i}"
+                    );
                 }
             }
-        }
+        });
     }
 
     /// The forward kernel is the transpose of the inverse one: `<y, x> = <fin, f>` for

@@ -27,7 +27,7 @@ use crate::symmetry::{cluster_pairs, Cluster, Member};
 use crate::wigner::{
     big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
 };
-use blocks::Blocks;
+use blocks::{Blocks, BufLayout};
 use dwt_stage::{all_members, Scratch};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -222,23 +222,18 @@ struct Pass {
     /// The last chunk of the transform's last group: after this call the forward's
     /// coefficients of the cluster are final.
     done: bool,
-    /// The buffer of the group's next chunk and its gap (see `gap`), if any: the next
-    /// call is this cluster on it, so that is what to prefetch (forward: this cluster's
-    /// block there; inverse: nothing, its coefficient rows are kept).
-    next_buf: Option<(SyncPtr<f64>, usize)>,
-    /// The group's first chunk, its buffer and gap: after the group's last chunk the next
-    /// call is the next cluster on that one (the forward prefetches its block there).
-    head: (Chunk, SyncPtr<f64>, usize),
-    /// Inverse: write the blocks with non-temporal stores and half-major (the group's
-    /// blocks are too large to stay in the cache until the FFT stage reads them, see
-    /// [`plain_store_limit`] and `plan/blocks.rs`).
-    stream: bool,
-    /// Forward: the group's buffers are split in two cluster-major halves (the forward's
-    /// chain, see [`Plan::forward_chain`] and `plan/blocks.rs`).
-    split: bool,
-    /// Half-major or split: doubles from the chunk buffer's low-beta half to its mirror
-    /// half.
-    gap: usize,
+    /// The buffer of the group's next chunk and its layout, if any: the next call is this
+    /// cluster on it, so that is what to prefetch (forward: this cluster's block there;
+    /// inverse: nothing, its coefficient rows are kept).
+    next_buf: Option<(SyncPtr<f64>, BufLayout)>,
+    /// The group's first chunk, its buffer and layout: after the group's last chunk the
+    /// next call is the next cluster on that one (the forward prefetches its block there).
+    head: (Chunk, SyncPtr<f64>, BufLayout),
+    /// How the chunk's buffer holds the blocks: cluster-major, split in two halves (the
+    /// forward's chain, [`Plan::chain`]), or half-major (an inverse whose blocks are too
+    /// large to stay in the cache until the FFT stage reads them, written with
+    /// non-temporal stores, see [`plain_store_limit`]); see `plan/blocks.rs`.
+    layout: BufLayout,
 }
 
 /// Shared mutable pointer for disjoint parallel writes.
@@ -304,7 +299,7 @@ impl Chunk {
 /// Where the buffers fit, both go further: a buffer in two halves (half-major for the
 /// inverse, two cluster-major halves for the forward, see `plan/blocks.rs`) can live in
 /// the low-beta and the mirror slices of one other chunk, and all chunks run as one group
-/// (see [`Plan::inverse_chain`], [`Plan::forward_chain`]).
+/// (see [`Plan::chain`]).
 struct Spare {
     /// Start of the array (`2B` slices of `slice_bytes`, beta slowest).
     base: *mut u8,
@@ -826,8 +821,8 @@ impl Plan {
     /// Without `spare` every group is one chunk. With each buffer comes the gap (doubles)
     /// from its low-beta half to its mirror half in the half-major layout; the plan's
     /// buffer has its halves `t.total() / 2` apart, and so do the buffers placed whole.
-    /// Also returns whether the groups are the inverse's chain (see
-    /// [`Plan::inverse_chain`]), whose buffers must be half-major.
+    /// Also returns whether the groups are a chain ([`Plan::chain`]), whose buffers are
+    /// in two pieces.
     #[allow(clippy::type_complexity)]
     fn chunk_groups(
         &self,
@@ -835,18 +830,17 @@ impl Plan {
         forward: bool,
         spare: Option<&Spare>,
     ) -> (Vec<Vec<(Chunk, Option<(*mut f64, usize)>)>>, bool) {
-        if let (true, Some(sp)) = (forward, spare) {
-            if let Some(g) = self.forward_chain(t, sp) {
-                return (vec![g], true);
-            }
-        }
-        // Only where the blocks would not stay in the cache anyway: the chain's buffers
-        // are half-major, written with non-temporal stores.
-        let chunks = self.chunks(t).count();
-        if let (false, Some(sp), true) = (forward, spare, self.streams_blocks(chunks)) {
-            if let Some(g) = self.inverse_chain(t, sp) {
-                return (vec![g], true);
-            }
+        // The inverse's chain only where the blocks would not stay in the cache anyway:
+        // its buffers are half-major, written with non-temporal stores.
+        let chain = match spare {
+            Some(sp) if forward => self.chain(t, sp, |_| 8 * (t.total() / 2)),
+            Some(sp) if self.streams_blocks(self.chunks(t).count()) => self
+                .chain(t, sp, |ch| 8 * t.half_len(ch.hp))
+                .map(|g| g.into_iter().rev().collect()),
+            _ => None,
+        };
+        if let Some(g) = chain {
+            return (vec![g], true);
         }
         let whole = t.total() / 2;
         let groups = self
@@ -861,69 +855,40 @@ impl Plan {
         (groups, false)
     }
 
-    /// The inverse's chunks as one group, the one at the equator first: each chunk's
-    /// buffer (half-major, two halves of `t.half_len(hp)` doubles) goes into the low-beta
-    /// and the mirror slices of the chunk after it, whose FFT stage writes them only once
-    /// this chunk's has read its buffer; the last chunk (at the poles) uses the plan's
-    /// buffer. The DWT stage then reads each cluster's coefficients and computes its
-    /// recurrence coefficients once, not once per group (B = 256 with the default
-    /// workspace, one thread: 4 groups before). `None` with fewer than two chunks, or if
-    /// a half does not fit: the real layout's row per lane (`4B^2 + 4B` doubles) is longer
-    /// than a real slice (`4B^2`), so a full chunk's buffer never fits in another full
-    /// chunk's slices, and its chain exists only for two chunks, the first one short.
+    /// All chunks of layout `t` as one group, each chunk's buffer except chunk 0's (the
+    /// plan's buffer) in two halves of `half_bytes(chunk)` bytes in the low-beta and the
+    /// mirror slices of the chunk before it, with the gap (doubles) between the halves;
+    /// `None` with fewer than two chunks or if a half does not fit.
+    ///
+    /// The forward (input it may overwrite) runs the chunks in this order: chunk `k - 1`'s
+    /// FFT stage has read its slices when chunk `k`'s writes there. Its buffers are split
+    /// in two cluster-major halves, each with room for a full chunk, so every cluster's
+    /// sums reach the coefficients once (B = 512 under the 5% memory rule: 6 groups of
+    /// the 22 chunks before). The inverse runs them in reverse (equator first): chunk
+    /// `k - 1`'s FFT stage writes its output slices only after chunk `k`'s has read its
+    /// buffer. Its buffers are half-major, and it reads each cluster's coefficients and
+    /// computes its recurrence coefficients once, not once per group (B = 256 with the
+    /// default workspace, one thread: 4 groups before).
+    ///
+    /// The real layout's row per lane (`4B^2 + 4B` doubles) is longer than a real slice
+    /// (`4B^2`), so in real samples a full chunk's buffer never fits in another full
+    /// chunk's slices: its inverse chain exists only for two chunks, the second one short
+    /// (half-major halves hold only the chunk's own pairs), its forward chain never.
     #[allow(clippy::type_complexity)]
-    fn inverse_chain(
+    fn chain(
         &self,
         t: &Blocks,
         spare: &Spare,
-    ) -> Option<Vec<(Chunk, Option<(*mut f64, usize)>)>> {
-        let order: Vec<Chunk> = self
-            .chunks(t)
-            .collect::<Vec<_>>()
-            .into_iter()
-            .rev()
-            .collect();
-        if order.len() < 2 {
-            return None;
-        }
-        let mut group = Vec::with_capacity(order.len());
-        for (i, ch) in order.iter().enumerate() {
-            let place = match order.get(i + 1) {
-                Some(next) => {
-                    let (a, b) = spare.halves(self.b, next, 8 * t.half_len(ch.hp))?;
-                    Some((a, (b as usize - a as usize) / 8))
-                }
-                None => None,
-            };
-            group.push((*ch, place));
-        }
-        Some(group)
-    }
-
-    /// The chunks of a forward that may overwrite its input as one group, in their
-    /// order from the poles: chunk 0 in the plan's buffer, each later chunk's buffer
-    /// split in two cluster-major halves (see `plan/blocks.rs`) in the low-beta and the
-    /// mirror input slices of the chunk before it, which that chunk's FFT stage has read
-    /// already. Every cluster's sums then reach the coefficients once (B = 512 under the
-    /// 5% memory rule: 6 groups of the 22 chunks before). `None` with fewer than two
-    /// chunks, or if a half does not fit (the real layout: its rows per lane are longer
-    /// than a real slice).
-    #[allow(clippy::type_complexity)]
-    fn forward_chain(
-        &self,
-        t: &Blocks,
-        spare: &Spare,
+        half_bytes: impl Fn(&Chunk) -> usize,
     ) -> Option<Vec<(Chunk, Option<(*mut f64, usize)>)>> {
         let chunks: Vec<Chunk> = self.chunks(t).collect();
         if chunks.len() < 2 {
             return None;
         }
-        // Every block has room for `t.lanes` rows, the chunk's own or not.
-        let half = 8 * (t.total() / 2);
         let mut group = vec![(chunks[0], None)];
-        for k in 1..chunks.len() {
-            let (a, b) = spare.halves(self.b, &chunks[k - 1], half)?;
-            group.push((chunks[k], Some((a, (b as usize - a as usize) / 8))));
+        for w in chunks.windows(2) {
+            let (a, b) = spare.halves(self.b, &w[0], half_bytes(&w[1]))?;
+            group.push((w[1], Some((a, (b as usize - a as usize) / 8))));
         }
         Some(group)
     }
@@ -1033,7 +998,7 @@ impl Plan {
             true,
             &self.blocks,
             spare,
-            |ch, buf, half| self.fft_chunk(ch, true, input.get(), buf, half),
+            |ch, buf, layout| self.fft_chunk(ch, true, input.get(), buf, layout),
             |sc, at, ch, buf, pass| unsafe {
                 self.forward_cluster(
                     sc,
@@ -1064,7 +1029,7 @@ impl Plan {
             false,
             &self.blocks,
             Some(spare),
-            |ch, buf, half| self.fft_chunk(ch, false, out.get(), buf, half),
+            |ch, buf, layout| self.fft_chunk(ch, false, out.get(), buf, layout),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
             },
@@ -1081,7 +1046,7 @@ impl Plan {
         forward: bool,
         t: &Blocks,
         spare: Option<Spare>,
-        fft: impl Fn(&Chunk, *mut f64, Option<usize>) -> Result<()> + Sync,
+        fft: impl Fn(&Chunk, *mut f64, BufLayout) -> Result<()> + Sync,
         cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
@@ -1103,14 +1068,20 @@ impl Plan {
                 .collect();
             self.pool().install(|| {
                 for (gi, group) in groups.iter().enumerate() {
-                    // The chains' buffers are in two pieces: the inverse's half-major, the
-                    // forward's split.
-                    let stream = !forward && (chained || self.streams_blocks(group.len()));
-                    let split = forward && chained;
+                    // The chains' buffers are in two pieces: the forward's split, the
+                    // inverse's half-major.
+                    let layout: fn(usize) -> BufLayout = if forward && chained {
+                        BufLayout::Split
+                    } else if !forward && (chained || self.streams_blocks(group.len())) {
+                        BufLayout::HalfMajor
+                    } else {
+                        |_| BufLayout::Blocks
+                    };
+                    let group: Vec<_> = group.iter().map(|&(c, p, g)| (c, p, layout(g))).collect();
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
-                        for (ch, buf, gap) in group {
-                            fft(ch, buf.get(), (stream || split).then_some(*gap))?;
+                        for (ch, buf, layout) in &group {
+                            fft(ch, buf.get(), *layout)?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
@@ -1120,7 +1091,7 @@ impl Plan {
                     }
                     let t1 = Instant::now();
                     self.for_each_cluster(t, |sc, at| {
-                        for (k, (ch, buf, gap)) in group.iter().enumerate() {
+                        for (k, (ch, buf, layout)) in group.iter().enumerate() {
                             let pass = Pass {
                                 first: gi == 0,
                                 k,
@@ -1128,9 +1099,7 @@ impl Plan {
                                 done: gi + 1 == groups.len() && k + 1 == group.len(),
                                 next_buf: group.get(k + 1).map(|g| (g.1, g.2)),
                                 head: group[0],
-                                stream,
-                                split,
-                                gap: *gap,
+                                layout: *layout,
                             };
                             cluster(sc, at, ch, buf.get(), pass);
                         }

@@ -14,8 +14,7 @@
 //! B = 256), each a few lines from memory. So an inverse whose blocks do not stay in the
 //! cache (see `plain_store_limit` in `plan.rs`) uses the buffer "half-major": two halves,
 //! one with the low-beta rows and one with the mirror rows, each holding row `j` of every
-//! block, cluster after cluster, then row `j + 1` ([`Blocks::half_stride`],
-//! [`Blocks::half_offset`]); its DWT kernel writes its rows far apart with non-temporal
+//! block, cluster after cluster, then row `j + 1` ([`BufLayout::HalfMajor`]); its DWT kernel writes its rows far apart with non-temporal
 //! stores, and its FFT stage reads two sequential runs. (The rows of a pair side by side,
 //! "pair-major", took the inverse's block reads at B = 256 from 0.6-0.65 s to 0.29-0.31 s
 //! on one thread.) The two halves need not be adjacent: a chunk's buffer can then live in
@@ -23,7 +22,7 @@
 //! `plan.rs`).
 //!
 //! A forward allowed to overwrite its input splits its buffers the same way but keeps
-//! them cluster-major within each half ([`Blocks::split_offset`]): its kernel reads a
+//! them cluster-major within each half ([`BufLayout::Split`]): its kernel reads a
 //! block at a time, `P` doubles per row, low-beta rows from one half and mirror rows from
 //! the other.
 //!
@@ -33,6 +32,20 @@
 //! is taken from the mirrored slice.
 
 use crate::symmetry::Cluster;
+
+/// How a chunk buffer holds the blocks (see the module documentation); the split layouts
+/// carry the doubles from their low-beta half to their mirror half (`t.total() / 2` in
+/// one piece of memory, far more when the halves are in two other chunks' slices).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum BufLayout {
+    /// Cluster-major, the two rows of a pair side by side.
+    Blocks,
+    /// Two cluster-major halves (the forward that may overwrite its input).
+    Split(usize),
+    /// Two halves each holding row `j` of every cluster, then row `j + 1` (an inverse
+    /// whose blocks do not stay in the cache: written with non-temporal stores).
+    HalfMajor(usize),
+}
 
 /// No slot (unused entry of a cluster with fewer than 8 members).
 pub(super) const NONE: u32 = u32::MAX;
@@ -71,7 +84,7 @@ pub(super) struct Blocks {
 const PREFETCH_ABOVE: usize = 2 << 20;
 
 impl Blocks {
-    /// Layout of the complex transforms: every member of every cluster, in member order.
+    /// BufLayout of the complex transforms: every member of every cluster, in member order.
     /// Slices are `2B x 2B` in the FFT scratch, rows `rs = slice_stride(2B)` apart, with
     /// `(M, M')` at `(M mod 2B) rs + (M' mod 2B)`.
     pub fn complex(b: usize, clusters: &[(u32, u32)], chunk: usize) -> Blocks {
@@ -88,7 +101,7 @@ impl Blocks {
         })
     }
 
-    /// Layout of the real-signal transforms: the representatives of each cluster (see
+    /// BufLayout of the real-signal transforms: the representatives of each cluster (see
     /// `real.rs`), indexed in the half spectrum of `2B x (B+1)` values of an r2c transform,
     /// `(a, b')` at `(a mod 2B)(B+1) + b'`. For `M' = 0`, `M > 0` the inverse also writes
     /// the value to `(-M, 0)` (`fi2`).
@@ -180,28 +193,24 @@ impl Blocks {
         self.pofs[c] * self.lanes
     }
 
-    /// Half-major layout (the large inverse's): doubles from one row of every block to
-    /// the next, within a half.
-    pub fn half_stride(&self) -> usize {
-        self.pofs[self.len()]
-    }
-
-    /// Half-major layout: offset (in doubles) of cluster `c`'s row within a row of every
-    /// block.
-    pub fn half_offset(&self, c: usize) -> usize {
-        self.pofs[c]
-    }
-
-    /// Split layout (a chained forward's, see `Plan::forward_chain`): offset (in doubles)
-    /// of cluster `c`'s low-beta rows within the low-beta half, and of its mirror rows
-    /// within the mirror half: each half is cluster-major, `t.total() / 2` doubles.
-    pub fn split_offset(&self, c: usize) -> usize {
-        self.pofs[c] * (self.lanes / 2)
+    /// Where cluster `c`'s two rows of pair `j` are in a chunk buffer of `layout`: the
+    /// offset (in doubles) of row `2j`, the doubles from one pair's rows to the next, and
+    /// from row `2j` to row `2j + 1`. The one place that knows the layouts.
+    pub fn pair_rows(&self, c: usize, j: usize, layout: BufLayout) -> (usize, usize, usize) {
+        let p = self.p(c);
+        match layout {
+            BufLayout::Blocks => (self.offset(c) + 2 * j * p, 2 * p, p),
+            BufLayout::Split(gap) => (self.pofs[c] * (self.lanes / 2) + j * p, p, gap),
+            BufLayout::HalfMajor(gap) => {
+                let stride = self.pofs[self.len()];
+                (j * stride + self.pofs[c], stride, gap)
+            }
+        }
     }
 
     /// Half-major layout: doubles of one half for `pairs` pairs of rows.
     pub fn half_len(&self, pairs: usize) -> usize {
-        pairs * self.half_stride()
+        pairs * self.pofs[self.len()]
     }
 
     /// Doubles of the whole buffer.

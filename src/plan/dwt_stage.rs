@@ -161,72 +161,57 @@ impl Plan {
         }
     }
 
-    /// Where cluster `c`'s block starts in the chunk buffer `buf` of layout `t`: its rows
-    /// one after another, or in the split layout (`split = Some(gap)`, see
-    /// `plan/blocks.rs`) its low-beta rows, its mirror rows `gap` doubles further.
-    pub(super) fn block_at(t: &Blocks, buf: *mut f64, c: usize, split: Option<usize>) -> *mut f64 {
-        match split {
-            None => buf.wrapping_add(t.offset(c)),
-            Some(_) => buf.wrapping_add(t.split_offset(c)),
-        }
-    }
-
-    /// Prefetch hints for cluster `c`'s block of `lanes` rows in `buf` (see
-    /// [`Plan::block_at`]): one range, or the two halves of the split layout.
+    /// Prefetch hints for cluster `c`'s block of `lanes` rows in `buf`, laid out as
+    /// `layout` (a forward's: cluster-major, one range, or split, a range in each half).
     fn push_block(
         pf: &mut Prefetch,
         t: &Blocks,
         buf: *mut f64,
         c: usize,
         lanes: usize,
-        split: Option<usize>,
+        layout: BufLayout,
     ) {
-        let (x, p) = (Self::block_at(t, buf, c, split) as *const f64, t.p(c));
-        match split {
-            None => pf.push(x, lanes * p),
-            Some(gap) => {
-                pf.push(x, lanes / 2 * p);
-                pf.push(x.wrapping_add(gap), lanes / 2 * p);
+        let (at, ps, gap) = t.pair_rows(c, 0, layout);
+        let x = buf.wrapping_add(at) as *const f64;
+        pf.push(x, lanes / 2 * ps);
+        if gap != t.p(c) {
+            pf.push(x.wrapping_add(gap), lanes / 2 * ps);
+        }
+    }
+
+    /// Zero the padding rows of a block (lanes `h..hp` of each half: rows `2h..2hp`) at
+    /// `(x, ps, gap)` (see [`Blocks::pair_rows`]), which the FFT stage does not write: the
+    /// forward kernel multiplies them by exact zeros, which must not meet a stale
+    /// non-finite value.
+    ///
+    /// # Safety
+    /// The block's `ch.lanes()` rows of `p` doubles are the caller's.
+    pub(super) unsafe fn zero_padding(
+        (x, ps, gap): (*mut f64, usize, usize),
+        p: usize,
+        ch: &Chunk,
+    ) {
+        for j in ch.h..ch.hp {
+            for r in [0, gap] {
+                std::ptr::write_bytes(x.add(j * ps + r), 0, p);
             }
         }
     }
 
-    /// Zero the padding rows of a block at `x` (lanes `h..hp` of each half: rows
-    /// `2h..2hp`, or in the split layout rows `h..hp` of each half), which the FFT stage
-    /// does not write: the forward kernel multiplies them by exact zeros, which must not
-    /// meet a stale non-finite value.
+    /// The forward kernel on the block at `(x, ps, gap)` (see [`Blocks::pair_rows`]) into
+    /// `sc.out`: degree `i` of column `q` (the real or imaginary part of a slot) at
+    /// `i * p + q`. `next` is what to prefetch while the kernel runs (see
+    /// [`Lanes::prefetch`]). Returns the kernel's `lo`: rows below it are zero.
     ///
     /// # Safety
-    /// `x` is a block of `ch.lanes()` rows of `p` doubles (see [`Plan::block_at`]) that
-    /// the caller owns.
-    pub(super) unsafe fn zero_padding(x: *mut f64, p: usize, ch: &Chunk, split: Option<usize>) {
-        let pad = (ch.hp - ch.h) * p;
-        match split {
-            None => std::ptr::write_bytes(x.add(2 * ch.h * p), 0, 2 * pad),
-            Some(gap) => {
-                for half in [x, x.add(gap)] {
-                    std::ptr::write_bytes(half.add(ch.h * p), 0, pad);
-                }
-            }
-        }
-    }
-
-    /// The forward kernel on the block at `x` (see [`Plan::block_at`]) into `sc.out`:
-    /// degree `i` of column `q` (the real or imaginary part of a slot) at `i * p + q`.
-    /// `next` is what to prefetch while the kernel runs (see [`Lanes::prefetch`]).
-    /// Returns the kernel's `lo`: rows below it are zero.
-    ///
-    /// # Safety
-    /// `x` is a block of `ch.lanes()` rows of `p` doubles that no one writes meanwhile.
-    #[allow(clippy::too_many_arguments)]
+    /// The block's `ch.lanes()` rows of `p` doubles are written by no one meanwhile.
     pub(super) unsafe fn run_forward(
         &self,
         sc: &mut Scratch,
         ch: &Chunk,
         p: usize,
         n: usize,
-        x: *const f64,
-        split: Option<usize>,
+        (x, ps, gap): (*const f64, usize, usize),
         next: Prefetch,
     ) -> usize {
         let mut out = Scratch::take(&mut sc.out, (n + 8) * p, (self.b + 8) * 16);
@@ -234,16 +219,14 @@ impl Plan {
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
         lanes.prefetch = next;
-        if let Some(gap) = split {
-            (lanes.pair_stride, lanes.row_gap) = (p, gap);
-        }
+        (lanes.pair_stride, lanes.row_gap) = (ps, gap);
         let lo = dwt::forward_raw(self.isa, p, &rec, &lanes, x, f);
         sc.out = out;
         lo
     }
 
     /// What the cluster after `at` in layout `t` will touch: its block of the chunk buffer
-    /// (with `block = Some(split)`, see [`Plan::block_at`]) and its coefficient rows
+    /// (with `block = Some(layout)`, see [`Plan::push_block`]) and its coefficient rows
     /// (`members` of it) from degree `from_l`
     /// less a margin, as prefetch hints (never read through these pointers). Rows below
     /// the first degree some beta of the chunk needs are not touched (see
@@ -255,15 +238,15 @@ impl Plan {
         buf: *mut f64,
         at: &At,
         ch: &Chunk,
-        block: Option<Option<usize>>,
+        block: Option<BufLayout>,
         coef: *const Complex64,
         members: Members,
         from_l: usize,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
         if let Some(cl) = &at.next {
-            if let Some(split) = block {
-                Self::push_block(&mut pf, t, buf, at.c + 1, ch.lanes(), split);
+            if let Some(layout) = block {
+                Self::push_block(&mut pf, t, buf, at.c + 1, ch.lanes(), layout);
             }
             // Neighbouring clusters need similar degrees; a few below the guess cover
             // the drift from one to the next.
@@ -304,28 +287,26 @@ impl Plan {
         let (c, cl) = (at.c, &at.cl);
         let n = self.setup(sc, cl, ch, pass.k == 0);
         let p = t.p(c);
-        let split = pass.split.then_some(pass.gap);
-        let x = Self::block_at(t, buf, c, split);
-        Self::zero_padding(x, p, ch, split);
+        let (at_c, ps, gap) = t.pair_rows(c, 0, pass.layout);
+        let x = buf.add(at_c);
+        Self::zero_padding((x, ps, gap), p, ch);
         let next = match pass.next_buf {
             // Within a group: this cluster's block in the next chunk.
-            Some((nb, gap)) => {
+            Some((nb, layout)) => {
                 let mut pf = Prefetch::none();
-                let split = pass.split.then_some(gap);
-                Self::push_block(&mut pf, t, nb.get(), c, ch.lanes(), split);
+                Self::push_block(&mut pf, t, nb.get(), c, ch.lanes(), layout);
                 pf
             }
             None => {
                 // The first group writes every row of the coefficients. The next cluster
                 // starts on the group's first chunk.
                 let from_l = if pass.first { 0 } else { sc.from_l };
-                let (hch, hbuf, hgap) = pass.head;
-                let block = Some(pass.split.then_some(hgap));
+                let (hch, hbuf, hl) = pass.head;
                 let c = coef.get();
-                self.next_cluster(t, hbuf.get(), at, &hch, block, c, members, from_l)
+                self.next_cluster(t, hbuf.get(), at, &hch, Some(hl), c, members, from_l)
             }
         };
-        let lo = self.run_forward(sc, ch, p, n, x, split, next).min(n);
+        let lo = self.run_forward(sc, ch, p, n, (x, ps, gap), next).min(n);
         sc.from_l = cl.l0() + lo;
         let (sums, lo) = if pass.k == 0 && pass.last {
             (&sc.out, lo)
@@ -379,8 +360,8 @@ impl Plan {
     }
 
     /// Inverse DWT of cluster `at` of layout `t` over one chunk (the order pairs `members`
-    /// gives), written into its block, or with `pass.stream` into its rows of the
-    /// half-major buffer (see `plan/blocks.rs`). For `pass.k > 0` the previous call was this
+    /// gives), written into its rows of the chunk buffer of `pass.layout` (see
+    /// `plan/blocks.rs`; half-major with non-temporal stores). For `pass.k > 0` the previous call was this
     /// cluster on the group's previous chunk, whose recurrence coefficients and
     /// coefficient rows are reused.
     ///
@@ -406,15 +387,11 @@ impl Plan {
         let mut data = Scratch::take(&mut sc.data, n * p, self.b * 16);
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = sc.lanes(self, ch);
-        lanes.stream = pass.stream;
-        // Blocks too large for the cache are half-major (see `plan/blocks.rs`).
-        let at_c = if pass.stream {
-            lanes.pair_stride = t.half_stride();
-            lanes.row_gap = pass.gap;
-            t.half_offset(c)
-        } else {
-            t.offset(c)
-        };
+        // Blocks too large for the cache are half-major, written with non-temporal
+        // stores (see `plan/blocks.rs`).
+        lanes.stream = matches!(pass.layout, BufLayout::HalfMajor(_));
+        let (at_c, ps, gap) = t.pair_rows(c, 0, pass.layout);
+        (lanes.pair_stride, lanes.row_gap) = (ps, gap);
         // Within a group the next call needs nothing new (its rows are kept here, its
         // block is written with non-temporal stores): prefetch for the next cluster only
         // on the group's last chunk.
@@ -435,10 +412,9 @@ impl Plan {
             }
             lo = from;
         };
-        // SAFETY: this cluster's `ch.lanes() <= t.lanes` rows: its block, or half-major
-        // rows `2j` at `j * half_stride + half_offset(c)` and `2j + 1` `pass.gap` further
-        // (`p` values each), `j < ch.hp`, within the buffer's two halves of
-        // `t.half_len(ch.hp)` doubles; the caller owns them.
+        // SAFETY: this cluster's `ch.lanes() <= t.lanes` rows (`p` values each, row `2j`
+        // at `j * ps`, row `2j + 1` `gap` further, `j < ch.hp`) are in the chunk buffer
+        // (`Blocks::pair_rows`); the caller owns them.
         dwt::inverse_raw(
             self.isa,
             p,

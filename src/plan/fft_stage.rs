@@ -12,7 +12,7 @@
 //! over the workers, or, with FFTW's threads, run one after another with the copies spread
 //! over the workers.
 
-use super::blocks::{Blocks, NONE};
+use super::blocks::{Blocks, BufLayout, NONE};
 use super::*;
 
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
@@ -36,16 +36,14 @@ pub(super) fn scratch_len(b: usize) -> usize {
 
 impl Plan {
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
-    /// from `buf` into `grid`. With `half = Some(gap)` (the doubles from the buffer's
-    /// low-beta half to its mirror half) the buffer is split in two halves, see
-    /// `plan/blocks.rs`: cluster-major halves (forward) or half-major (inverse).
+    /// from `buf` into `grid`, the buffer laid out as `layout` (see `plan/blocks.rs`).
     pub(super) fn fft_chunk(
         &self,
         ch: &Chunk,
         forward: bool,
         grid: *mut Complex64,
         buf: *mut f64,
-        half: Option<usize>,
+        layout: BufLayout,
     ) -> Result<()> {
         let fft = if forward {
             self.fwd_fft.as_ref()
@@ -57,7 +55,7 @@ impl Plan {
         let grid = SyncPtr(grid);
         let slices = move |k: usize| SyncPtr(grid.get().wrapping_add(k * nn));
         let threaded = self.fftw_threaded;
-        self.fft_pairs(ch, fft, threaded, forward, &slices, buf, half, ch.h)
+        self.fft_pairs(ch, fft, threaded, forward, &slices, buf, layout, ch.h)
     }
 
     /// The first `npairs` pairs of [`Plan::fft_chunk`] with the slice plan `fft`; `slice(k)`
@@ -73,7 +71,7 @@ impl Plan {
         forward: bool,
         slice: &(dyn Fn(usize) -> SyncPtr<Complex64> + Sync),
         buf: *mut f64,
-        half: Option<usize>,
+        layout: BufLayout,
         npairs: usize,
     ) -> Result<()> {
         let buf = SyncPtr(buf);
@@ -98,7 +96,7 @@ impl Plan {
                     &w[..2 * gn],
                     scratch.as_mut_ptr(),
                     buf.get(),
-                    half,
+                    layout,
                     j0,
                     fftw_threaded,
                 );
@@ -126,7 +124,7 @@ impl Plan {
         w: &[f64],
         sp: *mut Complex64,
         buf: *mut f64,
-        half: Option<usize>,
+        layout: BufLayout,
         j0: usize,
         parallel_copy: bool,
     ) {
@@ -166,11 +164,11 @@ impl Plan {
                 fft.in_place(dst.get());
             }
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                scatter_group(&self.blocks, s, w, false, b.get(), half, j0, c0..c1)
+                scatter_group(&self.blocks, s, w, false, b.get(), layout, j0, c0..c1)
             });
         } else {
             self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                gather_group(&self.blocks, s, false, b.get(), half, j0, c0..c1)
+                gather_group(&self.blocks, s, false, b.get(), layout, j0, c0..c1)
             });
             for (src, &dst) in s.iter().zip(grid) {
                 let src = src.get();
@@ -232,10 +230,9 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SyncPtr<Complex64>], write:
     let _ = (t, c, sp, write);
 }
 
-/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, adjacent, or with
-/// `split = Some(gap)` in the two halves of the split layout, see `plan/blocks.rs`) of the
-/// blocks of clusters `cs` from the transformed slices `s` (beta, then pi - beta, for each
-/// pair),
+/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, where `layout` puts them, see
+/// `plan/blocks.rs`) of the blocks of clusters `cs` from the transformed slices `s` (beta,
+/// then pi - beta, for each pair),
 /// scaled by their weights `w` (and conjugated with `conj`): the first row of a pair
 /// takes each slot from its own slice, the second from the other one; reversed slots the
 /// other way round. Unused slots are zero.
@@ -250,7 +247,7 @@ pub(super) unsafe fn scatter_group(
     w: &[f64],
     conj: bool,
     buf: *mut f64,
-    split: Option<usize>,
+    layout: BufLayout,
     j0: usize,
     cs: std::ops::Range<usize>,
 ) {
@@ -269,17 +266,13 @@ pub(super) unsafe fn scatter_group(
         }
         let p = t.p(c);
         let rev = t.rev[c];
-        // Where the group's first row goes: in the block, or in the split layout's
-        // low-beta half.
-        let dst = match split {
-            None => buf.add(t.offset(c) + 2 * j0 * p),
-            Some(_) => buf.add(t.split_offset(c) + j0 * p),
-        };
+        let (at, ps, gap) = t.pair_rows(c, j0, layout);
+        let dst = (buf.add(at), ps, gap);
         if t.regular[c] {
             // The common case (`Blocks::regular`), written out.
             match p {
-                16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst, split),
-                _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst, split),
+                16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst),
+                _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst),
             }
             continue;
         }
@@ -300,24 +293,36 @@ pub(super) unsafe fn scatter_group(
                 rows[rb + 1] = b.im * wi[2 * jj + 1];
             }
         }
-        store_rows(dst, &rows[..ns * p], p, split);
+        store_rows(dst, &rows[..ns * p], p);
     }
     fence();
 }
 
-/// Store the rows of a group of pairs (low-beta row and mirror row of each pair in turn)
-/// at `dst`: consecutive, or with `split = Some(gap)` the low-beta rows one after another
-/// at `dst` and the mirror rows `gap` doubles further.
+/// Store the rows of `p` doubles of a group of pairs (low-beta row and mirror row of each
+/// pair in turn) at `(dst, ps, gap)` from [`Blocks::pair_rows`]: row `2j` at
+/// `dst + j * ps`, row `2j + 1` `gap` further; in one piece where they are consecutive.
 #[inline(always)]
-unsafe fn store_rows(dst: *mut f64, rows: &[f64], p: usize, split: Option<usize>) {
-    match split {
-        None => stream_rows(dst, rows),
-        Some(gap) => {
-            for (k, row) in rows.chunks_exact(p).enumerate() {
-                stream_rows(dst.add((k / 2) * p + (k % 2) * gap), row);
-            }
-        }
+unsafe fn store_rows((dst, ps, gap): (*mut f64, usize, usize), rows: &[f64], p: usize) {
+    if ps == 2 * p && gap == p {
+        return stream_rows(dst, rows);
     }
+    for (k, row) in rows.chunks_exact(p).enumerate() {
+        stream_rows(dst.add((k / 2) * ps + (k % 2) * gap), row);
+    }
+}
+
+/// Prefetch `lines` cache lines from `a` into L1 (hints only: `a` may point past the
+/// buffer).
+#[inline(always)]
+fn prefetch_lines(a: *const f64, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for line in 0..lines {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch is a hint; it never faults.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((a as *const i8).wrapping_add(64 * line)) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (a, lines);
 }
 
 /// Clusters ahead whose rows [`gather_group`] prefetches in the cluster-major layout
@@ -330,9 +335,8 @@ const PREFETCH_CLUSTERS: usize = 16;
 /// (0.6-0.65 s in the cluster-major layout).
 const GATHER_AHEAD: usize = 4096;
 
-/// The reverse of [`scatter_group`] without weights, from blocks or (with `half`, the gap
-/// between its halves) the half-major layout of a large inverse (see `plan/blocks.rs`):
-/// slots of the rows of
+/// The reverse of [`scatter_group`] without weights, from a buffer of `layout` (blocks, or
+/// the half-major layout of a large inverse, see `plan/blocks.rs`): slots of the rows of
 /// the pairs `j0 ..` into the slices `s` (conjugated with `conj`; the real layout's
 /// second index `fi2` gets the value itself).
 ///
@@ -343,7 +347,7 @@ pub(super) unsafe fn gather_group(
     s: &[SyncPtr<Complex64>],
     conj: bool,
     buf: *const f64,
-    half: Option<usize>,
+    layout: BufLayout,
     j0: usize,
     cs: std::ops::Range<usize>,
 ) {
@@ -354,52 +358,27 @@ pub(super) unsafe fn gather_group(
         sp[i] = s[i].get();
     }
     let end = cs.end;
-    let half_stride = t.half_stride();
     for c in cs {
         if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, s, true);
         }
         let p = t.p(c);
-        // Where this cluster's low-beta row of the group's first pair is, doubles from one
-        // pair to the next and from the low-beta row to the mirror row: half-major, two
-        // sequential runs over the clusters for each pair; else within the cluster's block.
-        let (row, ps, gap) = match half {
-            Some(gap) => (
-                buf.add(j0 * half_stride + t.half_offset(c)),
-                half_stride,
-                gap,
-            ),
-            None => (buf.add(t.offset(c) + 2 * j0 * p), 2 * p, p),
-        };
-        #[cfg(target_arch = "x86_64")]
-        {
-            // Hints only (may point past the buffer): ahead in the sequential run, or the
-            // rows of a cluster further on.
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let ahead = if half.is_some() {
-                Some(((row as *const i8).wrapping_add(GATHER_AHEAD), p))
-            } else {
+        let (at, ps, gap) = t.pair_rows(c, j0, layout);
+        let row = buf.add(at);
+        match layout {
+            // The rows of a cluster further on.
+            BufLayout::Blocks => {
                 let cf = c + PREFETCH_CLUSTERS;
-                (cf < end).then(|| {
-                    let pf = t.p(cf);
-                    (
-                        buf.wrapping_add(t.offset(cf) + 2 * j0 * pf) as *const i8,
-                        pf,
-                    )
-                })
-            };
-            if let Some((a, pf)) = ahead {
-                // Half-major: as far ahead in the mirror half.
-                let runs = if half.is_some() { [0, 8 * gap] } else { [0, 0] };
-                let lines = if half.is_some() {
-                    ns * pf / 16
-                } else {
-                    ns * pf / 8
-                };
-                for r in &runs[..1 + half.is_some() as usize] {
-                    for line in 0..lines.max(1) {
-                        _mm_prefetch::<_MM_HINT_T0>(a.wrapping_add(r + 64 * line));
-                    }
+                if cf < end {
+                    let (at, _, _) = t.pair_rows(cf, j0, layout);
+                    prefetch_lines(buf.wrapping_add(at), ns * t.p(cf) / 8);
+                }
+            }
+            // The same distance ahead in the sequential run of each half.
+            BufLayout::Split(_) | BufLayout::HalfMajor(_) => {
+                for half in [row, row.wrapping_add(gap)] {
+                    let a = half.wrapping_add(GATHER_AHEAD / 8);
+                    prefetch_lines(a, (ns * p / 16).max(1));
                 }
             }
         }
@@ -450,8 +429,7 @@ unsafe fn scatter_regular<const S: usize>(
     sp: &[*const Complex64],
     w: &[f64],
     conj: bool,
-    dst: *mut f64,
-    split: Option<usize>,
+    dst: (*mut f64, usize, usize),
 ) {
     let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
     let (h, ns) = (S / 2, sp.len());
@@ -476,7 +454,6 @@ unsafe fn scatter_regular<const S: usize>(
         dst,
         std::slice::from_raw_parts(rows.as_ptr() as *const f64, ns * 2 * S),
         2 * S,
-        split,
     );
 }
 
@@ -572,10 +549,12 @@ mod speed {
                     .fold(f64::INFINITY, f64::min)
             };
             let bp = buf.as_mut_ptr() as *mut f64;
-            let ts = time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, None, 0, 0..t.len()) });
+            let blocks = BufLayout::Blocks;
+            let ts =
+                time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, blocks, 0, 0..t.len()) });
             // The gather as a large inverse runs it (half-major); the scatter's blocks are
             // only a source of values here.
-            let half = Some(t.total() / 2);
+            let half = BufLayout::HalfMajor(t.total() / 2);
             let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, half, 0, 0..t.len()) });
             let bytes = 2 * g * nn * 16;
             let src = AlignedBuf::new(bytes / 16).unwrap();

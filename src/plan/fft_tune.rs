@@ -125,7 +125,11 @@ impl Plan {
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
                 // The inverse's layout for one chunk (see `plan/blocks.rs`).
-                let half = self.streams_blocks(1).then_some(self.blocks.total() / 2);
+                let layout = if self.streams_blocks(1) {
+                    BufLayout::HalfMajor(self.blocks.total() / 2)
+                } else {
+                    BufLayout::Blocks
+                };
                 for round in 0..ROUNDS {
                     for i in 0..2 {
                         // Alternate which variant goes first.
@@ -135,7 +139,7 @@ impl Plan {
                         for (fft, forward) in [(f, true), (iv, false)] {
                             if let Some(fft) = fft {
                                 self.fft_pairs(
-                                    &ch, fft, threaded, forward, &slice, bp, half, npairs,
+                                    &ch, fft, threaded, forward, &slice, bp, layout, npairs,
                                 )?;
                             }
                         }
@@ -193,9 +197,13 @@ mod tests {
         let t = Instant::now();
         plan.with_buf(|buf| {
             plan.pool().install(|| {
-                let half = (!forward && plan.streams_blocks(1)).then_some(plan.blocks.total() / 2);
+                let layout = if !forward && plan.streams_blocks(1) {
+                    BufLayout::HalfMajor(plan.blocks.total() / 2)
+                } else {
+                    BufLayout::Blocks
+                };
                 for ch in plan.chunks(&plan.blocks) {
-                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, half)?;
+                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, layout)?;
                 }
                 Ok(())
             })

@@ -172,7 +172,9 @@ impl Plan {
             true,
             t,
             spare,
-            |ch, buf, half| self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, half),
+            |ch, buf, layout| {
+                self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, layout)
+            },
             |sc, at, ch, buf, pass| unsafe {
                 // The chunks accumulate the representatives only (half the coefficient
                 // traffic per chunk); the last one also writes their partners.
@@ -197,7 +199,7 @@ impl Plan {
             false,
             t,
             Some(spare),
-            |ch, buf, half| self.fft_chunk_real(ch, None, out.get(), buf, half),
+            |ch, buf, layout| self.fft_chunk_real(ch, None, out.get(), buf, layout),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
             },
@@ -213,15 +215,14 @@ impl Plan {
     /// FFT stage of one chunk for real data (see the module documentation), one mirrored
     /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
     /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
-    /// into `grid` (c2r); with `half = Some(gap)` the buffer is split in two halves (see
-    /// [`Plan::fft_chunk`]).
+    /// into `grid` (c2r), the buffer laid out as `layout` (see [`Plan::fft_chunk`]).
     fn fft_chunk_real(
         &self,
         ch: &Chunk,
         input: Option<SyncInput>,
         grid: *mut f64,
         buf: *mut f64,
-        half: Option<usize>,
+        layout: BufLayout,
     ) -> Result<()> {
         let fft = self.real_fft()?;
         let t = self.real_blocks()?;
@@ -262,13 +263,13 @@ impl Plan {
                             &[self.wq[k0], self.wq[k1]],
                             true,
                             buf.get(),
-                            half,
+                            layout,
                             j,
                             0..t.len(),
                         );
                     } else {
                         let sc = [SyncPtr(s[0]), SyncPtr(s[1])];
-                        fft_stage::gather_group(t, &sc, true, buf.get(), half, j, 0..t.len());
+                        fft_stage::gather_group(t, &sc, true, buf.get(), layout, j, 0..t.len());
                         for (&slot, k) in s.iter().zip([k0, k1]) {
                             // Frequency B (alpha or gamma) is outside the band limit.
                             for i in 0..=b {
