@@ -50,7 +50,7 @@ enum RealInput {
 struct SyncInput(RealInput);
 // SAFETY: the pointed-to samples are only read through it, by all workers, during one
 // execution; a forward destroying its input writes chunk buffers only into slices whose
-// reads are finished (see `Spare::consumed` and `Plan::forward_chain`).
+// reads are finished (see `Spare::consumed` and `Plan::chain`).
 unsafe impl Send for SyncInput {}
 unsafe impl Sync for SyncInput {}
 
