@@ -10,6 +10,8 @@
  *    which is also correct.)
  * 2. A bandwidth-1024 plan without a cap either succeeds (machines with enough memory for
  *    the 160 GB of arrays it implies) or fails with SO3FFT_ENOMEM; it must not crash.
+ * 3. Under a cap of 256 MiB, a small plan with 1024 worker threads (whose stacks need far
+ *    more address space) fails with SO3FFT_ENOMEM, not as an invalid argument.
  *
  * The parent reports a child killed by a signal (an abort on an infallible allocation, or
  * the OOM killer) as a failure. */
@@ -56,6 +58,18 @@ static int child(size_t headroom, int direction) {
     if (setrlimit(RLIMIT_AS, &rl) != 0) {
         perror("setrlimit");
         return 2;
+    }
+    if (direction == 0) {
+        p = so3fft_plan_general(2, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 1024);
+        printf("B=2 with 1024 threads, headroom %lu MiB: %s, code %d, \"%s\"\n",
+               (unsigned long)(headroom >> 20), p ? "plan created" : "NULL",
+               so3fft_last_error_code(), so3fft_last_error());
+        if (p) {
+            so3fft_destroy_plan(p);
+            return 1;
+        }
+        CHECK_ERR(SO3FFT_ENOMEM);
+        return g_failures ? 1 : 0;
     }
     p = so3fft_plan_general(512, direction, NULL, NULL, SO3FFT_ESTIMATE, 1);
     if (p != NULL) {
@@ -114,5 +128,6 @@ int main(void) {
     run_child((size_t)160 << 20, SO3FFT_INVERSE);
     run_child((size_t)400 << 20, SO3FFT_BOTH);
     run_child(0, SO3FFT_BOTH);
+    run_child((size_t)256 << 20, 0);
     return finish("test_oom");
 }

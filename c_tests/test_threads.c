@@ -1,9 +1,11 @@
 /* Thread safety: one plan executed concurrently from two pthreads on different arrays,
  * planners running concurrently (also with the host program's own FFTW planner calls),
- * and the thread-local error state. */
+ * the thread-local error state, and plans across fork(). */
 #define _POSIX_C_SOURCE 200809L
 #include <fftw3.h>
 #include <pthread.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "test_util.h"
 
@@ -134,9 +136,72 @@ static void thread_local_errors(void) {
     CHECK_ERR(SO3FFT_ENULL);
 }
 
+/* A plan whose worker threads ran in the parent, used in a child made by fork(): executing
+ * it fails with an error instead of waiting forever for the parent's threads, destroying it
+ * returns, and a plan made in the child works. alarm() turns a hang into a failure. The
+ * child reports through a pipe, not its exit status, which valgrind sets when it finds the
+ * memory the parent's vanished threads held. */
+static void plan_across_fork(void) {
+    so3fft_plan p = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
+    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B);
+    so3fft_complex *c = alloc_cx(nc), *s = alloc_cx(ns), *c2 = alloc_cx(nc);
+    int fd[2];
+    pid_t pid;
+    CHECK(p != NULL && pipe(fd) == 0);
+    if (!p) return;
+    fill_random(c, nc, 21);
+    CHECK(so3fft_execute_inverse(p, c, s) == SO3FFT_OK);
+    fflush(NULL);
+    pid = fork();
+    if (pid == 0) {
+        unsigned char code = 0;
+        so3fft_plan q;
+        int rc;
+        alarm(60);
+        close(fd[0]);
+        rc = so3fft_execute_inverse(p, c, s);
+        if (rc != SO3FFT_EINVAL) {
+            fprintf(stderr, "fork child: execute returned %d (%s)\n", rc, so3fft_last_error());
+            code |= 1;
+        }
+        if (strstr(so3fft_last_error(), "fork") == NULL) code |= 2;
+        so3fft_destroy_plan(p);
+        q = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
+        if (!q) {
+            code |= 4;
+        } else {
+            if (so3fft_execute_inverse(q, c, s) != SO3FFT_OK) code |= 8;
+            if (so3fft_execute_forward(q, s, c2) != SO3FFT_OK) code |= 8;
+            if (!(max_abs_diff(c, c2, nc) < 1e-12)) code |= 16;
+            so3fft_destroy_plan(q);
+        }
+        if (write(fd[1], &code, 1) != 1) _exit(3);
+        _exit(0);
+    }
+    close(fd[1]);
+    CHECK(pid > 0);
+    if (pid > 0) {
+        unsigned char code = 255;
+        int status = -1;
+        CHECK(read(fd[0], &code, 1) == 1);
+        if (code != 0) fprintf(stderr, "fork child: failure bits %d\n", code);
+        CHECK(code == 0);
+        CHECK(waitpid(pid, &status, 0) == pid && WIFEXITED(status));
+    }
+    close(fd[0]);
+    /* The parent's plan is unaffected. */
+    CHECK(so3fft_execute_forward(p, s, c2) == SO3FFT_OK);
+    CHECK(max_abs_diff(c, c2, nc) < 1e-12);
+    so3fft_destroy_plan(p);
+    free(c2);
+    free(s);
+    free(c);
+}
+
 int main(void) {
     concurrent_execute();
     concurrent_planning();
     thread_local_errors();
+    plan_across_fork();
     return finish("test_threads");
 }

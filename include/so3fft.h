@@ -27,21 +27,35 @@
  * reads or writes more than the sizes stated for B.
  *
  * Errors: functions return NULL, a negative SO3FFT_E* code, -1, 0 or NaN as documented, and set
- * a thread-local error state (so3fft_last_error_code, so3fft_last_error). No function aborts or
- * exits the process; Rust panics are caught at the boundary and reported as SO3FFT_EPANIC.
+ * a thread-local error state (so3fft_last_error_code, so3fft_last_error). No function exits the
+ * process or aborts because of its arguments or a failed large allocation; Rust panics are
+ * caught at the boundary and reported as SO3FFT_EPANIC. (A process so short of memory that the
+ * few bytes of an error message or of a thread's error state cannot be allocated is aborted by
+ * the Rust runtime.)
  *
  * Thread safety: all functions may be called from any thread. Planners may run concurrently.
  * One plan may be executed by several threads at once on different output arrays. A plan must
  * not be destroyed while another thread uses it.
  *
+ * Processes: a plan belongs to the process that made it (its worker threads run there). In a
+ * child made by fork(), executing a plan of the parent fails with SO3FFT_EINVAL and destroying
+ * it returns without waiting for the parent's threads (its memory is not reclaimed); make new
+ * plans in the child. FFTW's own threads are not inherited either: plans made in such a child
+ * do not use them.
+ *
  * FFTW interplay: the host program may use FFTW itself. so3fft holds an internal global lock
  * around each of its FFTW planner calls (plan creation and destruction) and calls
  * fftw_make_planner_thread_safe() once, when the first so3fft plan is created; that call is
- * process-wide and also makes the host's own FFTW planner calls safe against ours. so3fft never
- * calls fftw_init_threads, fftw_plan_with_nthreads, fftw_threads_set_callback or fftw_cleanup:
- * the host's FFTW thread settings are left alone (so3fft parallelises with its own worker
- * threads). so3fft's FFTW plans use and add to FFTW's process-wide wisdom. The host must not call
- * fftw_cleanup() or fftw_cleanup_threads() while so3fft plans exist.
+ * process-wide and also makes the host's own FFTW planner calls safe against ours. A plan made
+ * with SO3FFT_MEASURE or stronger and more than one thread also plans (to time it) a variant
+ * on FFTW's own threads: so3fft then calls fftw_init_threads() once and sets
+ * fftw_plan_with_nthreads() to its thread count during that FFTW planner call, under its lock,
+ * restoring the previous value afterwards (with FFTW before 3.3.9, which cannot report it, the
+ * value 1). A host thread that makes an FFTW plan at that same moment may get that thread
+ * count; where that matters, make so3fft plans with SO3FFT_ESTIMATE, with one thread, or while
+ * the host does not plan. so3fft never calls fftw_threads_set_callback or fftw_cleanup. Its
+ * FFTW plans use and add to FFTW's process-wide wisdom. The host must not call fftw_cleanup()
+ * or fftw_cleanup_threads() while so3fft plans exist.
  */
 
 #ifndef SO3FFT_H
@@ -296,7 +310,7 @@ so3fft_plan so3fft_plan_inverse(int B, so3fft_complex *in, so3fft_complex *out, 
  * Creates a plan for both transforms of bandwidth `B`, without arrays: use it with
  * `so3fft_execute_forward` and `so3fft_execute_inverse` (`so3fft_execute` on it
  * returns `SO3FFT_ENULL`). Costs a little more memory than a one-direction plan
- * (two sets of FFTW plans).
+ * (two sets of FFTW plans, which `so3fft_get_memory` does not count).
  *
  * Flags, threads, ownership, errors and thread safety as for `so3fft_plan_forward`.
  */
@@ -412,9 +426,10 @@ int so3fft_get_nthreads(so3fft_plan p);
 ptrdiff_t so3fft_get_memory(so3fft_plan p);
 
 /**
- * Bytes of memory a plan made now by `so3fft_plan_general(B, direction, ..., flags,
- * nthreads)` would hold (what `so3fft_get_memory` would then report), computed without
- * making it: nothing is allocated. `nthreads`: 0 = all cores. The default workspace uses
+ * Bytes of memory a plan made now by `so3fft_plan_general(B, d, ..., flags, nthreads)`
+ * would hold, whatever its direction `d` (what `so3fft_get_memory` would then report;
+ * FFTW's own plans are not counted), computed without making it: nothing is allocated.
+ * `nthreads`: 0 = all cores. The default workspace uses
  * at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
  * the memory available at the time of the call, so a plan made later may differ if that
  * has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and

@@ -149,7 +149,7 @@ impl From<Error> for CErr {
         let code = match e {
             Error::InvalidBandwidth { .. } => SO3FFT_EBANDWIDTH,
             Error::LengthMismatch { .. } | Error::InvalidArgument(_) => SO3FFT_EINVAL,
-            Error::OutOfMemory { .. } => SO3FFT_ENOMEM,
+            Error::OutOfMemory { .. } | Error::Resources(_) => SO3FFT_ENOMEM,
             Error::WrongDirection => SO3FFT_EDIRECTION,
             Error::Fftw(_) => SO3FFT_EFFTW,
         };
@@ -640,7 +640,7 @@ pub extern "C" fn so3fft_plan_inverse(
 /// Creates a plan for both transforms of bandwidth `B`, without arrays: use it with
 /// `so3fft_execute_forward` and `so3fft_execute_inverse` (`so3fft_execute` on it
 /// returns `SO3FFT_ENULL`). Costs a little more memory than a one-direction plan
-/// (two sets of FFTW plans).
+/// (two sets of FFTW plans, which `so3fft_get_memory` does not count).
 ///
 /// Flags, threads, ownership, errors and thread safety as for `so3fft_plan_forward`.
 #[no_mangle]
@@ -824,9 +824,10 @@ pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
     boundary_count(|| Ok(plan_ref(p)?.plan.memory_bytes() as isize))
 }
 
-/// Bytes of memory a plan made now by `so3fft_plan_general(B, direction, ..., flags,
-/// nthreads)` would hold (what `so3fft_get_memory` would then report), computed without
-/// making it: nothing is allocated. `nthreads`: 0 = all cores. The default workspace uses
+/// Bytes of memory a plan made now by `so3fft_plan_general(B, d, ..., flags, nthreads)`
+/// would hold, whatever its direction `d` (what `so3fft_get_memory` would then report;
+/// FFTW's own plans are not counted), computed without making it: nothing is allocated.
+/// `nthreads`: 0 = all cores. The default workspace uses
 /// at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
 /// the memory available at the time of the call, so a plan made later may differ if that
 /// has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and

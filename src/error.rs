@@ -32,6 +32,8 @@ pub enum Error {
     WrongDirection,
     /// FFTW could not create a plan.
     Fftw(String),
+    /// The system refused another resource than memory (e.g. worker threads).
+    Resources(String),
 }
 
 impl fmt::Display for Error {
@@ -56,6 +58,7 @@ impl fmt::Display for Error {
                 write!(f, "the plan was not made for this direction")
             }
             Error::Fftw(s) => write!(f, "FFTW: {s}"),
+            Error::Resources(s) => write!(f, "out of resources: {s}"),
         }
     }
 }

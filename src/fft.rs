@@ -174,6 +174,10 @@ fn fftw_planner_nthreads() -> std::os::raw::c_int {
 
 static THREADS_INIT: Once = Once::new();
 static THREADS_OK: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+/// The process that initialised FFTW's threads: in a child made by `fork()` FFTW's worker
+/// threads do not exist, and a threaded FFTW plan would wait for them forever, so plans
+/// made there are single-threaded.
+static THREADS_PID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
 
 /// Complex values of padding after each row of a slice in the FFT scratch. A slice's rows
 /// of `2B` values are a multiple of 4 KiB apart for many B, so a walk down a column stays
@@ -216,8 +220,10 @@ fn make_plan(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawPlan
                 THREADS_INIT.call_once(|| {
                     let ok = ffi::fftw_init_threads() != 0;
                     THREADS_OK.store(ok, std::sync::atomic::Ordering::Relaxed);
+                    THREADS_PID.store(std::process::id(), std::sync::atomic::Ordering::Relaxed);
                 });
                 THREADS_OK.load(std::sync::atomic::Ordering::Relaxed)
+                    && THREADS_PID.load(std::sync::atomic::Ordering::Relaxed) == std::process::id()
             };
             let host = if threaded {
                 let host = fftw_planner_nthreads();

@@ -196,6 +196,9 @@ pub struct Plan {
     /// Most bytes of blocks an inverse group writes with ordinary stores (see
     /// [`plain_store_limit`]).
     plain_store_limit: usize,
+    /// The process that made the plan: its worker threads exist only there (a child made
+    /// by `fork()` has none of them).
+    pid: u32,
 }
 
 /// A cluster of the processing order for the DWT stage: its index, the cluster, and the
@@ -370,6 +373,9 @@ fn lock_free<T>(pool: &[Mutex<T>]) -> Option<std::sync::MutexGuard<'_, T>> {
         Err(std::sync::TryLockError::WouldBlock) => None,
     })
 }
+
+/// Worker pools of plans dropped in a child made by `fork()` (see `Plan::drop`).
+static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
 
 /// A field of Linux's `/proc/meminfo` in bytes, if known.
 fn meminfo(field: &str) -> Option<usize> {
@@ -648,7 +654,7 @@ impl Plan {
                 cv.notify_all();
             })
             .build()
-            .map_err(|e| Error::InvalidArgument(format!("thread pool: {e}")))?;
+            .map_err(|e| Error::Resources(format!("cannot start {threads} worker threads: {e}")))?;
         Ok(Plan {
             b,
             direction: options.direction,
@@ -674,6 +680,7 @@ impl Plan {
             skip_bits,
             skip,
             plain_store_limit: plain_store_limit(),
+            pid: std::process::id(),
             buf: Mutex::new(Some(buf)),
             buf_bytes: layout.chunk_bytes,
         })
@@ -755,6 +762,13 @@ impl Plan {
     }
 
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
+        if std::process::id() != self.pid {
+            return Err(Error::InvalidArgument(
+                "plan made in another process (before fork()): its worker threads do not \
+                 exist here; make a new plan in this process"
+                    .into(),
+            ));
+        }
         let ok = if fwd {
             self.direction != Direction::Inverse
         } else {
@@ -1180,6 +1194,17 @@ impl Drop for Plan {
             .pool
             .as_ref()
             .is_none_or(|p| p.current_thread_index().is_none()));
+        if std::process::id() != self.pid {
+            // A child after fork(): the workers were the parent's. Dropping the pool would
+            // wait for them forever; it is kept (reachable) until the process ends.
+            if let Some(pool) = self.pool.take() {
+                ORPHAN_POOLS
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(pool);
+            }
+            return;
+        }
         drop(self.pool.take());
         let (n, cv) = &*self.live;
         let mut g = n.lock().unwrap_or_else(|e| e.into_inner());

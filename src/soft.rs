@@ -114,8 +114,9 @@ fn to_int(v: impl Into<i128> + Copy + std::fmt::Display) -> SoftResult<c_int> {
 // Plan cache
 // ----------------------------------------------------------------------------------------
 
-/// One slot per bandwidth; the slot's own lock serialises creation of that plan only.
-type Slot = Arc<Mutex<Option<Arc<Plan>>>>;
+/// One slot per bandwidth, holding its plan and the process that made it; the slot's own
+/// lock serialises creation of that plan only.
+type Slot = Arc<Mutex<Option<(Arc<Plan>, u32)>>>;
 
 static CACHE: Mutex<BTreeMap<usize, Slot>> = Mutex::new(BTreeMap::new());
 
@@ -156,13 +157,17 @@ fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
         map.entry(b).or_default().clone()
     };
     let mut g = slot.lock().unwrap_or_else(PoisonError::into_inner);
-    if let Some(p) = g.as_ref() {
-        return Ok(Arc::clone(p));
+    if let Some((p, pid)) = g.as_ref() {
+        if *pid == std::process::id() {
+            return Ok(Arc::clone(p));
+        }
+        // A child after fork(): the cached plan's worker threads are the parent's. Make a
+        // new one (dropping the old one in this process does not wait for them).
     }
     let p = Arc::new(
         Plan::new(b, cache_options()).map_err(|e| format!("cannot plan bandwidth {b}: {e}"))?,
     );
-    *g = Some(Arc::clone(&p));
+    *g = Some((Arc::clone(&p), std::process::id()));
     Ok(p)
 }
 
