@@ -32,7 +32,7 @@ usage: so3fft-bench [options]
   --plot PATH         SVG plot of time and error against B (default: the CSV path with
                       extension .svg, i.e. bench.svg)
   --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default
-                      measure: with estimate the FFT stage is about 6x slower at B = 256)
+                      measure: with estimate the FFT stage is 10-20% slower at B = 128 and 256)
   --naive-max B       largest B of the plain one-thread DWT timed for comparison (default 128,
                       0 = none; about 1 s per direction at 128)
   --big               also run B = 512 (added unless the list has a B above 256): needs minutes
