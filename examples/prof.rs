@@ -1,5 +1,6 @@
 //! Stage times of repeated transforms, for profiling (`perf record`) and for comparing two
-//! builds run alternately: each transform prints the seconds of its FFT and DWT stages.
+//! builds run alternately: each transform prints the seconds of its FFT and DWT stages (the
+//! forwards also the whole transform).
 //!
 //! ```text
 //! cargo run --release --example prof -- [B] [MODE] [REPS] [WORKSPACE_MIB]
@@ -92,7 +93,10 @@ fn main() {
             }
             if dir != "rinv" {
                 let t = p.forward_real_timed(&f, &mut c2).unwrap();
-                eprintln!("rfwd fft {:.4} dwt {:.4}", t.fft, t.dwt);
+                eprintln!(
+                    "rfwd fft {:.4} dwt {:.4} total {:.4}",
+                    t.fft, t.dwt, t.total
+                );
             }
         }
         return;
@@ -110,7 +114,7 @@ fn main() {
             eprintln!("dfwd fft {:.4} dwt {:.4}", t.fft, t.dwt);
         } else if dir != "inv" {
             let t = p.forward_timed(&f, &mut c2).unwrap();
-            eprintln!("fwd fft {:.4} dwt {:.4}", t.fft, t.dwt);
+            eprintln!("fwd fft {:.4} dwt {:.4} total {:.4}", t.fft, t.dwt, t.total);
         }
     }
     eprintln!("workspace {} MiB", p.workspace_bytes() >> 20);
