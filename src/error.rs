@@ -2,8 +2,10 @@
 
 use std::fmt;
 
-/// Everything that can go wrong when planning or executing a transform.
+/// Everything that can go wrong when planning or executing a transform. New kinds of
+/// error may be added (match with a wildcard arm).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     /// The bandwidth is 0 or larger than [`crate::MAX_BANDWIDTH`].
     InvalidBandwidth {
