@@ -4,8 +4,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include <fftw3.h>
 #include <pthread.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "test_util.h"
 
@@ -136,66 +134,59 @@ static void thread_local_errors(void) {
     CHECK_ERR(SO3FFT_ENULL);
 }
 
+/* What the child of plan_across_fork() checks; returns failure bits. */
+struct fork_case {
+    so3fft_plan p;
+    so3fft_complex *c, *s, *c2;
+    size_t nc;
+};
+
+static unsigned char fork_child(void *arg) {
+    struct fork_case *f = (struct fork_case *)arg;
+    unsigned char code = 0;
+    so3fft_plan q;
+    int rc = so3fft_execute_inverse(f->p, f->c, f->s);
+    if (rc != SO3FFT_EINVAL) {
+        fprintf(stderr, "fork child: execute returned %d (%s)\n", rc, so3fft_last_error());
+        code |= 1;
+    }
+    if (strstr(so3fft_last_error(), "fork") == NULL) code |= 2;
+    so3fft_destroy_plan(f->p);
+    q = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
+    if (!q) return code | 4;
+    if (so3fft_execute_inverse(q, f->c, f->s) != SO3FFT_OK) code |= 8;
+    if (so3fft_execute_forward(q, f->s, f->c2) != SO3FFT_OK) code |= 8;
+    if (!(max_abs_diff(f->c, f->c2, f->nc) < 1e-12)) code |= 16;
+    so3fft_destroy_plan(q);
+    return code;
+}
+
 /* A plan whose worker threads ran in the parent, used in a child made by fork(): executing
  * it fails with an error instead of waiting forever for the parent's threads, destroying it
- * returns, and a plan made in the child works. alarm() turns a hang into a failure. The
- * child reports through a pipe, not its exit status, which valgrind sets when it finds the
- * memory the parent's vanished threads held. */
+ * returns, and a plan made in the child works. */
 static void plan_across_fork(void) {
-    so3fft_plan p = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
-    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B);
-    so3fft_complex *c = alloc_cx(nc), *s = alloc_cx(ns), *c2 = alloc_cx(nc);
-    int fd[2];
-    pid_t pid;
-    CHECK(p != NULL && pipe(fd) == 0);
-    if (!p) return;
-    fill_random(c, nc, 21);
-    CHECK(so3fft_execute_inverse(p, c, s) == SO3FFT_OK);
-    fflush(NULL);
-    pid = fork();
-    if (pid == 0) {
-        unsigned char code = 0;
-        so3fft_plan q;
-        int rc;
-        alarm(60);
-        close(fd[0]);
-        rc = so3fft_execute_inverse(p, c, s);
-        if (rc != SO3FFT_EINVAL) {
-            fprintf(stderr, "fork child: execute returned %d (%s)\n", rc, so3fft_last_error());
-            code |= 1;
-        }
-        if (strstr(so3fft_last_error(), "fork") == NULL) code |= 2;
-        so3fft_destroy_plan(p);
-        q = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
-        if (!q) {
-            code |= 4;
-        } else {
-            if (so3fft_execute_inverse(q, c, s) != SO3FFT_OK) code |= 8;
-            if (so3fft_execute_forward(q, s, c2) != SO3FFT_OK) code |= 8;
-            if (!(max_abs_diff(c, c2, nc) < 1e-12)) code |= 16;
-            so3fft_destroy_plan(q);
-        }
-        if (write(fd[1], &code, 1) != 1) _exit(3);
-        _exit(0);
-    }
-    close(fd[1]);
-    CHECK(pid > 0);
-    if (pid > 0) {
-        unsigned char code = 255;
-        int status = -1;
-        CHECK(read(fd[0], &code, 1) == 1);
-        if (code != 0) fprintf(stderr, "fork child: failure bits %d\n", code);
-        CHECK(code == 0);
-        CHECK(waitpid(pid, &status, 0) == pid && WIFEXITED(status));
-    }
-    close(fd[0]);
+    struct fork_case f;
+    size_t ns = so3fft_num_samples(B);
+    int code;
+    f.nc = so3fft_num_coeffs(B);
+    f.p = so3fft_plan_general(B, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 2);
+    CHECK(f.p != NULL);
+    if (!f.p) return;
+    f.c = alloc_cx(f.nc);
+    f.s = alloc_cx(ns);
+    f.c2 = alloc_cx(f.nc);
+    fill_random(f.c, f.nc, 21);
+    CHECK(so3fft_execute_inverse(f.p, f.c, f.s) == SO3FFT_OK);
+    code = in_forked_child(fork_child, &f);
+    if (code != 0) fprintf(stderr, "fork child: failure bits %d\n", code);
+    CHECK(code == 0);
     /* The parent's plan is unaffected. */
-    CHECK(so3fft_execute_forward(p, s, c2) == SO3FFT_OK);
-    CHECK(max_abs_diff(c, c2, nc) < 1e-12);
-    so3fft_destroy_plan(p);
-    free(c2);
-    free(s);
-    free(c);
+    CHECK(so3fft_execute_forward(f.p, f.s, f.c2) == SO3FFT_OK);
+    CHECK(max_abs_diff(f.c, f.c2, f.nc) < 1e-12);
+    so3fft_destroy_plan(f.p);
+    free(f.c2);
+    free(f.s);
+    free(f.c);
 }
 
 int main(void) {

@@ -761,8 +761,14 @@ impl Plan {
         self.buf_bytes
     }
 
+    /// Whether the plan's worker threads exist in this process: `false` in a child made by
+    /// `fork()` after the plan was made.
+    pub(crate) fn in_own_process(&self) -> bool {
+        std::process::id() == self.pid
+    }
+
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
-        if std::process::id() != self.pid {
+        if !self.in_own_process() {
             return Err(Error::InvalidArgument(
                 "plan made in another process (before fork()): its worker threads do not \
                  exist here; make a new plan in this process"
@@ -1194,7 +1200,7 @@ impl Drop for Plan {
             .pool
             .as_ref()
             .is_none_or(|p| p.current_thread_index().is_none()));
-        if std::process::id() != self.pid {
+        if !self.in_own_process() {
             // A child after fork(): the workers were the parent's. Dropping the pool would
             // wait for them forever; it is kept (reachable) until the process ends.
             if let Some(pool) = self.pool.take() {

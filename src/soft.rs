@@ -114,9 +114,8 @@ fn to_int(v: impl Into<i128> + Copy + std::fmt::Display) -> SoftResult<c_int> {
 // Plan cache
 // ----------------------------------------------------------------------------------------
 
-/// One slot per bandwidth, holding its plan and the process that made it; the slot's own
-/// lock serialises creation of that plan only.
-type Slot = Arc<Mutex<Option<(Arc<Plan>, u32)>>>;
+/// One slot per bandwidth; the slot's own lock serialises creation of that plan only.
+type Slot = Arc<Mutex<Option<Arc<Plan>>>>;
 
 static CACHE: Mutex<BTreeMap<usize, Slot>> = Mutex::new(BTreeMap::new());
 
@@ -157,8 +156,8 @@ fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
         map.entry(b).or_default().clone()
     };
     let mut g = slot.lock().unwrap_or_else(PoisonError::into_inner);
-    if let Some((p, pid)) = g.as_ref() {
-        if *pid == std::process::id() {
+    if let Some(p) = g.as_ref() {
+        if p.in_own_process() {
             return Ok(Arc::clone(p));
         }
         // A child after fork(): the cached plan's worker threads are the parent's. Make a
@@ -167,7 +166,7 @@ fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
     let p = Arc::new(
         Plan::new(b, cache_options()).map_err(|e| format!("cannot plan bandwidth {b}: {e}"))?,
     );
-    *g = Some((Arc::clone(&p), std::process::id()));
+    *g = Some(Arc::clone(&p));
     Ok(p)
 }
 

@@ -7,8 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <fftw3.h>
 
@@ -45,6 +43,18 @@ static void *worker(void *arg) {
     fftw_free(c);
     fftw_free(s);
     return NULL;
+}
+
+/* The round trip of `job` (a struct job *) matches its single-threaded results: 1, else 0. */
+static unsigned char round_trip_in_child(void *job) {
+    struct job *j = (struct job *)job;
+    int bw = j->bw;
+    size_t n3 = (size_t)8 * bw * bw * bw, nc = (size_t)totalCoeffs_so3(bw);
+    fftw_complex *s = alloc_cx(n3), *c = alloc_cx(nc);
+    Inverse_SO3_Naive_fftw_W(bw, j->coeffs, s, j->flag);
+    Forward_SO3_Naive_fftw_W(bw, s, c, j->flag);
+    return max_abs_diff(s, j->want_samples, n3) <= 1e-13 &&
+           max_abs_diff(c, j->want_coeffs, nc) <= 1e-13;
 }
 
 int main(void) {
@@ -89,37 +99,8 @@ int main(void) {
     }
     /* A child made by fork() while the cache holds plans (whose worker threads are the
      * parent's) plans afresh instead of waiting for them forever, as SOFT itself works in
-     * a child; alarm() turns a hang into a failure. The child reports through a pipe, not
-     * its exit status, which valgrind sets for the memory of the parent's vanished threads. */
-    {
-        int bw = jobs[0].bw, fd[2];
-        size_t n3 = (size_t)8 * bw * bw * bw, nc = (size_t)totalCoeffs_so3(bw);
-        pid_t pid;
-        CHECK(pipe(fd) == 0);
-        fflush(NULL);
-        pid = fork();
-        if (pid == 0) {
-            fftw_complex *s = alloc_cx(n3), *c = alloc_cx(nc);
-            unsigned char ok;
-            alarm(60);
-            close(fd[0]);
-            Inverse_SO3_Naive_fftw_W(bw, jobs[0].coeffs, s, jobs[0].flag);
-            Forward_SO3_Naive_fftw_W(bw, s, c, jobs[0].flag);
-            ok = max_abs_diff(s, jobs[0].want_samples, n3) <= 1e-13 &&
-                 max_abs_diff(c, jobs[0].want_coeffs, nc) <= 1e-13;
-            if (write(fd[1], &ok, 1) != 1) _exit(3);
-            _exit(0);
-        }
-        close(fd[1]);
-        CHECK(pid > 0);
-        if (pid > 0) {
-            unsigned char ok = 0;
-            int status = -1;
-            CHECK(read(fd[0], &ok, 1) == 1 && ok == 1);
-            CHECK(waitpid(pid, &status, 0) == pid && WIFEXITED(status));
-        }
-        close(fd[0]);
-    }
+     * a child. */
+    CHECK(in_forked_child(round_trip_in_child, &jobs[0]) == 1);
     for (t = 0; t < NTHREADS; t++) {
         CHECK_CLOSE(jobs[t].err, 1e-13, "concurrent result vs single-threaded");
         fftw_free(jobs[t].want_coeffs);
