@@ -22,6 +22,8 @@
 #![warn(missing_docs)]
 
 pub mod capi;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod ceilings;
 mod dwt;
 mod error;
 mod fft;

@@ -1,0 +1,40 @@
+//! How often `FftThreading::Auto` keeps FFTW's threads: makes plans with two threads and
+//! `Rigor::Measure` and counts the choice (a check of the plan-time measurement's
+//! robustness; run it with and without load on the other core).
+//!
+//! `cargo run --release --example tune_count -- [B] [PLANS]` (defaults 128 and 20).
+
+use so3fft::{FftThreading, Plan, PlanOptions, Rigor};
+
+fn main() {
+    let arg = |i: usize, default: usize| -> usize {
+        match std::env::args().nth(i) {
+            None => default,
+            Some(s) => s.parse().unwrap_or_else(|_| {
+                eprintln!("usage: tune_count [B] [PLANS]  (got {s:?})");
+                std::process::exit(2)
+            }),
+        }
+    };
+    let (b, n) = (arg(1, 128), arg(2, 20));
+    let options = PlanOptions {
+        threads: 2,
+        rigor: Rigor::Measure,
+        ..Default::default()
+    };
+    let mut fftw = 0;
+    let t = std::time::Instant::now();
+    for _ in 0..n {
+        let plan = Plan::new(b, &options).unwrap_or_else(|e| {
+            eprintln!("tune_count: {e}");
+            std::process::exit(1)
+        });
+        if plan.fft_threading() == FftThreading::FftwThreads {
+            fftw += 1;
+        }
+    }
+    println!(
+        "B={b}: {fftw} of {n} plans kept FFTW's threads ({:.3} s per plan)",
+        t.elapsed().as_secs_f64() / n.max(1) as f64
+    );
+}
