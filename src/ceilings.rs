@@ -235,10 +235,10 @@ macro_rules! fwd_lane {
     };
 }
 
-/// One recurrence step of the next vector (`zmm26 = (a tau + c) p1 - p0` with `a`, `c`
-/// broadcast from the coefficient tables at `{b} + 2048`), its value stored to the
-/// other block buffer (`{b} + 1536`).
-macro_rules! step {
+/// One recurrence step, `zmm28 <- (a tau + c) zmm28 - zmm27` and `zmm27 <-` the old
+/// `zmm28`, with `a`, `c` broadcast from the coefficient tables at `{b} + 2048` and `tau`
+/// in `zmm29`.
+macro_rules! rec_step {
     ($k:literal) => {
         concat!(
             "vbroadcastsd zmm26, qword ptr [{b}+2048+",
@@ -247,12 +247,22 @@ macro_rules! step {
             "vfmadd213pd zmm26, zmm29, qword ptr [{b}+2112+",
             $k,
             "*8]{{1to8}}\n",
-            "vmovapd zmmword ptr [{b}+1536+",
-            $k,
-            "*64], zmm28\n",
             "vfmsub213pd zmm26, zmm28, zmm27\n",
             "vmovapd zmm27, zmm28\n",
             "vmovapd zmm28, zmm26\n",
+        )
+    };
+}
+
+/// The forward kernel's step of the next vector: its current value stored to the other
+/// block buffer (`{b} + 1536`), then [`rec_step`].
+macro_rules! step {
+    ($k:literal) => {
+        concat!(
+            "vmovapd zmmword ptr [{b}+1536+",
+            $k,
+            "*64], zmm28\n",
+            rec_step!($k),
         )
     };
 }
@@ -306,15 +316,7 @@ unsafe fn fwd_block_steps(n: usize, b: *mut f64) {
 macro_rules! inv_degree {
     ($k:literal) => {
         concat!(
-            "vbroadcastsd zmm26, qword ptr [{b}+2048+",
-            $k,
-            "*8]\n",
-            "vfmadd213pd zmm26, zmm29, qword ptr [{b}+2112+",
-            $k,
-            "*8]{{1to8}}\n",
-            "vfmsub213pd zmm26, zmm28, zmm27\n",
-            "vmovapd zmm27, zmm28\n",
-            "vmovapd zmm28, zmm26\n",
+            rec_step!($k),
             "vfmadd231pd zmm0, zmm27, qword ptr [{b}+",
             $k,
             "*128]{{1to8}}\n",
