@@ -311,6 +311,258 @@ unsafe fn fwd_block_steps(n: usize, b: *mut f64) {
     )
 }
 
+/// The multiply-adds of lanes `2 $q` and `2 $q + 1` of the 8-column forward block: both
+/// 8-column rows (at `{b} + $r`) loaded and split into their even and odd columns, then
+/// each degree's two d values (block at `{b} + $d`) broadcast as a pair, feeding one FMA
+/// into the even and one into the odd sums.
+macro_rules! fwd_pair8 {
+    ($q:literal, $r:literal, $d:literal) => {
+        concat!(
+            "vmovupd zmm16, zmmword ptr [{b}+",
+            $r,
+            "+",
+            $q,
+            "*128]\n",
+            "vmovupd zmm17, zmmword ptr [{b}+",
+            $r,
+            "+",
+            $q,
+            "*128+64]\n",
+            "vunpcklpd zmm18, zmm16, zmm17\n",
+            "vunpckhpd zmm19, zmm16, zmm17\n",
+            "vbroadcastf64x2 zmm20, xmmword ptr [{b}+",
+            $d,
+            "+0+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm0, zmm20, zmm18\n",
+            "vfmadd231pd zmm1, zmm20, zmm19\n",
+            "vbroadcastf64x2 zmm21, xmmword ptr [{b}+",
+            $d,
+            "+64+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm2, zmm21, zmm18\n",
+            "vfmadd231pd zmm3, zmm21, zmm19\n",
+            "vbroadcastf64x2 zmm22, xmmword ptr [{b}+",
+            $d,
+            "+128+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm4, zmm22, zmm18\n",
+            "vfmadd231pd zmm5, zmm22, zmm19\n",
+            "vbroadcastf64x2 zmm23, xmmword ptr [{b}+",
+            $d,
+            "+192+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm6, zmm23, zmm18\n",
+            "vfmadd231pd zmm7, zmm23, zmm19\n",
+            "vbroadcastf64x2 zmm20, xmmword ptr [{b}+",
+            $d,
+            "+256+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm8, zmm20, zmm18\n",
+            "vfmadd231pd zmm9, zmm20, zmm19\n",
+            "vbroadcastf64x2 zmm21, xmmword ptr [{b}+",
+            $d,
+            "+320+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm10, zmm21, zmm18\n",
+            "vfmadd231pd zmm11, zmm21, zmm19\n",
+            "vbroadcastf64x2 zmm22, xmmword ptr [{b}+",
+            $d,
+            "+384+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm12, zmm22, zmm18\n",
+            "vfmadd231pd zmm13, zmm22, zmm19\n",
+            "vbroadcastf64x2 zmm23, xmmword ptr [{b}+",
+            $d,
+            "+448+",
+            $q,
+            "*16]\n",
+            "vfmadd231pd zmm14, zmm23, zmm18\n",
+            "vfmadd231pd zmm15, zmm23, zmm19\n",
+        )
+    };
+}
+
+/// Lane `$w` of the 8-column forward block without pairing: its row loaded, then for
+/// each degree one FMA with the d value as an embedded broadcast, into the even lanes'
+/// sums (`zmm0-7`, `$s = 0`) or the odd lanes' (`zmm8-15`, `$s = 1`), so that no sum
+/// waits on the last.
+macro_rules! fwd_lane8 {
+    ($w:literal, 0) => {
+        concat!(
+            "vmovupd zmm16, zmmword ptr [{b}+",
+            $w,
+            "*64]\n",
+            "vfmadd231pd zmm0, zmm16, qword ptr [{b}+1024+0+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm1, zmm16, qword ptr [{b}+1024+64+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm2, zmm16, qword ptr [{b}+1024+128+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm3, zmm16, qword ptr [{b}+1024+192+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm4, zmm16, qword ptr [{b}+1024+256+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm5, zmm16, qword ptr [{b}+1024+320+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm6, zmm16, qword ptr [{b}+1024+384+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm7, zmm16, qword ptr [{b}+1024+448+",
+            $w,
+            "*8]{{1to8}}\n",
+        )
+    };
+    ($w:literal, 1) => {
+        concat!(
+            "vmovupd zmm16, zmmword ptr [{b}+",
+            $w,
+            "*64]\n",
+            "vfmadd231pd zmm8, zmm16, qword ptr [{b}+1024+0+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm9, zmm16, qword ptr [{b}+1024+64+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm10, zmm16, qword ptr [{b}+1024+128+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm11, zmm16, qword ptr [{b}+1024+192+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm12, zmm16, qword ptr [{b}+1024+256+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm13, zmm16, qword ptr [{b}+1024+320+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm14, zmm16, qword ptr [{b}+1024+384+",
+            $w,
+            "*8]{{1to8}}\n",
+            "vfmadd231pd zmm15, zmm16, qword ptr [{b}+1024+448+",
+            $w,
+            "*8]{{1to8}}\n",
+        )
+    };
+}
+
+/// A second vector's recurrence step for [`fwd8_two_chains`]: state `p0, p1, tau` in
+/// `zmm24, zmm25, zmm30`, its value stored to its next block at `{b} + 2176` (the
+/// coefficients are the first vector's; its current block is at `{b} + 2688`).
+macro_rules! step_b {
+    ($k:literal) => {
+        concat!(
+            "vmovapd zmmword ptr [{b}+2176+",
+            $k,
+            "*64], zmm25\n",
+            "vbroadcastsd zmm31, qword ptr [{b}+2048+",
+            $k,
+            "*8]\n",
+            "vfmadd213pd zmm31, zmm30, qword ptr [{b}+2112+",
+            $k,
+            "*8]{{1to8}}\n",
+            "vfmsub213pd zmm31, zmm25, zmm24\n",
+            "vmovapd zmm24, zmm25\n",
+            "vmovapd zmm25, zmm31\n",
+        )
+    };
+}
+
+/// The 8-column forward block as the kernel runs it (paired lanes, 64 FMAs): two steps of
+/// the next vector before each pair of lanes.
+#[target_feature(enable = "avx512f")]
+unsafe fn fwd8_block_steps(n: usize, b: *mut f64) {
+    asm_loop!(
+        n,
+        b,
+        step!(0),
+        step!(1),
+        fwd_pair8!(0, 0, 1024),
+        step!(2),
+        step!(3),
+        fwd_pair8!(1, 0, 1024),
+        step!(4),
+        step!(5),
+        fwd_pair8!(2, 0, 1024),
+        step!(6),
+        step!(7),
+        fwd_pair8!(3, 0, 1024),
+    )
+}
+
+/// The 8-column forward block with one embedded broadcast per FMA ([`fwd_lane8`]) and
+/// one step of the next vector per lane.
+#[target_feature(enable = "avx512f")]
+unsafe fn fwd8_embedded(n: usize, b: *mut f64) {
+    asm_loop!(
+        n,
+        b,
+        step!(0),
+        fwd_lane8!(0, 0),
+        step!(1),
+        fwd_lane8!(1, 1),
+        step!(2),
+        fwd_lane8!(2, 0),
+        step!(3),
+        fwd_lane8!(3, 1),
+        step!(4),
+        fwd_lane8!(4, 0),
+        step!(5),
+        fwd_lane8!(5, 1),
+        step!(6),
+        fwd_lane8!(6, 0),
+        step!(7),
+        fwd_lane8!(7, 1),
+    )
+}
+
+/// The 8-column forward block for two vectors at a time (128 FMAs): the next two vectors'
+/// steps, two independent chains, interleaved with the current two vectors' lanes.
+#[target_feature(enable = "avx512f")]
+unsafe fn fwd8_two_chains(n: usize, b: *mut f64) {
+    asm_loop!(
+        n,
+        b,
+        step!(0),
+        step_b!(0),
+        step!(1),
+        step_b!(1),
+        fwd_pair8!(0, 0, 1024),
+        fwd_pair8!(0, 512, 2688),
+        step!(2),
+        step_b!(2),
+        step!(3),
+        step_b!(3),
+        fwd_pair8!(1, 0, 1024),
+        fwd_pair8!(1, 512, 2688),
+        step!(4),
+        step_b!(4),
+        step!(5),
+        step_b!(5),
+        fwd_pair8!(2, 0, 1024),
+        fwd_pair8!(2, 512, 2688),
+        step!(6),
+        step_b!(6),
+        step!(7),
+        step_b!(7),
+        fwd_pair8!(3, 0, 1024),
+        fwd_pair8!(3, 512, 2688),
+    )
+}
+
 /// One degree of the inverse kernel (16 columns): the step, then 16 FMAs of the value
 /// vector with the embedded broadcasts of the degree's coefficient row (`{b} + 128 k`).
 macro_rules! inv_degree {
@@ -395,20 +647,31 @@ fn instruction_ceilings() {
     }
     // L1-resident data: rows (bytes 0..1024), two block buffers (..2048), recurrence
     // coefficients `a = 0`, `c = 1` (..2176): the steps `p2 = p1 - p0` cycle with period 6,
-    // so no value overflows or turns subnormal.
+    // so no value overflows or turns subnormal; a second vector's two blocks (..3200).
     let mut mem = vec![1.0e-3f64; 512 + 8];
     let base = mem.as_mut_ptr();
     let off = (64 - (base as usize % 64)) / 8 % 8;
     mem[off + 256..off + 264].fill(0.0);
     mem[off + 264..off + 272].fill(1.0);
     let b = unsafe { mem.as_mut_ptr().add(off) };
-    let loops: [(&str, Loop, usize); 8] = [
+    let loops: [(&str, Loop, usize); 11] = [
         ("16 FMAs, register operands (the peak)", regs, 16),
         ("broadcast load + 2 FMAs (forward lane)", bcast_two, 16),
         ("FMAs with {1to8} memory operands", embedded, 16),
         ("FMAs with 64-byte memory operands", full_loads, 16),
         ("forward 8x8 block, no recurrence", fwd_block, 128),
         ("forward 8x8 block with its 8 steps", fwd_block_steps, 128),
+        (
+            "forward 8-column block with its 8 steps",
+            fwd8_block_steps,
+            64,
+        ),
+        (
+            "the same, two vectors (two chains) at once",
+            fwd8_two_chains,
+            128,
+        ),
+        ("8 columns, embedded broadcasts, 16 sums", fwd8_embedded, 64),
         ("inverse, 8 degrees of step + 16 FMAs", inv_degrees, 128),
         ("16 FMAs, register operands (again)", regs, 16),
     ];
