@@ -184,6 +184,9 @@ unsafe fn full_loads(n: usize, b: *mut f64) {
 /// block buffer at `{b} + 1024`) broadcast, each feeding two FMAs into the 16 sums.
 macro_rules! fwd_lane {
     ($w:literal) => {
+        fwd_lane!($w, "1024")
+    };
+    ($w:literal, $d:literal) => {
         concat!(
             "vmovupd zmm24, zmmword ptr [{b}+",
             $w,
@@ -191,42 +194,58 @@ macro_rules! fwd_lane {
             "vmovupd zmm25, zmmword ptr [{b}+",
             $w,
             "*128+64]\n",
-            "vbroadcastsd zmm16, qword ptr [{b}+1024+",
+            "vbroadcastsd zmm16, qword ptr [{b}+",
+            $d,
+            "+0+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm0, zmm16, zmm24\n",
             "vfmadd231pd zmm1, zmm16, zmm25\n",
-            "vbroadcastsd zmm17, qword ptr [{b}+1088+",
+            "vbroadcastsd zmm17, qword ptr [{b}+",
+            $d,
+            "+64+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm2, zmm17, zmm24\n",
             "vfmadd231pd zmm3, zmm17, zmm25\n",
-            "vbroadcastsd zmm18, qword ptr [{b}+1152+",
+            "vbroadcastsd zmm18, qword ptr [{b}+",
+            $d,
+            "+128+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm4, zmm18, zmm24\n",
             "vfmadd231pd zmm5, zmm18, zmm25\n",
-            "vbroadcastsd zmm19, qword ptr [{b}+1216+",
+            "vbroadcastsd zmm19, qword ptr [{b}+",
+            $d,
+            "+192+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm6, zmm19, zmm24\n",
             "vfmadd231pd zmm7, zmm19, zmm25\n",
-            "vbroadcastsd zmm20, qword ptr [{b}+1280+",
+            "vbroadcastsd zmm20, qword ptr [{b}+",
+            $d,
+            "+256+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm8, zmm20, zmm24\n",
             "vfmadd231pd zmm9, zmm20, zmm25\n",
-            "vbroadcastsd zmm21, qword ptr [{b}+1344+",
+            "vbroadcastsd zmm21, qword ptr [{b}+",
+            $d,
+            "+320+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm10, zmm21, zmm24\n",
             "vfmadd231pd zmm11, zmm21, zmm25\n",
-            "vbroadcastsd zmm22, qword ptr [{b}+1408+",
+            "vbroadcastsd zmm22, qword ptr [{b}+",
+            $d,
+            "+384+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm12, zmm22, zmm24\n",
             "vfmadd231pd zmm13, zmm22, zmm25\n",
-            "vbroadcastsd zmm23, qword ptr [{b}+1472+",
+            "vbroadcastsd zmm23, qword ptr [{b}+",
+            $d,
+            "+448+",
             $w,
             "*8]\n",
             "vfmadd231pd zmm14, zmm23, zmm24\n",
@@ -258,8 +277,13 @@ macro_rules! rec_step {
 /// block buffer (`{b} + 1536`), then [`rec_step`].
 macro_rules! step {
     ($k:literal) => {
+        step!($k, "1536")
+    };
+    ($k:literal, $s:literal) => {
         concat!(
-            "vmovapd zmmword ptr [{b}+1536+",
+            "vmovapd zmmword ptr [{b}+",
+            $s,
+            "+",
             $k,
             "*64], zmm28\n",
             rec_step!($k),
@@ -563,6 +587,49 @@ unsafe fn fwd8_two_chains(n: usize, b: *mut f64) {
     )
 }
 
+/// [`fwd_block_steps`] for two vectors in turn, as the kernel runs them: each vector's d
+/// values are stored during the previous vector's lanes and read back as broadcasts (the
+/// two block buffers alternate), 256 FMAs.
+#[target_feature(enable = "avx512f")]
+unsafe fn fwd_block_alternating(n: usize, b: *mut f64) {
+    asm_loop!(
+        n,
+        b,
+        step!(0, "1536"),
+        fwd_lane!(0, "1024"),
+        step!(1, "1536"),
+        fwd_lane!(1, "1024"),
+        step!(2, "1536"),
+        fwd_lane!(2, "1024"),
+        step!(3, "1536"),
+        fwd_lane!(3, "1024"),
+        step!(4, "1536"),
+        fwd_lane!(4, "1024"),
+        step!(5, "1536"),
+        fwd_lane!(5, "1024"),
+        step!(6, "1536"),
+        fwd_lane!(6, "1024"),
+        step!(7, "1536"),
+        fwd_lane!(7, "1024"),
+        step!(0, "1024"),
+        fwd_lane!(0, "1536"),
+        step!(1, "1024"),
+        fwd_lane!(1, "1536"),
+        step!(2, "1024"),
+        fwd_lane!(2, "1536"),
+        step!(3, "1024"),
+        fwd_lane!(3, "1536"),
+        step!(4, "1024"),
+        fwd_lane!(4, "1536"),
+        step!(5, "1024"),
+        fwd_lane!(5, "1536"),
+        step!(6, "1024"),
+        fwd_lane!(6, "1536"),
+        step!(7, "1024"),
+        fwd_lane!(7, "1536"),
+    )
+}
+
 /// One degree of the inverse kernel (16 columns): the step, then 16 FMAs of the value
 /// vector with the embedded broadcasts of the degree's coefficient row (`{b} + 128 k`).
 macro_rules! inv_degree {
@@ -654,13 +721,18 @@ fn instruction_ceilings() {
     mem[off + 256..off + 264].fill(0.0);
     mem[off + 264..off + 272].fill(1.0);
     let b = unsafe { mem.as_mut_ptr().add(off) };
-    let loops: [(&str, Loop, usize); 11] = [
+    let loops: [(&str, Loop, usize); 12] = [
         ("16 FMAs, register operands (the peak)", regs, 16),
         ("broadcast load + 2 FMAs (forward lane)", bcast_two, 16),
         ("FMAs with {1to8} memory operands", embedded, 16),
         ("FMAs with 64-byte memory operands", full_loads, 16),
         ("forward 8x8 block, no recurrence", fwd_block, 128),
         ("forward 8x8 block with its 8 steps", fwd_block_steps, 128),
+        (
+            "the same, d blocks read back after storing",
+            fwd_block_alternating,
+            256,
+        ),
         (
             "forward 8-column block with its 8 steps",
             fwd8_block_steps,
