@@ -691,6 +691,12 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
             std::ptr::write_bytes(fp, 0, i0 * P);
         }
         let mut fast = [0usize; FWD_VECTORS];
+        let mut nf = 0;
+        // Whether `dbuf[cur]` already holds the block of `fast[0]` at `i0`; whether some
+        // vector took the masked path in the last full scan, and the lowest degree index
+        // at which a vector not yet started starts.
+        let (mut primed, mut cur) = (false, 0);
+        let (mut masked, mut wait) = (false, n);
         while i0 < n {
             let mut acc = [S::zero(); ACC];
             // Paired sums are folded and added to `ft` at the end of the block.
@@ -702,43 +708,66 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 }
             }
             // Vectors that start inside this block or still have inactive lanes, one at a
-            // time; the others are listed for the pipelined loop.
-            let mut nf = 0;
-            for (v, s) in st.iter_mut().enumerate() {
-                if s.i >= i0 + DB || s.i >= n {
-                    continue;
+            // time; the others are listed for the pipelined loop. While the list stays the
+            // same (no vector in its masked phase, none starting) it is not rebuilt.
+            if !primed {
+                nf = 0;
+                (masked, wait) = (false, n);
+                for (v, s) in st.iter_mut().enumerate() {
+                    if s.i >= n {
+                        continue;
+                    }
+                    if s.i >= i0 + DB {
+                        wait = wait.min(s.i);
+                        continue;
+                    }
+                    // A last block that ends past `n` runs in full too: its steps read the
+                    // zero padding of the coefficients, and its rows from `n` on are
+                    // scratch.
+                    if s.i == i0 && s.all_active() {
+                        fast[nf] = v;
+                        nf += 1;
+                        continue;
+                    }
+                    masked = true;
+                    pf.issue(pf_per_vector);
+                    let d = s.masked_block::<DB>(i0, n);
+                    let db = dbuf[0].0.as_mut_ptr();
+                    for (j, dj) in d.iter().enumerate() {
+                        S::store(db.add(j * W), *dj);
+                    }
+                    let (x, xs) = xrows(v0 + v * W);
+                    block_fmas::<S, W, P, DB>(&mut acc, db, x, xs);
                 }
-                // A last block that ends past `n` runs in full too: its steps read the
-                // zero padding of the coefficients, and its rows from `n` on are scratch.
-                if s.i == i0 && s.all_active() {
-                    fast[nf] = v;
-                    nf += 1;
-                    continue;
-                }
-                pf.issue(pf_per_vector);
-                let d = s.masked_block::<DB>(i0, n);
-                let db = dbuf[0].0.as_mut_ptr();
-                for (j, dj) in d.iter().enumerate() {
-                    S::store(db.add(j * W), *dj);
-                }
-                let (x, xs) = xrows(v0 + v * W);
-                block_fmas::<S, W, P, DB>(&mut acc, db, x, xs);
             }
             if nf > 0 {
-                // The first fast vector's block, then each next vector's steps
-                // interleaved with the previous one's multiply-adds.
-                let mut cur = 0;
-                let s = &mut st[fast[0]];
-                let (mut p0, mut p1) = (s.p0, s.p1);
-                let db = dbuf[cur].0.as_mut_ptr();
-                for j in 0..DB {
-                    S::store(db.add(j * W), p1);
-                    let p2 = S::fence(s.step(p0, p1, i0 + j));
-                    (p0, p1) = (p1, p2);
+                // The first fast vector's block (unless the previous block computed it),
+                // then each next vector's steps interleaved with the previous one's
+                // multiply-adds.
+                if !primed {
+                    cur = 0;
+                    let s = &mut st[fast[0]];
+                    let (mut p0, mut p1) = (s.p0, s.p1);
+                    let db = dbuf[cur].0.as_mut_ptr();
+                    for j in 0..DB {
+                        S::store(db.add(j * W), p1);
+                        let p2 = S::fence(s.step(p0, p1, i0 + j));
+                        (p0, p1) = (p1, p2);
+                    }
+                    (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
                 }
-                (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
+                // When the next block has the same list (no vector masked here, none
+                // starting there), its first vector's steps go with this block's last
+                // vector instead of running alone (their dependency chain exposed) at the
+                // start of the next block.
+                let next = !masked && wait >= i0 + 2 * DB && i0 + DB < n;
                 let mut ev = fast[0];
-                for &v in &fast[1..nf] {
+                for idx in 1..nf + next as usize {
+                    let (v, base) = if idx < nf {
+                        (fast[idx], i0)
+                    } else {
+                        (fast[0], i0 + DB)
+                    };
                     pf.issue(pf_per_vector);
                     let (x, xs) = xrows(v0 + ev * W);
                     let s = &mut st[v];
@@ -752,7 +781,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                                 // This lane's share of the next vector's steps.
                                 for k in $w * DB / W..($w + 1) * DB / W {
                                     S::store(dn.add(k * W), p1);
-                                    let p2 = S::fence(s.step(p0, p1, i0 + k));
+                                    let p2 = S::fence(s.step(p0, p1, base + k));
                                     (p0, p1) = (p1, p2);
                                 }
                                 lane_fmas::<S, W, P, DB>(&mut acc, dc, $w, x, xs);
@@ -767,14 +796,17 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     lane!(5);
                     lane!(6);
                     lane!(7);
-                    (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
+                    (s.p0, s.p1, s.i) = (p0, p1, base + DB);
                     cur = 1 - cur;
                     ev = v;
                 }
-                pf.issue(pf_per_vector);
-                let (x, xs) = xrows(v0 + ev * W);
-                let dc = dbuf[cur].0.as_ptr();
-                block_fmas::<S, W, P, DB>(&mut acc, dc, x, xs);
+                primed = next;
+                if !next {
+                    pf.issue(pf_per_vector);
+                    let (x, xs) = xrows(v0 + ev * W);
+                    let dc = dbuf[cur].0.as_ptr();
+                    block_fmas::<S, W, P, DB>(&mut acc, dc, x, xs);
+                }
             }
             if pair {
                 for j in 0..DB {
