@@ -148,8 +148,9 @@ impl Plan {
                     // A clear lead of the default needs no more rounds. A lead of FFTW's
                     // threads must survive every round: one round in which another
                     // process delays a worker makes the default look slow (at B = 64,
-                    // with bursts of load on one core, 9 of 20 plans kept FFTW's threads,
-                    // 1.5x slower there, when a single such round decided).
+                    // with bursts of load on the other core, 10 of 90 plans kept FFTW's
+                    // threads, 1.5x slower there, when a single such round decided; none
+                    // since: `examples/tune_count.rs`).
                     if best[1] > CLEAR * best[0] {
                         break;
                     }
