@@ -634,7 +634,8 @@ unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 /// spread over the lanes of the current one (`DB / W` steps before each lane's
 /// multiply-adds, in program order): the floating-point pipes issue the oldest ready
 /// instruction first, so the latency-bound chain of steps never waits behind a block of
-/// independent multiply-adds.
+/// independent multiply-adds. The pipeline runs on from one block to the next while the
+/// list of such vectors stays the same.
 ///
 /// `DB <= W`: callers size `ft` for `n + W` degrees. Returns the lowest degree index any
 /// lane reached active (rows below it are zero).
