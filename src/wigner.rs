@@ -1019,6 +1019,38 @@ mod tests {
         println!("coeffs for all clusters of B = {b}: {:.2} ms", best * 1e3);
     }
 
+    /// Time of the starting values of every cluster at B = 256, two halves of 51 points
+    /// per cluster and chunk, five chunks (what a plan with the default workspace does).
+    #[test]
+    #[ignore]
+    fn starts_speed() {
+        let b = 256;
+        let bt = BetaTables::grid(b);
+        let norm = Ext { mant: 0.5, exp: 0 };
+        let h = 51;
+        let (mut p, mut sc) = (vec![0.0; h], vec![0.0; h]);
+        let (isa, mut best) = (Isa::detect(), f64::MAX);
+        for _ in 0..5 {
+            let t = std::time::Instant::now();
+            for lo in (0..b).step_by(h) {
+                let h = h.min(b - lo);
+                for m in 0..b {
+                    for mp in 0..=m {
+                        for k0 in [lo, 2 * b - lo - h] {
+                            bt.starts(isa, k0, m, mp, norm, 64, &mut p[..h], &mut sc[..h]);
+                        }
+                    }
+                }
+            }
+            best = best.min(t.elapsed().as_secs_f64());
+            std::hint::black_box(&p);
+        }
+        println!(
+            "starts for all clusters and chunks of B = {b}: {:.2} ms",
+            best * 1e3
+        );
+    }
+
     /// The scaled coefficients undo their scales: `A'_i S_{i+1} / S_i = A_i` and
     /// `S_{i+1} / S_{i-1} = Bc_i`, against the closed forms evaluated directly.
     #[test]
