@@ -761,7 +761,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 // starting there), its first vector's steps go with this block's last
                 // vector instead of running alone (their dependency chain exposed) at the
                 // start of the next block.
-                let next = !masked && wait >= i0 + 2 * DB && i0 + DB < n;
+                let next = !masked && wait >= (i0 + 2 * DB).min(n) && i0 + DB < n;
                 let mut ev = fast[0];
                 for idx in 1..nf + next as usize {
                     let (v, base) = if idx < nf {

@@ -100,15 +100,17 @@ pub enum FftThreading {
     ///   direction the plan has, of the first groups of a chunk (up to 4 groups of up to 4
     ///   mirrored pairs of slices per worker, within 64 MiB), on a scratch array standing
     ///   in for the samples and on the plan's own chunk buffer, so the block copies run
-    ///   with their real strides. The variants alternate for up to three rounds (one when they differ by
-    ///   more than 25%) and each is judged by its fastest round (interference from other
-    ///   processes only adds time); FFTW's threads are kept only when at least 10% faster,
-    ///   as slices across workers balance their load dynamically and suffer less from other
-    ///   processes on the machine. On the development machine (two cores) this added about
-    ///   5 ms to plan creation at B = 64, 15 to 60 ms at B = 128 and 0.1 to 0.25 s at
-    ///   B = 256 with one group per worker (one transform takes about 0.01, 0.09 and 1.1 s
-    ///   there; the larger sample left the whole planning time at B = 128 and 256 unchanged
-    ///   within its noise, 0.8 and 4.2-4.6 s), plus FFTW's
+    ///   with their real strides. The variants alternate for up to five rounds (one when
+    ///   slices across workers are more than 25% faster) and each is judged by its fastest
+    ///   round (interference from other processes only adds time); FFTW's threads are kept
+    ///   only when at least 10% faster over all rounds, as slices across workers balance
+    ///   their load dynamically and suffer less from other processes on the machine. On the
+    ///   development machine (two cores) this added about 5 ms to plan creation at B = 64,
+    ///   15 to 60 ms at B = 128 and 0.1 to 0.25 s at B = 256 with one group per worker and
+    ///   at most three rounds (one transform takes about 0.01, 0.09 and 1.1 s there; the
+    ///   larger sample left the whole planning time at B = 128 and 256 unchanged within its
+    ///   noise, 0.8 and 4.2-4.6 s; up to five rounds when the host is busy made plans at
+    ///   B = 64 and 128 take 15-30% longer under load), plus FFTW's
     ///   planning of the second variant: 0.2 to 0.5 s the first time at each bandwidth
     ///   with `Rigor::Measure`. The scratch array is freed before [`Plan::new`] returns.
     ///   When the other variant cannot be planned, or the scratch array would take more

@@ -26,7 +26,8 @@ const SAMPLE_GROUPS: usize = 4;
 /// Most bytes of the scratch sample grid (at least one group per worker is timed).
 const SAMPLE_BYTES: usize = 64 << 20;
 
-/// Ratio of the two times beyond which no further round is run.
+/// Ratio by which FFTW's threads must be slower than slices across workers for no further
+/// round to be run.
 const CLEAR: f64 = 1.25;
 
 /// FFTW's threads are kept only when faster by at least this fraction: within the noise
