@@ -35,6 +35,19 @@ static size_t vm_size(void) {
     return (size_t)pages * (size_t)sysconf(_SC_PAGESIZE);
 }
 
+/* The child's exit status for plan `p`, made by the step `what`: a NULL plan must come with
+ * SO3FFT_ENOMEM; a plan that was made is destroyed and passes only if `may_succeed`. */
+static int outcome(so3fft_plan p, const char *what, int may_succeed) {
+    printf("%s: %s, code %d, \"%s\"\n", what, p ? "plan created" : "NULL",
+           so3fft_last_error_code(), so3fft_last_error());
+    if (p) {
+        so3fft_destroy_plan(p);
+        return may_succeed ? 0 : 1;
+    }
+    CHECK_ERR(SO3FFT_ENOMEM);
+    return g_failures ? 1 : 0;
+}
+
 static int child(size_t headroom, int direction) {
     struct rlimit rl;
     size_t now = vm_size();
@@ -45,14 +58,7 @@ static int child(size_t headroom, int direction) {
     }
     if (headroom == 0) {
         p = so3fft_plan_general(1024, direction, NULL, NULL, SO3FFT_ESTIMATE, 1);
-        printf("B=1024 without a cap: %s (code %d) %s\n", p ? "plan created" : "NULL",
-               so3fft_last_error_code(), so3fft_last_error());
-        if (p) {
-            so3fft_destroy_plan(p);
-            return 0;
-        }
-        CHECK_ERR(SO3FFT_ENOMEM);
-        return g_failures ? 1 : 0;
+        return outcome(p, "B=1024 without a cap", 1);
     }
     rl.rlim_cur = rl.rlim_max = (rlim_t)(now + headroom);
     if (setrlimit(RLIMIT_AS, &rl) != 0) {
@@ -61,15 +67,7 @@ static int child(size_t headroom, int direction) {
     }
     if (direction == 0) {
         p = so3fft_plan_general(2, SO3FFT_BOTH, NULL, NULL, SO3FFT_ESTIMATE, 1024);
-        printf("B=2 with 1024 threads, headroom %lu MiB: %s, code %d, \"%s\"\n",
-               (unsigned long)(headroom >> 20), p ? "plan created" : "NULL",
-               so3fft_last_error_code(), so3fft_last_error());
-        if (p) {
-            so3fft_destroy_plan(p);
-            return 1;
-        }
-        CHECK_ERR(SO3FFT_ENOMEM);
-        return g_failures ? 1 : 0;
+        return outcome(p, "B=2 with 1024 threads under the cap", 0);
     }
     p = so3fft_plan_general(512, direction, NULL, NULL, SO3FFT_ESTIMATE, 1);
     if (p != NULL) {

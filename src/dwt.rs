@@ -1535,13 +1535,13 @@ mod tests {
 }
 
 #[cfg(test)]
-mod kernel_speed {
+pub(crate) mod kernel_speed {
     use super::tests::{aligned, cluster_setup, grid_lanes};
     use super::*;
 
     /// FMA peak of one core, GFLOP/s: 16 independent chains of AVX-512 FMAs (AVX2 or
     /// scalar where missing), best of a few short runs.
-    pub(super) fn fma_peak() -> f64 {
+    pub(crate) fn fma_peak() -> f64 {
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx512f,fma")]
         unsafe fn chains(iters: usize) -> f64 {

@@ -45,7 +45,8 @@ static void *worker(void *arg) {
     return NULL;
 }
 
-/* The round trip of `job` (a struct job *) matches its single-threaded results: 1, else 0. */
+/* The round trip of `job` (a struct job *) gives back its coefficients and matches its
+ * single-threaded results: 1, else 0. */
 static unsigned char round_trip_in_child(void *job) {
     struct job *j = (struct job *)job;
     int bw = j->bw;
@@ -53,7 +54,8 @@ static unsigned char round_trip_in_child(void *job) {
     fftw_complex *s = alloc_cx(n3), *c = alloc_cx(nc);
     Inverse_SO3_Naive_fftw_W(bw, j->coeffs, s, j->flag);
     Forward_SO3_Naive_fftw_W(bw, s, c, j->flag);
-    return max_abs_diff(s, j->want_samples, n3) <= 1e-13 &&
+    return max_abs_diff(c, j->coeffs, nc) <= 1e-12 &&
+           max_abs_diff(s, j->want_samples, n3) <= 1e-13 &&
            max_abs_diff(c, j->want_coeffs, nc) <= 1e-13;
 }
 
