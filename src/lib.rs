@@ -20,6 +20,8 @@
 //! ```
 
 #![warn(missing_docs)]
+#![warn(unsafe_op_in_unsafe_fn)]
+#![warn(clippy::undocumented_unsafe_blocks)]
 
 pub mod capi;
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -28,6 +30,9 @@ mod dwt;
 mod error;
 mod fft;
 mod grid;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+pub mod internals;
 mod plan;
 mod simd;
 pub mod soft;

@@ -1,0 +1,2 @@
+//! Crate-internal kernels and stages, exposed for the measuring tools in `benches/`
+//! (feature `internals`). Not part of the public API: no stability promise.
