@@ -39,7 +39,7 @@ pub fn gamma(b: usize, j: usize) -> f64 {
 ///
 /// They integrate band-limited functions against `sin(beta) dbeta` exactly.
 pub fn weights(b: usize) -> Vec<f64> {
-    use crate::wigner::{sin_cos_dd, Dd, PI_DD};
+    use crate::numeric::{sin_cos_dd, Dd, PI_DD};
     // sin(pi j / (4B)) for j = 0..8B in double-double: every angle of the sums is such a
     // multiple of pi / (4B), `(2i+1) beta_k = pi (2i+1)(2k+1) / (4B)`, reduced exactly
     // in integers; forming it in doubles instead would put an error of up to

@@ -33,6 +33,7 @@ mod grid;
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub mod internals;
+mod numeric;
 mod plan;
 mod simd;
 pub mod soft;

@@ -22,10 +22,11 @@ mod fft_stage;
 mod fft_tune;
 mod real;
 use crate::grid::{block_start, num_coeffs, num_samples, weights};
+use crate::numeric::Ext;
 use crate::simd::Isa;
 use crate::symmetry::{cluster_pairs, Cluster, Member};
 use crate::wigner::{
-    big, start_norms, BetaTables, Ext, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
+    big, start_norms, BetaTables, RecCoeffs, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
 };
 use blocks::{Blocks, BufLayout};
 use dwt_stage::{all_members, Scratch};

@@ -163,7 +163,7 @@ pub(crate) const TILE: usize = 8;
 /// enumerated with the seed paper's index map ([`kappa_to_pair`] on the triangle
 /// `1 <= tb + 1 < ta + 2 <= T + 1`), which interleaves expensive rows of tiles (small
 /// `m`) with cheap ones, so any contiguous run of tiles carries a similar amount of work.
-pub(crate) fn cluster_pairs(b: usize) -> Vec<(u32, u32)> {
+pub fn cluster_pairs(b: usize) -> Vec<(u32, u32)> {
     let t = b.div_ceil(TILE);
     let tiles = (0..t * (t + 1) / 2).map(|k| {
         let (x, y) = kappa_to_pair(t + 2, k);

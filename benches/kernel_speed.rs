@@ -1,0 +1,142 @@
+//! Throughput of the DWT kernels (measures, asserts nothing): one cluster at a time
+//! against the FMA peak of one core, and the kernel time summed over every cluster of a
+//! bandwidth.
+//!
+//! Run: `cargo bench --features internals --bench kernel_speed`
+//! (the skip threshold follows `SO3FFT_SKIP_BITS` if set).
+
+use so3fft::internals::{
+    aligned, cluster_pairs, cluster_setup, fma_peak, forward, grid_lanes, inverse, Rec,
+};
+use so3fft::Isa;
+
+fn main() {
+    println!("FMA peak of one core: {:.1} GFLOP/s", fma_peak());
+    kernel_gflops();
+    all_clusters_gflops();
+}
+
+/// Kernel-only throughput: GFLOP/s of the fused
+/// recurrence + accumulation for one generic cluster, all 2B grid betas, against the
+/// FMA peak. Forward, inverse and the peak are measured in alternation and each keeps
+/// its best batch: the machine is shared and noisy.
+fn kernel_gflops() {
+    // (B, betas, columns, m): m = B / 8 has long negligible prefixes near the poles,
+    // m = 2 nearly none (the fast phase alone).
+    for &(b, nbs, pw, m) in &[
+        (256usize, 512usize, 16usize, 32usize),
+        (256, 128, 16, 32),
+        (128, 256, 16, 16),
+        (256, 512, 8, 32),
+        (256, 512, 16, 2),
+        (256, 512, 8, 2),
+    ] {
+        let mp = m / 2;
+        let n = b - m;
+        let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
+        let rec = Rec::new(&rc, n);
+        let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
+        let xbuf = vec![0.5; nbs * 16 + 8];
+        let xin = aligned(&xbuf, nbs * 16);
+        let mut f = vec![0.0; (n + 8) * 16];
+        let mut y = vec![0.0; nbs * 16];
+        let isa = Isa::detect();
+        let batch = |f: &mut dyn FnMut()| {
+            let t = std::time::Instant::now();
+            for _ in 0..50 {
+                f();
+            }
+            t.elapsed().as_secs_f64() / 50.0
+        };
+        let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
+        for _ in 0..7 {
+            tf = tf.min(batch(&mut || {
+                forward(isa, pw, &rec, &lanes, xin, &mut f);
+            }));
+            ti = ti.min(batch(&mut || {
+                inverse(
+                    isa,
+                    pw,
+                    &rec,
+                    &lanes,
+                    &mut f[..n * pw],
+                    &mut |_, _, _| {},
+                    &mut y,
+                )
+            }));
+            peak = peak.max(fma_peak());
+        }
+        let flops = (n * nbs * pw * 2) as f64;
+        let (gf, gi) = (flops / tf / 1e9, flops / ti / 1e9);
+        println!(
+            "B={b} nb={nbs} L={n} P={pw} m={m}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}",
+            100.0 * gf / peak,
+            100.0 * gi / peak
+        );
+    }
+}
+
+/// Kernel time summed over every cluster of a bandwidth (all 2B betas as one chunk),
+/// against the nominal DWT flop count.
+fn all_clusters_gflops() {
+    let isa = Isa::detect();
+    for b in [128usize, 256] {
+        let nbs = 2 * b;
+        let (mut tf, mut ti) = (0.0, 0.0);
+        let mut qt = [0.0f64; 4];
+        let mut qtf = [0.0f64; 4];
+        let mut qf = [0.0f64; 4];
+        let xbuf = vec![0.5; nbs * 16 + 8];
+        let xin = aligned(&xbuf, nbs * 16);
+        let mut f = vec![0.0; (b + 8) * 16];
+        let mut y = vec![0.0; nbs * 16];
+        for (m, mp) in cluster_pairs(b) {
+            let (m, mp) = (m as usize, mp as usize);
+            let n = b - m;
+            let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
+            let rec = Rec::new(&rc, n);
+            let lanes = grid_lanes(&x, &p, &sc, b);
+            let pw = if m == mp || mp == 0 { 8 } else { 16 };
+            let t = std::time::Instant::now();
+            forward(isa, pw, &rec, &lanes, xin, &mut f[..(n + 8) * pw]);
+            let dt = t.elapsed().as_secs_f64();
+            tf += dt;
+            qtf[4 * m / b] += dt;
+            let t = std::time::Instant::now();
+            let y = &mut y[..nbs * pw];
+            inverse(
+                isa,
+                pw,
+                &rec,
+                &lanes,
+                &mut f[..n * pw],
+                &mut |_, _, _| {},
+                y,
+            );
+            let dt = t.elapsed().as_secs_f64();
+            ti += dt;
+            qt[4 * m / b] += dt;
+            qf[4 * m / b] += (n * nbs * pw * 2) as f64;
+        }
+        for q in 0..4 {
+            println!(
+                "  m in quarter {q}: forward {:.1}, inverse {:.1} GFLOP/s nominal, {:.3} s / {:.3} s",
+                qf[q] / qtf[q] / 1e9,
+                qf[q] / qt[q] / 1e9,
+                qtf[q],
+                qt[q]
+            );
+        }
+        let flops = 8.0 * b as f64 * (4.0 * (b as f64).powi(3) - b as f64) / 3.0;
+        let peak = fma_peak();
+        println!(
+            "B={b}: kernels over all clusters: forward {:.3} s ({:.1} GFLOP/s, {:.0}%), inverse {:.3} s ({:.1} GFLOP/s, {:.0}%), peak {peak:.1}",
+            tf,
+            flops / tf / 1e9,
+            100.0 * flops / tf / 1e9 / peak,
+            ti,
+            flops / ti / 1e9,
+            100.0 * flops / ti / 1e9 / peak
+        );
+    }
+}

@@ -1,0 +1,71 @@
+//! Kernel inputs for one cluster on the sample grid: shared by the kernel tests and the
+//! measuring tools in `benches/` (feature `internals`).
+
+use super::lanes::{Lanes, Prefetch};
+use crate::wigner::starts::{big, start_norm, BaseStart, BetaTables, DEFAULT_SKIP_BITS};
+use crate::wigner::{RecCoeffs, RecTables};
+
+/// Skip threshold of the kernel tests and benchmarks: `SO3FFT_SKIP_BITS` or the default.
+pub fn test_skip_bits() -> u32 {
+    std::env::var("SO3FFT_SKIP_BITS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(DEFAULT_SKIP_BITS)
+}
+
+/// Recurrence coefficients of base pair `(m, mp)` at bandwidth `b` and lane inputs for
+/// `nbs` points spread evenly over the grid (lower half first, as in a chunk).
+pub fn cluster_setup(
+    b: usize,
+    m: usize,
+    mp: usize,
+    nbs: usize,
+) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let ks: Vec<usize> = (0..nbs).map(|s| s * (2 * b) / nbs).collect();
+    cluster_setup_at(b, m, mp, &ks)
+}
+
+/// As [`cluster_setup`], for the grid betas `ks`.
+pub fn cluster_setup_at(
+    b: usize,
+    m: usize,
+    mp: usize,
+    ks: &[usize],
+) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let nbs = ks.len();
+    let bt = BetaTables::grid(b);
+    let norm = start_norm(m, mp);
+    let mut rc = RecCoeffs::new(b - m);
+    RecTables::new(b).coeffs(m, mp, &mut rc);
+    let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
+    let base = BaseStart::new(m, mp, norm, test_skip_bits());
+    for (s, &k) in ks.iter().enumerate() {
+        tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
+        (p[s], sc[s]) = bt.start(k, &base, 1.0);
+    }
+    (rc, tau, p, sc)
+}
+
+/// `len` values of `buf` from its first 64-byte boundary (as the plan's chunk
+/// buffers); `buf` holds at least `len + 7`.
+#[cfg(feature = "internals")]
+pub fn aligned(buf: &[f64], len: usize) -> &[f64] {
+    &buf[buf.as_ptr().align_offset(64)..][..len]
+}
+
+/// Kernel lanes over `cluster_setup`'s arrays, default skip threshold.
+pub fn grid_lanes<'a>(tau: &'a [f64], p: &'a [f64], sc: &'a [f64], upper_from: usize) -> Lanes<'a> {
+    Lanes {
+        tau,
+        p,
+        sc,
+        upper_from,
+        big: big(test_skip_bits()),
+        skip: true,
+        interleaved: true,
+        prefetch: Prefetch::none(),
+        stream: true,
+        pair_stride: 0,
+        row_gap: 0,
+    }
+}

@@ -1,0 +1,201 @@
+//! The inverse kernel: `y[row(s)][q] = sum_i dt_{l0+i}(beta_s) fin[i][q]`.
+
+use super::lanes::{Lanes, Rec};
+use super::state::{prefix_states, State};
+use crate::simd::Simd;
+use std::mem::MaybeUninit;
+
+/// `acc[q] += v * row[q]` (the inverse kernel's accumulation of one degree).
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
+/// entries read or written (`P` values an input row, the output rows of the lanes).
+#[inline(always)]
+unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *const f64) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        for (q, a) in acc.iter_mut().enumerate() {
+            *a = S::fma(v, S::splat(*row.add(q)), *a);
+        }
+    }
+}
+
+/// Fills rows `from..to` of the inverse kernel's input (see [`inverse_raw`]).
+pub type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
+
+/// Vectors of betas whose states the inverse kernel sets up before it needs their input
+/// rows.
+const INV_VECTORS: usize = 16;
+
+/// # Safety
+/// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
+/// entries read or written (`P` values an input row, the output rows of the lanes).
+#[inline(always)]
+unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: *mut f64,
+) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let n = rec.len();
+        let nb = lanes.tau.len();
+        debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P);
+        let (ps, gap) = lanes.pair_layout(P);
+        let mut pf = lanes.prefetch;
+        let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
+        // Rows `have..n` of `fin` are filled.
+        let mut have = n;
+        let mut v0 = 0;
+        while v0 < nb {
+            // Up to INV_VECTORS vectors through their negligible prefixes, then the rows from
+            // the first degree any of them needs.
+            let nv = ((nb - v0) / W).min(INV_VECTORS);
+            let mut st_mem = [const { MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
+            let (first, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut st_mem[..nv]);
+            if first < have {
+                fill(fin, first, have);
+                have = first;
+            }
+            let fp = fin.as_ptr();
+            let mut gi = 0;
+            while gi < nv {
+                // With 8 columns, two vectors run together once both are fully active: each
+                // data broadcast then feeds two multiply-adds, and the two recurrences are
+                // independent chains (one vector's step and 8 multiply-adds per degree leave
+                // the pipes half idle).
+                let pair = P <= 8 && gi + 1 < nv;
+                let mut st = [states[gi], states[(gi + 1).min(nv - 1)]];
+                let mut acc = [[S::zero(); P]; 2];
+                pf.issue(pf_per_vector * (1 + pair as usize));
+                if pair {
+                    let [a0, a1] = &mut acc;
+                    for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
+                        s.run_slow(n, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    }
+                    // The one behind catches up alone, then both run together.
+                    let i0 = st[0].i.max(st[1].i);
+                    for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
+                        s.run_fast(i0, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    }
+                    let [s0, s1] = &mut st;
+                    let (mut p0, mut p1, mut r0, mut r1) = (s0.p0, s0.p1, s1.p0, s1.p1);
+                    for i in i0..n {
+                        let (v, u) = (p1, r1);
+                        let p2 = S::fence(s0.step(p0, p1, i));
+                        let r2 = S::fence(s1.step(r0, r1, i));
+                        (p0, p1, r0, r1) = (p1, p2, r1, r2);
+                        let row = fp.add(i * P);
+                        for q in 0..P {
+                            let c = S::splat(*row.add(q));
+                            a0[q] = S::fma(v, c, a0[q]);
+                            a1[q] = S::fma(u, c, a1[q]);
+                        }
+                    }
+                } else {
+                    // A local copy, so the state lives in registers during the run.
+                    let mut s = st[0];
+                    let a = &mut acc[0];
+                    s.run(n, |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                }
+                // Rows of the output are lanes: each W x W block of (order column, lane) is
+                // transposed in registers on the way out, and with `lanes.stream` written
+                // without reading the lines first (see `Lanes::stream`).
+                // `NT` is a parameter of the kernel: a run-time branch here cost the 8-column
+                // kernel a third of its speed (its register allocation changed).
+                for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
+                    // Interleaved rows step by 2: one pair of rows to the next.
+                    let (r0, step) = lanes.rows(v0 + (gi + k) * W);
+                    let (at, stride) = (
+                        (r0 / 2) * ps + (r0 % 2) * gap,
+                        if step == 2 { ps } else { P },
+                    );
+                    for q0 in (0..P).step_by(W) {
+                        S::store_transposed(&a[q0..q0 + W], y.add(at + q0), stride, NT);
+                    }
+                }
+                gi += 1 + pair as usize;
+            }
+            v0 += nv * W;
+        }
+    }
+}
+
+/// A `#[target_feature]` entry point: [`inverse_body`] for one instruction set, vector
+/// width and column count.
+macro_rules! entry {
+    ($name:ident, $feat:literal, $S:ty, $W:literal, $N:literal) => {
+        /// # Safety
+        /// As [`inverse_body`], for the instruction set of `$S`.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        unsafe fn $name<const NT: bool>(
+            rec: &Rec,
+            lanes: &Lanes,
+            fin: &mut [f64],
+            fill: Fill,
+            y: *mut f64,
+        ) {
+            // SAFETY: the caller upholds `inverse_body`'s contract.
+            unsafe { inverse_body::<$S, $W, $N, NT>(rec, lanes, fin, fill, y) }
+        }
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{avx2::Avx2, avx512::Avx512};
+use crate::simd::{scalar::Scalar, Isa};
+
+entry!(inv_avx512_16, "avx512f,fma", Avx512, 8, 16);
+entry!(inv_avx512_8, "avx512f,fma", Avx512, 8, 8);
+entry!(inv_avx2_16, "avx2,fma", Avx2, 4, 16);
+entry!(inv_avx2_8, "avx2,fma", Avx2, 4, 8);
+
+/// The inverse kernel for `isa` and `p` columns (8 or 16).
+///
+/// # Safety
+/// `isa` is supported by this CPU; `fin` holds `n * p` values; every row of the lanes is
+/// valid for writes at its place after `y` (see `dwt::inverse_raw`) and written by no one
+/// else meanwhile; the lane arrays hold `lanes.tau.len()` entries, a multiple of
+/// `isa.lanes()`.
+pub(super) unsafe fn run(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: *mut f64,
+) {
+    // SAFETY: the caller's contract covers every kernel's (`inverse_body`'s) and the
+    // instruction set of the one chosen.
+    unsafe {
+        // The kernel for the store mode `lanes.stream`.
+        macro_rules! nt {
+            ($f:ident $(::<$($g:tt),*>)?) => {
+                if lanes.stream {
+                    $f::<$($($g,)*)? true>(rec, lanes, fin, fill, y)
+                } else {
+                    $f::<$($($g,)*)? false>(rec, lanes, fin, fill, y)
+                }
+            };
+        }
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => nt!(inv_avx512_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 8) => nt!(inv_avx512_8),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => nt!(inv_avx2_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 8) => nt!(inv_avx2_8),
+            (_, 16) => nt!(inverse_body::<Scalar, 1, 16>),
+            (_, 8) => nt!(inverse_body::<Scalar, 1, 8>),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
+    // The output rows may have been written with non-temporal stores.
+    crate::simd::sfence();
+}

@@ -1,0 +1,184 @@
+//! The kernels' inputs besides the data: recurrence coefficients ([`Rec`]), per-lane
+//! inputs and the data layout ([`Lanes`]), prefetch hints ([`Prefetch`]).
+
+use crate::wigner::{RecCoeffs, REC_PAD};
+
+/// Recurrence coefficients of one cluster, index `i = l - l0`, for the scaled values
+/// `e_i` of `RecTables::coeffs`: `e_{i+1} = (A'_i x + C'_i) e_i - e_{i-1}`. Each slice
+/// holds [`REC_PAD`] finite values past the `n` degrees (what the forward kernel's last
+/// block steps through).
+pub struct Rec<'a> {
+    /// `A'_i`
+    pub a: &'a [f64],
+    /// `-A'_i`
+    pub neg_a: &'a [f64],
+    /// `A'_i + C'_i`
+    pub a_plus_c: &'a [f64],
+    /// `C'_i - A'_i`
+    pub c_minus_a: &'a [f64],
+    n: usize,
+}
+
+impl<'a> Rec<'a> {
+    /// The first `n` degrees of `r`.
+    pub fn new(r: &'a RecCoeffs, n: usize) -> Rec<'a> {
+        assert!(n <= r.len());
+        let end = n + REC_PAD;
+        Rec {
+            a: &r.a[..end],
+            neg_a: &r.neg_a[..end],
+            a_plus_c: &r.a_plus_c[..end],
+            c_minus_a: &r.c_minus_a[..end],
+            n,
+        }
+    }
+
+    /// Number of degrees.
+    pub(crate) fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Whether every slice holds the `n` degrees and the padding.
+    pub(crate) fn padded(&self) -> bool {
+        [self.a, self.neg_a, self.a_plus_c, self.c_minus_a]
+            .iter()
+            .all(|v| v.len() == self.n + REC_PAD)
+    }
+}
+
+/// Per-lane inputs: recurrence argument `tau`, scaled starting value and scale index (see
+/// the `wigner::starts` module).
+/// Lengths are a multiple of the vector width (pad with zeros). Vectors starting before
+/// `upper_from` are in the lower half (`beta < pi/2`, `tau = 1 - cos beta`), the others in
+/// the upper half (`tau = 1 + cos beta`): the recurrence multiplier `A cos(beta) + C` is
+/// formed as `(A + C) - A tau` or `A tau + (C - A)`, never from a rounded `cos(beta)`,
+/// which near the poles would shift beta and move `d^l` by up to `l^2 eps`.
+pub struct Lanes<'a> {
+    /// Recurrence argument `1 - cos beta` (lower half) or `1 + cos beta` (upper half).
+    pub tau: &'a [f64],
+    /// Scaled starting value (`wigner::starts::to_scaled`).
+    pub p: &'a [f64],
+    /// Scale index of the starting value (`<= 0`).
+    pub sc: &'a [f64],
+    /// First lane of the upper half.
+    pub upper_from: usize,
+    /// Rescale threshold of the scaled values, `wigner::big(skip bits)`.
+    pub big: f64,
+    /// Skip the degrees where no lane of a vector is active yet (`false` only to measure
+    /// what skipping saves: inactive lanes then accumulate exact zeros).
+    pub skip: bool,
+    /// Row of lane `u` in the data arrays: `u`, or, interleaved, `2u` for `u < upper_from`
+    /// and `2(u - upper_from) + 1` above (the lanes count `2 upper_from`), so that lanes
+    /// `u` and `u + upper_from` (a beta and its mirror, see `plan/blocks.rs`) are adjacent.
+    pub interleaved: bool,
+    /// Memory to prefetch into L2 while the kernel runs, a few lines at a time (the next
+    /// cluster's block and coefficient rows); hints only, never read.
+    pub prefetch: Prefetch,
+    /// Inverse: write the output with non-temporal stores (for outputs far larger than
+    /// the caches, read back only later; ordinary stores would first read every line).
+    pub stream: bool,
+    /// Interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the inverse's
+    /// output or the forward's input (`forward_raw`) to the next; row `r` is at
+    /// `(r / 2) * pair_stride + (r % 2) * row_gap`. 0 means `2P`, rows one after another.
+    pub pair_stride: usize,
+    /// With `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`, side by
+    /// side). Far larger in the half-major and split layouts of `plan/blocks.rs`, where
+    /// the low-beta rows and the mirror rows are in two separate halves.
+    pub row_gap: usize,
+}
+
+/// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
+#[derive(Clone, Copy)]
+pub struct Prefetch {
+    /// `(start, 64-byte lines)`.
+    ranges: [(*const u8, usize); Prefetch::MAX],
+    n: usize,
+    /// Position: range index and line within it.
+    at: (usize, usize),
+}
+
+impl Prefetch {
+    const MAX: usize = 10;
+
+    /// Nothing to prefetch.
+    pub fn none() -> Prefetch {
+        Prefetch {
+            ranges: [(std::ptr::null(), 0); Prefetch::MAX],
+            n: 0,
+            at: (0, 0),
+        }
+    }
+
+    /// Add `len` doubles from `p` (ignored beyond [`Prefetch::MAX`] ranges).
+    pub fn push(&mut self, p: *const f64, len: usize) {
+        if self.n < Prefetch::MAX && len > 0 {
+            self.ranges[self.n] = (p as *const u8, (len * 8).div_ceil(64));
+            self.n += 1;
+        }
+    }
+
+    /// Lines in all ranges.
+    pub(crate) fn lines(&self) -> usize {
+        self.ranges[..self.n].iter().map(|r| r.1).sum()
+    }
+
+    /// Issue the next `k` prefetches (into L2).
+    #[inline(always)]
+    pub(crate) fn issue(&mut self, mut k: usize) {
+        while k > 0 && self.at.0 < self.n {
+            let (p, len) = self.ranges[self.at.0];
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: a prefetch is a hint that never faults, whatever the address; SSE is part
+            // of x86-64.
+            unsafe {
+                use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
+                _mm_prefetch::<_MM_HINT_T1>(p.wrapping_add(64 * self.at.1) as *const i8);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            let _ = p;
+            self.at.1 += 1;
+            if self.at.1 >= len {
+                self.at = (self.at.0 + 1, 0);
+            }
+            k -= 1;
+        }
+    }
+}
+
+impl Lanes<'_> {
+    /// Interleaved rows: doubles from one pair of rows to the next and from row `2j` to
+    /// row `2j + 1` (`pair_stride`, `row_gap` with their defaults for `P` doubles a row).
+    #[inline(always)]
+    pub(crate) fn pair_layout(&self, p: usize) -> (usize, usize) {
+        let ps = if self.pair_stride == 0 {
+            2 * p
+        } else {
+            self.pair_stride
+        };
+        (ps, if self.row_gap == 0 { p } else { self.row_gap })
+    }
+
+    /// Panics unless the rows of the `tau.len()` lanes (`p` doubles each) cannot overlap:
+    /// consecutive, the two rows of a pair side by side, or the second rows of all pairs
+    /// after the first rows (the split layouts of `plan/blocks.rs`).
+    pub(crate) fn assert_rows_apart(&self, p: usize) {
+        let (ps, gap, nb) = (self.pair_stride, self.row_gap, self.tau.len());
+        assert!(ps == 0 || self.interleaved);
+        assert!(gap == 0 || ps > 0);
+        assert!(gap > 0 || ps == 0 || ps >= 2 * p);
+        assert!(gap == 0 || (ps >= p && (gap == p || gap >= nb / 2 * ps)));
+        assert!(gap != p || ps >= 2 * p);
+    }
+
+    /// First row and row step (in rows) of the vector of lanes starting at `s0`.
+    #[inline(always)]
+    pub(crate) fn rows(&self, s0: usize) -> (usize, usize) {
+        if !self.interleaved {
+            (s0, 1)
+        } else if s0 < self.upper_from {
+            (2 * s0, 2)
+        } else {
+            (2 * (s0 - self.upper_from) + 1, 2)
+        }
+    }
+}

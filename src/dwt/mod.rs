@@ -1,0 +1,135 @@
+//! Discrete Wigner transform kernels: the Wigner-d recurrence fused with the accumulation.
+//!
+//! One call handles one cluster (see the `symmetry` module) and a list of beta points. The
+//! recurrence runs in registers, vectorised over `W` betas; nothing of size
+//! `(B - m) x 2B` is ever stored.
+//!
+//! * forward: `f[i][q] = sum_s dt_{l0+i}(beta_s) * xin[row(s)][q]` (`P` real columns `q`)
+//! * inverse: `y[row(s)][q] = sum_i dt_{l0+i}(beta_s) * fin[i][q]`
+//!
+//! where `row(s)` is `s` or, for the chunk buffer's blocks, interleaves each beta with its
+//! mirror ([`Lanes::interleaved`]).
+//!
+//! `P` is 16 (8 complex order pairs) or 8 (4 pairs). Each beta lane starts in the scaled
+//! form of the `wigner::starts` module; lanes below the skip threshold contribute nothing,
+//! and while no lane of a vector is active only the recurrence runs (the negligible prefix
+//! in `l` is skipped).
+//!
+//! Files: [`lanes`] (the kernels' inputs), `state` (the recurrence state of a vector of
+//! betas, shared by both kernels), `forward`, `inverse`; this file checks the arguments
+//! and dispatches on the instruction set.
+
+#[cfg(any(test, feature = "internals"))]
+pub(crate) mod fixtures;
+mod forward;
+mod inverse;
+pub(crate) mod lanes;
+mod state;
+#[cfg(test)]
+mod tests;
+
+use crate::simd::Isa;
+
+/// The FMA peak under its former path, for `src/ceilings.rs` until that moves to `benches/`.
+#[cfg(all(test, target_arch = "x86_64"))]
+pub(crate) mod kernel_speed {
+    pub(crate) use crate::simd::peak::fma_peak;
+}
+pub(crate) use inverse::Fill;
+pub(crate) use lanes::{Lanes, Prefetch, Rec};
+
+/// Forward kernel: `ft[i*P + q] = sum_s dt_{l0+i}(beta_s) xin[row(s)*P + q]` for `i < n`,
+/// `P` = 8 or 16 (`row` see [`Lanes::interleaved`]): degree-major, the inverse kernel's
+/// input layout; what `ft` held before is ignored. `ft` holds at least `(n + W) * P`
+/// values, `W = isa.lanes()` (rows from `n` on are scratch: the last block of degrees runs in full).
+///
+/// Returns `lo <= n`: rows `0..lo` are zero because every lane of every beta is still in
+/// its negligible prefix there (see [`Lanes::skip`]). Callers that accumulate the sums
+/// elsewhere need only add rows `lo..n`.
+///
+/// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
+/// length a multiple of `isa.lanes()`.
+#[cfg(any(test, feature = "internals"))]
+pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) -> usize {
+    assert!(lanes.pair_stride == 0 && lanes.row_gap == 0);
+    assert!(xin.len() >= lanes.tau.len() * p);
+    // SAFETY: the rows are consecutive, within `xin`.
+    unsafe { forward_raw(isa, p, rec, lanes, xin.as_ptr(), ft) }
+}
+
+/// [`forward`] reading row `r` of the input at `xin + r * P`, or for interleaved lanes at
+/// `xin + (r / 2) * lanes.pair_stride + (r % 2) * lanes.row_gap` (defaults `2P` and `P`:
+/// consecutive rows; see `plan/blocks.rs` for the split layout).
+///
+/// # Safety
+/// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for reads and
+/// written by no one meanwhile.
+pub(crate) unsafe fn forward_raw(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    xin: *const f64,
+    ft: &mut [f64],
+) -> usize {
+    let n = rec.len();
+    let nb = lanes.tau.len();
+    assert!(rec.padded());
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
+    assert!(ft.len() >= (n + isa.lanes()) * p);
+    assert!(isa.is_supported());
+    lanes.assert_rows_apart(p);
+    // SAFETY: lengths checked above, rows by the caller, instruction set checked by
+    // is_supported.
+    unsafe { forward::run(isa, p, rec, lanes, xin, ft) }
+}
+
+/// [`inverse_raw`] into consecutive rows of `y` (bounds checked).
+#[cfg(any(test, feature = "internals"))]
+pub fn inverse(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: &mut [f64],
+) {
+    assert!(lanes.pair_stride == 0 && y.len() >= lanes.tau.len() * p);
+    // SAFETY: `y` holds every row (consecutive rows of `p` values).
+    unsafe { inverse_raw(isa, p, rec, lanes, fin, fill, y.as_mut_ptr()) }
+}
+
+/// Inverse kernel: `y[row(s)*P + q] = sum_i dt_{l0+i}(beta_s) fin[i*P + q]`, `P` = 8 or 16
+/// (the layout of the forward kernel's input, see `plan/blocks.rs`), with row `r` of the
+/// output at `y + r * P`, or, with a nonzero `lanes.pair_stride` (the half-major layout),
+/// at `y + (r / 2) * lanes.pair_stride + (r % 2) * lanes.row_gap` (`P` if `row_gap` is 0).
+///
+/// The input rows are filled on demand: before it reads them, the kernel calls
+/// `fill(fin, from, to)` to fill rows `from..to` (the calls cover the rows from the first
+/// degree where some lane is past its negligible prefix up to `n`, top down, each row
+/// once; rows below are never read). A chunked inverse thus reads only the coefficients
+/// its betas need.
+///
+/// # Safety
+/// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for writes and
+/// written by no one else meanwhile; a nonzero `pair_stride` needs interleaved lanes.
+pub(crate) unsafe fn inverse_raw(
+    isa: Isa,
+    p: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &mut [f64],
+    fill: Fill,
+    y: *mut f64,
+) {
+    let n = rec.len();
+    let nb = lanes.tau.len();
+    assert!(rec.padded());
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
+    assert!(fin.len() >= n * p && isa.is_supported());
+    lanes.assert_rows_apart(p);
+    // SAFETY: lengths checked above, rows by the caller, instruction set checked by
+    // is_supported.
+    unsafe { inverse::run(isa, p, rec, lanes, fin, fill, y) }
+}

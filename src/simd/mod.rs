@@ -1,0 +1,203 @@
+//! Minimal SIMD abstraction with run-time dispatch (AVX-512, AVX2+FMA, portable scalar).
+//!
+//! Kernels are written once, generic over [`Simd`], and instantiated inside
+//! `#[target_feature]` entry points (see the `dwt` module): every method is
+//! `#[inline(always)]`, so after inlining the intrinsics sit in a function that has the
+//! features enabled. One file per instruction set: [`scalar`], `avx2`, `avx512`.
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx2;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx512;
+#[cfg(any(test, feature = "internals"))]
+pub(crate) mod peak;
+pub(crate) mod scalar;
+
+/// Instruction set chosen for the DWT kernels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// AVX-512F, 8 doubles per vector.
+    Avx512,
+    /// AVX2 with FMA, 4 doubles per vector.
+    Avx2,
+    /// Portable scalar code (one double per "vector", no FMA).
+    Scalar,
+}
+
+impl Isa {
+    /// The best instruction set this CPU supports.
+    pub fn detect() -> Isa {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                return Isa::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+            {
+                return Isa::Avx2;
+            }
+        }
+        Isa::Scalar
+    }
+
+    /// Whether this CPU can run kernels for `self`.
+    pub fn is_supported(self) -> bool {
+        match self {
+            Isa::Scalar => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => {
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => {
+                std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
+    /// Number of doubles per vector.
+    pub fn lanes(self) -> usize {
+        match self {
+            Isa::Avx512 => 8,
+            Isa::Avx2 => 4,
+            Isa::Scalar => 1,
+        }
+    }
+}
+
+/// Vector operations used by the kernels, one implementation per instruction set.
+///
+/// # Safety
+/// Every method is unsafe: the caller guarantees that the CPU supports the instruction set
+/// of the implementation ([`Isa::is_supported`]) and that every pointer argument is valid
+/// for `W` doubles (two for [`Simd::splat2`]), `W` the vector width.
+pub(crate) trait Simd: Copy {
+    /// The vector type.
+    type V: Copy;
+    /// `x` in every lane.
+    unsafe fn splat(x: f64) -> Self::V;
+    /// `W` doubles from `p` (no alignment needed).
+    unsafe fn load(p: *const f64) -> Self::V;
+    /// `v` to the `W` doubles at `p` (no alignment needed).
+    unsafe fn store(p: *mut f64, v: Self::V);
+    /// `a + b`
+    unsafe fn add(a: Self::V, b: Self::V) -> Self::V;
+    /// `a * b`
+    unsafe fn mul(a: Self::V, b: Self::V) -> Self::V;
+    /// `a * b + c`
+    unsafe fn fma(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
+    /// `a * b - c`
+    unsafe fn fms(a: Self::V, b: Self::V, c: Self::V) -> Self::V;
+    /// Whether any lane has `a >= b`.
+    unsafe fn any_ge(a: Self::V, b: Self::V) -> bool;
+    /// `|v|`
+    unsafe fn abs(v: Self::V) -> Self::V;
+    /// Lane-wise `if a >= b { x } else { y }`.
+    unsafe fn blend_ge(a: Self::V, b: Self::V, x: Self::V, y: Self::V) -> Self::V;
+    /// Lane-wise maximum.
+    unsafe fn max(a: Self::V, b: Self::V) -> Self::V;
+    /// Transpose the `W x W` block `v` (vector `j`, lane `w`) in registers: afterwards
+    /// vector `w` holds lane `w` of every former vector.
+    unsafe fn transpose(v: &mut [Self::V]);
+    /// `[p[0], p[1]]` repeated in every pair of lanes (`W >= 2` only).
+    unsafe fn splat2(p: *const f64) -> Self::V;
+    /// The even lanes of `a` and `b` interleaved, `[a0, b0, a2, b2, ...]` (`W >= 2` only).
+    unsafe fn unpack_even(a: Self::V, b: Self::V) -> Self::V;
+    /// The odd lanes of `a` and `b` interleaved, `[a1, b1, a3, b3, ...]` (`W >= 2` only).
+    unsafe fn unpack_odd(a: Self::V, b: Self::V) -> Self::V;
+    /// Store `v` at `p` without reading the cache line first (a non-temporal store) where
+    /// `p` is aligned to the vector size, else an ordinary store. Callers end a run of these
+    /// with [`sfence`].
+    #[inline(always)]
+    unsafe fn stream(p: *mut f64, v: Self::V) {
+        // SAFETY: the trait's contract.
+        unsafe { Self::store(p, v) }
+    }
+    /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
+    /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j` (with
+    /// [`Simd::stream`] if `stream`, else ordinary stores).
+    #[inline(always)]
+    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize, stream: bool) {
+        // SAFETY: the instruction set by the trait's contract; the caller guarantees the
+        // `W` rows `dst + w * stride` (`W` doubles each) valid for writes.
+        unsafe {
+            let mut t = [Self::zero(); 8];
+            let w = v.len();
+            t[..w].copy_from_slice(v);
+            Self::transpose(&mut t[..w]);
+            for (r, x) in t[..w].iter().enumerate() {
+                if stream {
+                    Self::stream(dst.add(r * stride), *x);
+                } else {
+                    Self::store(dst.add(r * stride), *x);
+                }
+            }
+        }
+    }
+    /// `v` unchanged, through an empty `asm!` the compiler may not move code across:
+    /// pins the program order of what is computed before and after it.
+    #[inline(always)]
+    unsafe fn fence(v: Self::V) -> Self::V {
+        v
+    }
+    /// Zero in every lane.
+    #[inline(always)]
+    unsafe fn zero() -> Self::V {
+        // SAFETY: the trait's contract.
+        unsafe { Self::splat(0.0) }
+    }
+}
+
+/// Orders earlier non-temporal stores ([`Simd::stream`]) before everything after it.
+#[inline(always)]
+pub(crate) fn sfence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a store fence has no operands; SSE is part of x86-64.
+    unsafe {
+        std::arch::x86_64::_mm_sfence()
+    };
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::avx2::Avx2;
+    use super::avx512::Avx512;
+    use super::{Isa, Simd};
+
+    /// `splat2`, `unpack_even` and `unpack_odd` against their definitions, lane by lane.
+    fn pair_ops<S: Simd, const W: usize>() {
+        let a: Vec<f64> = (0..W).map(|k| 1.0 + k as f64).collect();
+        let b: Vec<f64> = (0..W).map(|k| -10.0 - k as f64).collect();
+        let mut out = [[0.0; W]; 3];
+        // SAFETY: callers check the instruction set; every pointer covers W doubles.
+        unsafe {
+            let (va, vb) = (S::load(a.as_ptr()), S::load(b.as_ptr()));
+            S::store(out[0].as_mut_ptr(), S::splat2(a[2..].as_ptr()));
+            S::store(out[1].as_mut_ptr(), S::unpack_even(va, vb));
+            S::store(out[2].as_mut_ptr(), S::unpack_odd(va, vb));
+        }
+        for k in 0..W {
+            assert_eq!(out[0][k], a[2 + k % 2]);
+            let (src, lane) = (if k % 2 == 0 { &a } else { &b }, k - k % 2);
+            assert_eq!(out[1][k], src[lane]);
+            assert_eq!(out[2][k], src[lane + 1]);
+        }
+    }
+
+    #[test]
+    fn pair_operations() {
+        if Isa::Avx512.is_supported() {
+            pair_ops::<Avx512, 8>();
+        }
+        if Isa::Avx2.is_supported() {
+            pair_ops::<Avx2, 4>();
+        }
+    }
+}
