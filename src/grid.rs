@@ -1,4 +1,5 @@
-//! Sample grid, quadrature weights, array sizes and index maps (SPEC.md sections 2 and 3).
+//! Sample grid, quadrature weights, array sizes and index maps (see docs/conventions.md:
+//! the sample grid and layout, the coefficients and their layout).
 
 use crate::error::{Error, Result};
 use std::f64::consts::PI;

@@ -1,7 +1,7 @@
 //! Wigner-d symmetries and DWT clusters: all the symmetry bookkeeping lives here.
 //!
 //! For a base pair `(m, m')` with `m >= m' >= 0` and `v_l(beta) = d^l_{m,m'}(beta)`,
-//! the seven symmetries (SPEC.md section 1) give, with `beta' = pi - beta`:
+//! the seven symmetries (docs/conventions.md: rotations, Wigner d) give, with `beta' = pi - beta`:
 //!
 //! | member      | d^l of the member at beta       |
 //! |-------------|---------------------------------|

@@ -35,18 +35,17 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        let pv = P / W;
+        let col_vectors = P / W;
         let mut x = [S::zero(); P];
-        for (h, xh) in x.iter_mut().enumerate().take(pv) {
+        for (h, xh) in x.iter_mut().enumerate().take(col_vectors) {
             *xh = S::load(xw.add(h * W));
         }
         for j in 0..DB {
             let e = S::splat(*db.add(j * W + w));
-            for h in 0..pv {
+            for h in 0..col_vectors {
                 // Pinned in program order: left alone, LLVM hoists the broadcasts of the next
-                // lanes above these multiply-adds and spills them and half of the sums
-                // (measured: 40% of the FMA peak against 51%).
-                acc[j * pv + h] = S::fence(S::fma(e, x[h], acc[j * pv + h]));
+                // lanes above these multiply-adds and spills them and half of the sums.
+                acc[j * col_vectors + h] = S::fence(S::fma(e, x[h], acc[j * col_vectors + h]));
             }
         }
     }
@@ -62,8 +61,8 @@ const fn paired(w: usize, p: usize) -> bool {
 /// of the pair `(d[j][w], d[j][w + 1])` feeds two multiply-adds, with the two beta rows
 /// interleaved column by column: `acc[2j]` holds columns `0, 2, 4, ...` and `acc[2j + 1]`
 /// columns `1, 3, 5, ...`, alternate lanes summing the even and the odd betas
-/// ([`fold_pair`] adds them). A broadcast per multiply-add ran at about two thirds of the
-/// FMA peak on Zen 5; one per two at about four fifths.
+/// ([`fold_pair`] adds them). Half as many broadcasts per multiply-add leave more of the
+/// load ports to the data.
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
@@ -107,6 +106,10 @@ unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
 /// Lane `w`'s share of the multiply-adds of a stored d block: [`beta_fmas`], or with
 /// paired betas [`pair_fmas`] for lanes `w - 1` and `w` at each odd `w` (nothing at even
 /// `w`). `x` is lane 0's data row, `xs` the stride between rows.
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; `db` holds a `DB x W` d block and the data
+/// rows `x + w * xs` of the lanes used are valid for `P` values each.
 #[inline(always)]
 unsafe fn lane_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
@@ -183,7 +186,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
     unsafe {
         let n = rec.len();
         let nb = lanes.tau.len();
-        let pv = P / W;
+        let col_vectors = P / W;
         const {
             assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
             assert!(DB <= REC_PAD);
@@ -192,43 +195,45 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let pair = paired(W, P);
         debug_assert!(nb.is_multiple_of(W));
         debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
-        let fp = ft.as_mut_ptr();
-        // Prefetch hints: the lines of `lanes.prefetch`, a few per vector and block. (Issued in
-        // bursts at each block start they stalled the core when the miss buffers ran full: 9%
-        // of the 8-column kernel's time in the real forward at B = 256.) The (block, vector)
-        // pairs of skipped prefixes issue nothing, so the end of the list (8-16% of the lines,
-        // the last coefficient rows) is left to demand loads; issuing twice as fast was 3%
-        // slower at B = 128.
-        let mut pf = lanes.prefetch;
-        let pf_per_vector = pf.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
-        let (ps, gap) = lanes.pair_layout(P);
-        let xrows = |s0: usize| {
+        let sums = ft.as_mut_ptr();
+        // Prefetch hints: the lines of `lanes.prefetch`, a few per vector and block (bursts
+        // at each block start would fill the miss buffers and stall the core). The (block,
+        // vector) pairs of skipped prefixes issue nothing, so the end of the list (the last
+        // coefficient rows) is left to demand loads.
+        let mut prefetch = lanes.prefetch;
+        let prefetch_per_vector = prefetch.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
+        let (pair_stride, row_gap) = lanes.pair_layout(P);
+        let data_rows = |s0: usize| {
             let (r0, step) = lanes.rows(s0);
             if step == 2 {
-                (xin.add((r0 / 2) * ps + (r0 % 2) * gap), ps)
+                (
+                    xin.add((r0 / 2) * pair_stride + (r0 % 2) * row_gap),
+                    pair_stride,
+                )
             } else {
                 (xin.add(r0 * P), P)
             }
         };
-        let mut dbuf = [DBlock([0.0; 128]); 2];
+        let mut d_blocks = [DBlock([0.0; 128]); 2];
         let mut lo = n;
         let mut v0 = 0;
         while v0 < nb {
             // Up to FWD_VECTORS vectors, each through its negligible prefix.
-            let nv = ((nb - v0) / W).min(FWD_VECTORS);
-            let mut st_mem = [const { MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
-            let (first, st) = prefix_states::<S, W>(rec, lanes, v0, n, &mut st_mem[..nv]);
+            let vectors = ((nb - v0) / W).min(FWD_VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
+            let (first, states) =
+                prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
             lo = lo.min(first);
             let mut i0 = first - first % DB;
             // The first group of vectors writes the sums (zeros below its first block), the
             // others add to them: `ft` needs no clearing beforehand.
             let assign = v0 == 0;
             if assign {
-                std::ptr::write_bytes(fp, 0, i0 * P);
+                std::ptr::write_bytes(sums, 0, i0 * P);
             }
             let mut fast = [0usize; FWD_VECTORS];
-            let mut nf = 0;
-            // Whether `dbuf[cur]` already holds the block of `fast[0]` at `i0`; whether some
+            let mut n_fast = 0;
+            // Whether `d_blocks[cur]` already holds the block of `fast[0]` at `i0`; whether some
             // vector took the masked path in the last full scan, and the lowest degree index
             // at which a vector not yet started starts.
             let (mut primed, mut cur) = (false, 0);
@@ -238,8 +243,8 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 // Paired sums are folded and added to `ft` at the end of the block.
                 if !assign && !pair {
                     for j in 0..DB {
-                        for h in 0..pv {
-                            acc[j * pv + h] = S::load(fp.add((i0 + j) * P + h * W));
+                        for h in 0..col_vectors {
+                            acc[j * col_vectors + h] = S::load(sums.add((i0 + j) * P + h * W));
                         }
                     }
                 }
@@ -247,9 +252,9 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 // time; the others are listed for the pipelined loop. While the list stays the
                 // same (no vector in its masked phase, none starting) it is not rebuilt.
                 if !primed {
-                    nf = 0;
+                    n_fast = 0;
                     (masked, wait) = (false, n);
-                    for (v, s) in st.iter_mut().enumerate() {
+                    for (v, s) in states.iter_mut().enumerate() {
                         if s.i >= n {
                             continue;
                         }
@@ -261,30 +266,30 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                         // zero padding of the coefficients, and its rows from `n` on are
                         // scratch.
                         if s.i == i0 && s.all_active() {
-                            fast[nf] = v;
-                            nf += 1;
+                            fast[n_fast] = v;
+                            n_fast += 1;
                             continue;
                         }
                         masked = true;
-                        pf.issue(pf_per_vector);
+                        prefetch.issue(prefetch_per_vector);
                         let d = s.masked_block::<DB>(i0, n);
-                        let db = dbuf[0].0.as_mut_ptr();
+                        let db = d_blocks[0].0.as_mut_ptr();
                         for (j, dj) in d.iter().enumerate() {
                             S::store(db.add(j * W), *dj);
                         }
-                        let (x, xs) = xrows(v0 + v * W);
+                        let (x, xs) = data_rows(v0 + v * W);
                         block_fmas::<S, W, P, DB>(&mut acc, db, x, xs);
                     }
                 }
-                if nf > 0 {
+                if n_fast > 0 {
                     // The first fast vector's block (unless the previous block computed it),
                     // then each next vector's steps interleaved with the previous one's
                     // multiply-adds.
                     if !primed {
                         cur = 0;
-                        let s = &mut st[fast[0]];
+                        let s = &mut states[fast[0]];
                         let (mut p0, mut p1) = (s.p0, s.p1);
-                        let db = dbuf[cur].0.as_mut_ptr();
+                        let db = d_blocks[cur].0.as_mut_ptr();
                         for j in 0..DB {
                             S::store(db.add(j * W), p1);
                             let p2 = S::fence(s.step(p0, p1, i0 + j));
@@ -297,30 +302,30 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     // vector instead of running alone (their dependency chain exposed) at the
                     // start of the next block.
                     let next = !masked && wait >= (i0 + 2 * DB).min(n) && i0 + DB < n;
-                    let mut ev = fast[0];
-                    for idx in 1..nf + next as usize {
-                        let (v, base) = if idx < nf {
+                    let mut fma_vector = fast[0];
+                    for idx in 1..n_fast + next as usize {
+                        let (v, base) = if idx < n_fast {
                             (fast[idx], i0)
                         } else {
                             (fast[0], i0 + DB)
                         };
-                        pf.issue(pf_per_vector);
-                        let (x, xs) = xrows(v0 + ev * W);
-                        let s = &mut st[v];
+                        prefetch.issue(prefetch_per_vector);
+                        let (x, xs) = data_rows(v0 + fma_vector * W);
+                        let s = &mut states[v];
                         let (mut p0, mut p1) = (s.p0, s.p1);
-                        let dc = dbuf[cur].0.as_ptr();
-                        let dn = dbuf[1 - cur].0.as_mut_ptr();
+                        let d_cur = d_blocks[cur].0.as_ptr();
+                        let d_next = d_blocks[1 - cur].0.as_mut_ptr();
                         // Written out for each lane, so that the state stays in registers.
                         macro_rules! lane {
                             ($w:literal) => {
                                 if $w < W {
                                     // This lane's share of the next vector's steps.
                                     for k in $w * DB / W..($w + 1) * DB / W {
-                                        S::store(dn.add(k * W), p1);
+                                        S::store(d_next.add(k * W), p1);
                                         let p2 = S::fence(s.step(p0, p1, base + k));
                                         (p0, p1) = (p1, p2);
                                     }
-                                    lane_fmas::<S, W, P, DB>(&mut acc, dc, $w, x, xs);
+                                    lane_fmas::<S, W, P, DB>(&mut acc, d_cur, $w, x, xs);
                                 }
                             };
                         }
@@ -334,32 +339,32 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                         lane!(7);
                         (s.p0, s.p1, s.i) = (p0, p1, base + DB);
                         cur = 1 - cur;
-                        ev = v;
+                        fma_vector = v;
                     }
                     primed = next;
                     if !next {
-                        pf.issue(pf_per_vector);
-                        let (x, xs) = xrows(v0 + ev * W);
-                        let dc = dbuf[cur].0.as_ptr();
-                        block_fmas::<S, W, P, DB>(&mut acc, dc, x, xs);
+                        prefetch.issue(prefetch_per_vector);
+                        let (x, xs) = data_rows(v0 + fma_vector * W);
+                        let d_cur = d_blocks[cur].0.as_ptr();
+                        block_fmas::<S, W, P, DB>(&mut acc, d_cur, x, xs);
                     }
                 }
                 if pair {
                     for j in 0..DB {
-                        let r = fp.add((i0 + j) * P);
+                        let r = sums.add((i0 + j) * P);
                         let v = fold_pair::<S>(&acc, j);
                         S::store(r, if assign { v } else { S::add(S::load(r), v) });
                     }
                 } else {
                     for j in 0..DB {
-                        for h in 0..pv {
-                            S::store(fp.add((i0 + j) * P + h * W), acc[j * pv + h]);
+                        for h in 0..col_vectors {
+                            S::store(sums.add((i0 + j) * P + h * W), acc[j * col_vectors + h]);
                         }
                     }
                 }
                 i0 += DB;
             }
-            v0 += nv * W;
+            v0 += vectors * W;
         }
         lo
     }

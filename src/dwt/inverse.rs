@@ -20,7 +20,7 @@ unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *c
     }
 }
 
-/// Fills rows `from..to` of the inverse kernel's input (see [`inverse_raw`]).
+/// Fills rows `from..to` of the inverse kernel's input (see [`crate::dwt::inverse_raw`]).
 pub type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
 
 /// Vectors of betas whose states the inverse kernel sets up before it needs their input
@@ -43,51 +43,52 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
         let n = rec.len();
         let nb = lanes.tau.len();
         debug_assert!(nb.is_multiple_of(W) && fin.len() >= n * P);
-        let (ps, gap) = lanes.pair_layout(P);
-        let mut pf = lanes.prefetch;
-        let pf_per_vector = pf.lines().div_ceil((nb / W).max(1));
+        let (pair_stride, row_gap) = lanes.pair_layout(P);
+        let mut prefetch = lanes.prefetch;
+        let prefetch_per_vector = prefetch.lines().div_ceil((nb / W).max(1));
         // Rows `have..n` of `fin` are filled.
         let mut have = n;
         let mut v0 = 0;
         while v0 < nb {
             // Up to INV_VECTORS vectors through their negligible prefixes, then the rows from
             // the first degree any of them needs.
-            let nv = ((nb - v0) / W).min(INV_VECTORS);
-            let mut st_mem = [const { MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
-            let (first, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut st_mem[..nv]);
+            let vectors = ((nb - v0) / W).min(INV_VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
+            let (first, states) =
+                prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
             if first < have {
                 fill(fin, first, have);
                 have = first;
             }
-            let fp = fin.as_ptr();
-            let mut gi = 0;
-            while gi < nv {
+            let fin_rows = fin.as_ptr();
+            let mut vector = 0;
+            while vector < vectors {
                 // With 8 columns, two vectors run together once both are fully active: each
                 // data broadcast then feeds two multiply-adds, and the two recurrences are
                 // independent chains (one vector's step and 8 multiply-adds per degree leave
                 // the pipes half idle).
-                let pair = P <= 8 && gi + 1 < nv;
-                let mut st = [states[gi], states[(gi + 1).min(nv - 1)]];
+                let pair = P <= 8 && vector + 1 < vectors;
+                let mut run_states = [states[vector], states[(vector + 1).min(vectors - 1)]];
                 let mut acc = [[S::zero(); P]; 2];
-                pf.issue(pf_per_vector * (1 + pair as usize));
+                prefetch.issue(prefetch_per_vector * (1 + pair as usize));
                 if pair {
                     let [a0, a1] = &mut acc;
-                    for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
-                        s.run_slow(n, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    for (s, a) in run_states.iter_mut().zip([&mut *a0, &mut *a1]) {
+                        s.run_slow(n, &mut |v, i| acc_row::<S, P>(a, v, fin_rows.add(i * P)));
                     }
                     // The one behind catches up alone, then both run together.
-                    let i0 = st[0].i.max(st[1].i);
-                    for (s, a) in st.iter_mut().zip([&mut *a0, &mut *a1]) {
-                        s.run_fast(i0, &mut |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    let i0 = run_states[0].i.max(run_states[1].i);
+                    for (s, a) in run_states.iter_mut().zip([&mut *a0, &mut *a1]) {
+                        s.run_fast(i0, &mut |v, i| acc_row::<S, P>(a, v, fin_rows.add(i * P)));
                     }
-                    let [s0, s1] = &mut st;
+                    let [s0, s1] = &mut run_states;
                     let (mut p0, mut p1, mut r0, mut r1) = (s0.p0, s0.p1, s1.p0, s1.p1);
                     for i in i0..n {
                         let (v, u) = (p1, r1);
                         let p2 = S::fence(s0.step(p0, p1, i));
                         let r2 = S::fence(s1.step(r0, r1, i));
                         (p0, p1, r0, r1) = (p1, p2, r1, r2);
-                        let row = fp.add(i * P);
+                        let row = fin_rows.add(i * P);
                         for q in 0..P {
                             let c = S::splat(*row.add(q));
                             a0[q] = S::fma(v, c, a0[q]);
@@ -96,29 +97,29 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                     }
                 } else {
                     // A local copy, so the state lives in registers during the run.
-                    let mut s = st[0];
+                    let mut s = run_states[0];
                     let a = &mut acc[0];
-                    s.run(n, |v, i| acc_row::<S, P>(a, v, fp.add(i * P)));
+                    s.run(n, |v, i| acc_row::<S, P>(a, v, fin_rows.add(i * P)));
                 }
                 // Rows of the output are lanes: each W x W block of (order column, lane) is
                 // transposed in registers on the way out, and with `lanes.stream` written
                 // without reading the lines first (see `Lanes::stream`).
-                // `NT` is a parameter of the kernel: a run-time branch here cost the 8-column
-                // kernel a third of its speed (its register allocation changed).
+                // `NT` is a parameter of the kernel: a run-time branch here changes the
+                // register allocation of the 8-column kernel and slows it down markedly.
                 for (k, a) in acc.iter().enumerate().take(1 + pair as usize) {
                     // Interleaved rows step by 2: one pair of rows to the next.
-                    let (r0, step) = lanes.rows(v0 + (gi + k) * W);
+                    let (r0, step) = lanes.rows(v0 + (vector + k) * W);
                     let (at, stride) = (
-                        (r0 / 2) * ps + (r0 % 2) * gap,
-                        if step == 2 { ps } else { P },
+                        (r0 / 2) * pair_stride + (r0 % 2) * row_gap,
+                        if step == 2 { pair_stride } else { P },
                     );
                     for q0 in (0..P).step_by(W) {
                         S::store_transposed(&a[q0..q0 + W], y.add(at + q0), stride, NT);
                     }
                 }
-                gi += 1 + pair as usize;
+                vector += 1 + pair as usize;
             }
-            v0 += nv * W;
+            v0 += vectors * W;
         }
     }
 }

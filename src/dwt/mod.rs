@@ -30,7 +30,8 @@ mod tests;
 
 use crate::simd::Isa;
 
-/// The FMA peak under its former path, for `src/ceilings.rs` until that moves to `benches/`.
+/// The FMA peak under the path `src/ceilings.rs` uses (goes with that file's move to
+/// `benches/`).
 #[cfg(all(test, target_arch = "x86_64"))]
 pub(crate) mod kernel_speed {
     pub(crate) use crate::simd::peak::fma_peak;
@@ -57,6 +58,17 @@ pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &m
     unsafe { forward_raw(isa, p, rec, lanes, xin.as_ptr(), ft) }
 }
 
+/// Panics unless the arguments both kernels take are consistent: `isa` supported, the
+/// coefficients padded, every lane array of the same length (a multiple of the vector
+/// width), and rows of `p` values that cannot overlap.
+fn check_shared(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes) {
+    let nb = lanes.tau.len();
+    assert!(isa.is_supported());
+    assert!(rec.padded());
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
+    lanes.assert_rows_apart(p);
+}
+
 /// [`forward`] reading row `r` of the input at `xin + r * P`, or for interleaved lanes at
 /// `xin + (r / 2) * lanes.pair_stride + (r % 2) * lanes.row_gap` (defaults `2P` and `P`:
 /// consecutive rows; see `plan/blocks.rs` for the split layout).
@@ -72,13 +84,8 @@ pub(crate) unsafe fn forward_raw(
     xin: *const f64,
     ft: &mut [f64],
 ) -> usize {
-    let n = rec.len();
-    let nb = lanes.tau.len();
-    assert!(rec.padded());
-    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(ft.len() >= (n + isa.lanes()) * p);
-    assert!(isa.is_supported());
-    lanes.assert_rows_apart(p);
+    check_shared(isa, p, rec, lanes);
+    assert!(ft.len() >= (rec.len() + isa.lanes()) * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe { forward::run(isa, p, rec, lanes, xin, ft) }
@@ -123,12 +130,8 @@ pub(crate) unsafe fn inverse_raw(
     fill: Fill,
     y: *mut f64,
 ) {
-    let n = rec.len();
-    let nb = lanes.tau.len();
-    assert!(rec.padded());
-    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
-    assert!(fin.len() >= n * p && isa.is_supported());
-    lanes.assert_rows_apart(p);
+    check_shared(isa, p, rec, lanes);
+    assert!(fin.len() >= rec.len() * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe { inverse::run(isa, p, rec, lanes, fin, fill, y) }

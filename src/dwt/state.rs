@@ -9,15 +9,18 @@ use std::mem::MaybeUninit;
 /// Recurrence state of one vector of betas.
 #[derive(Clone, Copy)]
 pub(crate) struct State<'r, S: Simd> {
+    /// Recurrence argument of each lane (see [`Lanes`]).
     pub(crate) tau: S::V,
     /// `-A` (lower half) or `A` (upper half).
-    pub(crate) ka: &'r [f64],
+    pub(crate) slope: &'r [f64],
     /// `A + C` (lower half) or `C - A` (upper half).
-    pub(crate) kc: &'r [f64],
+    pub(crate) offset: &'r [f64],
+    /// The (scaled) values of the degree before the next one.
     pub(crate) p0: S::V,
+    /// The (scaled) values of the next degree `i`.
     pub(crate) p1: S::V,
     /// Scale index of each lane (`<= 0`, see the `wigner::starts` module).
-    pub(crate) sc: S::V,
+    pub(crate) scale_index: S::V,
     /// 1 for the active lanes (scale index 0), else 0.
     pub(crate) mask: S::V,
     /// Next degree index (`l - l0`).
@@ -36,25 +39,25 @@ impl<'r, S: Simd> State<'r, S> {
     pub(crate) unsafe fn new(rec: &Rec<'r>, lanes: &Lanes, s0: usize) -> Self {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
         unsafe {
-            let sc = S::load(lanes.sc.as_ptr().add(s0));
+            let scale_index = S::load(lanes.sc.as_ptr().add(s0));
             let p1 = S::load(lanes.p.as_ptr().add(s0));
-            let (ka, kc) = if s0 >= lanes.upper_from {
+            let (slope, offset) = if s0 >= lanes.upper_from {
                 (rec.a, rec.c_minus_a)
             } else {
                 (rec.neg_a, rec.a_plus_c)
             };
             State {
                 tau: S::load(lanes.tau.as_ptr().add(s0)),
-                ka,
-                kc,
+                slope,
+                offset,
                 p0: S::zero(),
                 p1,
-                sc,
+                scale_index,
                 // Active: scale index 0 and a nonzero value. Padding lanes (value 0, scale 0)
                 // are neither active nor scaled down: they never hold back the skipping of
                 // their vector's prefix, nor its fast phase.
                 mask: S::mul(
-                    S::blend_ge(sc, S::zero(), S::splat(1.0), S::zero()),
+                    S::blend_ge(scale_index, S::zero(), S::splat(1.0), S::zero()),
                     S::blend_ge(
                         S::abs(p1),
                         S::splat(f64::MIN_POSITIVE),
@@ -81,10 +84,13 @@ impl<'r, S: Simd> State<'r, S> {
     }
 
     /// Whether every lane is active.
+    ///
+    /// # Safety
+    /// The CPU supports `S`'s instruction set.
     #[inline(always)]
     pub(crate) unsafe fn all_active(&self) -> bool {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
-        unsafe { !S::any_ge(S::splat(-0.5), self.sc) }
+        unsafe { !S::any_ge(S::splat(-0.5), self.scale_index) }
     }
 
     /// Rescale the scaled-down lanes of `(p0, p1)` that grew past `big` by `2^-SCALE_STEP`
@@ -101,16 +107,16 @@ impl<'r, S: Simd> State<'r, S> {
         unsafe {
             let (zero, one) = (S::zero(), S::splat(1.0));
             // |p1| of the scaled-down lanes, 0 for the active ones.
-            let a = S::blend_ge(self.sc, zero, zero, S::abs(*p1));
+            let a = S::blend_ge(self.scale_index, zero, zero, S::abs(*p1));
             let f = S::blend_ge(a, self.big, S::splat(TINY), one);
             *p0 = S::mul(*p0, f);
             *p1 = S::mul(*p1, f);
             let hit = S::blend_ge(a, self.big, one, zero);
-            self.sc = S::add(self.sc, hit);
+            self.scale_index = S::add(self.scale_index, hit);
             // Lanes rescaled to scale index 0 become active; the others keep their state.
             self.mask = S::max(
                 self.mask,
-                S::mul(hit, S::blend_ge(self.sc, zero, one, zero)),
+                S::mul(hit, S::blend_ge(self.scale_index, zero, one, zero)),
             );
         }
     }
@@ -180,9 +186,9 @@ impl<'r, S: Simd> State<'r, S> {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
         unsafe {
             let t = S::fma(
-                S::splat(*self.ka.get_unchecked(i)),
+                S::splat(*self.slope.get_unchecked(i)),
                 self.tau,
-                S::splat(*self.kc.get_unchecked(i)),
+                S::splat(*self.offset.get_unchecked(i)),
             );
             S::fms(t, p1, p0)
         }
@@ -239,8 +245,7 @@ impl<'r, S: Simd> State<'r, S> {
     /// The fast phase of [`State::run`] (all lanes hold true values), up to degree `end`.
     /// The step to the next degree comes first in program order: the FMA pipes issue the
     /// oldest ready instruction, so a step placed after the accumulation would queue behind
-    /// it and put its latency on the critical path at every degree (measured: 13.4 against
-    /// 10.7 cycles per degree).
+    /// it and put its latency on the critical path at every degree.
     ///
     /// # Safety
     /// The CPU supports `S`'s instruction set; the lanes from the vector's first one hold `W`
@@ -291,10 +296,10 @@ pub(crate) unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec:
         let big = st[0].big;
         let (mut p0, mut p1, mut tau) =
             ([S::zero(); GROUP], [S::zero(); GROUP], [S::zero(); GROUP]);
-        let (mut ka, mut kc) = ([rec.a; GROUP], [rec.a; GROUP]);
+        let (mut slope, mut offset) = ([rec.a; GROUP], [rec.a; GROUP]);
         for k in 0..GROUP {
-            (p0[k], p1[k], tau[k], ka[k], kc[k]) =
-                (st[k].p0, st[k].p1, st[k].tau, st[k].ka, st[k].kc);
+            (p0[k], p1[k], tau[k], slope[k], offset[k]) =
+                (st[k].p0, st[k].p1, st[k].tau, st[k].slope, st[k].offset);
         }
         loop {
             let mut hit = false;
@@ -302,9 +307,9 @@ pub(crate) unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec:
                 let mut m = S::zero();
                 for k in 0..GROUP {
                     let t = S::fma(
-                        S::splat(*ka[k].get_unchecked(i)),
+                        S::splat(*slope[k].get_unchecked(i)),
                         tau[k],
-                        S::splat(*kc[k].get_unchecked(i)),
+                        S::splat(*offset[k].get_unchecked(i)),
                     );
                     let p2 = S::fms(t, p1[k], p0[k]);
                     p0[k] = p1[k];

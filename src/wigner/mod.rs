@@ -1,6 +1,6 @@
 //! Wigner-d functions: the public d functions on top of the recurrence coefficients
-//! ([`recurrence`]) and the overflow/underflow-free starting values ([`starts`]) that the
-//! DWT kernels use.
+//! (`recurrence.rs`) and the overflow/underflow-free starting values (`starts.rs`) that
+//! the DWT kernels use; `column.rs` runs the recurrence for one beta as the kernels do.
 //!
 //! The kernels run the three-term recurrence in `l` for the normalised
 //! `dt^l = sqrt((2l+1)/2) d^l` of a base pair `(m, m')`, `m >= m' >= 0`:

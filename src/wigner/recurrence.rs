@@ -93,21 +93,21 @@ impl RecTables {
     fn new_body(lmax: usize, orders: &[usize], use_fma: bool) -> RecTables {
         let stride = lmax + 2;
         let mut order_row = vec![usize::MAX; lmax + 1];
-        let mut ms = Vec::new();
+        let mut tabulated = Vec::new();
         for &m in orders {
             assert!(m <= lmax, "order {m} above lmax {lmax}");
             if order_row[m] == usize::MAX {
-                order_row[m] = ms.len();
-                ms.push(m);
+                order_row[m] = tabulated.len();
+                tabulated.push(m);
             }
         }
         // `l^2 - m^2` and `(l+1)^2 - m^2` are exact integers in a double (l < 2^26).
         let sq = |k: usize| (k * k) as f64;
-        let k1 = |l: usize| {
+        let a_numerator = |l: usize| {
             let l = l as f64;
             Dd::prod(2.0 * l + 3.0, 2.0 * l + 1.0).sqrt().mul_f(l + 1.0)
         };
-        let k2 = |l: usize| {
+        let bc_numerator = |l: usize| {
             let l = l as f64;
             Dd::new(2.0 * l + 3.0)
                 .div(Dd::new(2.0 * l - 1.0))
@@ -115,18 +115,18 @@ impl RecTables {
                 .mul_f(l + 1.0)
                 .div(Dd::new(l))
         };
-        let a_factor = DdVec::from_fn(ms.len() * stride, |k| {
-            let (m, l) = (ms[k / stride], k % stride);
+        let a_factor = DdVec::from_fn(tabulated.len() * stride, |k| {
+            let (m, l) = (tabulated[k / stride], k % stride);
             if l >= m && l <= lmax {
-                k1(l).div(Dd::new(sq(l + 1) - sq(m))).sqrt()
+                a_numerator(l).div(Dd::new(sq(l + 1) - sq(m))).sqrt()
             } else {
                 Dd::new(0.0)
             }
         });
-        let bc_factor = DdVec::from_fn(ms.len() * stride, |k| {
-            let (m, l) = (ms[k / stride], k % stride);
+        let bc_factor = DdVec::from_fn(tabulated.len() * stride, |k| {
+            let (m, l) = (tabulated[k / stride], k % stride);
             if l >= m && l <= lmax && l > 0 {
-                k2(l)
+                bc_numerator(l)
                     .mul_f(sq(l) - sq(m))
                     .div(Dd::new(sq(l + 1) - sq(m)))
                     .sqrt()
@@ -207,22 +207,24 @@ impl RecTables {
         if n == 0 {
             return;
         }
-        let st = self.stride;
+        let stride = self.stride;
         let mm = (m * mp) as f64;
         // Table runs for `l = m .. m + n`, as slices of length `n` so that the loops below
         // have no bounds checks and vectorise.
-        let (k3h, k3l) = self.inv_l_l1.run(m, n);
-        let (rm, rp) = (self.order_row[m] * st, self.order_row[mp] * st);
-        let (amh, aml) = self.a_factor.run(rm + m, n);
-        let (aph, apl) = self.a_factor.run(rp + m, n);
-        let (bmh, bml) = self.bc_factor.run(rm + m, n);
-        let (bph, bpl) = self.bc_factor.run(rp + m, n);
-        let llv = &self.l_l1[m..m + n];
+        let (inv_ll_hi, inv_ll_lo) = self.inv_l_l1.run(m, n);
+        let (row_m, row_mp) = (self.order_row[m] * stride, self.order_row[mp] * stride);
+        let (a_m_hi, a_m_lo) = self.a_factor.run(row_m + m, n);
+        let (a_mp_hi, a_mp_lo) = self.a_factor.run(row_mp + m, n);
+        let (bc_m_hi, bc_m_lo) = self.bc_factor.run(row_m + m, n);
+        let (bc_mp_hi, bc_mp_lo) = self.bc_factor.run(row_mp + m, n);
+        let l_l1 = &self.l_l1[m..m + n];
         let dd = |h: &[f64], l: &[f64], i: usize| Dd { hi: h[i], lo: l[i] };
         // `Bc` rounded (into `r.c_minus_a` for now), then the scales `S_i`.
         let bc = &mut r.c_minus_a[..n];
         for (i, b) in bc.iter_mut().enumerate() {
-            *b = dd(bmh, bml, i).mul(dd(bph, bpl, i)).to_f64();
+            *b = dd(bc_m_hi, bc_m_lo, i)
+                .mul(dd(bc_mp_hi, bc_mp_lo, i))
+                .to_f64();
         }
         let scale = &mut r.s[..n];
         let (mut s0, mut s1) = (1.0, 1.0);
@@ -232,7 +234,7 @@ impl RecTables {
             let s2 = if i == 0 { 1.0 } else { bc[i] * s0 };
             (s0, s1) = (s1, s2);
         }
-        let (ra, ran, rd, re) = (
+        let (out_a, out_neg_a, out_a_plus_c, out_c_minus_a) = (
             &mut r.a[..n],
             &mut r.neg_a[..n],
             &mut r.a_plus_c[..n],
@@ -246,15 +248,15 @@ impl RecTables {
                 let i = $i;
                 // `A' = A S_i / S_{i+1}`.
                 let f = Dd::quot(scale[i], $s_next);
-                let a = dd(amh, aml, i).mul(dd(aph, apl, i)).mul(f);
+                let a = dd(a_m_hi, a_m_lo, i).mul(dd(a_mp_hi, a_mp_lo, i)).mul(f);
                 // `A + C = A (ll - mm) / ll`, `C - A = -A (ll + mm) / ll`: exact integers
                 // times `1 / ll`, no cancellation.
-                let ll = llv[i];
-                let d = a.mul(dd(k3h, k3l, i).mul_f(ll - mm));
-                ra[i] = a.to_f64();
-                ran[i] = -ra[i];
-                rd[i] = d.to_f64();
-                re[i] = -a.mul(dd(k3h, k3l, i).mul_f(ll + mm)).to_f64();
+                let ll = l_l1[i];
+                let d = a.mul(dd(inv_ll_hi, inv_ll_lo, i).mul_f(ll - mm));
+                out_a[i] = a.to_f64();
+                out_neg_a[i] = -out_a[i];
+                out_a_plus_c[i] = d.to_f64();
+                out_c_minus_a[i] = -a.mul(dd(inv_ll_hi, inv_ll_lo, i).mul_f(ll + mm)).to_f64();
             }};
         }
         for i in 0..n - 1 {
@@ -265,7 +267,7 @@ impl RecTables {
         coeff!(n - 1, scale[n - 1]);
         if m == 0 {
             // `l = 0`: `C = 0` (`1 / ll` is stored as 0).
-            (rd[0], re[0]) = (ra[0], -ra[0]);
+            (out_a_plus_c[0], out_c_minus_a[0]) = (out_a[0], -out_a[0]);
         }
     }
 }
