@@ -6,7 +6,8 @@
 //! (the skip threshold follows `SO3FFT_SKIP_BITS` if set).
 
 use so3fft::internals::{
-    aligned, cluster_pairs, cluster_setup, fma_peak, forward, grid_lanes, inverse, Rec,
+    aligned, cluster_pairs, cluster_setup, fma_peak, forward, grid_lanes, inverse, ClusterInputs,
+    Rec,
 };
 use so3fft::Isa;
 
@@ -33,7 +34,12 @@ fn kernel_gflops() {
     ] {
         let mp = m / 2;
         let n = b - m;
-        let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
+        let ClusterInputs {
+            coeffs: rc,
+            tau: x,
+            p,
+            sc,
+        } = cluster_setup(b, m, mp, nbs);
         let rec = Rec::new(&rc, n);
         let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
         let xbuf = vec![0.5; nbs * 16 + 8];
@@ -93,7 +99,12 @@ fn all_clusters_gflops() {
         for (m, mp) in cluster_pairs(b) {
             let (m, mp) = (m as usize, mp as usize);
             let n = b - m;
-            let (rc, x, p, sc) = cluster_setup(b, m, mp, nbs);
+            let ClusterInputs {
+                coeffs: rc,
+                tau: x,
+                p,
+                sc,
+            } = cluster_setup(b, m, mp, nbs);
             let rec = Rec::new(&rc, n);
             let lanes = grid_lanes(&x, &p, &sc, b);
             let pw = if m == mp || mp == 0 { 8 } else { 16 };

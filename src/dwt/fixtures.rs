@@ -13,25 +13,27 @@ pub fn test_skip_bits() -> u32 {
         .unwrap_or(DEFAULT_SKIP_BITS)
 }
 
+/// The kernel inputs of one cluster at some grid betas.
+pub struct ClusterInputs {
+    /// Recurrence coefficients for the degrees `m .. b`.
+    pub coeffs: RecCoeffs,
+    /// Recurrence argument of each beta ([`Lanes::tau`]).
+    pub tau: Vec<f64>,
+    /// Scaled starting value of each beta ([`Lanes::p`]).
+    pub p: Vec<f64>,
+    /// Scale index of each beta ([`Lanes::sc`]).
+    pub sc: Vec<f64>,
+}
+
 /// Recurrence coefficients of base pair `(m, mp)` at bandwidth `b` and lane inputs for
 /// `nbs` points spread evenly over the grid (lower half first, as in a chunk).
-pub fn cluster_setup(
-    b: usize,
-    m: usize,
-    mp: usize,
-    nbs: usize,
-) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+pub fn cluster_setup(b: usize, m: usize, mp: usize, nbs: usize) -> ClusterInputs {
     let ks: Vec<usize> = (0..nbs).map(|s| s * (2 * b) / nbs).collect();
     cluster_setup_at(b, m, mp, &ks)
 }
 
 /// As [`cluster_setup`], for the grid betas `ks`.
-pub fn cluster_setup_at(
-    b: usize,
-    m: usize,
-    mp: usize,
-    ks: &[usize],
-) -> (RecCoeffs, Vec<f64>, Vec<f64>, Vec<f64>) {
+pub fn cluster_setup_at(b: usize, m: usize, mp: usize, ks: &[usize]) -> ClusterInputs {
     let nbs = ks.len();
     let bt = BetaTables::grid(b);
     let norm = start_norm(m, mp);
@@ -43,7 +45,12 @@ pub fn cluster_setup_at(
         tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
         (p[s], sc[s]) = bt.start(k, &base, 1.0);
     }
-    (rc, tau, p, sc)
+    ClusterInputs {
+        coeffs: rc,
+        tau,
+        p,
+        sc,
+    }
 }
 
 /// `len` values of `buf` from its first 64-byte boundary (as the plan's chunk

@@ -1,7 +1,7 @@
 //! Tests of the kernels: layouts, adjointness, instruction sets against the scalar code,
 //! and the one-beta column against the reference evaluation of `wigner`.
 
-use super::fixtures::{cluster_setup, cluster_setup_at, grid_lanes, test_skip_bits};
+use super::fixtures::{cluster_setup, cluster_setup_at, grid_lanes, test_skip_bits, ClusterInputs};
 use super::{forward, forward_raw, inverse, inverse_raw, Lanes, Prefetch, Rec};
 use crate::simd::Isa;
 use crate::wigner::column::column;
@@ -59,7 +59,12 @@ fn pseudo(n: usize, seed: u64) -> Vec<f64> {
 fn layout_cases(mut f: impl FnMut(Isa, usize, usize, &Rec, Lanes)) {
     let (b, nbs) = (40, 48);
     for &(m, mp) in &[(3usize, 1usize), (20, 20), (33, 0)] {
-        let (rc, tau, p, sc) = cluster_setup(b, m, mp, nbs);
+        let ClusterInputs {
+            coeffs: rc,
+            tau,
+            p,
+            sc,
+        } = cluster_setup(b, m, mp, nbs);
         let rec = Rec::new(&rc, b - m);
         for pw in [8usize, 16] {
             for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
@@ -171,7 +176,12 @@ fn forward_is_the_adjoint_of_inverse() {
         // Spread over the grid, and (16) the 8 betas nearest each pole, where the
         // kernels skip the first degrees of every lane.
         for nbs in [24usize, 40, 56, 72, 16] {
-            let (rc, tau, p, sc) = if nbs == 16 {
+            let ClusterInputs {
+                coeffs: rc,
+                tau,
+                p,
+                sc,
+            } = if nbs == 16 {
                 let ks: Vec<usize> = (0..8).chain(2 * b - 8..2 * b).collect();
                 cluster_setup_at(b, m, mp, &ks)
             } else {
@@ -259,7 +269,12 @@ fn simd_paths_match_scalar() {
     for &(m, mp) in &[(0usize, 0usize), (5, 3), (150, 20), (199, 199), (120, 0)] {
         let n = b - m;
         let nb = 2 * b;
-        let (rc, x, p, sc) = cluster_setup(b, m, mp, nb);
+        let ClusterInputs {
+            coeffs: rc,
+            tau: x,
+            p,
+            sc,
+        } = cluster_setup(b, m, mp, nb);
         let rec = Rec::new(&rc, n);
         let lanes = grid_lanes(&x, &p, &sc, b);
         for pw in [8usize, 16] {

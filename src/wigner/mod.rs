@@ -35,8 +35,8 @@ pub(crate) fn wigner_d_column_isa(
     lmax: usize,
     beta: f64,
 ) -> Vec<f64> {
-    let (bm, bmp, mem) = crate::symmetry::locate(m, mp);
-    if lmax < bm {
+    let (base_m, base_mp, member) = crate::symmetry::locate(m, mp);
+    if lmax < base_m {
         return Vec::new();
     }
     // pi - beta for reversed members, without rounding: swap the half-angle cos and sin.
@@ -46,15 +46,15 @@ pub(crate) fn wigner_d_column_isa(
     } else {
         (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
     };
-    let point = if mem.reversed { (s, c) } else { (c, s) };
-    let betas = BetaTables::new(&[point], 2 * bm);
-    let tables = RecTables::for_orders(lmax + 1, &[bm, bmp]);
-    let col = column(isa, &betas, &tables, 0, (bm, bmp), lmax + 1);
+    let point = if member.reversed { (s, c) } else { (c, s) };
+    let betas = BetaTables::new(&[point], 2 * base_m);
+    let tables = RecTables::for_orders(lmax + 1, &[base_m, base_mp]);
+    let col = column(isa, &betas, &tables, 0, (base_m, base_mp), lmax + 1);
     col.iter()
         .enumerate()
         .map(|(i, v)| {
-            let l = bm + i;
-            mem.sign_at(l) * v / ((2 * l + 1) as f64 / 2.0).sqrt()
+            let l = base_m + i;
+            member.sign_at(l) * v / ((2 * l + 1) as f64 / 2.0).sqrt()
         })
         .collect()
 }
@@ -62,19 +62,22 @@ pub(crate) fn wigner_d_column_isa(
 /// Normalised `dt^l_{m,mp}(beta_k)` on the bandwidth-`b` grid: rows `l = max(|m|,|mp|)..b`,
 /// each of `2b` values (`k = 0..2b`), row-major. Same tables and arithmetic as the DWT.
 pub fn dt_on_grid(b: usize, m: isize, mp: isize) -> Vec<f64> {
-    let (bm, bmp, mem) = crate::symmetry::locate(m, mp);
-    assert!(bm < b, "order ({m},{mp}) out of range for bandwidth {b}");
+    let (base_m, base_mp, member) = crate::symmetry::locate(m, mp);
+    assert!(
+        base_m < b,
+        "order ({m},{mp}) out of range for bandwidth {b}"
+    );
     let n = 2 * b;
     let betas = BetaTables::grid(b);
     let tables = RecTables::new(b);
     let isa = Isa::detect();
-    let rows = b - bm;
+    let rows = b - base_m;
     let mut out = vec![0.0; rows * n];
     for k in 0..n {
-        let src = if mem.reversed { n - 1 - k } else { k };
-        let col = column(isa, &betas, &tables, src, (bm, bmp), b);
+        let src = if member.reversed { n - 1 - k } else { k };
+        let col = column(isa, &betas, &tables, src, (base_m, base_mp), b);
         for (i, v) in col.iter().enumerate() {
-            out[i * n + k] = mem.sign_at(bm + i) * v;
+            out[i * n + k] = member.sign_at(base_m + i) * v;
         }
     }
     out
