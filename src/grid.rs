@@ -147,7 +147,7 @@ pub fn try_coef_index(b: usize, l: usize, m: isize, mp: isize) -> Result<usize> 
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{beta, coef_index, num_coeffs, weights};
 
     #[test]
     fn spec_spot_values() {

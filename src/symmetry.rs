@@ -196,7 +196,7 @@ pub(crate) fn locate(m: isize, mp: isize) -> (usize, usize, Member) {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{cluster_pairs, kappa_to_pair, num_generic, Cluster};
     use std::collections::HashSet;
 
     #[test]
