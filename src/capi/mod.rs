@@ -10,12 +10,18 @@
 // requirements in prose for the C header rather than in "# Safety" sections.
 #![allow(non_camel_case_types, non_snake_case, clippy::missing_safety_doc)]
 
-// Declared in the order of their items in the header (cbindgen follows this order).
-mod errors;
-mod execute;
-mod grid;
+// Declared in the order of their items in the header: cbindgen follows the declarations.
+// A comment before each keeps rustfmt from sorting them.
+// Planner settings, planners, destroy.
 mod planner;
+// Execute, new-array execute.
+mod execute;
+// Plan queries, memory of a plan to be made.
 mod query;
+// Sizes, indices, angles, weights.
+mod grid;
+// Version and errors.
+mod errors;
 
 #[doc(hidden)]
 pub use errors::so3fft_internal_test_panic;
