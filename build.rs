@@ -51,7 +51,7 @@ fn generate_header() {
     let version = env::var("CARGO_PKG_VERSION").expect("CARGO_PKG_VERSION");
     let part = |k: &str| env::var(k).expect("CARGO_PKG_VERSION_*");
     config.after_includes = Some(format!(
-        "\n/** Version of this header (compare with so3fft_version() at run time). */\n\
+        "\n// Version of this header (compare with so3fft_version() at run time).\n\
          #define SO3FFT_VERSION \"{version}\"\n\
          #define SO3FFT_VERSION_MAJOR {}\n\
          #define SO3FFT_VERSION_MINOR {}\n\

@@ -9,37 +9,25 @@ use std::ffi::{c_char, c_int};
 
 static VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "\0");
 
-/// The library version, e.g. "0.1.0" (the value of `SO3FFT_VERSION` in the library
-/// actually linked). A static string: do not free. Thread-safe; does not touch the
-/// error state.
+/// The library version string (static; compare with `SO3FFT_VERSION`).
 #[no_mangle]
 pub extern "C" fn so3fft_version() -> *const c_char {
     VERSION.as_ptr() as *const c_char
 }
 
-/// The code of the last error on the calling thread: `SO3FFT_OK` (0) if the last
-/// so3fft call on this thread succeeded, else one of the negative `SO3FFT_E*` codes.
-/// Every so3fft function except `so3fft_last_error_code`, `so3fft_last_error`,
-/// `so3fft_strerror` and `so3fft_version` resets the error state when it starts.
-/// Useful after a planner returned NULL.
+/// Code of the last error on this thread (`SO3FFT_OK` after success).
 #[no_mangle]
 pub extern "C" fn so3fft_last_error_code() -> c_int {
     last_error::kind().map_or(SO3FFT_OK, error_code)
 }
 
-/// A message describing the last error on the calling thread, "" if the last so3fft
-/// call on this thread succeeded. Never NULL. The string is owned by the library and
-/// stays valid until the next so3fft call on the same thread (other than
-/// `so3fft_last_error_code`, `so3fft_last_error`, `so3fft_strerror`, `so3fft_version`)
-/// or until the thread exits: copy it to keep it.
+/// Message of the last error on this thread ("" after success; never NULL; library-owned).
 #[no_mangle]
 pub extern "C" fn so3fft_last_error() -> *const c_char {
     last_error::message()
 }
 
-/// A static description of an error code ("success", "invalid argument", ...; "unknown
-/// error code" for other values). Do not free. Thread-safe; does not touch the error
-/// state.
+/// Static description of an error code.
 #[no_mangle]
 pub extern "C" fn so3fft_strerror(code: c_int) -> *const c_char {
     let s: &'static str = match code {

@@ -97,23 +97,7 @@ unsafe fn run_inverse(
     plan.inverse(coeffs, samples).map_err(CallError::from)
 }
 
-/// Executes a plan on the arrays given at planning: the forward transform for a
-/// forward plan, the inverse for an inverse plan. The input array is not modified,
-/// except by the forward of a plan made with `SO3FFT_DESTROY_INPUT`.
-///
-/// Returns `SO3FFT_OK`, or an error code with `so3fft_last_error()` set:
-/// `SO3FFT_ENULL` (NULL plan, or a plan made without arrays, such as every
-/// `so3fft_plan_both` plan), `SO3FFT_ENOMEM` (a concurrent execution of the same plan
-/// could not allocate its temporary buffer), `SO3FFT_EFFTW`, `SO3FFT_EPANIC`. On error
-/// the output array (and, with `SO3FFT_DESTROY_INPUT`, the forward's input) may have
-/// been partly written; nothing outside them is.
-///
-/// Thread safety: a plan may be executed by several threads at the same time (each
-/// call uses the plan's worker pool; a call that finds the plan's buffer in use
-/// allocates a temporary one), but with this function they would all write the same
-/// output array: use the new-array execute functions with distinct outputs instead.
-///
-/// Requirements: `p` is NULL or a live plan whose arrays are still valid.
+/// Executes a plan on the arrays given at planning. Returns `SO3FFT_OK` or an error code.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_execute(p: so3fft_plan) -> c_int {
     guarded_code(|| {
@@ -141,27 +125,7 @@ pub unsafe extern "C" fn so3fft_execute(p: so3fft_plan) -> c_int {
     })
 }
 
-/// New-array execute of the forward transform: samples `in` (`(2B)^3` values) to
-/// coefficients `out` (`(4B^3-B)/3` values) with a plan made by `so3fft_plan_forward`,
-/// `so3fft_plan_both` or `so3fft_plan_general` (with or without arrays; the arrays
-/// given at planning are ignored). `in` is not modified, unless the plan was made with
-/// `SO3FFT_DESTROY_INPUT`: then its contents afterwards are unspecified (and on error too).
-///
-/// The arrays need no particular alignment beyond that of `double` (unlike FFTW's
-/// new-array execute), must not overlap, and are not retained after the call.
-///
-/// Returns `SO3FFT_OK`, or `SO3FFT_ENULL` (NULL plan or array), `SO3FFT_EDIRECTION`
-/// (inverse-only plan), `SO3FFT_EINVAL` (misaligned or overlapping arrays),
-/// `SO3FFT_ENOMEM`, `SO3FFT_EFFTW`, `SO3FFT_EPANIC`, with `so3fft_last_error()` set.
-/// Nothing is written on argument errors.
-///
-/// Thread safety: one plan may be executed from several threads at the same time on
-/// different output arrays (inputs may be shared, except with `SO3FFT_DESTROY_INPUT`,
-/// where each call needs its own input). A call that finds the plan's chunk
-/// buffer in use by another call allocates a temporary one of `so3fft`'s workspace
-/// size (may fail with `SO3FFT_ENOMEM`).
-///
-/// Requirements: `p` is NULL or a live plan; non-NULL arrays have the sizes above.
+/// Forward transform of samples `in` into coefficients `out` (new-array execute).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_execute_forward(
     p: so3fft_plan,
@@ -175,14 +139,7 @@ pub unsafe extern "C" fn so3fft_execute_forward(
     })
 }
 
-/// New-array execute of the inverse transform: coefficients `in` (`(4B^3-B)/3`
-/// values) to samples `out` (`(2B)^3` values) with a plan made by
-/// `so3fft_plan_inverse`, `so3fft_plan_both` or `so3fft_plan_general`.
-///
-/// Everything else as for `so3fft_execute_forward` (`SO3FFT_EDIRECTION` for a
-/// forward-only plan).
-///
-/// Requirements: `p` is NULL or a live plan; non-NULL arrays have the sizes above.
+/// Inverse transform of coefficients `in` into samples `out` (new-array execute).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_execute_inverse(
     p: so3fft_plan,

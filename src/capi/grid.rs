@@ -6,26 +6,19 @@ use crate::ffi::last_error;
 use crate::ffi::CallError;
 use std::ffi::{c_double, c_int};
 
-/// Number of samples `(2B)^3` at bandwidth `B`: the length of a sample array.
-/// Returns 0 (and sets the error state to `SO3FFT_EBANDWIDTH`) for an invalid `B`.
-/// Thread-safe, as are all the helpers below.
+/// Number of samples `(2B)^3` (0 for an invalid `B`).
 #[no_mangle]
 pub extern "C" fn so3fft_num_samples(B: c_int) -> usize {
     guarded(0, || Ok(crate::num_samples(checks::bandwidth(B)?)))
 }
 
-/// Number of coefficients `(4B^3-B)/3` at bandwidth `B`: the length of a coefficient
-/// array. Returns 0 (and sets `SO3FFT_EBANDWIDTH`) for an invalid `B`.
+/// Number of coefficients `(4B^3-B)/3` (0 for an invalid `B`).
 #[no_mangle]
 pub extern "C" fn so3fft_num_coeffs(B: c_int) -> usize {
     guarded(0, || Ok(crate::num_coeffs(checks::bandwidth(B)?)))
 }
 
-/// Index of the coefficient `fhat(l, m, mp)` in a coefficient array (SOFT's
-/// `so3CoefLoc(m, mp, l, B)`; note the different argument order). `m` pairs with
-/// alpha, `mp` with gamma. Requires `0 <= l < B`, `|m| <= l`, `|mp| <= l`.
-///
-/// Returns the index, or -1 (error state `SO3FFT_EBANDWIDTH` or `SO3FFT_EINVAL`).
+/// Index of `fhat(l, m, mp)` (SOFT's `so3CoefLoc(m, mp, l, B)`), or -1.
 #[no_mangle]
 pub extern "C" fn so3fft_coef_index(B: c_int, l: c_int, m: c_int, mp: c_int) -> isize {
     guarded(-1, || {
@@ -40,10 +33,7 @@ pub extern "C" fn so3fft_coef_index(B: c_int, l: c_int, m: c_int, mp: c_int) -> 
     })
 }
 
-/// Index of the sample `f(alpha_{j_alpha}, beta_{k_beta}, gamma_{j_gamma})` in a sample
-/// array: `k_beta*(2B)^2 + j_alpha*(2B) + j_gamma`. Requires all three in `0 .. 2B-1`.
-///
-/// Returns the index, or -1 (error state `SO3FFT_EBANDWIDTH` or `SO3FFT_EINVAL`).
+/// Index `k_beta*(2B)^2 + j_alpha*(2B) + j_gamma` of a sample, or -1.
 #[no_mangle]
 pub extern "C" fn so3fft_sample_index(
     B: c_int,
@@ -83,34 +73,25 @@ fn angle(b: c_int, j: c_int, name: &str, f: fn(usize, usize) -> f64) -> f64 {
     })
 }
 
-/// Sample angle `alpha_j = pi j / B`, `0 <= j < 2B`. NaN on invalid arguments (error
-/// state `SO3FFT_EBANDWIDTH` or `SO3FFT_EINVAL`).
+/// Sample angle `alpha_j = pi j / B`, `0 <= j < 2B` (NaN on invalid arguments).
 #[no_mangle]
 pub extern "C" fn so3fft_alpha(B: c_int, j: c_int) -> c_double {
     angle(B, j, "alpha", crate::alpha)
 }
 
-/// Sample angle `beta_k = pi (2k+1) / (4B)`, `0 <= k < 2B`. NaN on invalid arguments.
+/// Sample angle `beta_k = pi (2k+1) / (4B)`, `0 <= k < 2B` (NaN on invalid arguments).
 #[no_mangle]
 pub extern "C" fn so3fft_beta(B: c_int, k: c_int) -> c_double {
     angle(B, k, "beta", crate::beta)
 }
 
-/// Sample angle `gamma_j = pi j / B`, `0 <= j < 2B`. NaN on invalid arguments.
+/// Sample angle `gamma_j = pi j / B`, `0 <= j < 2B` (NaN on invalid arguments).
 #[no_mangle]
 pub extern "C" fn so3fft_gamma(B: c_int, j: c_int) -> c_double {
     angle(B, j, "gamma", crate::gamma)
 }
 
-/// Fills `w[0 .. 2B-1]` with the quadrature weights
-/// `w_B(k) = (2/B) sin(beta_k) sum_{i<B} sin((2i+1) beta_k)/(2i+1)` (the values of
-/// SOFT's `makeweights2`). Writes exactly `2B` doubles; no alignment beyond that of
-/// `double` is required.
-///
-/// Returns `SO3FFT_OK`, or `SO3FFT_EBANDWIDTH`, `SO3FFT_ENULL` or `SO3FFT_EINVAL` (`w` not
-/// aligned like `double`); nothing is written then.
-///
-/// Requirements: `w` is NULL or points to at least `2B` writable doubles.
+/// Writes the `2B` quadrature weights `w_B(k)` to `w` (SOFT's `makeweights2`).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_weights(B: c_int, w: *mut c_double) -> c_int {
     guarded_code(|| {
@@ -125,8 +106,7 @@ pub unsafe extern "C" fn so3fft_weights(B: c_int, w: *mut c_double) -> c_int {
     })
 }
 
-/// Largest bandwidth accepted (the value of `SO3FFT_MAX_BANDWIDTH` in the library
-/// actually linked). Never fails.
+/// `SO3FFT_MAX_BANDWIDTH` of the library linked.
 #[no_mangle]
 pub extern "C" fn so3fft_max_bandwidth() -> c_int {
     last_error::clear();

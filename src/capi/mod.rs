@@ -1,13 +1,30 @@
-//! C ABI in the spirit of `fftw3.h` (see `include/so3fft.h`, generated from this file by
-//! `build.rs` through cbindgen: the doc comments below are the header's documentation).
+//! The native C API, in the spirit of `fftw3.h`. `include/so3fft.h` is generated from this
+//! module and its submodules by `build.rs` through cbindgen: their doc comments are the
+//! header's (terse) comments. The full reference is `docs/c-api.md`.
 //!
-//! Every exported function catches panics at the boundary, validates its pointers and
-//! sizes, and reports failures through a return value plus a thread-local error state
-//! (code and message). Nothing is ever written outside the caller's arrays, whose sizes
-//! are fixed by the bandwidth.
+//! Every exported function runs through the shared boundary of [`crate::ffi`]: panics are
+//! caught, arguments checked, and failures reported through a return value plus the
+//! thread-local error state (code and message). Nothing is written outside the caller's
+//! arrays, whose sizes are fixed by the bandwidth.
+//!
+//! # Safety
+//!
+//! The `unsafe` functions dereference the caller's pointers. Their contract, the same for all:
+//!
+//! - a plan argument `p` is NULL or a plan returned by a planner and not yet destroyed, and
+//!   no other thread destroys it during the call;
+//! - a non-NULL array argument points to at least the number of values the function
+//!   documents for the plan's bandwidth (`(2B)^3` samples, `(4B^3-B)/3` coefficients, `2B`
+//!   weights), valid for reads (inputs) or writes (outputs) for the whole call, and no other
+//!   thread writes an input or accesses an output during the call;
+//! - the arrays given to a planner stay valid as long as `so3fft_execute` is used on the plan.
+//!
+//! The library checks what it can: NULL, alignment like `double`, overlap of input and
+//! output, and that an array's extent fits in the address space. The extent itself cannot
+//! be checked and rests on the caller, as with FFTW.
 
-// Names follow C conventions (so3fft_plan, B); the unsafe functions state their
-// requirements in prose for the C header rather than in "# Safety" sections.
+// Names follow C conventions (so3fft_plan, B); the safety contract is stated once above
+// rather than in a "# Safety" section per function (those sections would fill the header).
 #![allow(non_camel_case_types, non_snake_case, clippy::missing_safety_doc)]
 
 // Declared in the order of their items in the header: cbindgen follows the declarations.
@@ -46,15 +63,10 @@ use crate::ffi::{boundary, CallError, ErrorKind};
 use crate::{Direction, Plan, Rigor, MAX_BANDWIDTH};
 use std::ffi::{c_double, c_int, c_uint};
 
-/// One complex number: `[0]` is the real part, `[1]` the imaginary part.
-///
-/// Identical to `fftw_complex` (`double[2]`): a `fftw_complex *` can be passed where a
-/// `so3fft_complex *` is expected without any cast. Arrays of C99 `double _Complex`
-/// have the same layout and are passed with a pointer cast `(so3fft_complex *)`.
-/// No alignment beyond that of `double` is required.
+/// One complex number `{re, im}`, identical to `fftw_complex` (`double[2]`).
 pub type so3fft_complex = [c_double; 2];
 
-/// Opaque plan object, created by a planner and released by `so3fft_destroy_plan`.
+/// Opaque plan object (made by a planner, released by `so3fft_destroy_plan`).
 pub struct so3fft_plan_s {
     plan: Plan,
     /// Input array given at planning (samples for a forward plan, coefficients for an
@@ -75,39 +87,21 @@ pub type so3fft_plan = *mut so3fft_plan_s;
 // Constants
 // ---------------------------------------------------------------------------------------
 
-/// Largest bandwidth `B` accepted by the planners and the helpers.
+/// Largest bandwidth `B` accepted.
 pub const SO3FFT_MAX_BANDWIDTH: c_int = 2048;
 const _: () = assert!(SO3FFT_MAX_BANDWIDTH as usize == MAX_BANDWIDTH);
 
-/// Planner flag: heuristic FFTW plans, no measurement (fast planning). This is the
-/// default (the value is 0), like `FFTW_ESTIMATE`.
+/// Planner flag: heuristic FFTW plans, no measurement (the default, 0).
 pub const SO3FFT_ESTIMATE: c_uint = 0;
-/// Planner flag: FFTW measures a few candidate plans (planning takes up to about a
-/// second; transforms are faster), like `FFTW_MEASURE`. The caller's arrays are never
-/// used for the measurements: so3fft plans on its own scratch memory.
+/// Planner flag: FFTW measures a few candidate plans (on so3fft's own scratch memory).
 pub const SO3FFT_MEASURE: c_uint = 1;
-/// Planner flag: FFTW measures more candidates (`FFTW_PATIENT`).
+/// Planner flag: FFTW measures more candidates.
 pub const SO3FFT_PATIENT: c_uint = 2;
-/// Planner flag: FFTW measures every candidate (`FFTW_EXHAUSTIVE`).
-/// When several rigour flags are given, the most rigorous one applies.
+/// Planner flag: FFTW measures every candidate (the most rigorous flag given applies).
 pub const SO3FFT_EXHAUSTIVE: c_uint = 4;
-/// Planner flag: the forward transform may overwrite its input (sample) array, like
-/// `FFTW_DESTROY_INPUT`; its contents afterwards are unspecified. When the plan's chunk
-/// buffer holds fewer betas than the grid (large bandwidths, see `so3fft_plan_memory`),
-/// the forward then keeps its later chunk buffers in the sample slices it has already
-/// read and adds to the coefficients once per group of chunks instead of once per chunk
-/// (at B = 512 under the default memory rule: one pass over the coefficients instead of
-/// one per chunk: 22 of them, fewer with `SO3FFT_REAL`, whose chunks are larger). No
-/// extra memory; the same results up to rounding. Concurrent forwards with such a plan
-/// need distinct input arrays. The inverse never reads its output and never
-/// modifies its input. (Earlier builds accepted this flag and ignored it.)
+/// Planner flag: the forward transform may overwrite its sample array.
 pub const SO3FFT_DESTROY_INPUT: c_uint = 16;
-/// Planner flag: the signal is real-valued. The array layouts do not change, and about
-/// half the work is done (r2c/c2r FFTs, one order pair of each `(m,m')`, `(-m,-m')`).
-/// Forward: only the real parts of the samples are read; all coefficients are written
-/// and satisfy `fhat(l,-m,-m') = (-1)^(m-m') conj(fhat(l,m,m'))` exactly. Inverse: the
-/// coefficients must satisfy that symmetry, and only the blocks with `m' > 0`, or `m' = 0`
-/// and `m >= 0`, are read; the samples' imaginary parts are written as exactly 0.
+/// Planner flag: real-valued signal (same layouts, about half the work).
 pub const SO3FFT_REAL: c_uint = 32;
 
 const KNOWN_FLAGS: c_uint =
@@ -120,29 +114,26 @@ pub const SO3FFT_INVERSE: c_int = 2;
 /// Direction for `so3fft_plan_general`: both (no arrays; new-array execute only).
 pub const SO3FFT_BOTH: c_int = 3;
 
-/// Returned by `so3fft_get_fft_threading`: each worker thread of the plan transforms whole
-/// beta slices with a single-threaded FFTW plan.
+/// FFT threading: each worker transforms whole slices with a single-threaded FFTW plan.
 pub const SO3FFT_FFT_SLICES_ACROSS_WORKERS: c_int = 1;
-/// Returned by `so3fft_get_fft_threading`: the beta slices are transformed one after
-/// another, each on FFTW's own threads.
+/// FFT threading: slices one after another, each on FFTW's own threads.
 pub const SO3FFT_FFT_FFTW_THREADS: c_int = 2;
 
 /// Success.
 pub const SO3FFT_OK: c_int = 0;
-/// Invalid argument: unknown flag bits, index or thread count out of range, direction
-/// value unknown, arrays misaligned (not aligned like `double`) or overlapping.
+/// Invalid argument (flags, index, thread count, direction; misaligned or overlapping arrays).
 pub const SO3FFT_EINVAL: c_int = -1;
 /// Bandwidth `B` outside `1 .. SO3FFT_MAX_BANDWIDTH`.
 pub const SO3FFT_EBANDWIDTH: c_int = -2;
-/// A required pointer is NULL (plan, array, or an execute of a plan made without arrays).
+/// A required pointer is NULL (plan, array, or the arrays of a plan made without them).
 pub const SO3FFT_ENULL: c_int = -3;
-/// Memory allocation failed (nothing was leaked; the library stays usable).
+/// Memory allocation failed (nothing leaked; the library stays usable).
 pub const SO3FFT_ENOMEM: c_int = -4;
 /// The plan was made for the other direction only.
 pub const SO3FFT_EDIRECTION: c_int = -5;
 /// FFTW could not create a plan.
 pub const SO3FFT_EFFTW: c_int = -6;
-/// Internal error (a Rust panic, caught at the library boundary). Please report it.
+/// Internal error (a Rust panic caught at the boundary). Please report it.
 pub const SO3FFT_EPANIC: c_int = -7;
 // ---------------------------------------------------------------------------------------
 // Error codes, the boundary and argument conversion

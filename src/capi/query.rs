@@ -10,9 +10,7 @@ use crate::ffi::checks;
 use crate::{FftThreading, Plan, PlanOptions};
 use std::ffi::{c_int, c_uint};
 
-/// The bandwidth of a plan, or `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
-///
-/// Requirements: `p` is NULL or a live plan.
+/// The bandwidth of a plan (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_bandwidth(p: so3fft_plan) -> c_int {
     guarded(SO3FFT_ENULL, || {
@@ -21,10 +19,7 @@ pub unsafe extern "C" fn so3fft_get_bandwidth(p: so3fft_plan) -> c_int {
     })
 }
 
-/// The number of worker threads of a plan (after resolving 0 = all cores), or
-/// `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
-///
-/// Requirements: `p` is NULL or a live plan.
+/// The worker thread count of a plan (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_nthreads(p: so3fft_plan) -> c_int {
     guarded(SO3FFT_ENULL, || {
@@ -33,12 +28,7 @@ pub unsafe extern "C" fn so3fft_get_nthreads(p: so3fft_plan) -> c_int {
     })
 }
 
-/// Bytes of memory a plan holds: its chunk buffer (beta slices in the layout of the
-/// Wigner transforms), per-worker FFT buffers and `O(B^2)` tables; `SO3FFT_ENULL` if `p`
-/// is NULL. A transform needs its input and output arrays on top and nothing else large.
-/// Thread-safe.
-///
-/// Requirements: `p` is NULL or a live plan.
+/// Bytes of memory a plan holds (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
     guarded_count(|| {
@@ -47,17 +37,8 @@ pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
     })
 }
 
-/// Bytes of memory a plan made now by `so3fft_plan_general(B, d, ..., flags, nthreads)`
-/// would hold, whatever its direction `d` (what `so3fft_get_memory` would then report;
-/// FFTW's own plans are not counted), computed without making it: nothing is allocated.
-/// `nthreads`: 0 = all cores. The default workspace uses
-/// at most 4.7% of the caller's arrays at large B (at least 512 MiB) and at most half of
-/// the memory available at the time of the call, so a plan made later may differ if that
-/// has changed; the formulas are in the crate documentation of `Plan::memory_bytes` and
-/// `Plan::workspace_bytes`. A cap set with `so3fft_plan_with_max_workspace` applies.
-///
-/// Returns the byte count, or a negative `SO3FFT_E*` code (`SO3FFT_EBANDWIDTH` for an
-/// invalid `B`, `SO3FFT_EINVAL` for unknown flags or `nthreads < 0`). Thread-safe.
+/// Bytes a plan made now with these arguments would hold, computed without making it;
+/// or a negative `SO3FFT_E*` code.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -> isize {
     guarded_count(|| {
@@ -75,15 +56,7 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
     })
 }
 
-/// How the FFT stage of a plan uses its threads: `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or
-/// `SO3FFT_FFT_FFTW_THREADS`; `SO3FFT_ENULL` if `p` is NULL. Thread-safe.
-///
-/// The planner chooses: with `SO3FFT_ESTIMATE` or one thread, slices across workers; with
-/// `SO3FFT_MEASURE`, `SO3FFT_PATIENT` or `SO3FFT_EXHAUSTIVE` and more than one thread, it
-/// plans both variants, times them on a sample of the FFT stage and keeps the faster.
-/// Real-signal transforms (`SO3FFT_REAL`) always spread slices across the workers.
-///
-/// Requirements: `p` is NULL or a live plan.
+/// `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS` (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_fft_threading(p: so3fft_plan) -> c_int {
     guarded(SO3FFT_ENULL, || {
