@@ -2,7 +2,7 @@
 //! module and its submodules by `build.rs` through cbindgen: their doc comments are the
 //! header's (terse) comments. The full reference is `docs/c-api.md`.
 //!
-//! Every exported function runs through the shared boundary of [`crate::ffi`]: panics are
+//! Every exported function runs through the shared boundary of `crate::ffi`: panics are
 //! caught, arguments checked, and failures reported through a return value plus the
 //! thread-local error state (code and message). Nothing is written outside the caller's
 //! arrays, whose sizes are fixed by the bandwidth.

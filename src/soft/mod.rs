@@ -7,8 +7,8 @@
 //!
 //! Behaviour shared by all transform entry points:
 //!
-//! - **Plans.** One [`Plan`] per bandwidth is created on first use and cached for the life of
-//!   the process (a global map, [`Direction::Both`]), so repeated calls at the same bandwidth
+//! - **Plans.** One [`Plan`](crate::Plan) per bandwidth is created on first use and cached for the life of
+//!   the process (a global map, [`Direction::Both`](crate::Direction::Both)), so repeated calls at the same bandwidth
 //!   pay set-up once. Plans use all cores and FFTW's `MEASURE` rigour by default; the
 //!   environment variables `SO3FFT_SOFT_THREADS` (a positive number) and `SO3FFT_SOFT_RIGOR`
 //!   (`estimate`, `measure`, `patient`, `exhaustive`), read once, override that. Calls from

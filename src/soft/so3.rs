@@ -188,7 +188,7 @@ pub unsafe extern "C" fn Inverse_SO3_Naive_fftw(
 // soft_fftw_pc.h
 
 /// Forward transform with a precomputed Wigner table (`soft_fftw_pc.h`): same as
-/// [`Forward_SO3_Naive_fftw`]; the table `wigners` (from [`genWigAll`]) is not read.
+/// [`Forward_SO3_Naive_fftw`]; the table `wigners` (from [`genWigAll`](super::genWigAll)) is not read.
 ///
 /// cbindgen:ignore
 #[no_mangle]
@@ -211,7 +211,7 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw_pc(
 }
 
 /// Inverse transform with a precomputed Wigner table (`soft_fftw_pc.h`): same as
-/// [`Inverse_SO3_Naive_fftw`]; the table `wignersTrans` (from [`genWigAllTrans`]) is not read.
+/// [`Inverse_SO3_Naive_fftw`]; the table `wignersTrans` (from [`genWigAllTrans`](super::genWigAllTrans)) is not read.
 ///
 /// cbindgen:ignore
 #[no_mangle]
