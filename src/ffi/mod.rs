@@ -102,8 +102,8 @@ pub(crate) fn boundary<R>(
     body: impl FnOnce() -> Result<R, CallError>,
 ) -> Result<R, ErrorKind> {
     sink.start();
-    // AssertUnwindSafe: after a panic nothing the body touched is used again except
-    // through the error it reports (plans keep their own invariants across panics).
+    // AssertUnwindSafe: after a panic the call only reports it; state shared across calls
+    // (plans, the SOFT layer's caches) is behind locks whose poisoning is recovered from.
     let err = match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(value)) => return Ok(value),
         Ok(Err(err)) => err,
