@@ -88,24 +88,24 @@ pub unsafe extern "C" fn so3CombineCoef_fftw(
         // SAFETY: each input is non-NULL, aligned and disjoint from the output (checked)
         // and holds bwIn^2 doubles (the module's safety contract); only read.
         let read = |p: *mut c_double| unsafe { std::slice::from_raw_parts(p.cast_const(), nin) };
-        let (fr, fi, hr, hi) = (
+        let (sig_re, sig_im, pat_re, pat_im) = (
             read(sigCoefR),
             read(sigCoefI),
             read(patCoefR),
             read(patCoefI),
         );
-        let bi = bin as i64;
+        let bw_in = bin as i64;
         for l in 0..=degLim as i64 {
             let norm = 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
             for m1 in -l..=l {
-                let fidx = sean_index(-m1, l, bi) as usize;
-                let f = Complex64::new(fr[fidx], fi[fidx]);
+                let sig_at = sean_index(-m1, l, bw_in) as usize;
+                let sig = Complex64::new(sig_re[sig_at], sig_im[sig_at]);
                 for m2 in -l..=l {
-                    let hidx = sean_index(-m2, l, bi) as usize;
-                    let h = Complex64::new(hr[hidx], hi[hidx]);
-                    let s = norm * parity(m1 as isize, m2 as isize);
-                    let o = crate::coef_index(bout, l as usize, m1 as isize, m2 as isize);
-                    out[o] = f * h.conj() * s;
+                    let pat_at = sean_index(-m2, l, bw_in) as usize;
+                    let pat = Complex64::new(pat_re[pat_at], pat_im[pat_at]);
+                    let scale = norm * parity(m1 as isize, m2 as isize);
+                    let at = crate::coef_index(bout, l as usize, m1 as isize, m2 as isize);
+                    out[at] = sig * pat.conj() * scale;
                 }
             }
         }
