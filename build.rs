@@ -35,13 +35,11 @@ fn generate_header() {
     let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(env::var("OUT_DIR").expect("OUT_DIR"));
     let capi = root.join(CAPI_ROOT);
-    let sources: Vec<PathBuf> = fs::read_dir(capi.parent().expect("src/capi"))
-        .expect("reading src/capi")
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .collect();
     let config_path = root.join("cbindgen.toml");
     let header_path = root.join("include/so3fft.h");
-    for p in sources.iter().chain([&config_path, &header_path]) {
+    // A directory: cargo scans all of it for changes.
+    let capi_dir = capi.parent().expect("src/capi");
+    for p in [capi_dir, &config_path, &header_path] {
         println!("cargo:rerun-if-changed={}", p.display());
     }
     println!("cargo:rerun-if-env-changed=SO3FFT_CHECK_HEADER");
