@@ -1,5 +1,5 @@
 //! Build script: link FFTW's threads library, give the shared library a SONAME, and
-//! generate the C header `include/so3fft.h` from `src/capi.rs` with cbindgen.
+//! generate the C header `include/so3fft.h` from `src/capi/` with cbindgen.
 //!
 //! The header is committed. It is rewritten only when its content changes, so builds do
 //! not touch it needlessly. With `SO3FFT_CHECK_HEADER=1` in the environment (CI) the
@@ -9,6 +9,10 @@
 use std::env;
 use std::fs;
 use std::path::PathBuf;
+
+/// The native C API: cbindgen reads this file and the modules it declares, in the order
+/// of their declarations.
+const CAPI_ROOT: &str = "src/capi/mod.rs";
 
 /// SONAME of the shared library: bump the number with any ABI break.
 const SONAME: &str = "libso3fft.so.0";
@@ -30,10 +34,12 @@ fn main() {
 fn generate_header() {
     let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(env::var("OUT_DIR").expect("OUT_DIR"));
-    let capi = root.join("src/capi.rs");
+    let capi = root.join(CAPI_ROOT);
     let config_path = root.join("cbindgen.toml");
     let header_path = root.join("include/so3fft.h");
-    for p in [&capi, &config_path, &header_path] {
+    // A directory: cargo scans all of it for changes.
+    let capi_dir = capi.parent().expect("src/capi");
+    for p in [capi_dir, &config_path, &header_path] {
         println!("cargo:rerun-if-changed={}", p.display());
     }
     println!("cargo:rerun-if-env-changed=SO3FFT_CHECK_HEADER");
@@ -43,7 +49,7 @@ fn generate_header() {
     let version = env::var("CARGO_PKG_VERSION").expect("CARGO_PKG_VERSION");
     let part = |k: &str| env::var(k).expect("CARGO_PKG_VERSION_*");
     config.after_includes = Some(format!(
-        "\n/** Version of this header (compare with so3fft_version() at run time). */\n\
+        "\n// Version of this header (compare with so3fft_version() at run time).\n\
          #define SO3FFT_VERSION \"{version}\"\n\
          #define SO3FFT_VERSION_MAJOR {}\n\
          #define SO3FFT_VERSION_MINOR {}\n\
@@ -57,7 +63,7 @@ fn generate_header() {
         .with_config(config)
         .with_src(&capi)
         .generate()
-        .unwrap_or_else(|e| panic!("cbindgen failed on {}: {e}", capi.display()));
+        .unwrap_or_else(|e| panic!("cbindgen failed on src/capi/: {e}"));
     let mut raw = Vec::new();
     bindings.write(&mut raw);
     let generated = parenthesize_negative_defines(&String::from_utf8(raw).expect("UTF-8 header"));
@@ -71,7 +77,7 @@ fn generate_header() {
     if env::var("SO3FFT_CHECK_HEADER").is_ok_and(|v| v == "1") {
         panic!(
             "include/so3fft.h is out of date: it differs from the header generated from \
-             src/capi.rs (see {}). Rebuild without SO3FFT_CHECK_HEADER=1 to regenerate it \
+             src/capi/ (see {}). Rebuild without SO3FFT_CHECK_HEADER=1 to regenerate it \
              and commit the result.",
             out_dir.join("so3fft.h").display()
         );

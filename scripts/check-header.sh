@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fails when the committed C header include/so3fft.h differs from the one cbindgen generates
-# from src/capi.rs (build.rs). Used by CI (.ci/run).
+# from src/capi/ (build.rs). Used by CI (.ci/run).
 #
 # 1. build.rs in check mode (SO3FFT_CHECK_HEADER=1): it never writes the header and fails
 #    the build when include/so3fft.h differs from the generated header.
@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 SO3FFT_CHECK_HEADER=1 cargo build --release --lib --quiet
-echo "check-header: include/so3fft.h matches the header generated from src/capi.rs"
+echo "check-header: include/so3fft.h matches the header generated from src/capi/"
 
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1 &&
    git ls-files --error-unmatch include/so3fft.h >/dev/null 2>&1; then

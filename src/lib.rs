@@ -28,6 +28,7 @@ pub mod capi;
 mod ceilings;
 mod dwt;
 mod error;
+mod ffi;
 mod fft;
 mod grid;
 #[cfg(feature = "internals")]

@@ -1,7 +1,7 @@
 /*
  * so3fft SOFT 2.0 compatibility layer: soft_fftw_pc.h, the transforms with precomputed Wigner tables.
  *
- * Written for so3fft from the specification of SOFT 2.0's interface (SPEC.md sections 3-5);
+ * Written for so3fft from the specification of SOFT 2.0's interface (see docs/conventions.md);
  * no SOFT source or header text is used. Copyright (C) the so3fft authors.
  * SPDX-License-Identifier: GPL-2.0-or-later
  *

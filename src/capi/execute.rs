@@ -1,0 +1,154 @@
+//! Execution: `so3fft_execute` on the arrays given at planning, and the new-array execute
+//! functions.
+
+use super::{guarded_code, plan_ref, so3fft_complex, so3fft_plan, so3fft_plan_s};
+use crate::ffi::checks::{input_output, Array};
+use crate::ffi::{CallError, ErrorKind};
+use crate::{Complex64, Direction};
+use std::ffi::c_int;
+
+/// Forward transform of the plan `state` from the samples at `samples` to the coefficients
+/// at `coeffs`, after checking the direction and the arrays (non-NULL, aligned like
+/// `double`, not overlapping).
+///
+/// # Safety
+/// Non-NULL `samples` and `coeffs` point to `(2B)^3` and `(4B^3-B)/3` values of the plan's
+/// bandwidth `B`, not accessed by anyone else during the call (the samples may be read
+/// concurrently unless the plan destroys its input).
+unsafe fn run_forward(
+    state: &so3fft_plan_s,
+    samples: *mut so3fft_complex,
+    coeffs: *mut so3fft_complex,
+) -> Result<(), CallError> {
+    if state.plan.direction() == Direction::Inverse {
+        return Err(CallError::new(
+            ErrorKind::Direction,
+            "forward transform requested from a plan made for the inverse transform only",
+        ));
+    }
+    let plan = &state.plan;
+    let (ns, nc) = (plan.num_samples(), plan.num_coeffs());
+    input_output(
+        &Array::new(samples, ns, "samples"),
+        &Array::new(coeffs, nc, "coefficients"),
+    )?;
+    // SAFETY: checked non-NULL, aligned and disjoint; `nc` values by this function's
+    // contract. Complex64 is #[repr(C)] { re: f64, im: f64 }, the layout of double[2].
+    let coeffs = unsafe { std::slice::from_raw_parts_mut(coeffs.cast::<Complex64>(), nc) };
+    if state.destroy_input {
+        // SAFETY: as above, `ns` values; the caller allowed the samples to be overwritten
+        // (SO3FFT_DESTROY_INPUT), so no one else reads them during the call.
+        let samples = unsafe { std::slice::from_raw_parts_mut(samples.cast::<Complex64>(), ns) };
+        return if state.real {
+            plan.forward_real_parts_destroying_input(samples, coeffs)
+                .map(|_| ())
+        } else {
+            plan.forward_destroying_input(samples, coeffs)
+        }
+        .map_err(CallError::from);
+    }
+    // SAFETY: as above, `ns` values, only read.
+    let samples =
+        unsafe { std::slice::from_raw_parts(samples.cast_const().cast::<Complex64>(), ns) };
+    if state.real {
+        return plan
+            .forward_real_parts(samples, coeffs)
+            .map(|_| ())
+            .map_err(CallError::from);
+    }
+    plan.forward(samples, coeffs).map_err(CallError::from)
+}
+
+/// Inverse transform of the plan `state` from the coefficients at `coeffs` to the samples
+/// at `samples`, after the same checks as [`run_forward`].
+///
+/// # Safety
+/// As [`run_forward`]; the coefficients are only read.
+unsafe fn run_inverse(
+    state: &so3fft_plan_s,
+    coeffs: *mut so3fft_complex,
+    samples: *mut so3fft_complex,
+) -> Result<(), CallError> {
+    if state.plan.direction() == Direction::Forward {
+        return Err(CallError::new(
+            ErrorKind::Direction,
+            "inverse transform requested from a plan made for the forward transform only",
+        ));
+    }
+    let plan = &state.plan;
+    let (ns, nc) = (plan.num_samples(), plan.num_coeffs());
+    input_output(
+        &Array::new(coeffs, nc, "coefficients"),
+        &Array::new(samples, ns, "samples"),
+    )?;
+    // SAFETY: checked non-NULL, aligned and disjoint; the sizes by this function's contract;
+    // the coefficients are only read, the samples only written by this call.
+    let (coeffs, samples) = unsafe {
+        (
+            std::slice::from_raw_parts(coeffs.cast_const().cast::<Complex64>(), nc),
+            std::slice::from_raw_parts_mut(samples.cast::<Complex64>(), ns),
+        )
+    };
+    if state.real {
+        return plan
+            .inverse_real_to_complex(coeffs, samples)
+            .map_err(CallError::from);
+    }
+    plan.inverse(coeffs, samples).map_err(CallError::from)
+}
+
+/// Executes a plan on the arrays given at planning. Returns `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_execute(p: so3fft_plan) -> c_int {
+    guarded_code(|| {
+        // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
+        let state = unsafe { plan_ref(p) }?;
+        if state.input.is_null() || state.output.is_null() {
+            return Err(CallError::new(
+                ErrorKind::Null,
+                "the plan was made without arrays: use so3fft_execute_forward or so3fft_execute_inverse",
+            ));
+        }
+        // SAFETY: the arrays given at planning were checked then (non-NULL, aligned, disjoint)
+        // and have the sizes of the plan's bandwidth; the caller keeps them valid as long as
+        // so3fft_execute is used (its contract); run_* check them again.
+        unsafe {
+            match state.plan.direction() {
+                Direction::Forward => run_forward(state, state.input, state.output),
+                Direction::Inverse => run_inverse(state, state.input, state.output),
+                Direction::Both => Err(CallError::new(
+                    ErrorKind::Null,
+                    "a plan for both directions has no arrays",
+                )),
+            }
+        }
+    })
+}
+
+/// Forward transform of samples `in` into coefficients `out` (new-array execute).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_execute_forward(
+    p: so3fft_plan,
+    r#in: *mut so3fft_complex,
+    out: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: `p` is NULL or a live plan, and non-NULL arrays have the sizes of its
+        // bandwidth (the caller's contract, see the module doc); run_forward checks the rest.
+        unsafe { run_forward(plan_ref(p)?, r#in, out) }
+    })
+}
+
+/// Inverse transform of coefficients `in` into samples `out` (new-array execute).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_execute_inverse(
+    p: so3fft_plan,
+    r#in: *mut so3fft_complex,
+    out: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: `p` is NULL or a live plan, and non-NULL arrays have the sizes of its
+        // bandwidth (the caller's contract, see the module doc); run_inverse checks the rest.
+        unsafe { run_inverse(plan_ref(p)?, r#in, out) }
+    })
+}

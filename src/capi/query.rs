@@ -1,0 +1,69 @@
+//! Queries on a plan (bandwidth, threads, memory, FFT threading) and the memory a plan
+//! would need.
+
+use super::planner::planner_workspace_cap;
+use super::{
+    guarded, guarded_count, plan_ref, rigor_of, so3fft_plan, threads_of, SO3FFT_ENULL,
+    SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_REAL,
+};
+use crate::ffi::checks;
+use crate::{FftThreading, Plan, PlanOptions};
+use std::ffi::{c_int, c_uint};
+
+/// The bandwidth of a plan (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_bandwidth(p: so3fft_plan) -> c_int {
+    guarded(SO3FFT_ENULL, || {
+        // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
+        Ok(unsafe { plan_ref(p) }?.plan.bandwidth() as c_int)
+    })
+}
+
+/// The worker thread count of a plan (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_nthreads(p: so3fft_plan) -> c_int {
+    guarded(SO3FFT_ENULL, || {
+        // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
+        Ok(unsafe { plan_ref(p) }?.plan.threads() as c_int)
+    })
+}
+
+/// Bytes of memory a plan holds (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
+    guarded_count(|| {
+        // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
+        Ok(unsafe { plan_ref(p) }?.plan.memory_bytes() as isize)
+    })
+}
+
+/// Bytes a plan made now with these arguments would hold, computed without making it;
+/// or a negative `SO3FFT_E*` code.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -> isize {
+    guarded_count(|| {
+        let b = checks::bandwidth(B)?;
+        let rigor = rigor_of(flags)?;
+        let threads = threads_of(nthreads)?;
+        let options = PlanOptions {
+            threads,
+            rigor,
+            real: flags & SO3FFT_REAL != 0,
+            max_workspace_bytes: planner_workspace_cap(),
+            ..PlanOptions::default()
+        };
+        Ok(Plan::memory_needed(b, &options)? as isize)
+    })
+}
+
+/// `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS` (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_get_fft_threading(p: so3fft_plan) -> c_int {
+    guarded(SO3FFT_ENULL, || {
+        // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
+        Ok(match unsafe { plan_ref(p) }?.plan.fft_threading() {
+            FftThreading::FftwThreads => SO3FFT_FFT_FFTW_THREADS,
+            _ => SO3FFT_FFT_SLICES_ACROSS_WORKERS,
+        })
+    })
+}

@@ -1,0 +1,201 @@
+//! Page-aligned buffers, the padded layout of a slice in the FFT scratch, and row copies.
+
+use crate::error::{Error, Result};
+use num_complex::Complex64;
+
+/// A page-aligned complex buffer, zero-filled. Large buffers are mapped directly and
+/// asked to use transparent huge pages: the chunk buffer is read and written with large
+/// strides, and 4 KiB pages would make nearly every access a TLB miss.
+pub(crate) struct AlignedBuf {
+    ptr: *mut Complex64,
+    bytes: usize,
+}
+
+// SAFETY: the buffer is plain memory owned by this value; moving it to another thread moves
+// the ownership.
+unsafe impl Send for AlignedBuf {}
+// SAFETY: `&AlignedBuf` only hands out the pointer; whoever writes through it guarantees
+// (with its own SAFETY argument) that concurrent writers use disjoint parts.
+unsafe impl Sync for AlignedBuf {}
+
+impl AlignedBuf {
+    /// Allocate `len` complex values, zero-filled and touched (so page faults happen here).
+    /// From 2 MiB on the mapping starts on a 2 MiB boundary and is a whole number of 2 MiB
+    /// pages, so that transparent huge pages can back all of it (an unaligned mapping of a
+    /// little over 2 MiB holds no huge page at all).
+    pub fn new(len: usize) -> Result<AlignedBuf> {
+        const HUGE: usize = 1 << 21;
+        let want = len
+            .checked_mul(16)
+            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?
+            .max(4096);
+        let huge = want >= HUGE;
+        let bytes = if huge {
+            want.checked_next_multiple_of(HUGE)
+                .ok_or(Error::OutOfMemory { bytes: usize::MAX })?
+        } else {
+            want
+        };
+        // Room to move the start to a 2 MiB boundary.
+        let map = bytes
+            .checked_add(if huge { HUGE } else { 0 })
+            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?;
+        // SAFETY: a new anonymous private mapping (no existing memory is affected); failure
+        // is checked below.
+        let raw = unsafe {
+            libc::mmap(
+                std::ptr::null_mut(),
+                map,
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS | libc::MAP_NORESERVE,
+                -1,
+                0,
+            )
+        };
+        if raw == libc::MAP_FAILED {
+            return Err(Error::OutOfMemory { bytes: want });
+        }
+        let ptr = if huge {
+            // Give back the unaligned head and the tail beyond `bytes`.
+            let start = raw as usize;
+            let aligned = start.next_multiple_of(HUGE);
+            let (head, tail) = (aligned - start, start + map - (aligned + bytes));
+            // SAFETY: both ranges lie inside the mapping just made, are page-aligned, and
+            // nothing points into them.
+            unsafe {
+                if head > 0 {
+                    libc::munmap(raw, head);
+                }
+                if tail > 0 {
+                    libc::munmap((aligned + bytes) as *mut libc::c_void, tail);
+                }
+            }
+            aligned as *mut libc::c_void
+        } else {
+            raw
+        };
+        // SAFETY: `ptr .. ptr + bytes` is the part of the mapping we keep, readable and
+        // writable, and not yet shared.
+        unsafe {
+            if huge {
+                libc::madvise(ptr, bytes, libc::MADV_HUGEPAGE);
+            }
+            // Touch every page now rather than inside the first transform. With no swap
+            // and overcommit, a failure here would be the kernel's OOM killer, so callers
+            // check available memory for very large plans (see Plan::new).
+            std::ptr::write_bytes(ptr.cast::<u8>(), 0, bytes);
+        }
+        Ok(AlignedBuf {
+            ptr: ptr.cast::<Complex64>(),
+            bytes,
+        })
+    }
+
+    /// Start of the buffer (valid for the `len` values asked for, while `self` lives).
+    pub fn as_mut_ptr(&self) -> *mut Complex64 {
+        self.ptr
+    }
+}
+
+impl Drop for AlignedBuf {
+    fn drop(&mut self) {
+        // SAFETY: the mapping was created in `new` with this start and size and is unmapped
+        // once; no pointer into it outlives `self` (the users' contract of `as_mut_ptr`).
+        unsafe {
+            libc::munmap(self.ptr.cast::<libc::c_void>(), self.bytes);
+        }
+    }
+}
+
+/// Complex values of padding after each row of a slice in the FFT scratch. A slice's rows
+/// of `2B` values are a multiple of 4 KiB apart for many B, so a walk down a column stays
+/// in one set of the caches and FFTW copies columns out and back (`fftw_cpy2d`). One
+/// cache line of padding avoids that.
+pub(crate) const SLICE_PAD: usize = 4;
+
+/// Row stride, in complex values, of an `n x n` slice in the FFT scratch.
+pub(crate) const fn slice_stride(n: usize) -> usize {
+    n + SLICE_PAD
+}
+
+/// Copy `rows` rows of `len` doubles from rows `ss` doubles apart at `src` to rows `ds`
+/// apart at `dst`; with `stream`, by non-temporal stores where `dst` and its rows are
+/// 16-byte aligned (for memory the transform does not read again: ordinary stores would
+/// first read every line).
+///
+/// # Safety
+/// `src` is valid for reads and `dst` for writes of those extents (`rows` rows of `len`
+/// doubles at the given strides), and the two do not overlap.
+pub(crate) unsafe fn copy_rows(
+    src: *const f64,
+    ss: usize,
+    dst: *mut f64,
+    ds: usize,
+    rows: usize,
+    len: usize,
+    stream: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if stream && (dst as usize).is_multiple_of(16) && ds.is_multiple_of(2) && len.is_multiple_of(2)
+    {
+        use std::arch::x86_64::{_mm_loadu_pd, _mm_sfence, _mm_stream_pd};
+        for r in 0..rows {
+            // SAFETY: row `r` of both extents is in bounds (this function's contract); each
+            // store writes 2 doubles at an even offset of a 16-byte aligned row (checked
+            // above), and SSE2 is part of x86_64.
+            unsafe {
+                let (s, d) = (src.add(r * ss), dst.add(r * ds));
+                for i in (0..len).step_by(2) {
+                    _mm_stream_pd(d.add(i), _mm_loadu_pd(s.add(i)));
+                }
+            }
+        }
+        // SAFETY: a store fence (SSE, part of x86_64) orders the streaming stores before
+        // any later access.
+        unsafe { _mm_sfence() };
+        return;
+    }
+    let _ = stream;
+    for r in 0..rows {
+        // SAFETY: row `r` of both extents is in bounds and they do not overlap (this
+        // function's contract).
+        unsafe { std::ptr::copy_nonoverlapping(src.add(r * ss), dst.add(r * ds), len) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::AlignedBuf;
+    use num_complex::Complex64;
+
+    /// Buffers from 2 MiB on start on a 2 MiB boundary; every size is zero-filled and
+    /// writable to its last value, and dropping gives the memory back (no crash when
+    /// many are made and dropped).
+    #[test]
+    fn aligned_buffers() {
+        for len in [
+            1usize,
+            255,
+            4096,
+            (1 << 17) - 1,
+            1 << 17,
+            (1 << 17) + 1,
+            300_000,
+        ] {
+            for _ in 0..3 {
+                let b = AlignedBuf::new(len).unwrap();
+                let p = b.as_mut_ptr();
+                if len * 16 >= 1 << 21 {
+                    assert_eq!(p as usize % (1 << 21), 0, "len {len}");
+                } else {
+                    assert_eq!(p as usize % 4096, 0, "len {len}");
+                }
+                // SAFETY: `len` values were allocated and `b` outlives the slice.
+                let s = unsafe { std::slice::from_raw_parts_mut(p, len) };
+                assert!(s.iter().all(|z| z.re == 0.0 && z.im == 0.0));
+                s[len - 1] = Complex64::new(1.0, 2.0);
+                s[0] = Complex64::new(3.0, 4.0);
+            }
+        }
+    }
+}

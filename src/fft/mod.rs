@@ -1,0 +1,57 @@
+//! The FFTW stage: 2-D DFTs of beta slices over (alpha, gamma).
+//!
+//! FFTW's planner is not thread-safe, and the host program may use FFTW too: every planner
+//! call (plan creation and destruction) holds the global planner lock, and
+//! `fftw_make_planner_thread_safe()` is called once so planning from the host's own threads
+//! is serialised with ours. Executing a plan on new arrays is thread-safe, so slices are
+//! transformed in parallel on the plan's rayon pool.
+//!
+//! FFTW's process-wide thread settings: a slice plan on FFTW's own threads (asked for with
+//! more than one thread) makes this module call `fftw_init_threads()` once, and set
+//! `fftw_plan_with_nthreads()` to the plan's thread count for the duration of that one
+//! planner call, under the planner lock, restoring the previous value afterwards (FFTW's
+//! default 1 where FFTW older than 3.3.9 cannot report it).
+//!
+//! - `planner`: the planner lock, FFTW's thread initialisation, owned FFTW plans;
+//! - `slices`: the slice transforms ([`SliceFft`], [`SliceFftReal`]);
+//! - `buf`: page-aligned buffers, the padded slice layout and row copies.
+
+mod buf;
+mod planner;
+mod slices;
+
+pub(crate) use buf::{copy_rows, slice_stride, AlignedBuf};
+pub(crate) use slices::{SliceFft, SliceFftReal};
+
+use fftw_sys as fftw;
+
+/// FFTW planner rigour (FFTW_ESTIMATE ... FFTW_EXHAUSTIVE).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Rigor {
+    /// Heuristic plan, no measurement (fast planning).
+    #[default]
+    Estimate,
+    /// Measure a few candidates (planning takes up to a second; faster transforms).
+    Measure,
+    /// Measure more candidates.
+    Patient,
+    /// Measure everything.
+    Exhaustive,
+}
+
+impl Rigor {
+    /// The FFTW planner flag of this rigour.
+    fn flags(self) -> u32 {
+        match self {
+            Rigor::Estimate => fftw::FFTW_ESTIMATE,
+            Rigor::Measure => fftw::FFTW_MEASURE,
+            Rigor::Patient => fftw::FFTW_PATIENT,
+            Rigor::Exhaustive => fftw::FFTW_EXHAUSTIVE,
+        }
+    }
+}
+
+/// Sign of the exponent: `+1` is FFTW_BACKWARD (used by the forward SO(3) transform).
+pub(crate) const SIGN_PLUS: i32 = fftw::FFTW_BACKWARD as i32;
+/// `-1` is FFTW_FORWARD (used by the inverse SO(3) transform).
+pub(crate) const SIGN_MINUS: i32 = fftw::FFTW_FORWARD;

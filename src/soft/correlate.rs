@@ -1,0 +1,114 @@
+//! The correlation helpers of `so3_correlate_fftw.h` (S^2 coefficient index, combination of
+//! S^2 coefficients into SO(3) coefficients).
+
+use super::real::parity;
+use super::{guarded, to_int, FftwComplex};
+use crate::ffi::checks::{self, input_output, Array};
+use crate::ffi::CallError;
+use crate::{num_coeffs, Complex64};
+use std::f64::consts::PI;
+use std::ffi::{c_double, c_int};
+
+/// Index of the spherical-harmonic coefficient of degree `l` and order `m` at bandwidth `b`
+/// in SOFT's/S2kit's layout (docs/conventions.md, spherical harmonics): `m >= 0`: `m b - m(m-1)/2 + (l-m)`;
+/// `m < 0`: `L(L+3)/2 + 1 + (L+m)(L+m+1)/2 + (l-|m|)` with `L = b-1`.
+fn sean_index(m: i64, l: i64, b: i64) -> i64 {
+    if m >= 0 {
+        m * b - m * (m - 1) / 2 + (l - m)
+    } else {
+        let big_l = b - 1;
+        big_l * (big_l + 3) / 2 + 1 + (big_l + m) * (big_l + m + 1) / 2 + (l + m)
+    }
+}
+
+/// Index of the S^2 coefficient `(l, m)` at bandwidth `bw` in S2kit's layout (see docs/conventions.md,
+/// spherical harmonics); -1 if `|m| > l` or `l >= bw`.
+///
+/// cbindgen:ignore
+#[no_mangle]
+pub extern "C" fn seanindex(m: c_int, l: c_int, bw: c_int) -> c_int {
+    guarded("seanindex", -1, || {
+        if l < 0 || l >= bw || (m as i64).abs() > l as i64 {
+            return Err(CallError::invalid(format!(
+                "coefficient (m={m}, l={l}) does not exist at bandwidth {bw}"
+            )));
+        }
+        to_int(sean_index(m as i64, l as i64, bw as i64))
+    })
+}
+
+/// Combine the S^2 coefficients of a signal (`sigCoefR/I`) and a pattern (`patCoefR/I`),
+/// both of bandwidth `bwIn` in `seanindex` order, into the SO(3) coefficients of their
+/// correlation at bandwidth `bwOut`:
+/// `so3Coef[so3CoefLoc(m1,m2,l,bwOut)] = 2pi sqrt(2/(2l+1)) (-1)^(m1+m2) f(l,-m1) conj(h(l,-m2))`
+/// for `l <= degLim`, 0 for all other coefficients (all `(4bwOut^3-bwOut)/3` are written).
+/// Requires `degLim < min(bwIn, bwOut)` (a negative `degLim` gives all zeros).
+///
+/// cbindgen:ignore
+#[no_mangle]
+pub unsafe extern "C" fn so3CombineCoef_fftw(
+    bwIn: c_int,
+    bwOut: c_int,
+    degLim: c_int,
+    sigCoefR: *mut c_double,
+    sigCoefI: *mut c_double,
+    patCoefR: *mut c_double,
+    patCoefI: *mut c_double,
+    so3Coef: *mut FftwComplex,
+) {
+    guarded("so3CombineCoef_fftw", (), || {
+        let bin = checks::bandwidth(bwIn)?;
+        let bout = checks::bandwidth(bwOut)?;
+        if degLim >= bwIn || degLim >= bwOut {
+            return Err(CallError::invalid(format!(
+                "degLim {degLim} must be below both bandwidths ({bwIn}, {bwOut})"
+            )));
+        }
+        let nin = bin * bin;
+        let nout = num_coeffs(bout);
+        let output = Array::new(so3Coef.cast_const(), nout, "so3Coef");
+        output.check()?;
+        let ins = [sigCoefR, sigCoefI, patCoefR, patCoefI];
+        if degLim >= 0 {
+            for (p, name) in ins
+                .iter()
+                .zip(["sigCoefR", "sigCoefI", "patCoefR", "patCoefI"])
+            {
+                input_output(&Array::new(p.cast_const(), nin, name), &output)?;
+            }
+        }
+        // SAFETY: non-NULL and aligned (checked); (4bwOut^3-bwOut)/3 values, not used by
+        // anyone else during the call (the module's safety contract); disjoint from the
+        // inputs (checked when they are read).
+        let out = unsafe { std::slice::from_raw_parts_mut(so3Coef.cast::<Complex64>(), nout) };
+        out.fill(Complex64::new(0.0, 0.0));
+        if degLim < 0 {
+            return Ok(());
+        }
+        // SAFETY: each input is non-NULL, aligned and disjoint from the output (checked)
+        // and holds bwIn^2 doubles (the module's safety contract); only read.
+        let read = |p: *mut c_double| unsafe { std::slice::from_raw_parts(p.cast_const(), nin) };
+        let (sig_re, sig_im, pat_re, pat_im) = (
+            read(sigCoefR),
+            read(sigCoefI),
+            read(patCoefR),
+            read(patCoefI),
+        );
+        let bw_in = bin as i64;
+        for l in 0..=degLim as i64 {
+            let norm = 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
+            for m1 in -l..=l {
+                let sig_at = sean_index(-m1, l, bw_in) as usize;
+                let sig = Complex64::new(sig_re[sig_at], sig_im[sig_at]);
+                for m2 in -l..=l {
+                    let pat_at = sean_index(-m2, l, bw_in) as usize;
+                    let pat = Complex64::new(pat_re[pat_at], pat_im[pat_at]);
+                    let scale = norm * parity(m1 as isize, m2 as isize);
+                    let at = crate::coef_index(bout, l as usize, m1 as isize, m2 as isize);
+                    out[at] = sig * pat.conj() * scale;
+                }
+            }
+        }
+        Ok(())
+    })
+}

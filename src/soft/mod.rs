@@ -1,0 +1,149 @@
+//! SOFT 2.0 drop-in layer: C entry points with the names, prototypes, array layouts and
+//! semantics of Kostelec and Rockmore's SOFT 2.0 (docs/conventions.md: layouts, normalisation,
+//! SOFT compatibility), running on the so3fft engine. The C declarations are the hand-written headers in `include/soft/`
+//! (`soft_fftw.h`, `soft_fftw_pc.h`, `soft_fftw_nt.h`, `wrap_fftw.h`, `utils_so3.h`,
+//! `makeweights.h`, `makeWigner.h`, `so3_correlate_fftw.h`, `csecond.h`); none of these
+//! functions belongs to the native API in `so3fft.h` (every item carries `cbindgen:ignore`).
+//!
+//! Behaviour shared by all transform entry points:
+//!
+//! - **Plans.** One [`Plan`](crate::Plan) per bandwidth is created on first use and cached for the life of
+//!   the process (a global map, [`Direction::Both`](crate::Direction::Both)), so repeated calls at the same bandwidth
+//!   pay set-up once. Plans use all cores and FFTW's `MEASURE` rigour by default; the
+//!   environment variables `SO3FFT_SOFT_THREADS` (a positive number) and `SO3FFT_SOFT_RIGOR`
+//!   (`estimate`, `measure`, `patient`, `exhaustive`), read once, override that. Calls from
+//!   several client threads at once are safe (the cache is locked; plans execute concurrently).
+//! - **Caller's FFTW plans and workspaces** are accepted and never used: the `fftw_plan *`
+//!   argument is never dereferenced or executed and the workspaces are never read or written
+//!   (all temporaries are private), so any buffer at least as large as SOFT documents (or
+//!   smaller) is fine.
+//! - **Inputs are never modified** (including the sample array of the `_nt` forward, which
+//!   SOFT may overwrite).
+//! - **Errors.** SOFT has no error channel: on invalid input (bandwidth outside
+//!   `1..=MAX_BANDWIDTH`, NULL or misaligned arrays, overlapping input and output) or an
+//!   internal error (e.g. out of memory), a function prints one line to stderr and returns
+//!   without writing its output; functions returning `int` return -1. Panics never cross the
+//!   C boundary.
+//! - **Safety contract.** The `unsafe` entry points dereference the caller's pointers: each
+//!   array argument that is read or written must be NULL (reported as an error where the
+//!   function checks it) or point to at least as many values as SOFT documents for the
+//!   bandwidth, valid for the whole call, and output arrays must not be accessed by other
+//!   threads during the call. NULL, alignment and input/output overlap are checked; the
+//!   extent cannot be, and rests on the caller (as in SOFT).
+//! - **Real data** (`flag != 0`): see [`Forward_SO3_Naive_fftw`] and [`Inverse_SO3_Naive_fftw`].
+
+#![allow(non_snake_case)]
+#![allow(clippy::missing_safety_doc)]
+
+mod cache;
+mod correlate;
+mod index;
+mod real;
+mod so3;
+mod tables;
+
+pub use correlate::{seanindex, so3CombineCoef_fftw};
+pub use index::{
+    coefLoc_so3, howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3,
+};
+pub use so3::{
+    Forward_SO3_Naive_fftw, Forward_SO3_Naive_fftw_W, Forward_SO3_Naive_fftw_nt,
+    Forward_SO3_Naive_fftw_pc, Inverse_SO3_Naive_fftw, Inverse_SO3_Naive_fftw_W,
+    Inverse_SO3_Naive_fftw_nt, Inverse_SO3_Naive_fftw_pc,
+};
+pub use tables::{genWigAll, genWigAllTrans, makeweights, makeweights2};
+
+use crate::ffi::{boundary, CallError, ErrorSink};
+use std::ffi::{c_double, c_int};
+use std::io::Write;
+
+/// `fftw_complex`: interleaved real and imaginary parts.
+type FftwComplex = [f64; 2];
+
+/// Result of an entry point's body: the error's message is printed to stderr.
+type SoftResult<T> = Result<T, CallError>;
+
+/// The [`ErrorSink`] of the SOFT layer, which has no error channel: one line on stderr
+/// naming the function.
+struct Stderr {
+    /// The C function that failed.
+    func: &'static str,
+}
+
+impl ErrorSink for Stderr {
+    fn report(&self, err: &CallError) {
+        // Never panic here (eprintln! would on a closed stderr).
+        let _ = writeln!(
+            std::io::stderr(),
+            "so3fft (SOFT layer): {}: {}",
+            self.func,
+            err.msg
+        );
+    }
+}
+
+/// Runs the body of the SOFT entry point `func` through the shared boundary (panics
+/// caught, failures printed to stderr); `fallback` on failure.
+fn guarded<T>(func: &'static str, fallback: T, body: impl FnOnce() -> SoftResult<T>) -> T {
+    boundary(&Stderr { func }, body).unwrap_or(fallback)
+}
+
+/// Converts an index or size to the C `int` SOFT returns.
+fn to_int(v: impl Into<i128> + Copy + std::fmt::Display) -> SoftResult<c_int> {
+    c_int::try_from(v.into())
+        .map_err(|_| CallError::invalid(format!("result {v} does not fit in a C int")))
+}
+
+// csecond.h
+
+/// Wall-clock time in seconds (since the Unix epoch), for timing as SOFT's clients do.
+/// (SOFT's `csecond` may return CPU time; with multithreaded transforms wall time is the
+/// meaningful measure.)
+///
+/// cbindgen:ignore
+#[no_mangle]
+pub extern "C" fn csecond() -> c_double {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs_f64())
+        .unwrap_or(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{howMany_so3, numCoeffs_so3, sampLoc_so3, seanindex, so3CoefLoc, totalCoeffs_so3};
+
+    #[test]
+    fn index_functions() {
+        assert_eq!(so3CoefLoc(0, 0, 0, 256), 0);
+        assert_eq!(so3CoefLoc(0, 0, 255, 256), 255);
+        assert_eq!(so3CoefLoc(0, 1, 1, 256), 256);
+        assert_eq!(so3CoefLoc(0, -1, 1, 256), 65281);
+        assert_eq!(so3CoefLoc(1, 0, 1, 256), 65536);
+        assert_eq!(so3CoefLoc(-1, 0, 1, 256), 22304001);
+        assert_eq!(so3CoefLoc(-1, -1, 255, 256), 22369535);
+        assert_eq!(totalCoeffs_so3(256), 22369536);
+        assert_eq!(totalCoeffs_so3(2048), -1);
+        assert_eq!(numCoeffs_so3(8, 3), 55);
+        assert_eq!(numCoeffs_so3(3, 8), 55);
+        assert_eq!(numCoeffs_so3(8, -3), 55);
+        assert_eq!(howMany_so3(-2, 5, 8), 3);
+        assert_eq!(sampLoc_so3(1, -1, 4), 8 * (8 + 7));
+        for bw in 1..6 {
+            let mut k = 0;
+            for m in 0..bw {
+                for l in m..bw {
+                    assert_eq!(seanindex(m, l, bw), k);
+                    k += 1;
+                }
+            }
+            for m in (1..bw).rev() {
+                for l in m..bw {
+                    assert_eq!(seanindex(-m, l, bw), k);
+                    k += 1;
+                }
+            }
+            assert_eq!(k, bw * bw);
+        }
+    }
+}
