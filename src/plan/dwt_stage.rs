@@ -2,7 +2,18 @@
 //! coefficients and starting values, the kernel on the cluster's block of the chunk buffer
 //! (see `blocks.rs`), and the coefficients' signs and layout.
 
-use super::*;
+use super::blocks::{Blocks, BufLayout};
+use super::coeffs;
+use super::real;
+use super::schedule::{At, Chunk, Pass};
+use super::shared::SyncPtr;
+use super::Plan;
+use crate::dwt::{self, Lanes, Prefetch, Rec};
+use crate::grid::block_start;
+use crate::symmetry::{Cluster, Member};
+use crate::wigner::{big, RecCoeffs};
+use num_complex::Complex64;
+use std::f64::consts::PI;
 
 /// The order pairs of a cluster a layout transforms, in slot order, and their number:
 /// [`all_members`] (complex layout) or `real::representatives` (real layout).

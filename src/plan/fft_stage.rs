@@ -13,7 +13,13 @@
 //! over the workers.
 
 use super::blocks::{Blocks, BufLayout, NONE};
-use super::*;
+use super::schedule::Chunk;
+use super::shared::{lock_free, SyncPtr};
+use super::Plan;
+use crate::error::{Error, Result};
+use crate::fft::{self, AlignedBuf, SliceFft};
+use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
 pub(super) const MAX_GROUP: usize = 4;
@@ -35,6 +41,20 @@ pub(super) fn scratch_len(b: usize) -> usize {
 }
 
 impl Plan {
+    /// Run `f` with a per-worker FFT scratch buffer (`2 group` padded slices). A worker may
+    /// take on another execution's group while it waits inside a parallel copy, so buffers
+    /// are taken by try_lock, never by blocking; when all are busy a private one is
+    /// allocated.
+    pub(super) fn with_fft_scratch<R>(
+        &self,
+        f: impl FnOnce(&AlignedBuf) -> Result<R>,
+    ) -> Result<R> {
+        match lock_free(&self.fft_scratch) {
+            Some(g) => f(&g),
+            None => f(&AlignedBuf::new(scratch_len(self.b))?),
+        }
+    }
+
     /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
     /// from `buf` into `grid`, the buffer laid out as `layout` (see `plan/blocks.rs`).
     pub(super) fn fft_chunk(
@@ -510,65 +530,4 @@ fn fence() {
     unsafe {
         std::arch::x86_64::_mm_sfence()
     };
-}
-
-#[cfg(test)]
-mod speed {
-    use super::*;
-
-    /// Time of the block copies of one group of pairs over all clusters (run with
-    /// --ignored --nocapture): scatter and gather, against a plain copy of as many bytes.
-    #[test]
-    #[ignore]
-    fn copy_speed() {
-        for b in [64usize, 128, 256] {
-            let n = 2 * b;
-            let nn = n * n;
-            let g = std::env::var("G")
-                .ok()
-                .and_then(|x| x.parse().ok())
-                .unwrap_or(pairs_per_group(16 * nn));
-            let t = Blocks::complex(b, &crate::symmetry::cluster_pairs(b), 8);
-            let buf = AlignedBuf::new(t.total() / 2 + 8).unwrap();
-            let ps = n * crate::fft::slice_stride(n);
-            let sl = AlignedBuf::new(2 * g * ps).unwrap();
-            let s: Vec<SyncPtr<Complex64>> = (0..2 * g)
-                .map(|i| SyncPtr(unsafe { sl.as_mut_ptr().add(i * ps) }))
-                .collect();
-            let w = vec![1.0; 2 * g];
-            let reps = 20;
-            let time = |f: &dyn Fn()| {
-                (0..5)
-                    .map(|_| {
-                        let t0 = Instant::now();
-                        for _ in 0..reps {
-                            f();
-                        }
-                        t0.elapsed().as_secs_f64() / reps as f64
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let bp = buf.as_mut_ptr() as *mut f64;
-            let blocks = BufLayout::Blocks;
-            let ts =
-                time(&|| unsafe { scatter_group(&t, &s, &w, false, bp, blocks, 0, 0..t.len()) });
-            // The gather as a large inverse runs it (half-major); the scatter's blocks are
-            // only a source of values here.
-            let half = BufLayout::HalfMajor(t.total() / 2);
-            let tg = time(&|| unsafe { gather_group(&t, &s, false, bp, half, 0, 0..t.len()) });
-            let bytes = 2 * g * nn * 16;
-            let src = AlignedBuf::new(bytes / 16).unwrap();
-            let dst = AlignedBuf::new(bytes / 16).unwrap();
-            let tc = time(&|| unsafe {
-                std::ptr::copy_nonoverlapping(src.as_mut_ptr(), dst.as_mut_ptr(), bytes / 16)
-            });
-            println!(
-                "B={b} g={g}: scatter {:.2} ms, gather {:.2} ms per pair, memcpy of the same bytes {:.2} ms ({:.1} GB/s)",
-                ts * 1e3 / g as f64,
-                tg * 1e3 / g as f64,
-                tc * 1e3 / g as f64,
-                bytes as f64 / tc / 1e9
-            );
-        }
-    }
 }

@@ -12,7 +12,14 @@
 //! run, else up to [`ROUNDS`]. The faster variant is kept (FFTW's threads need a margin of
 //! [`FFTW_MARGIN`]) and the other's FFTW plans are destroyed.
 
-use super::*;
+use super::blocks::BufLayout;
+use super::build::mem_available;
+use super::schedule::Chunk;
+use super::shared::SyncPtr;
+use super::{FftThreading, Plan, PlanOptions};
+use crate::error::Result;
+use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
+use std::time::Instant;
 
 /// Timed rounds per variant, at most (the fastest of them counts).
 const ROUNDS: usize = 5;
@@ -161,163 +168,5 @@ impl Plan {
         })
         .ok()?;
         Some(best)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Test helper: wait (up to a minute) until both cores have been idle for 300 ms, so that
-    /// timings are not taken while another process runs.
-    fn wait_idle() {
-        fn idle_total() -> (u64, u64) {
-            let s = std::fs::read_to_string("/proc/stat").unwrap_or_default();
-            let v: Vec<u64> = s
-                .lines()
-                .next()
-                .unwrap_or("")
-                .split_whitespace()
-                .skip(1)
-                .filter_map(|x| x.parse().ok())
-                .collect();
-            if v.len() < 5 {
-                return (0, 0);
-            }
-            (v[3] + v[4], v.iter().sum())
-        }
-        let t0 = Instant::now();
-        while t0.elapsed().as_secs() < 60 {
-            let (i0, a0) = idle_total();
-            std::thread::sleep(std::time::Duration::from_millis(300));
-            let (i1, a1) = idle_total();
-            if a1 == a0 || (i1 - i0) as f64 >= 0.95 * (a1 - a0) as f64 {
-                return;
-            }
-        }
-    }
-
-    /// Whole FFT stage (every chunk) of one direction on `grid`, in seconds.
-    fn fft_stage(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> f64 {
-        let g = SyncPtr(grid.as_mut_ptr());
-        let t = Instant::now();
-        plan.with_buf(|buf| {
-            plan.pool().install(|| {
-                let layout = if !forward && plan.streams_blocks(1) {
-                    BufLayout::HalfMajor(plan.blocks.total() / 2)
-                } else {
-                    BufLayout::Blocks
-                };
-                for ch in plan.chunks(&plan.blocks) {
-                    plan.fft_chunk(&ch, forward, g.get(), buf.as_mut_ptr() as *mut f64, layout)?;
-                }
-                Ok(())
-            })
-        })
-        .unwrap();
-        t.elapsed().as_secs_f64()
-    }
-
-    fn median(mut v: Vec<f64>) -> f64 {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    }
-
-    /// FFT stage alone: one thread, two threads with each variant, two threads with Auto.
-    /// `SO3FFT_B=64,128,256 SO3FFT_ROUNDS=5 cargo test --release --lib fft_stage_timing -- --ignored --nocapture`
-    #[test]
-    #[ignore]
-    fn fft_stage_timing() {
-        let bs: Vec<usize> = std::env::var("SO3FFT_B")
-            .unwrap_or("64,128,256".into())
-            .split(',')
-            .map(|x| x.trim().parse().unwrap())
-            .collect();
-        let rounds: usize = std::env::var("SO3FFT_ROUNDS")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(5);
-        for b in bs {
-            let mk = |threads, fft_threading| {
-                let t = Instant::now();
-                let p = Plan::new(
-                    b,
-                    &PlanOptions {
-                        threads,
-                        rigor: Rigor::Measure,
-                        fft_threading,
-                        ..Default::default()
-                    },
-                )
-                .unwrap();
-                (p, t.elapsed().as_secs_f64())
-            };
-            let plans = [
-                ("1 thread", mk(1, FftThreading::Auto)),
-                ("2 workers", mk(2, FftThreading::SlicesAcrossWorkers)),
-                ("2 fftw", mk(2, FftThreading::FftwThreads)),
-                ("2 auto", mk(2, FftThreading::Auto)),
-            ];
-            let n = 2 * b;
-            let mut grid: Vec<Complex64> = (0..n * n * n)
-                .map(|i| Complex64::new((i % 7) as f64 - 3.0, (i % 5) as f64))
-                .collect();
-            let mut times = vec![[Vec::new(), Vec::new()]; plans.len()];
-            for _ in 0..rounds {
-                for (i, (_, (p, _))) in plans.iter().enumerate() {
-                    wait_idle();
-                    times[i][0].push(fft_stage(p, true, &mut grid));
-                    times[i][1].push(fft_stage(p, false, &mut grid));
-                }
-            }
-            let one = median(times[0][0].clone()) + median(times[0][1].clone());
-            for ((name, (p, tp)), t) in plans.iter().zip(&times) {
-                let (f, i) = (median(t[0].clone()), median(t[1].clone()));
-                println!(
-                    "B={b:4} {name:10} ({:?}, plan {tp:.3} s): fwd {f:.4e} inv {i:.4e} (min {:.4e} {:.4e}) speed-up over 1 thread {:.2}x",
-                    p.fft_threading(),
-                    t[0].iter().cloned().fold(f64::INFINITY, f64::min),
-                    t[1].iter().cloned().fold(f64::INFINITY, f64::min),
-                    one / (f + i)
-                );
-            }
-        }
-    }
-
-    /// Repeated inverse (or forward, SO3FFT_FWD=1) FFT stages, for profiling.
-    #[test]
-    #[ignore]
-    fn fft_stage_loop() {
-        let b: usize = std::env::var("SO3FFT_B")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(128);
-        let threads: usize = std::env::var("SO3FFT_THREADS")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(2);
-        let fwd = std::env::var("SO3FFT_FWD").is_ok();
-        let plan = Plan::new(
-            b,
-            &PlanOptions {
-                threads,
-                rigor: Rigor::Measure,
-                fft_threading: FftThreading::SlicesAcrossWorkers,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let n = 2 * b;
-        let mut grid = vec![Complex64::new(1.0, 0.5); n * n * n];
-        let t = Instant::now();
-        let mut k = 0;
-        while t.elapsed().as_secs_f64() < 5.0 {
-            fft_stage(&plan, fwd, &mut grid);
-            k += 1;
-        }
-        println!(
-            "{k} stages, {:.4} s each",
-            t.elapsed().as_secs_f64() / k as f64
-        );
     }
 }

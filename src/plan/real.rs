@@ -8,8 +8,17 @@
 //! `2B (B+1)` half-spectrum rows per slot. The inverse fills the c2r input
 //! `Y[M mod 2B][M'] = conj(G(M,M'))` for `M' >= 0`, which makes `f = c2r(Y)` the samples.
 
-use super::*;
+use super::blocks::{Blocks, BufLayout};
+use super::fft_stage;
+use super::schedule::{Chunk, Spare};
+use super::shared::SyncPtr;
+use super::{Plan, StageTimes};
+use crate::error::{Error, Result};
+use crate::fft::SliceFftReal;
+use crate::symmetry::Cluster;
 use crate::symmetry::Member;
+use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Whether `mem` is the representative of its negation pair.
 fn representative(mem: &Member) -> bool {
