@@ -31,6 +31,7 @@
 //! is where that value sits in a transformed slice, and bit `q` of `rev[c]` says whether it
 //! is taken from the mirrored slice.
 
+use super::shared::SendPtr;
 use crate::symmetry::Cluster;
 
 /// How a chunk buffer holds the blocks (see the module documentation); the split layouts
@@ -45,6 +46,15 @@ pub(super) enum BufLayout {
     /// Two halves each holding row `j` of every cluster, then row `j + 1` (an inverse
     /// whose blocks do not stay in the cache: written with non-temporal stores).
     HalfMajor(usize),
+}
+
+/// A chunk buffer: where its blocks start and how they are laid out.
+#[derive(Clone, Copy)]
+pub(super) struct ChunkBuf {
+    /// Start of the buffer (64-byte aligned).
+    pub base: SendPtr<f64>,
+    /// How the buffer holds the blocks.
+    pub layout: BufLayout,
 }
 
 /// No slot (unused entry of a cluster with fewer than 8 members).
@@ -111,7 +121,7 @@ impl Blocks {
         let pair_bytes = 2 * (2 * b) * (b + 1) * 16;
         Blocks::build(clusters, chunk, pair_bytes, |cl| {
             let mut out = [(NONE, NONE, false); 8];
-            let (reps, nr) = super::real::representatives(cl);
+            let (reps, nr) = super::members::representatives(cl);
             for (q, mem) in reps[..nr].iter().enumerate() {
                 let fi2 = if mem.mp == 0 && mem.m != 0 {
                     half(-mem.m, 0)
@@ -266,7 +276,7 @@ mod tests {
             let r = Blocks::real(b, &cl, 8);
             for (c, &(m, mp)) in cl.iter().enumerate() {
                 let cluster = Cluster::new(m as usize, mp as usize);
-                let (reps, nr) = crate::plan::real::representatives(&cluster);
+                let (reps, nr) = crate::plan::members::representatives(&cluster);
                 let slots = [(&t, cluster.members()), (&r, &reps[..nr])];
                 for (l, members) in slots {
                     let p = if members.len() > 4 { 16 } else { 8 };

@@ -2,15 +2,14 @@
 
 use super::blocks::Blocks;
 use super::dwt_stage::Scratch;
-use super::fft_stage;
-use super::{Direction, FftThreading, Plan, PlanOptions, MAX_BANDWIDTH};
+use super::fft_stage::{self, FftStage};
+use super::{Plan, PlanOptions, MAX_BANDWIDTH};
 use crate::error::{Error, Result};
-use crate::fft::{AlignedBuf, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
-use crate::grid::{num_coeffs, num_samples, weights};
+use crate::fft::AlignedBuf;
+use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
 use crate::wigner::{start_norms, BetaTables, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
-use std::f64::consts::PI;
 use std::sync::Mutex;
 
 /// A field of Linux's `/proc/meminfo` in bytes, if known.
@@ -195,7 +194,6 @@ impl Plan {
         let b = bandwidth;
         let (threads, skip_bits, isa) = Plan::validate(b, options)?;
         let skip = options.skip_bits != Some(0);
-        let n = 2 * b;
         let layout = Plan::layout(b, threads, options);
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
         // available memory, and plan plus the caller's arrays in the machine.
@@ -221,23 +219,7 @@ impl Plan {
                 bytes: layout.table_bytes,
             })?;
         drop(probe);
-        let want_fwd = options.direction != Direction::Inverse;
-        let want_inv = options.direction != Direction::Forward;
-        let fftw_threaded = threads > 1
-            && match options.fft_threading {
-                FftThreading::Auto | FftThreading::SlicesAcrossWorkers => false,
-                FftThreading::FftwThreads => true,
-            };
-        let fftw_threads = if fftw_threaded { threads } else { 1 };
-        let slice_fft = |want: bool, sign: i32| -> Result<Option<SliceFft>> {
-            Ok(if want {
-                Some(SliceFft::new(n, sign, options.rigor, fftw_threads)?)
-            } else {
-                None
-            })
-        };
-        let fwd_fft = slice_fft(want_fwd, SIGN_PLUS)?;
-        let inv_fft = slice_fft(want_inv, SIGN_MINUS)?;
+        let fft = FftStage::new(b, threads, options)?;
         let clusters = cluster_pairs(b);
         let blocks = Blocks::complex(b, &clusters, layout.chunk);
         // The real layout is about half as large per beta: its chunks take twice the betas.
@@ -245,17 +227,6 @@ impl Plan {
         let dwt_scratch = (0..threads)
             .map(|_| Mutex::new(Scratch::for_layouts(b, &blocks, blocks_real.as_ref())))
             .collect();
-        let real_fft = if options.real {
-            Some(SliceFftReal::new(n, options.rigor)?)
-        } else {
-            None
-        };
-        let group = fft_stage::pairs_per_group(16 * n * n);
-        let fft_scratch = (0..threads)
-            .map(|_| AlignedBuf::new(fft_stage::scratch_len(b)).map(Mutex::new))
-            .collect::<Result<Vec<_>>>()?;
-        let norm = PI / (2.0 * (b * b) as f64);
-        let wq = weights(b).iter().map(|w| w * norm).collect();
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
@@ -280,15 +251,9 @@ impl Plan {
             clusters,
             bt: BetaTables::grid(b),
             norms: start_norms(b),
-            wq,
             rt: RecTables::new(b),
-            fwd_fft,
-            inv_fft,
-            real_fft,
-            fft_scratch,
+            fft,
             dwt_scratch,
-            fftw_threaded,
-            group,
             blocks,
             blocks_real,
             memory: layout.total(),

@@ -4,9 +4,9 @@
 
 use super::blocks::{Blocks, BufLayout};
 use super::coeffs;
-use super::real;
+use super::members;
 use super::schedule::{At, Chunk, Pass};
-use super::shared::SyncPtr;
+use super::shared::SendPtr;
 use super::Plan;
 use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::grid::block_start;
@@ -18,13 +18,6 @@ use std::f64::consts::PI;
 /// The order pairs of a cluster a layout transforms, in slot order, and their number:
 /// [`all_members`] (complex layout) or `real::representatives` (real layout).
 pub(super) type Members = fn(&Cluster) -> ([Member; 8], usize);
-
-/// All members of a cluster (the complex layout's slots).
-pub(super) fn all_members(cl: &Cluster) -> ([Member; 8], usize) {
-    let mut m = [cl.members()[0]; 8];
-    m[..cl.members().len()].copy_from_slice(cl.members());
-    (m, cl.members().len())
-}
 
 /// Per-worker scratch, sized for the largest cluster and chunk.
 pub(super) struct Scratch {
@@ -292,7 +285,7 @@ impl Plan {
         at: &At,
         ch: &Chunk,
         buf: *mut f64,
-        coef: SyncPtr<Complex64>,
+        coef: SendPtr<Complex64>,
         pass: Pass,
     ) {
         let (c, cl) = (at.c, &at.cl);
@@ -356,7 +349,7 @@ impl Plan {
             // below `lo` (not touched by this group) are final already.
             let partner = if partners && pass.done && (mem.m, mem.mp) != (0, 0) {
                 let d2 = coef.get().add(block_start(self.b, -mem.m, -mem.mp));
-                let ps = real::neg_sign(mem.m, mem.mp);
+                let ps = members::neg_sign(mem.m, mem.mp);
                 coeffs::partner_copy(d2, dst, lo, ps);
                 Some((d2.add(lo), ps))
             } else {

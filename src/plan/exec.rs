@@ -1,11 +1,12 @@
 //! Running a plan: the chunk loop shared by every transform and the parallel loop over
 //! the clusters of the DWT stage.
 
-use super::blocks::{Blocks, BufLayout};
+use super::blocks::{Blocks, BufLayout, ChunkBuf};
 use super::build::mem_available;
-use super::dwt_stage::{all_members, Scratch};
+use super::dwt_stage::Scratch;
+use super::members::all_members;
 use super::schedule::{At, Chunk, Pass, Spare};
-use super::shared::{lock_free, SyncPtr};
+use super::shared::{lock_free, SendPtr};
 use super::{Plan, StageTimes};
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
@@ -46,13 +47,15 @@ impl Plan {
         coeffs: &mut [Complex64],
         spare: Option<Spare>,
     ) -> Result<StageTimes> {
-        let coef = SyncPtr(coeffs.as_mut_ptr());
-        let input = SyncPtr(samples as *mut Complex64);
+        let coef = SendPtr(coeffs.as_mut_ptr());
+        // The forward only reads the samples (a forward that may overwrite them puts
+        // chunk buffers in read slices through `spare`, never through this pointer).
+        let input = SendPtr(samples as *mut Complex64);
         self.run_chunks(
             true,
             &self.blocks,
             spare,
-            |ch, buf, layout| self.fft_chunk(ch, true, input.get(), buf, layout),
+            |ch, buf| self.fft.chunk(&self.blocks, ch, true, input, buf),
             |sc, at, ch, buf, pass| unsafe {
                 self.forward_cluster(
                     sc,
@@ -77,13 +80,13 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
         // One raw pointer for the output slices and for the buffers in the free ones.
-        let out = SyncPtr(samples.as_mut_ptr());
+        let out = SendPtr(samples.as_mut_ptr());
         let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             &self.blocks,
             Some(spare),
-            |ch, buf, layout| self.fft_chunk(ch, false, out.get(), buf, layout),
+            |ch, buf| self.fft.chunk(&self.blocks, ch, false, out, buf),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
             },
@@ -100,7 +103,7 @@ impl Plan {
         forward: bool,
         t: &Blocks,
         spare: Option<Spare>,
-        fft: impl Fn(&Chunk, *mut f64, BufLayout) -> Result<()> + Sync,
+        fft: impl Fn(&Chunk, ChunkBuf) -> Result<()> + Sync,
         cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
@@ -109,13 +112,13 @@ impl Plan {
         self.with_buf(|buf| {
             let bp = buf.as_mut_ptr() as *mut f64;
             let whole = t.total() / 2;
-            let groups: Vec<Vec<(Chunk, SyncPtr<f64>, usize)>> = groups
+            let groups: Vec<Vec<(Chunk, SendPtr<f64>, usize)>> = groups
                 .iter()
                 .map(|g| {
                     g.iter()
                         .map(|(c, p)| {
                             let (p, gap) = p.unwrap_or((bp, whole));
-                            (*c, SyncPtr(p), gap)
+                            (*c, SendPtr(p), gap)
                         })
                         .collect()
                 })
@@ -135,7 +138,13 @@ impl Plan {
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
                         for (ch, buf, layout) in &group {
-                            fft(ch, buf.get(), *layout)?;
+                            fft(
+                                ch,
+                                ChunkBuf {
+                                    base: *buf,
+                                    layout: *layout,
+                                },
+                            )?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())

@@ -1,34 +1,40 @@
-//! The FFT stage of the complex transforms, a group of mirrored pairs of beta slices at a
-//! time.
+//! The FFT stage: FFTW over (alpha, gamma) of each beta slice, and the moves between the
+//! transformed slices and the blocks of the chunk buffer, a group of mirrored pairs of beta
+//! slices at a time.
 //!
 //! Forward: the slices of a group of pairs (`beta` and `pi - beta`) are copied into the
 //! worker's cache-resident scratch (rows padded, see [`fft::slice_stride`]), transformed in
 //! place, and moved, weighted, into the rows of every cluster's block (`blocks.rs`): the
 //! group fills `2g` adjacent rows of each block completely (in the split layout `g` rows
-//! of each half), written as whole cache lines with non-temporal stores. Inverse: those rows of every block are read back into the
-//! slices, which are transformed in place and streamed to the samples. Small slices move
-//! in groups of up to 4 pairs (one longer piece of each block per group), larger ones a
-//! pair at a time, which keeps the slices' random accesses in L2. The groups are spread
-//! over the workers, or, with FFTW's threads, run one after another with the copies spread
-//! over the workers.
+//! of each half), written as whole cache lines with non-temporal stores. Inverse: those
+//! rows of every block are read back into the slices, which are transformed in place and
+//! streamed to the samples. Small slices move in groups of up to 4 pairs (one longer piece
+//! of each block per group), larger ones a pair at a time, which keeps the slices' random
+//! accesses in L2. The groups are spread over the workers, or, with FFTW's threads, run one
+//! after another with the copies spread over the workers.
+//!
+//! Real signals (`real.rs`) go one mirrored pair at a time through r2c / c2r slice FFTs,
+//! whose half spectra fill the blocks of the real layout.
 
-use super::blocks::{Blocks, BufLayout, NONE};
+use super::blocks::{Blocks, BufLayout, ChunkBuf, NONE};
+use super::options::{Direction, FftThreading, PlanOptions};
 use super::schedule::Chunk;
-use super::shared::{lock_free, SyncPtr};
-use super::Plan;
+use super::shared::{lock_free, SendConstPtr, SendPtr};
 use crate::error::{Error, Result};
-use crate::fft::{self, AlignedBuf, SliceFft};
+use crate::fft::{self, AlignedBuf, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
+use crate::grid::weights;
 use num_complex::Complex64;
 use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::sync::Mutex;
 
 /// Most pairs per group (the row buffers of [`scatter_group`] hold `2 * MAX_GROUP` rows).
 pub(super) const MAX_GROUP: usize = 4;
 
 /// Pairs per group for slices of `slice_bytes` (unpadded): up to [`MAX_GROUP`], as many as
 /// keep the group's slices within about 512 KiB, half of a core's L2 (B <= 32: 4, from
-/// B = 64 on: 1).
-/// The copies between slices and blocks are bound by the slice side's cache misses: one
-/// pair at B = 64 copies twice as fast per pair as a group of four (`copy_speed` test).
+/// B = 64 on: 1). The copies between slices and blocks are bound by the slice side's cache
+/// misses, which fewer pairs per group keep down.
 pub(super) fn pairs_per_group(slice_bytes: usize) -> usize {
     ((512usize << 10) / (2 * slice_bytes)).clamp(1, MAX_GROUP)
 }
@@ -40,63 +46,183 @@ pub(super) fn scratch_len(b: usize) -> usize {
     2 * pairs_per_group(16 * n * n) * n * fft::slice_stride(n)
 }
 
-impl Plan {
-    /// Run `f` with a per-worker FFT scratch buffer (`2 group` padded slices). A worker may
-    /// take on another execution's group while it waits inside a parallel copy, so buffers
-    /// are taken by try_lock, never by blocking; when all are busy a private one is
-    /// allocated.
-    pub(super) fn with_fft_scratch<R>(
-        &self,
-        f: impl FnOnce(&AlignedBuf) -> Result<R>,
-    ) -> Result<R> {
-        match lock_free(&self.fft_scratch) {
+/// Where the real samples of a forward transform come from.
+#[derive(Clone, Copy)]
+pub(super) enum RealInput {
+    /// `(2B)^3` doubles.
+    Real(SendConstPtr<f64>),
+    /// The real parts of `(2B)^3` complex values.
+    RealParts(SendConstPtr<Complex64>),
+}
+
+/// A slice FFT and how it runs: which direction, and whether on FFTW's threads (groups
+/// one after another, block copies spread over the workers) or one slice per worker.
+#[derive(Clone, Copy)]
+pub(super) struct SliceRun<'a> {
+    /// The slice plan.
+    pub fft: &'a SliceFft,
+    /// Forward (samples into blocks) or inverse (blocks into samples).
+    pub forward: bool,
+    /// Whether `fft` runs on FFTW's threads.
+    pub fftw_threaded: bool,
+}
+
+/// The slices of a group of mirrored pairs and where their rows are in the blocks.
+pub(super) struct SliceGroup<'a> {
+    /// The group's transformed slices: beta, mirror, beta, mirror, ...
+    pub slices: &'a [SendPtr<Complex64>],
+    /// Forward: the weight of each slice (quadrature weight and normalisation); unused by
+    /// the inverse.
+    pub weights: &'a [f64],
+    /// The group's first pair in its chunk (block rows `2 first_pair ..`).
+    pub first_pair: usize,
+}
+
+/// The FFT stage of a plan: its slice FFTs, weights and per-worker scratch.
+pub(super) struct FftStage {
+    b: usize,
+    threads: usize,
+    /// Forward slice FFT (plans that run the forward).
+    fwd: Option<SliceFft>,
+    /// Inverse slice FFT (plans that run the inverse).
+    inv: Option<SliceFft>,
+    /// Real-data slice FFTs (with `PlanOptions::real`).
+    real: Option<SliceFftReal>,
+    /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight of beta `k` with the
+    /// normalisation folded in.
+    weights: Vec<f64>,
+    /// Per-worker buffers of `2 pairs_per_group` padded slices (see [`fft::slice_stride`]).
+    scratch: Vec<Mutex<AlignedBuf>>,
+    /// Whether the complex slice FFTs run on FFTW's threads (else slices are spread over
+    /// the workers).
+    fftw_threaded: bool,
+    /// Mirrored pairs of beta slices per group of the complex transforms.
+    pairs_per_group: usize,
+}
+
+impl FftStage {
+    /// The slice FFTs the options ask for (the complex ones on FFTW's threads only with
+    /// [`FftThreading::FftwThreads`]), weights and `threads` scratch buffers.
+    pub(super) fn new(b: usize, threads: usize, options: &PlanOptions) -> Result<FftStage> {
+        let n = 2 * b;
+        let fftw_threaded = threads > 1
+            && match options.fft_threading {
+                FftThreading::Auto | FftThreading::SlicesAcrossWorkers => false,
+                FftThreading::FftwThreads => true,
+            };
+        let fftw_threads = if fftw_threaded { threads } else { 1 };
+        let slice_fft = |want: bool, sign: i32| -> Result<Option<SliceFft>> {
+            Ok(if want {
+                Some(SliceFft::new(n, sign, options.rigor, fftw_threads)?)
+            } else {
+                None
+            })
+        };
+        let fwd = slice_fft(options.direction != Direction::Inverse, SIGN_PLUS)?;
+        let inv = slice_fft(options.direction != Direction::Forward, SIGN_MINUS)?;
+        let real = if options.real {
+            Some(SliceFftReal::new(n, options.rigor)?)
+        } else {
+            None
+        };
+        let scratch = (0..threads)
+            .map(|_| AlignedBuf::new(scratch_len(b)).map(Mutex::new))
+            .collect::<Result<Vec<_>>>()?;
+        let norm = PI / (2.0 * (b * b) as f64);
+        Ok(FftStage {
+            b,
+            threads,
+            fwd,
+            inv,
+            real,
+            weights: weights(b).iter().map(|w| w * norm).collect(),
+            scratch,
+            fftw_threaded,
+            pairs_per_group: pairs_per_group(16 * n * n),
+        })
+    }
+
+    /// Whether the complex slice FFTs run on FFTW's threads.
+    pub(super) fn fftw_threaded(&self) -> bool {
+        self.fftw_threaded
+    }
+
+    /// Mirrored pairs of beta slices per group of the complex transforms.
+    pub(super) fn pairs_per_group(&self) -> usize {
+        self.pairs_per_group
+    }
+
+    /// The forward and inverse slice FFTs (`None` for a direction the plan does not run).
+    pub(super) fn complex_ffts(&self) -> (Option<&SliceFft>, Option<&SliceFft>) {
+        (self.fwd.as_ref(), self.inv.as_ref())
+    }
+
+    /// Replace the complex slice FFTs by ones that run on FFTW's threads (the measured
+    /// choice of [`FftThreading::Auto`]).
+    pub(super) fn use_fftw_threads(&mut self, fwd: Option<SliceFft>, inv: Option<SliceFft>) {
+        self.fwd = fwd;
+        self.inv = inv;
+        self.fftw_threaded = true;
+    }
+
+    /// The real-data slice FFTs, or an error for a plan made without them.
+    pub(super) fn real_fft(&self) -> Result<&SliceFftReal> {
+        self.real.as_ref().ok_or_else(|| {
+            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
+        })
+    }
+
+    /// Run `f` with a per-worker FFT scratch buffer (`2 pairs_per_group` padded slices). A
+    /// worker may take on another execution's group while it waits inside a parallel copy,
+    /// so buffers are taken by try_lock, never by blocking; when all are busy a private one
+    /// is allocated.
+    fn with_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
+        match lock_free(&self.scratch) {
             Some(g) => f(&g),
             None => f(&AlignedBuf::new(scratch_len(self.b))?),
         }
     }
 
-    /// FFT stage of one chunk: forward from `grid` into the blocks of `buf`, or inverse
-    /// from `buf` into `grid`, the buffer laid out as `layout` (see `plan/blocks.rs`).
-    pub(super) fn fft_chunk(
+    /// FFT stage of one chunk of the complex layout `blocks`: forward from the sample array
+    /// `grid` into the chunk buffer `buf`, or inverse from `buf` into `grid`.
+    pub(super) fn chunk(
         &self,
+        blocks: &Blocks,
         ch: &Chunk,
         forward: bool,
-        grid: *mut Complex64,
-        buf: *mut f64,
-        layout: BufLayout,
+        grid: SendPtr<Complex64>,
+        buf: ChunkBuf,
     ) -> Result<()> {
         let fft = if forward {
-            self.fwd_fft.as_ref()
+            self.fwd.as_ref()
         } else {
-            self.inv_fft.as_ref()
+            self.inv.as_ref()
         }
         .ok_or(Error::WrongDirection)?;
         let nn = 4 * self.b * self.b;
-        let grid = SyncPtr(grid);
-        let slices = move |k: usize| SyncPtr(grid.get().wrapping_add(k * nn));
-        let threaded = self.fftw_threaded;
-        self.fft_pairs(ch, fft, threaded, forward, &slices, buf, layout, ch.h)
+        let slices = move |k: usize| SendPtr(grid.get().wrapping_add(k * nn));
+        let run = SliceRun {
+            fft,
+            forward,
+            fftw_threaded: self.fftw_threaded,
+        };
+        self.pairs(blocks, ch, run, &slices, buf)
     }
 
-    /// The first `npairs` pairs of [`Plan::fft_chunk`] with the slice plan `fft`; `slice(k)`
-    /// is where the samples of beta `k` are. With `fftw_threaded`, groups one after another
-    /// (`fft` runs on FFTW's threads, the block copies are spread over the workers), else
-    /// groups spread over the workers.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn fft_pairs(
+    /// The pairs of `ch` through the slice FFT of `run`; `slice(k)` is where the samples of
+    /// beta `k` are. With FFTW's threads, groups one after another (the block copies spread
+    /// over the workers), else groups spread over the workers.
+    pub(super) fn pairs(
         &self,
+        blocks: &Blocks,
         ch: &Chunk,
-        fft: &SliceFft,
-        fftw_threaded: bool,
-        forward: bool,
-        slice: &(dyn Fn(usize) -> SyncPtr<Complex64> + Sync),
-        buf: *mut f64,
-        layout: BufLayout,
-        npairs: usize,
+        run: SliceRun,
+        slice: &(dyn Fn(usize) -> SendPtr<Complex64> + Sync),
+        buf: ChunkBuf,
     ) -> Result<()> {
-        let buf = SyncPtr(buf);
-        let g = self.group;
-        let run = |gi: usize| -> Result<()> {
+        let g = self.pairs_per_group;
+        let npairs = ch.h;
+        let one_group = |gi: usize| -> Result<()> {
             let j0 = gi * g;
             let gn = g.min(npairs - j0);
             let mut grid = [std::ptr::null_mut(); 2 * MAX_GROUP];
@@ -104,63 +230,65 @@ impl Plan {
             for jj in 0..gn {
                 let (k0, k1) = ch.pair_betas(self.b, j0 + jj);
                 (grid[2 * jj], grid[2 * jj + 1]) = (slice(k0).get(), slice(k1).get());
-                (w[2 * jj], w[2 * jj + 1]) = (self.wq[k0], self.wq[k1]);
+                (w[2 * jj], w[2 * jj + 1]) = (self.weights[k0], self.weights[k1]);
             }
-            self.with_fft_scratch(|scratch| unsafe {
-                // SAFETY: the scratch holds 2g padded slices; the group owns its rows of every
-                // block and its sample slices.
-                self.fft_group(
-                    fft,
-                    forward,
-                    &grid[..2 * gn],
-                    &w[..2 * gn],
-                    scratch.as_mut_ptr(),
-                    buf.get(),
-                    layout,
-                    j0,
-                    fftw_threaded,
-                );
+            self.with_scratch(|scratch| {
+                let group = GroupSlices {
+                    grid: &grid[..2 * gn],
+                    weights: &w[..2 * gn],
+                    first_pair: j0,
+                };
+                // SAFETY: the scratch holds `2 pairs_per_group >= 2 gn` padded slices and is
+                // this task's alone (locked or private); the group's pairs are its own: no
+                // other task reads or writes their sample slices or their rows of the
+                // blocks (`Blocks::pair_rows` gives each pair its own rows).
+                unsafe { self.group(blocks, run, &group, scratch.as_mut_ptr(), buf) };
                 Ok(())
             })
         };
         let ngroups = npairs.div_ceil(g);
-        if fftw_threaded {
-            (0..ngroups).try_for_each(run)
+        if run.fftw_threaded {
+            (0..ngroups).try_for_each(one_group)
         } else {
-            (0..ngroups).into_par_iter().try_for_each(run)
+            (0..ngroups).into_par_iter().try_for_each(one_group)
         }
     }
 
-    /// One group of pairs of a chunk through the scratch `sp` (`2g` padded slices, see
-    /// [`fft::slice_stride`]): `grid` are the group's sample slices (beta, mirror, beta,
-    /// mirror, ...), `w` their forward weights, `j0` its first pair; `parallel_copy`
-    /// spreads the block copies over the workers.
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn fft_group(
+    /// One group of pairs through the scratch `sp` (`2g` padded slices, see
+    /// [`fft::slice_stride`]); with FFTW's threads the block copies are spread over the
+    /// workers.
+    ///
+    /// # Safety
+    /// `sp` is valid for `group.grid.len()` padded slices and used by no one else; the
+    /// sample slices `group.grid` (`(2B)^2` values each) are valid and read (forward) or
+    /// written (inverse) by no other task meanwhile, nor are the group's rows of every
+    /// block of `buf`, which holds a chunk of `blocks`.
+    unsafe fn group(
         &self,
-        fft: &SliceFft,
-        forward: bool,
-        grid: &[*mut Complex64],
-        w: &[f64],
+        blocks: &Blocks,
+        run: SliceRun,
+        group: &GroupSlices,
         sp: *mut Complex64,
-        buf: *mut f64,
-        layout: BufLayout,
-        j0: usize,
-        parallel_copy: bool,
+        buf: ChunkBuf,
     ) {
+        let (fft, forward, parallel_copy) = (run.fft, run.forward, run.fftw_threaded);
         let n = 2 * self.b;
         let rs = fft::slice_stride(n);
-        let ns = grid.len();
-        let mut s = [SyncPtr(std::ptr::null_mut()); 2 * MAX_GROUP];
+        let ns = group.grid.len();
+        let mut s = [SendPtr(std::ptr::null_mut()); 2 * MAX_GROUP];
         for (i, si) in s.iter_mut().enumerate().take(ns) {
-            *si = SyncPtr(sp.add(i * n * rs));
+            *si = SendPtr(sp.wrapping_add(i * n * rs));
         }
         let s = &s[..ns];
-        let b = SyncPtr(buf);
+        let slices = SliceGroup {
+            slices: s,
+            weights: group.weights,
+            first_pair: group.first_pair,
+        };
         // Rows of a slice between the samples (rows `2n` doubles apart) and the scratch
         // (`2 rs`), spread over the workers with `parallel_copy` (FFTW's threads wait).
         let copy = |from: *const Complex64, to: *mut Complex64| {
-            let (from, to) = (SyncPtr(from as *mut f64), SyncPtr(to as *mut f64));
+            let (from, to) = (SendConstPtr(from as *const f64), SendPtr(to as *mut f64));
             let (ss, ds) = if forward {
                 (2 * n, 2 * rs)
             } else {
@@ -171,43 +299,125 @@ impl Plan {
                     from.get().wrapping_add(r0 * ss),
                     to.get().wrapping_add(r0 * ds),
                 );
-                // SAFETY: rows r0..r1 of both slices, disjoint between the pieces.
+                // SAFETY: rows r0..r1 of both slices (valid by the caller's contract),
+                // disjoint between the pieces `for_ranges` hands out.
                 unsafe { fft::copy_rows(f, ss, t, ds, r1 - r0, 2 * n, !forward) };
             };
             self.for_ranges(n, parallel_copy, rows);
         };
         if forward {
-            for (dst, &src) in s.iter().zip(grid) {
+            for (dst, &src) in s.iter().zip(group.grid) {
                 // Copied first (a sequential read the prefetchers follow), then
                 // transformed in the cache: faster than FFTW reading the samples.
                 copy(src, dst.get());
-                fft.in_place(dst.get());
+                // SAFETY: `dst` is a padded slice of the scratch, this task's alone.
+                unsafe { fft.in_place(dst.get()) };
             }
-            self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                scatter_group(&self.blocks, s, w, false, b.get(), layout, j0, c0..c1)
+            self.for_ranges(blocks.len(), parallel_copy, |c0, c1| {
+                // SAFETY: the slices hold every slot index of `blocks`; the pieces write
+                // the group's rows of disjoint clusters' blocks, which only this group
+                // writes (caller's contract).
+                unsafe { scatter_group(blocks, &slices, false, buf, c0..c1) }
             });
         } else {
-            self.for_ranges(self.blocks.len(), parallel_copy, |c0, c1| {
-                gather_group(&self.blocks, s, false, b.get(), layout, j0, c0..c1)
+            self.for_ranges(blocks.len(), parallel_copy, |c0, c1| {
+                // SAFETY: the pieces read the group's rows of disjoint clusters' blocks and
+                // write distinct slots of the scratch slices (each in-band frequency
+                // belongs to one cluster's slot).
+                unsafe { gather_group(blocks, &slices, false, buf, c0..c1) }
             });
-            for (src, &dst) in s.iter().zip(grid) {
+            for (src, &dst) in s.iter().zip(group.grid) {
                 let src = src.get();
-                // Frequency B (alpha or gamma) is outside the band limit.
-                for i in 0..n {
-                    *src.add(self.b * rs + i) = Complex64::new(0.0, 0.0);
-                    *src.add(i * rs + self.b) = Complex64::new(0.0, 0.0);
+                // SAFETY: row `b` and column `b` of a padded `n x rs` slice of the scratch.
+                unsafe {
+                    // Frequency B (alpha or gamma) is outside the band limit.
+                    for i in 0..n {
+                        *src.add(self.b * rs + i) = Complex64::new(0.0, 0.0);
+                        *src.add(i * rs + self.b) = Complex64::new(0.0, 0.0);
+                    }
+                    // In place in the cache, then streamed to the samples: FFTW's own
+                    // stores would first read every line of `dst` from memory.
+                    fft.in_place(src);
                 }
-                // In place in the cache, then streamed to the samples: FFTW's own stores
-                // would first read every line of `dst` from memory.
-                fft.in_place(src);
                 copy(src, dst);
             }
         }
     }
 
+    /// FFT stage of one chunk for real data (see `real.rs`) with the real layout `blocks`,
+    /// one mirrored pair of slices at a time: forward from `input` into the blocks (r2c,
+    /// then the conjugated half spectra, weighted), or (with `input = None`) inverse from
+    /// the blocks into the real sample array `grid` (c2r).
+    pub(super) fn chunk_real(
+        &self,
+        blocks: &Blocks,
+        ch: &Chunk,
+        input: Option<RealInput>,
+        grid: SendPtr<f64>,
+        buf: ChunkBuf,
+    ) -> Result<()> {
+        let fft = self.real_fft()?;
+        let (b, n) = (self.b, 2 * self.b);
+        let (nn, nh) = (n * n, n * (b + 1));
+        (0..ch.h).into_par_iter().try_for_each(|j| -> Result<()> {
+            let (k0, k1) = ch.pair_betas(b, j);
+            self.with_scratch(|scratch| {
+                let sp = scratch.as_mut_ptr();
+                let s = [sp, sp.wrapping_add(nh)];
+                let slices = [SendPtr(s[0]), SendPtr(s[1])];
+                let w = [self.weights[k0], self.weights[k1]];
+                let group = SliceGroup {
+                    slices: &slices,
+                    weights: &w,
+                    first_pair: j,
+                };
+                // SAFETY: the scratch (this task's alone) holds at least two padded slices,
+                // 2n(n + 4) complex values: two half spectra (nh = n^2/2 + n each) and n^2
+                // packed reals (n^2/2 values) fit; pair `j` owns its two rows of every
+                // block and its two sample slices (n^2 reals each), which no other task
+                // touches.
+                unsafe {
+                    if let Some(input) = input {
+                        // Real parts of complex samples are first packed into the free
+                        // part of the scratch, one slice at a time.
+                        let packed = sp.add(2 * nh) as *mut f64;
+                        for (&dst, k) in s.iter().zip([k0, k1]) {
+                            let src = match input {
+                                RealInput::Real(p) => p.get().add(k * nn),
+                                RealInput::RealParts(p) => {
+                                    let slice = p.get().add(k * nn);
+                                    for i in 0..nn {
+                                        *packed.add(i) = (*slice.add(i)).re;
+                                    }
+                                    packed as *const f64
+                                }
+                            };
+                            fft.r2c(src, dst);
+                        }
+                        // S(M,M') = conj(R[M][M']) for M' >= 0.
+                        scatter_group(blocks, &group, true, buf, 0..blocks.len());
+                    } else {
+                        gather_group(blocks, &group, true, buf, 0..blocks.len());
+                        for (&slot, k) in s.iter().zip([k0, k1]) {
+                            // Frequency B (alpha or gamma) is outside the band limit.
+                            for i in 0..=b {
+                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
+                            }
+                            for a in 0..n {
+                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
+                            }
+                            fft.c2r(slot, grid.get().add(k * nn));
+                        }
+                    }
+                }
+                Ok(())
+            })
+        })
+    }
+
     /// Run `f(i0, i1)` over `0..len`: in one piece, or, with `parallel`, in pieces spread
     /// over the workers.
-    pub(super) fn for_ranges(&self, len: usize, parallel: bool, f: impl Fn(usize, usize) + Sync) {
+    fn for_ranges(&self, len: usize, parallel: bool, f: impl Fn(usize, usize) + Sync) {
         if parallel {
             let step = len.div_ceil(4 * self.threads).max(1);
             (0..len.div_ceil(step))
@@ -219,6 +429,14 @@ impl Plan {
     }
 }
 
+/// The sample slices of a group of pairs (beta, mirror, beta, mirror, ...), their forward
+/// weights and the group's first pair.
+struct GroupSlices<'a> {
+    grid: &'a [*mut Complex64],
+    weights: &'a [f64],
+    first_pair: usize,
+}
+
 /// Clusters ahead whose slice values [`prefetch_slots`] requests.
 const PREFETCH_SLOTS: usize = 8;
 
@@ -227,7 +445,7 @@ const PREFETCH_SLOTS: usize = 8;
 /// rows of the slices, which from B = 256 on are larger than L2. Measured with
 /// `copy_speed` at B = 256: gather 1.6 -> 1.3 ms per pair of slices, scatter 1.24 -> 1.16.
 #[inline(always)]
-unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SyncPtr<Complex64>], write: bool) {
+unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SendPtr<Complex64>], write: bool) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_ET0, _MM_HINT_T1};
@@ -263,14 +481,13 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SyncPtr<Complex64>], write:
 #[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter_group(
     t: &Blocks,
-    s: &[SyncPtr<Complex64>],
-    w: &[f64],
+    group: &SliceGroup,
     conj: bool,
-    buf: *mut f64,
-    layout: BufLayout,
-    j0: usize,
+    buf: ChunkBuf,
     cs: std::ops::Range<usize>,
 ) {
+    let (s, w, j0) = (group.slices, group.weights, group.first_pair);
+    let (buf, layout) = (buf.base.get(), buf.layout);
     let ns = s.len();
     debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP && w.len() == ns);
     let mut sp = [std::ptr::null::<Complex64>(); 2 * MAX_GROUP];
@@ -364,13 +581,13 @@ const GATHER_AHEAD: usize = 4096;
 /// As for [`scatter_group`], with `s` written.
 pub(super) unsafe fn gather_group(
     t: &Blocks,
-    s: &[SyncPtr<Complex64>],
+    group: &SliceGroup,
     conj: bool,
-    buf: *const f64,
-    layout: BufLayout,
-    j0: usize,
+    buf: ChunkBuf,
     cs: std::ops::Range<usize>,
 ) {
+    let (s, j0) = (group.slices, group.first_pair);
+    let (buf, layout) = (buf.base.get() as *const f64, buf.layout);
     let ns = s.len();
     debug_assert!(ns.is_multiple_of(2) && ns <= 2 * MAX_GROUP);
     let mut sp = [std::ptr::null_mut::<Complex64>(); 2 * MAX_GROUP];

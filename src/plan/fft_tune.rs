@@ -12,10 +12,11 @@
 //! run, else up to [`ROUNDS`]. The faster variant is kept (FFTW's threads need a margin of
 //! [`FFTW_MARGIN`]) and the other's FFTW plans are destroyed.
 
-use super::blocks::BufLayout;
+use super::blocks::{BufLayout, ChunkBuf};
 use super::build::mem_available;
+use super::fft_stage::SliceRun;
 use super::schedule::Chunk;
-use super::shared::SyncPtr;
+use super::shared::SendPtr;
 use super::{FftThreading, Plan, PlanOptions};
 use crate::error::Result;
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
@@ -53,7 +54,7 @@ impl Plan {
         if options.fft_threading != FftThreading::Auto
             || options.rigor == Rigor::Estimate
             || self.threads < 2
-            || self.fftw_threaded
+            || self.fft.fftw_threaded()
         {
             return;
         }
@@ -65,9 +66,10 @@ impl Plan {
                 Ok(None)
             }
         };
+        let (own_fwd, own_inv) = self.fft.complex_ffts();
         let (Ok(fwd), Ok(inv)) = (
-            plan_threaded(self.fwd_fft.is_some(), SIGN_PLUS),
-            plan_threaded(self.inv_fft.is_some(), SIGN_MINUS),
+            plan_threaded(own_fwd.is_some(), SIGN_PLUS),
+            plan_threaded(own_inv.is_some(), SIGN_MINUS),
         ) else {
             return;
         };
@@ -75,9 +77,7 @@ impl Plan {
             return;
         };
         if fftw < (1.0 - FFTW_MARGIN) * workers {
-            self.fwd_fft = fwd;
-            self.inv_fft = inv;
-            self.fftw_threaded = true;
+            self.fft.use_fftw_threads(fwd, inv);
         }
     }
 
@@ -97,7 +97,7 @@ impl Plan {
         // `2B-1-j`) uses slices `2j` and `2j+1`, distinct for the pairs timed
         // concurrently. (Mapping fresh memory costs more than the measurement itself when
         // transparent huge pages must be compacted.)
-        let per_group = self.threads * self.group;
+        let per_group = self.threads * self.fft.pairs_per_group();
         let fit = SAMPLE_BYTES / (2 * nn * 16) / per_group;
         let npairs = (per_group * fit.clamp(1, SAMPLE_GROUPS)).min(self.blocks.chunk);
         let slices = 2 * npairs;
@@ -108,21 +108,21 @@ impl Plan {
         // (At least one padded slice, for the warm-up below.)
         let grid = AlignedBuf::new((slices * nn).max(n * fft::slice_stride(n))).ok()?;
         let h = self.blocks.chunk;
+        // The timed pairs: the first `npairs` of the first chunk.
         let ch = Chunk {
             lo: 0,
-            h,
+            h: npairs,
             hp: h.next_multiple_of(self.isa.lanes()),
         };
-        let g = SyncPtr(grid.as_mut_ptr());
+        let g = SendPtr(grid.as_mut_ptr());
+        let (own_fwd, own_inv) = self.fft.complex_ffts();
         let b = self.b;
         let slice = move |k: usize| {
             let (j, mirror) = if k < b { (k, 0) } else { (2 * b - 1 - k, 1) };
-            SyncPtr(g.get().wrapping_add((2 * (j % npairs) + mirror) * nn))
+            SendPtr(g.get().wrapping_add((2 * (j % npairs) + mirror) * nn))
         };
-        let variants: [(Option<&SliceFft>, Option<&SliceFft>, bool); 2] = [
-            (self.fwd_fft.as_ref(), self.inv_fft.as_ref(), false),
-            (fwd, inv, true),
-        ];
+        let variants: [(Option<&SliceFft>, Option<&SliceFft>, bool); 2] =
+            [(own_fwd, own_inv, false), (fwd, inv, true)];
         let mut best = [f64::INFINITY; 2];
         self.with_buf(|buf| {
             self.pool().install(|| {
@@ -146,9 +146,16 @@ impl Plan {
                         let t = Instant::now();
                         for (fft, forward) in [(f, true), (iv, false)] {
                             if let Some(fft) = fft {
-                                self.fft_pairs(
-                                    &ch, fft, threaded, forward, &slice, bp, layout, npairs,
-                                )?;
+                                let run = SliceRun {
+                                    fft,
+                                    forward,
+                                    fftw_threaded: threaded,
+                                };
+                                let buf = ChunkBuf {
+                                    base: SendPtr(bp),
+                                    layout,
+                                };
+                                self.fft.pairs(&self.blocks, &ch, run, &slice, buf)?;
                             }
                         }
                         best[v] = best[v].min(t.elapsed().as_secs_f64());

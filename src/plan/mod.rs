@@ -18,6 +18,7 @@ mod dwt_stage;
 mod exec;
 mod fft_stage;
 mod fft_tune;
+mod members;
 mod options;
 mod real;
 mod schedule;
@@ -28,12 +29,13 @@ mod tests;
 pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDTH};
 
 use crate::error::{Error, Result};
-use crate::fft::{AlignedBuf, SliceFft, SliceFftReal};
+use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::wigner::{BetaTables, Ext, RecTables};
 use blocks::Blocks;
 use dwt_stage::Scratch;
+use fft_stage::FftStage;
 use num_complex::Complex64;
 use schedule::Spare;
 use std::sync::Mutex;
@@ -57,22 +59,11 @@ pub struct Plan {
     clusters: Vec<(u32, u32)>,
     bt: BetaTables,
     norms: Vec<Ext>,
-    /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight with the normalisation folded in.
-    wq: Vec<f64>,
     rt: RecTables,
-    fwd_fft: Option<SliceFft>,
-    inv_fft: Option<SliceFft>,
-    /// Real-data slice FFTs (with `PlanOptions::real`).
-    real_fft: Option<SliceFftReal>,
-    /// Per-worker buffers of `2 group` padded slices (see [`fft::slice_stride`]): a group
-    /// of mirrored pairs of beta slices in the FFT stage.
-    fft_scratch: Vec<Mutex<AlignedBuf>>,
+    /// The FFT stage: slice FFTs, weights, per-worker FFT scratch.
+    fft: FftStage,
     /// Per-worker DWT scratch.
     dwt_scratch: Vec<Mutex<Scratch>>,
-    /// Whether the slice FFTs run on FFTW's threads (else slices are spread over workers).
-    fftw_threaded: bool,
-    /// Mirrored pairs of beta slices per group of the complex FFT stage.
-    group: usize,
     /// Chunk-buffer layout of the complex transforms.
     blocks: Blocks,
     /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
@@ -147,7 +138,7 @@ impl Plan {
     /// never [`FftThreading::Auto`]. With one thread this is always
     /// [`FftThreading::SlicesAcrossWorkers`] (FFTW's threads are not used).
     pub fn fft_threading(&self) -> FftThreading {
-        if self.fftw_threaded {
+        if self.fft.fftw_threaded() {
             FftThreading::FftwThreads
         } else {
             FftThreading::SlicesAcrossWorkers

@@ -8,60 +8,15 @@
 //! `2B (B+1)` half-spectrum rows per slot. The inverse fills the c2r input
 //! `Y[M mod 2B][M'] = conj(G(M,M'))` for `M' >= 0`, which makes `f = c2r(Y)` the samples.
 
-use super::blocks::{Blocks, BufLayout};
-use super::fft_stage;
-use super::schedule::{Chunk, Spare};
-use super::shared::SyncPtr;
+use super::blocks::Blocks;
+use super::fft_stage::RealInput;
+use super::members::representatives;
+use super::schedule::Spare;
+use super::shared::{SendConstPtr, SendPtr};
 use super::{Plan, StageTimes};
 use crate::error::{Error, Result};
-use crate::fft::SliceFftReal;
-use crate::symmetry::Cluster;
-use crate::symmetry::Member;
 use num_complex::Complex64;
 use rayon::prelude::*;
-
-/// Whether `mem` is the representative of its negation pair.
-fn representative(mem: &Member) -> bool {
-    mem.mp > 0 || (mem.mp == 0 && mem.m >= 0)
-}
-
-/// The representatives of a cluster (1, 2 or 4 members, then padding) and their number.
-pub(super) fn representatives(cl: &Cluster) -> ([Member; 8], usize) {
-    let mut reps = [cl.members()[0]; 8];
-    let mut nr = 0;
-    for mem in cl.members().iter().filter(|m| representative(m)) {
-        reps[nr] = *mem;
-        nr += 1;
-    }
-    (reps, nr)
-}
-
-/// `(-1)^(M - M')`.
-pub(super) fn neg_sign(m: isize, mp: isize) -> f64 {
-    if (m - mp).rem_euclid(2) == 0 {
-        1.0
-    } else {
-        -1.0
-    }
-}
-
-/// Where the real samples of a forward transform come from.
-#[derive(Clone, Copy)]
-enum RealInput {
-    /// `(2B)^3` doubles.
-    Real(*const f64),
-    /// The real parts of `(2B)^3` complex values.
-    RealParts(*const Complex64),
-}
-
-/// `RealInput` shared by the FFT workers (read only through it).
-#[derive(Clone, Copy)]
-struct SyncInput(RealInput);
-// SAFETY: the pointed-to samples are only read through it, by all workers, during one
-// execution; a forward destroying its input writes chunk buffers only into slices whose
-// reads are finished (see `Spare::consumed` and `Plan::chain`).
-unsafe impl Send for SyncInput {}
-unsafe impl Sync for SyncInput {}
 
 impl Plan {
     /// Forward transform of a real signal: `(2B)^3` real samples (SPEC layout) to all
@@ -104,12 +59,6 @@ impl Plan {
         Ok(())
     }
 
-    fn real_fft(&self) -> Result<&SliceFftReal> {
-        self.real_fft.as_ref().ok_or_else(|| {
-            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
-    }
-
     /// Like [`Plan::forward_real`], also returning the time of each stage.
     pub fn forward_real_timed(
         &self,
@@ -117,7 +66,11 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::Real(samples.as_ptr()), coeffs, None)
+        self.forward_real_impl(
+            RealInput::Real(SendConstPtr(samples.as_ptr())),
+            coeffs,
+            None,
+        )
     }
 
     /// [`Plan::forward_real`] that may overwrite `samples`, for fewer passes over the
@@ -141,7 +94,7 @@ impl Plan {
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_real_impl(RealInput::Real(base), coeffs, Some(spare))
+        self.forward_real_impl(RealInput::Real(SendConstPtr(base)), coeffs, Some(spare))
     }
 
     /// Forward transform of the real parts of complex samples (the imaginary parts are not
@@ -152,7 +105,11 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::RealParts(samples.as_ptr()), coeffs, None)
+        self.forward_real_impl(
+            RealInput::RealParts(SendConstPtr(samples.as_ptr())),
+            coeffs,
+            None,
+        )
     }
 
     /// [`Plan::forward_real_parts`] that may overwrite `samples`.
@@ -164,7 +121,11 @@ impl Plan {
         self.check(true, samples.len(), coeffs.len())?;
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_real_impl(RealInput::RealParts(base), coeffs, Some(spare))
+        self.forward_real_impl(
+            RealInput::RealParts(SendConstPtr(base)),
+            coeffs,
+            Some(spare),
+        )
     }
 
     fn forward_real_impl(
@@ -173,16 +134,16 @@ impl Plan {
         coeffs: &mut [Complex64],
         spare: Option<Spare>,
     ) -> Result<StageTimes> {
-        self.real_fft()?;
-        let input = SyncInput(input);
-        let coef = SyncPtr(coeffs.as_mut_ptr());
+        self.fft.real_fft()?;
+        let coef = SendPtr(coeffs.as_mut_ptr());
         let t = self.real_blocks()?;
         self.run_chunks(
             true,
             t,
             spare,
-            |ch, buf, layout| {
-                self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, layout)
+            |ch, buf| {
+                let no_output = SendPtr(std::ptr::null_mut());
+                self.fft.chunk_real(t, ch, Some(input), no_output, buf)
             },
             |sc, at, ch, buf, pass| unsafe {
                 // The chunks accumulate the representatives only (half the coefficient
@@ -199,16 +160,16 @@ impl Plan {
         samples: &mut [f64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.real_fft()?;
+        self.fft.real_fft()?;
         // One raw pointer for the output slices and for the buffers in the free ones.
-        let out = SyncPtr(samples.as_mut_ptr());
+        let out = SendPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
         let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             t,
             Some(spare),
-            |ch, buf, layout| self.fft_chunk_real(ch, None, out.get(), buf, layout),
+            |ch, buf| self.fft.chunk_real(t, ch, None, out, buf),
             |sc, at, ch, buf, pass| unsafe {
                 self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
             },
@@ -218,81 +179,6 @@ impl Plan {
     fn real_blocks(&self) -> Result<&Blocks> {
         self.blocks_real.as_ref().ok_or_else(|| {
             Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
-    }
-
-    /// FFT stage of one chunk for real data (see the module documentation), one mirrored
-    /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
-    /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
-    /// into `grid` (c2r), the buffer laid out as `layout` (see [`Plan::fft_chunk`]).
-    fn fft_chunk_real(
-        &self,
-        ch: &Chunk,
-        input: Option<SyncInput>,
-        grid: *mut f64,
-        buf: *mut f64,
-        layout: BufLayout,
-    ) -> Result<()> {
-        let fft = self.real_fft()?;
-        let t = self.real_blocks()?;
-        let (b, n) = (self.b, 2 * self.b);
-        let (nn, nh) = (n * n, n * (b + 1));
-        let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        (0..ch.h).into_par_iter().try_for_each(|j| -> Result<()> {
-            let (k0, k1) = ch.pair_betas(b, j);
-            self.with_fft_scratch(|scratch| {
-                let sp = scratch.as_mut_ptr();
-                // SAFETY: the scratch holds at least two padded slices, 2n(n + 4) complex
-                // values: two half spectra (nh = n^2/2 + n each) and n^2 packed reals
-                // (n^2/2 values) fit; pair `j` owns its two rows of every block and its two
-                // sample slices (n^2 reals each).
-                unsafe {
-                    let s = [sp, sp.add(nh)];
-                    if let Some(SyncInput(input)) = input {
-                        // Real parts of complex samples are first packed into the free
-                        // part of the scratch, one slice at a time.
-                        let packed = sp.add(2 * nh) as *mut f64;
-                        for (&dst, k) in s.iter().zip([k0, k1]) {
-                            let src = match input {
-                                RealInput::Real(p) => p.add(k * nn),
-                                RealInput::RealParts(p) => {
-                                    let slice = p.add(k * nn);
-                                    for i in 0..nn {
-                                        *packed.add(i) = (*slice.add(i)).re;
-                                    }
-                                    packed as *const f64
-                                }
-                            };
-                            fft.r2c(src, dst);
-                        }
-                        // S(M,M') = conj(R[M][M']) for M' >= 0.
-                        fft_stage::scatter_group(
-                            t,
-                            &[SyncPtr(s[0]), SyncPtr(s[1])],
-                            &[self.wq[k0], self.wq[k1]],
-                            true,
-                            buf.get(),
-                            layout,
-                            j,
-                            0..t.len(),
-                        );
-                    } else {
-                        let sc = [SyncPtr(s[0]), SyncPtr(s[1])];
-                        fft_stage::gather_group(t, &sc, true, buf.get(), layout, j, 0..t.len());
-                        for (&slot, k) in s.iter().zip([k0, k1]) {
-                            // Frequency B (alpha or gamma) is outside the band limit.
-                            for i in 0..=b {
-                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
-                            }
-                            for a in 0..n {
-                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
-                            }
-                            fft.c2r(slot, grid.get().add(k * nn));
-                        }
-                    }
-                }
-                Ok(())
-            })
         })
     }
 }

@@ -2,7 +2,7 @@
 //! sharing one pass of the DWT stage, and where each chunk's buffer lives.
 
 use super::blocks::{Blocks, BufLayout};
-use super::shared::SyncPtr;
+use super::shared::SendPtr;
 use super::Plan;
 use crate::symmetry::Cluster;
 
@@ -33,10 +33,10 @@ pub(super) struct Pass {
     /// The buffer of the group's next chunk and its layout, if any: the next call is this
     /// cluster on it, so that is what to prefetch (forward: this cluster's block there;
     /// inverse: nothing, its coefficient rows are kept).
-    pub(super) next_buf: Option<(SyncPtr<f64>, BufLayout)>,
+    pub(super) next_buf: Option<(SendPtr<f64>, BufLayout)>,
     /// The group's first chunk, its buffer and layout: after the group's last chunk the
     /// next call is the next cluster on that one (the forward prefetches its block there).
-    pub(super) head: (Chunk, SyncPtr<f64>, BufLayout),
+    pub(super) head: (Chunk, SendPtr<f64>, BufLayout),
     /// How the chunk's buffer holds the blocks: cluster-major, split in two halves (the
     /// forward's chain, [`Plan::chain`]), or half-major (an inverse whose blocks are too
     /// large to stay in the cache until the FFT stage reads them, written with

@@ -208,7 +208,7 @@ fn block_stores_do_not_change_results() {
                             if (m, mp) == (0, 0) {
                                 coefs[i].im = 0.0;
                             } else if i < j {
-                                coefs[j] = coefs[i].conj() * super::real::neg_sign(m, mp);
+                                coefs[j] = coefs[i].conj() * super::members::neg_sign(m, mp);
                             }
                         }
                     }
