@@ -57,6 +57,16 @@ pub(super) struct ChunkBuf {
     pub layout: BufLayout,
 }
 
+/// Where a cluster's block is in a chunk buffer: row `2j` at `base + j * pair_stride`,
+/// row `2j + 1` `row_gap` further, `width` doubles each (see [`Blocks::pair_rows`]).
+#[derive(Clone, Copy)]
+pub(super) struct BlockRows {
+    pub base: *mut f64,
+    pub width: usize,
+    pub pair_stride: usize,
+    pub row_gap: usize,
+}
+
 /// No slot (unused entry of a cluster with fewer than 8 members).
 pub(super) const NONE: u32 = u32::MAX;
 
@@ -215,6 +225,17 @@ impl Blocks {
                 let stride = self.pofs[self.len()];
                 (j * stride + self.pofs[c], stride, gap)
             }
+        }
+    }
+
+    /// Where cluster `c`'s block is in the chunk buffer `buf`.
+    pub fn rows(&self, c: usize, buf: ChunkBuf) -> BlockRows {
+        let (at, pair_stride, row_gap) = self.pair_rows(c, 0, buf.layout);
+        BlockRows {
+            base: buf.base.get().wrapping_add(at),
+            width: self.p(c),
+            pair_stride,
+            row_gap,
         }
     }
 

@@ -1,7 +1,7 @@
 //! Making a plan: validation of the options, the memory layout, and construction.
 
 use super::blocks::Blocks;
-use super::dwt_stage::Scratch;
+use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
 use super::{Plan, PlanOptions, MAX_BANDWIDTH};
 use crate::error::{Error, Result};
@@ -9,7 +9,7 @@ use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
-use crate::wigner::{start_norms, BetaTables, RecTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
+use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 use std::sync::Mutex;
 
 /// A field of Linux's `/proc/meminfo` in bytes, if known.
@@ -224,9 +224,10 @@ impl Plan {
         let blocks = Blocks::complex(b, &clusters, layout.chunk);
         // The real layout is about half as large per beta: its chunks take twice the betas.
         let blocks_real = layout.chunk_real.map(|h| Blocks::real(b, &clusters, h));
-        let dwt_scratch = (0..threads)
-            .map(|_| Mutex::new(Scratch::for_layouts(b, &blocks, blocks_real.as_ref())))
-            .collect();
+        let lanes = blocks
+            .lanes
+            .max(blocks_real.as_ref().map_or(0, |t| t.lanes));
+        let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
@@ -245,20 +246,13 @@ impl Plan {
             b,
             direction: options.direction,
             threads,
-            isa,
             pool: Some(pool),
             live,
-            clusters,
-            bt: BetaTables::grid(b),
-            norms: start_norms(b),
-            rt: RecTables::new(b),
             fft,
-            dwt_scratch,
+            dwt,
             blocks,
             blocks_real,
             memory: layout.total(),
-            skip_bits,
-            skip,
             plain_store_limit: plain_store_limit(),
             pid: std::process::id(),
             buf: Mutex::new(Some(buf)),

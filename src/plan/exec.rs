@@ -3,16 +3,13 @@
 
 use super::blocks::{Blocks, BufLayout, ChunkBuf};
 use super::build::mem_available;
-use super::dwt_stage::Scratch;
-use super::members::all_members;
-use super::schedule::{At, Chunk, Pass, Spare};
-use super::shared::{lock_free, SendPtr};
+use super::dwt_stage::{DwtLayout, Scratch};
+use super::schedule::{Chunk, ChunkGroups, ClusterStep, Pass, PlacedChunk, Spare};
+use super::shared::SendPtr;
 use super::{Plan, StageTimes};
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
-use crate::symmetry::Cluster;
 use num_complex::Complex64;
-use rayon::prelude::*;
 use std::time::Instant;
 
 impl Plan {
@@ -41,6 +38,8 @@ impl Plan {
         f(g.as_ref().expect("plan buffer present"))
     }
 
+    /// The forward of complex samples at `samples` into `coeffs`, with chunk buffers in
+    /// the read input slices when `spare` is given.
     pub(super) fn forward_impl(
         &self,
         samples: *const Complex64,
@@ -51,24 +50,20 @@ impl Plan {
         // The forward only reads the samples (a forward that may overwrite them puts
         // chunk buffers in read slices through `spare`, never through this pointer).
         let input = SendPtr(samples as *mut Complex64);
+        let layout = DwtLayout {
+            blocks: &self.blocks,
+            real: false,
+        };
         self.run_chunks(
             true,
             &self.blocks,
             spare,
             |ch, buf| self.fft.chunk(&self.blocks, ch, true, input, buf),
-            |sc, at, ch, buf, pass| unsafe {
-                self.forward_cluster(
-                    sc,
-                    &self.blocks,
-                    all_members,
-                    false,
-                    at,
-                    ch,
-                    buf,
-                    coef,
-                    pass,
-                );
-            },
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer and coefficient rows no other task touches; the buffer holds the
+            // chunk's blocks (filled by the FFT stage before); `coeffs` has
+            // `num_coeffs` entries (checked by the caller).
+            |sc, step, pass| unsafe { self.dwt.forward_cluster(sc, &layout, step, coef, pass) },
         )
     }
 
@@ -82,14 +77,18 @@ impl Plan {
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SendPtr(samples.as_mut_ptr());
         let spare = Spare::over(out.get(), self.b);
+        let layout = DwtLayout {
+            blocks: &self.blocks,
+            real: false,
+        };
         self.run_chunks(
             false,
             &self.blocks,
             Some(spare),
             |ch, buf| self.fft.chunk(&self.blocks, ch, false, out, buf),
-            |sc, at, ch, buf, pass| unsafe {
-                self.inverse_cluster(sc, &self.blocks, all_members, at, ch, buf, coeffs, pass)
-            },
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer no other task touches; the buffer is the chunk's.
+            |sc, step, pass| unsafe { self.dwt.inverse_cluster(sc, &layout, step, coeffs, pass) },
         )
     }
 
@@ -97,34 +96,23 @@ impl Plan {
     /// [`Plan::chunk_groups`]), the FFT stage of each chunk and the DWT of every cluster of
     /// layout `t` over the group's chunks, in the order of the direction (forward: FFT
     /// then DWT), timed. The cluster stage learns where the chunk stands ([`Pass`]).
-    #[allow(clippy::type_complexity)]
     pub(super) fn run_chunks(
         &self,
         forward: bool,
         t: &Blocks,
         spare: Option<Spare>,
         fft: impl Fn(&Chunk, ChunkBuf) -> Result<()> + Sync,
-        cluster: impl Fn(&mut Scratch, &At, &Chunk, *mut f64, Pass) + Sync,
+        cluster: impl Fn(&mut Scratch, &ClusterStep, &Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
-        let (groups, chained) = self.chunk_groups(t, forward, spare.as_ref());
+        let ChunkGroups { groups, chained } = self.chunk_groups(t, forward, spare.as_ref());
         self.with_buf(|buf| {
-            let bp = buf.as_mut_ptr() as *mut f64;
+            let own = SendPtr(buf.as_mut_ptr() as *mut f64);
             let whole = t.total() / 2;
-            let groups: Vec<Vec<(Chunk, SendPtr<f64>, usize)>> = groups
+            let groups: Vec<Vec<PlacedChunk>> = groups
                 .iter()
-                .map(|g| {
-                    g.iter()
-                        .map(|(c, p)| {
-                            let (p, gap) = p.unwrap_or((bp, whole));
-                            (*c, SendPtr(p), gap)
-                        })
-                        .collect()
-                })
-                .collect();
-            self.pool().install(|| {
-                for (gi, group) in groups.iter().enumerate() {
+                .map(|group| {
                     // The chains' buffers are in two pieces: the forward's split, the
                     // inverse's half-major.
                     let layout: fn(usize) -> BufLayout = if forward && chained {
@@ -134,17 +122,30 @@ impl Plan {
                     } else {
                         |_| BufLayout::Blocks
                     };
-                    let group: Vec<_> = group.iter().map(|&(c, p, g)| (c, p, layout(g))).collect();
+                    group
+                        .iter()
+                        .map(|place| {
+                            let (base, gap) = match place.spare {
+                                Some(s) => (SendPtr(s.low), s.gap),
+                                None => (own, whole),
+                            };
+                            PlacedChunk {
+                                chunk: place.chunk,
+                                buf: ChunkBuf {
+                                    base,
+                                    layout: layout(gap),
+                                },
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            self.pool().install(|| {
+                for (gi, group) in groups.iter().enumerate() {
                     let mut fft_stage = || -> Result<()> {
                         let t = Instant::now();
-                        for (ch, buf, layout) in &group {
-                            fft(
-                                ch,
-                                ChunkBuf {
-                                    base: *buf,
-                                    layout: *layout,
-                                },
-                            )?;
+                        for placed in group {
+                            fft(&placed.chunk, placed.buf)?;
                         }
                         times.fft += t.elapsed().as_secs_f64();
                         Ok(())
@@ -153,18 +154,19 @@ impl Plan {
                         fft_stage()?;
                     }
                     let t1 = Instant::now();
-                    self.for_each_cluster(t, |sc, at| {
-                        for (k, (ch, buf, layout)) in group.iter().enumerate() {
+                    self.dwt.for_each_cluster(t, |sc, step| {
+                        for (k, placed) in group.iter().enumerate() {
+                            let last_in_group = k + 1 == group.len();
                             let pass = Pass {
-                                first: gi == 0,
-                                k,
-                                last: k + 1 == group.len(),
-                                done: gi + 1 == groups.len() && k + 1 == group.len(),
-                                next_buf: group.get(k + 1).map(|g| (g.1, g.2)),
-                                head: group[0],
-                                layout: *layout,
+                                placed: *placed,
+                                first_group: gi == 0,
+                                position: k,
+                                last_in_group,
+                                last_of_transform: gi + 1 == groups.len() && last_in_group,
+                                next_in_group: group.get(k + 1).map(|g| g.buf),
+                                group_head: group[0],
                             };
-                            cluster(sc, at, ch, buf.get(), pass);
+                            cluster(sc, step, &pass);
                         }
                     });
                     times.dwt += t1.elapsed().as_secs_f64();
@@ -177,40 +179,5 @@ impl Plan {
         })?;
         times.total = t0.elapsed().as_secs_f64();
         Ok(times)
-    }
-
-    /// Run `f(scratch, at)` on every cluster in parallel (work stealing over runs of
-    /// consecutive clusters, whose blocks are consecutive in the chunk buffer). While a
-    /// cluster's kernel runs it prefetches what the next one will touch (see
-    /// `Plan::next_cluster`), so `at` carries that one too; each cluster is built once.
-    pub(super) fn for_each_cluster(&self, t: &Blocks, f: impl Fn(&mut Scratch, &At) + Sync) {
-        let nc = t.len();
-        const RUN: usize = 8;
-        (0..nc.div_ceil(RUN)).into_par_iter().for_each(|r| {
-            let mut guard = lock_free(&self.dwt_scratch);
-            let mut own = None;
-            let sc: &mut Scratch = match guard.as_deref_mut() {
-                Some(s) => s,
-                // All busy (concurrent executions of this plan): use a private one.
-                None => own.insert(Scratch::for_layouts(
-                    self.b,
-                    &self.blocks,
-                    self.blocks_real.as_ref(),
-                )),
-            };
-            let (c0, c1) = (r * RUN, ((r + 1) * RUN).min(nc));
-            let pair = |c: usize| {
-                let (m, mp) = self.clusters[c];
-                Cluster::new(m as usize, mp as usize)
-            };
-            let mut cl = pair(c0);
-            for c in c0..c1 {
-                let next = (c + 1 < nc).then(|| pair(c + 1));
-                f(sc, &At { c, cl, next });
-                if let Some(n) = next {
-                    cl = n;
-                }
-            }
-        });
     }
 }

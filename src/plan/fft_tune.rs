@@ -112,7 +112,7 @@ impl Plan {
         let ch = Chunk {
             lo: 0,
             h: npairs,
-            hp: h.next_multiple_of(self.isa.lanes()),
+            hp: h.next_multiple_of(self.dwt.isa().lanes()),
         };
         let g = SendPtr(grid.as_mut_ptr());
         let (own_fwd, own_inv) = self.fft.complex_ffts();

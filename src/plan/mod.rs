@@ -32,9 +32,8 @@ use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
-use crate::wigner::{BetaTables, Ext, RecTables};
 use blocks::Blocks;
-use dwt_stage::Scratch;
+use dwt_stage::DwtStage;
 use fft_stage::FftStage;
 use num_complex::Complex64;
 use schedule::Spare;
@@ -46,43 +45,34 @@ use std::sync::Mutex;
 /// Execution methods take `&self`; a plan may be executed from several threads at once
 /// on different arrays (a concurrent call that finds the chunk buffer busy allocates its own).
 pub struct Plan {
+    /// The bandwidth `B`.
     b: usize,
     direction: Direction,
     threads: usize,
-    isa: Isa,
     /// Worker pool (an `Option` so `Drop` can release it before waiting for the workers).
     pool: Option<rayon::ThreadPool>,
     /// Number of pool threads still running; `Drop` waits for zero.
     live: std::sync::Arc<(Mutex<usize>, std::sync::Condvar)>,
-    /// Base pairs of the clusters, in processing order (8 x 8 tiles, see
-    /// `symmetry::cluster_pairs`).
-    clusters: Vec<(u32, u32)>,
-    bt: BetaTables,
-    norms: Vec<Ext>,
-    rt: RecTables,
+    /// The process that made the plan: its worker threads exist only there (a child made
+    /// by `fork()` has none of them).
+    pid: u32,
+    /// Bytes this plan holds.
+    memory: usize,
     /// The FFT stage: slice FFTs, weights, per-worker FFT scratch.
     fft: FftStage,
-    /// Per-worker DWT scratch.
-    dwt_scratch: Vec<Mutex<Scratch>>,
+    /// The DWT stage: cluster order, Wigner-d tables, per-worker DWT scratch.
+    dwt: DwtStage,
     /// Chunk-buffer layout of the complex transforms.
     blocks: Blocks,
     /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
     blocks_real: Option<Blocks>,
-    /// Bytes this plan holds.
-    memory: usize,
-    /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
-    skip_bits: u32,
-    /// Whether degrees below the threshold are skipped (`PlanOptions::skip_bits` not `Some(0)`).
-    skip: bool,
+    /// The chunk buffer (taken by one execution at a time, see `Plan::with_buf`).
     buf: Mutex<Option<AlignedBuf>>,
     /// Bytes of the chunk buffer.
     buf_bytes: usize,
     /// Most bytes of blocks an inverse group writes with ordinary stores (see
-    /// [`plain_store_limit`]).
+    /// `build::plain_store_limit`).
     plain_store_limit: usize,
-    /// The process that made the plan: its worker threads exist only there (a child made
-    /// by `fork()` has none of them).
-    pid: u32,
 }
 
 /// Worker pools of plans dropped in a child made by `fork()` (see `Plan::drop`).
@@ -131,7 +121,7 @@ impl Plan {
 
     /// Instruction set of the DWT kernels.
     pub fn isa(&self) -> Isa {
-        self.isa
+        self.dwt.isa()
     }
 
     /// How the FFT stage of the complex transforms uses the threads: the resolved variant,

@@ -9,8 +9,8 @@
 //! `Y[M mod 2B][M'] = conj(G(M,M'))` for `M' >= 0`, which makes `f = c2r(Y)` the samples.
 
 use super::blocks::Blocks;
+use super::dwt_stage::DwtLayout;
 use super::fft_stage::RealInput;
-use super::members::representatives;
 use super::schedule::Spare;
 use super::shared::{SendConstPtr, SendPtr};
 use super::{Plan, StageTimes};
@@ -137,6 +137,10 @@ impl Plan {
         self.fft.real_fft()?;
         let coef = SendPtr(coeffs.as_mut_ptr());
         let t = self.real_blocks()?;
+        let layout = DwtLayout {
+            blocks: t,
+            real: true,
+        };
         self.run_chunks(
             true,
             t,
@@ -145,11 +149,12 @@ impl Plan {
                 let no_output = SendPtr(std::ptr::null_mut());
                 self.fft.chunk_real(t, ch, Some(input), no_output, buf)
             },
-            |sc, at, ch, buf, pass| unsafe {
-                // The chunks accumulate the representatives only (half the coefficient
-                // traffic per chunk); the last one also writes their partners.
-                self.forward_cluster(sc, t, representatives, true, at, ch, buf, coef, pass);
-            },
+            // The chunks accumulate the representatives only (half the coefficient traffic
+            // per chunk); the last one also writes their partners.
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer and coefficient rows (representatives and their partners) no
+            // other task touches; `coeffs` has `num_coeffs` entries (checked above).
+            |sc, step, pass| unsafe { self.dwt.forward_cluster(sc, &layout, step, coef, pass) },
         )
     }
 
@@ -164,15 +169,19 @@ impl Plan {
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SendPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
+        let layout = DwtLayout {
+            blocks: t,
+            real: true,
+        };
         let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             t,
             Some(spare),
             |ch, buf| self.fft.chunk_real(t, ch, None, out, buf),
-            |sc, at, ch, buf, pass| unsafe {
-                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
-            },
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer no other task touches.
+            |sc, step, pass| unsafe { self.dwt.inverse_cluster(sc, &layout, step, coeffs, pass) },
         )
     }
 

@@ -1,47 +1,76 @@
 //! The schedule of an execution: chunks of mirrored pairs of beta slices, groups of chunks
 //! sharing one pass of the DWT stage, and where each chunk's buffer lives.
 
-use super::blocks::{Blocks, BufLayout};
-use super::shared::SendPtr;
+use super::blocks::{Blocks, ChunkBuf};
 use super::Plan;
 use crate::symmetry::Cluster;
 
 /// A cluster of the processing order for the DWT stage: its index, the cluster, and the
 /// one after it (whose memory its kernel prefetches), if any.
 #[derive(Clone, Copy)]
-pub(super) struct At {
-    pub(super) c: usize,
-    pub(super) cl: Cluster,
+pub(super) struct ClusterStep {
+    pub(super) index: usize,
+    pub(super) cluster: Cluster,
     pub(super) next: Option<Cluster>,
+}
+
+/// A chunk and the buffer that holds its blocks.
+#[derive(Clone, Copy)]
+pub(super) struct PlacedChunk {
+    pub(super) chunk: Chunk,
+    pub(super) buf: ChunkBuf,
 }
 
 /// Where a chunk stands for the DWT stage of a cluster.
 #[derive(Clone, Copy)]
 pub(super) struct Pass {
+    /// The chunk and its buffer. The buffer's layout is cluster-major, split in two halves
+    /// (the forward's chain, [`Plan::chain`]), or half-major (an inverse whose blocks are
+    /// too large to stay in the cache until the FFT stage reads them, written with
+    /// non-temporal stores, see `build::plain_store_limit`); see `plan/blocks.rs`.
+    pub(super) placed: PlacedChunk,
     /// A chunk of the transform's first group (the forward assigns the coefficients
     /// rather than adds to them then).
-    pub(super) first: bool,
-    /// Position in its group; for `k > 0` the previous call was the same cluster on the
-    /// group's previous chunk (the inverse reuses its coefficient rows, the forward adds
-    /// to its sums).
-    pub(super) k: usize,
+    pub(super) first_group: bool,
+    /// Position in its group; for a position above 0 the previous call was the same
+    /// cluster on the group's previous chunk (the inverse reuses its coefficient rows, the
+    /// forward adds to its sums).
+    pub(super) position: usize,
     /// The group's last chunk (the forward writes the cluster's sums then).
-    pub(super) last: bool,
+    pub(super) last_in_group: bool,
     /// The last chunk of the transform's last group: after this call the forward's
     /// coefficients of the cluster are final.
-    pub(super) done: bool,
-    /// The buffer of the group's next chunk and its layout, if any: the next call is this
-    /// cluster on it, so that is what to prefetch (forward: this cluster's block there;
-    /// inverse: nothing, its coefficient rows are kept).
-    pub(super) next_buf: Option<(SendPtr<f64>, BufLayout)>,
-    /// The group's first chunk, its buffer and layout: after the group's last chunk the
-    /// next call is the next cluster on that one (the forward prefetches its block there).
-    pub(super) head: (Chunk, SendPtr<f64>, BufLayout),
-    /// How the chunk's buffer holds the blocks: cluster-major, split in two halves (the
-    /// forward's chain, [`Plan::chain`]), or half-major (an inverse whose blocks are too
-    /// large to stay in the cache until the FFT stage reads them, written with
-    /// non-temporal stores, see [`plain_store_limit`]); see `plan/blocks.rs`.
-    pub(super) layout: BufLayout,
+    pub(super) last_of_transform: bool,
+    /// The buffer of the group's next chunk, if any: the next call is this cluster on it,
+    /// so that is what to prefetch (forward: this cluster's block there; inverse: nothing,
+    /// its coefficient rows are kept).
+    pub(super) next_in_group: Option<ChunkBuf>,
+    /// The group's first chunk: after the group's last chunk the next call is the next
+    /// cluster on that one (the forward prefetches its block there).
+    pub(super) group_head: PlacedChunk,
+}
+
+/// A buffer for a chunk in spare memory (see [`Spare`]): its low-beta half, and the
+/// doubles from there to its mirror half (the split and half-major layouts; a buffer in
+/// one piece has its halves half its length apart).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SpareBuf {
+    pub(super) low: *mut f64,
+    pub(super) gap: usize,
+}
+
+/// A chunk of a group and where its buffer is: `None` for the plan's chunk buffer.
+#[derive(Clone, Copy)]
+pub(super) struct ChunkPlace {
+    pub(super) chunk: Chunk,
+    pub(super) spare: Option<SpareBuf>,
+}
+
+/// The chunks of a transform in groups that share one pass of the DWT stage.
+pub(super) struct ChunkGroups {
+    pub(super) groups: Vec<Vec<ChunkPlace>>,
+    /// Whether the groups are a chain ([`Plan::chain`]), whose buffers are in two pieces.
+    pub(super) chained: bool,
 }
 
 /// The beta slices of one chunk: the `h` low betas `lo .. lo+h` and their mirrors
@@ -171,15 +200,12 @@ impl Plan {
     /// Without `spare` every group is one chunk. With each buffer comes the gap (doubles)
     /// from its low-beta half to its mirror half in the half-major layout; the plan's
     /// buffer has its halves `t.total() / 2` apart, and so do the buffers placed whole.
-    /// Also returns whether the groups are a chain ([`Plan::chain`]), whose buffers are
-    /// in two pieces.
-    #[allow(clippy::type_complexity)]
     pub(super) fn chunk_groups(
         &self,
         t: &Blocks,
         forward: bool,
         spare: Option<&Spare>,
-    ) -> (Vec<Vec<(Chunk, Option<(*mut f64, usize)>)>>, bool) {
+    ) -> ChunkGroups {
         // The inverse's chain only where the blocks would not stay in the cache anyway:
         // its buffers are half-major, written with non-temporal stores.
         let chain = match spare {
@@ -189,20 +215,16 @@ impl Plan {
                 .map(|g| g.into_iter().rev().collect()),
             _ => None,
         };
-        if let Some(g) = chain {
-            return (vec![g], true);
+        match chain {
+            Some(g) => ChunkGroups {
+                groups: vec![g],
+                chained: true,
+            },
+            None => ChunkGroups {
+                groups: self.chunk_groups_whole(t, forward, spare),
+                chained: false,
+            },
         }
-        let whole = t.total() / 2;
-        let groups = self
-            .chunk_groups_whole(t, forward, spare)
-            .into_iter()
-            .map(|g| {
-                g.into_iter()
-                    .map(|(c, p)| (c, p.map(|p| (p, whole))))
-                    .collect()
-            })
-            .collect();
-        (groups, false)
     }
 
     /// All chunks of layout `t` as one group, each chunk's buffer except chunk 0's (the
@@ -213,32 +235,36 @@ impl Plan {
     /// The forward (input it may overwrite) runs the chunks in this order: chunk `k - 1`'s
     /// FFT stage has read its slices when chunk `k`'s writes there. Its buffers are split
     /// in two cluster-major halves, each with room for a full chunk, so every cluster's
-    /// sums reach the coefficients once (B = 512 under the 5% memory rule: 6 groups of
-    /// the 22 chunks before). The inverse runs them in reverse (equator first): chunk
-    /// `k - 1`'s FFT stage writes its output slices only after chunk `k`'s has read its
-    /// buffer. Its buffers are half-major, and it reads each cluster's coefficients and
-    /// computes its recurrence coefficients once, not once per group (B = 256 with the
-    /// default workspace, one thread: 4 groups before).
+    /// sums reach the coefficients once. The inverse runs them in reverse (equator first):
+    /// chunk `k - 1`'s FFT stage writes its output slices only after chunk `k`'s has read
+    /// its buffer. Its buffers are half-major, and it reads each cluster's coefficients and
+    /// computes its recurrence coefficients once, not once per group.
     ///
     /// The real layout's row per lane (`4B^2 + 4B` doubles) is longer than a real slice
     /// (`4B^2`), so in real samples a full chunk's buffer never fits in another full
     /// chunk's slices: its inverse chain exists only for two chunks, the second one short
     /// (half-major halves hold only the chunk's own pairs), its forward chain never.
-    #[allow(clippy::type_complexity)]
     pub(super) fn chain(
         &self,
         t: &Blocks,
         spare: &Spare,
         half_bytes: impl Fn(&Chunk) -> usize,
-    ) -> Option<Vec<(Chunk, Option<(*mut f64, usize)>)>> {
+    ) -> Option<Vec<ChunkPlace>> {
         let chunks: Vec<Chunk> = self.chunks(t).collect();
         if chunks.len() < 2 {
             return None;
         }
-        let mut group = vec![(chunks[0], None)];
+        let mut group = vec![ChunkPlace {
+            chunk: chunks[0],
+            spare: None,
+        }];
         for w in chunks.windows(2) {
-            let (a, b) = spare.halves(self.b, &w[0], half_bytes(&w[1]))?;
-            group.push((w[1], Some((a, (b as usize - a as usize) / 8))));
+            let (low, mirror) = spare.halves(self.b, &w[0], half_bytes(&w[1]))?;
+            let gap = (mirror as usize - low as usize) / 8;
+            group.push(ChunkPlace {
+                chunk: w[1],
+                spare: Some(SpareBuf { low, gap }),
+            });
         }
         Some(group)
     }
@@ -249,7 +275,8 @@ impl Plan {
         t: &Blocks,
         forward: bool,
         spare: Option<&Spare>,
-    ) -> Vec<Vec<(Chunk, Option<*mut f64>)>> {
+    ) -> Vec<Vec<ChunkPlace>> {
+        let whole = t.total() / 2;
         let chunks: Vec<Chunk> = self.chunks(t).collect();
         let bytes = (t.total() * 8).next_multiple_of(64);
         let mut groups = Vec::new();
@@ -274,12 +301,18 @@ impl Plan {
                     }
                 }
             }
-            let mut group = vec![(chunks[i], None)];
+            let mut group = vec![ChunkPlace {
+                chunk: chunks[i],
+                spare: None,
+            }];
             group.extend(
                 chunks[i + 1..i + g]
                     .iter()
                     .zip(at)
-                    .map(|(c, p)| (*c, Some(p))),
+                    .map(|(c, low)| ChunkPlace {
+                        chunk: *c,
+                        spare: Some(SpareBuf { low, gap: whole }),
+                    }),
             );
             groups.push(group);
             i += g;
@@ -292,7 +325,7 @@ impl Plan {
         let (b, chunk) = (self.b, t.chunk);
         (0..b).step_by(chunk).map(move |lo| {
             let h = chunk.min(b - lo);
-            let hp = h.next_multiple_of(self.isa.lanes());
+            let hp = h.next_multiple_of(self.dwt.isa().lanes());
             Chunk { lo, h, hp }
         })
     }

@@ -1,5 +1,7 @@
 //! Tests of the plan's schedule, lifetime and block layouts.
 
+use super::schedule::{Chunk, ChunkGroups, ChunkPlace, Spare, SpareBuf};
+
 /// The chunk groups of an inverse with its output as room: in order, covering every
 /// chunk once; every spare buffer 64-byte aligned, inside the output, clear of the
 /// other buffers and of the output slices of its own and all earlier groups (which the
@@ -33,14 +35,15 @@ fn chunk_groups_keep_clear_of_written_slices() {
         let slice_bytes = 4 * b * b * if real { 8 } else { 16 };
         let total = 2 * b * slice_bytes;
         let out = vec![0u8; total + 64];
-        let spare = super::schedule::Spare {
+        let spare = Spare {
             base: out.as_ptr().wrapping_add(8) as *mut u8,
             slice_bytes,
         };
         let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
         // A chain's buffer halves `(a, gap)` of `half` bytes each: 64-byte aligned,
         // in the low-beta and the mirror slices of chunk `host`.
-        let in_slices = |host: super::schedule::Chunk, (a, gap): (*mut f64, usize), half: usize| {
+        let in_slices = |host: Chunk, buf: SpareBuf, half: usize| {
+            let (a, gap) = (buf.low, buf.gap);
             let a = a as usize - spare.base as usize;
             let m = a + 8 * gap;
             assert_eq!((spare.base as usize + a) % 64, 0);
@@ -55,21 +58,28 @@ fn chunk_groups_keep_clear_of_written_slices() {
         // The complex forward's chain: one group in the chunks' order, chunk 0 in the
         // plan's buffer, each other buffer's halves in the slices of the chunk before
         // it (read by then). The real layout's do not fit in real slices.
-        let (chain, chained) = plan.chunk_groups(t, true, Some(&spare));
+        let ChunkGroups {
+            groups: chain,
+            chained,
+        } = plan.chunk_groups(t, true, Some(&spare));
         assert_eq!(chained, !real, "B={b} real={real}: forward chain");
         if chained {
             assert_eq!(chain.len(), 1);
             let g = &chain[0];
-            let order: Vec<_> = g.iter().map(|(c, _)| (c.lo, c.h)).collect();
+            let order: Vec<_> = g.iter().map(|p| (p.chunk.lo, p.chunk.h)).collect();
             assert_eq!(order, chunks);
-            assert!(g[0].1.is_none());
+            assert!(g[0].spare.is_none());
             for k in 1..g.len() {
-                in_slices(g[k - 1].0, g[k].1.unwrap(), 8 * (t.total() / 2));
+                in_slices(g[k - 1].chunk, g[k].spare.unwrap(), 8 * (t.total() / 2));
             }
         }
         // Otherwise: buffers in the slices of earlier groups only.
         let groups = plan.chunk_groups_whole(t, true, Some(&spare));
-        let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
+        let flat: Vec<_> = groups
+            .iter()
+            .flatten()
+            .map(|p| (p.chunk.lo, p.chunk.h))
+            .collect();
         assert_eq!(
             flat,
             plan.chunks(t).map(|c| (c.lo, c.h)).collect::<Vec<_>>()
@@ -81,10 +91,10 @@ fn chunk_groups_keep_clear_of_written_slices() {
         let bytes = t.total() * 8;
         // The spare buffers of a group (all but its first chunk's): offsets into the
         // array, each 64-byte aligned and clear of the group's other buffers.
-        let offsets = |g: &[(super::schedule::Chunk, Option<*mut f64>)]| -> Vec<usize> {
+        let offsets = |g: &[ChunkPlace]| -> Vec<usize> {
             let mut ranges: Vec<(usize, usize)> = Vec::new();
-            for (_, p) in &g[1..] {
-                let a = (p.unwrap() as usize) - (spare.base as usize);
+            for p in &g[1..] {
+                let a = (p.spare.unwrap().low as usize) - (spare.base as usize);
                 assert_eq!((spare.base as usize + a) % 64, 0);
                 assert!(ranges.iter().all(|&(x, y)| a + bytes <= x || a >= y));
                 ranges.push((a, a + bytes));
@@ -92,14 +102,14 @@ fn chunk_groups_keep_clear_of_written_slices() {
             ranges.iter().map(|r| r.0).collect()
         };
         for g in &groups {
-            let lo = g[0].0.lo;
+            let lo = g[0].chunk.lo;
             for a in offsets(g) {
                 let low = a + bytes <= lo * slice_bytes;
                 let high = a >= (2 * b - lo) * slice_bytes && a + bytes <= total;
                 assert!(low || high, "B={b}: forward buffer outside the read slices");
             }
         }
-        assert!(!plan.chunk_groups(t, false, Some(&spare)).1);
+        assert!(!plan.chunk_groups(t, false, Some(&spare)).chained);
         // Blocks too large for the cache (every limit below theirs): the complex
         // inverse runs as one group, equator first, each buffer's halves in the
         // low-beta and the mirror slices of the next chunk (written after its own FFT
@@ -112,27 +122,34 @@ fn chunk_groups_keep_clear_of_written_slices() {
         } else {
             &plan.blocks
         };
-        let (chain, chained) = plan.chunk_groups(t, false, Some(&spare));
+        let ChunkGroups {
+            groups: chain,
+            chained,
+        } = plan.chunk_groups(t, false, Some(&spare));
         let short_pair = chunks.len() == 2 && chunks[1].1 * 2 <= chunks[0].1;
         assert_eq!(chained, !real || short_pair, "B={b} real={real}");
         if chained {
             assert_eq!(chain.len(), 1);
             let g = &chain[0];
-            let order: Vec<_> = g.iter().map(|(c, _)| (c.lo, c.h)).collect();
+            let order: Vec<_> = g.iter().map(|p| (p.chunk.lo, p.chunk.h)).collect();
             assert_eq!(order, chunks.iter().rev().copied().collect::<Vec<_>>());
-            assert!(g.last().unwrap().1.is_none());
-            for (i, (ch, p)) in g[..g.len() - 1].iter().enumerate() {
-                in_slices(g[i + 1].0, p.unwrap(), 8 * t.half_len(ch.hp));
+            assert!(g.last().unwrap().spare.is_none());
+            for (i, p) in g[..g.len() - 1].iter().enumerate() {
+                in_slices(g[i + 1].chunk, p.spare.unwrap(), 8 * t.half_len(p.chunk.hp));
             }
             continue;
         }
         let groups = plan.chunk_groups_whole(t, false, Some(&spare));
-        let flat: Vec<_> = groups.iter().flatten().map(|(c, _)| (c.lo, c.h)).collect();
+        let flat: Vec<_> = groups
+            .iter()
+            .flatten()
+            .map(|p| (p.chunk.lo, p.chunk.h))
+            .collect();
         assert_eq!(flat, chunks, "B={b} real={real}");
         assert!(groups.len() < chunks.len(), "B={b} real={real}: no group");
         for g in &groups {
-            assert!(g[0].1.is_none());
-            let written = g.last().map(|(c, _)| c.lo + c.h).unwrap();
+            assert!(g[0].spare.is_none());
+            let written = g.last().map(|p| p.chunk.lo + p.chunk.h).unwrap();
             for a in offsets(g) {
                 assert!(
                     a >= written * slice_bytes,
@@ -294,9 +311,9 @@ fn real_parts_forward_chains_and_matches() {
                 Complex64::new(x, 0.25 - x)
             })
             .collect();
-        let spare = super::schedule::Spare::over(samples.as_mut_ptr(), b);
+        let spare = Spare::over(samples.as_mut_ptr(), b);
         assert!(
-            plan.chunk_groups(t, true, Some(&spare)).1,
+            plan.chunk_groups(t, true, Some(&spare)).chained,
             "B={b}: no chain"
         );
         let mut want = vec![Complex64::new(f64::NAN, 0.0); plan.num_coeffs()];
