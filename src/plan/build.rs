@@ -45,13 +45,8 @@ pub(super) fn default_workspace(b: usize, real: bool) -> usize {
 /// blocks rather than with non-temporal ones into the half-major layout (see
 /// `plan/blocks.rs`): a quarter of the last-level cache (from Linux's sysfs; the cache is
 /// shared with the other cores), 0 (always non-temporal) where unknown. Blocks that stay
-/// in the cache are read back by the FFT stage much faster: at B = 64 (34 MiB of blocks,
-/// 480 MiB of L3 on the development machine) the complex inverse took 8% less time and the
-/// real one 17% less; at B = 128 (254 MiB) non-temporal stores were faster (DWT stage
-/// 0.062 against 0.069 s), and with the blocks capped at 64-128 MiB the two were even.
-/// Pair-major blocks (the rows of a pair side by side, what the half-major layout replaced)
-/// in the cache were slower still (B = 64 complex inverse DWT stage 0.0084 against
-/// 0.0053 s: each row on its own page).
+/// in the cache are read back by the FFT stage much faster; blocks that do not are better
+/// written with non-temporal stores.
 pub(super) fn plain_store_limit() -> usize {
     let size = |dir: &std::path::Path| -> Option<usize> {
         let level = std::fs::read_to_string(dir.join("level")).ok()?;

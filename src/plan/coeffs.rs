@@ -3,9 +3,7 @@
 //! contiguous run of degrees per order pair. These copies move one pair's run between the
 //! two, with the pair's sign for even and odd degree offsets applied on the way.
 //!
-//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64): the scalar
-//! element-by-element loop this replaces took about a fifth of the inverse DWT stage
-//! with several chunks.
+//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64).
 
 use num_complex::Complex64;
 
@@ -45,8 +43,8 @@ pub(super) unsafe fn gather(
 /// `partner = Some((d2, ps))` also `d2[i] = ps * conj(dst[i])` (the real forward's partner
 /// pair, from the value in a register: no second pass over the coefficients).
 ///
-/// Plain stores: non-temporal ones made the B = 128 forward's DWT stage about 30% slower
-/// here, where the coefficients fit in the (large, shared) L3 cache.
+/// Plain stores: the coefficients are read back by the next group or stay in the
+/// last-level cache.
 ///
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at

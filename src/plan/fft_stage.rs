@@ -442,20 +442,19 @@ const PREFETCH_SLOTS: usize = 8;
 
 /// Prefetch the slice values of cluster `c`'s slots in the slices `sp` (into L2 for
 /// reading, into L1 for writing with `write`): the slots of a cluster lie in different
-/// rows of the slices, which from B = 256 on are larger than L2. Measured with
-/// `copy_speed` at B = 256: gather 1.6 -> 1.3 ms per pair of slices, scatter 1.24 -> 1.16.
+/// rows of the slices, which from B = 256 on are larger than L2.
 #[inline(always)]
 unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SendPtr<Complex64>], write: bool) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_ET0, _MM_HINT_T1};
-        for q in 0..t.p(c) / 2 {
-            let fi = *t.fi.get_unchecked(8 * c + q);
-            if fi == NONE {
+        for q in 0..t.row_len(c) / 2 {
+            let idx = *t.slot_index.get_unchecked(8 * c + q);
+            if idx == NONE {
                 continue;
             }
             for s in sp {
-                let a = s.get().wrapping_add(fi as usize) as *const i8;
+                let a = s.get().wrapping_add(idx as usize) as *const i8;
                 if write {
                     _mm_prefetch::<_MM_HINT_ET0>(a);
                 } else {
@@ -501,8 +500,8 @@ pub(super) unsafe fn scatter_group(
         if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, s, false);
         }
-        let p = t.p(c);
-        let rev = t.rev[c];
+        let p = t.row_len(c);
+        let reversed = t.reversed[c];
         let (at, ps, gap) = t.pair_rows(c, j0, layout);
         let dst = (buf.add(at), ps, gap);
         if t.regular[c] {
@@ -515,14 +514,14 @@ pub(super) unsafe fn scatter_group(
         }
         let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
         for q in 0..p / 2 {
-            let fi = *t.fi.get_unchecked(8 * c + q);
-            if fi == NONE {
+            let idx = *t.slot_index.get_unchecked(8 * c + q);
+            if idx == NONE {
                 continue;
             }
-            let fi = fi as usize;
-            let r = ((rev >> q) & 1) as usize;
+            let idx = idx as usize;
+            let r = ((reversed >> q) & 1) as usize;
             for jj in 0..ns / 2 {
-                let (a, b) = (*sp[2 * jj].add(fi), *sp[2 * jj + 1].add(fi));
+                let (a, b) = (*sp[2 * jj].add(idx), *sp[2 * jj + 1].add(idx));
                 let (ra, rb) = ((2 * jj + r) * p + 2 * q, (2 * jj + 1 - r) * p + 2 * q);
                 rows[ra] = a.re * wr[2 * jj];
                 rows[ra + 1] = a.im * wi[2 * jj];
@@ -567,15 +566,13 @@ fn prefetch_lines(a: *const f64, lines: usize) {
 const PREFETCH_CLUSTERS: usize = 16;
 
 /// Bytes ahead of its reads in the half-major buffer that [`gather_group`] prefetches.
-/// The hardware prefetchers follow the sequential reads, but not far enough: at B = 256
-/// (one thread) the gather took 0.29-0.31 s with 2-4 KiB ahead, 0.39-0.42 s with none
-/// (0.6-0.65 s in the cluster-major layout).
+/// The hardware prefetchers follow the sequential reads, but not far enough ahead.
 const GATHER_AHEAD: usize = 4096;
 
 /// The reverse of [`scatter_group`] without weights, from a buffer of `layout` (blocks, or
 /// the half-major layout of a large inverse, see `plan/blocks.rs`): slots of the rows of
 /// the pairs `j0 ..` into the slices `s` (conjugated with `conj`; the real layout's
-/// second index `fi2` gets the value itself).
+/// second index (`Blocks::slot_neg_index`) gets the value itself).
 ///
 /// # Safety
 /// As for [`scatter_group`], with `s` written.
@@ -599,7 +596,7 @@ pub(super) unsafe fn gather_group(
         if t.prefetch_slices && c + PREFETCH_SLOTS < end {
             prefetch_slots(t, c + PREFETCH_SLOTS, s, true);
         }
-        let p = t.p(c);
+        let p = t.row_len(c);
         let (at, ps, gap) = t.pair_rows(c, j0, layout);
         let row = buf.add(at);
         match layout {
@@ -608,7 +605,7 @@ pub(super) unsafe fn gather_group(
                 let cf = c + PREFETCH_CLUSTERS;
                 if cf < end {
                     let (at, _, _) = t.pair_rows(cf, j0, layout);
-                    prefetch_lines(buf.wrapping_add(at), ns * t.p(cf) / 8);
+                    prefetch_lines(buf.wrapping_add(at), ns * t.row_len(cf) / 8);
                 }
             }
             // The same distance ahead in the sequential run of each half.
@@ -619,7 +616,7 @@ pub(super) unsafe fn gather_group(
                 }
             }
         }
-        let rev = t.rev[c];
+        let reversed = t.reversed[c];
         if t.regular[c] {
             // The common case (`Blocks::regular`), written out.
             match p {
@@ -629,28 +626,28 @@ pub(super) unsafe fn gather_group(
             continue;
         }
         for q in 0..p / 2 {
-            let fi = *t.fi.get_unchecked(8 * c + q);
-            if fi == NONE {
+            let idx = *t.slot_index.get_unchecked(8 * c + q);
+            if idx == NONE {
                 continue;
             }
-            let fi = fi as usize;
-            let fi2 = *t.fi2.get_unchecked(8 * c + q);
-            let r = ((rev >> q) & 1) as usize;
+            let idx = idx as usize;
+            let neg_idx = *t.slot_neg_index.get_unchecked(8 * c + q);
+            let r = ((reversed >> q) & 1) as usize;
             for jj in 0..ns / 2 {
                 let (ra, rb) = (jj * ps + r * gap + 2 * q, jj * ps + (1 - r) * gap + 2 * q);
                 let a = Complex64::new(*row.add(ra), *row.add(ra + 1));
                 let b = Complex64::new(*row.add(rb), *row.add(rb + 1));
                 let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
                 if conj {
-                    *s0.add(fi) = a.conj();
-                    *s1.add(fi) = b.conj();
-                    if fi2 != NONE {
-                        *s0.add(fi2 as usize) = a;
-                        *s1.add(fi2 as usize) = b;
+                    *s0.add(idx) = a.conj();
+                    *s1.add(idx) = b.conj();
+                    if neg_idx != NONE {
+                        *s0.add(neg_idx as usize) = a;
+                        *s1.add(neg_idx as usize) = b;
                     }
                 } else {
-                    *s0.add(fi) = a;
-                    *s1.add(fi) = b;
+                    *s0.add(idx) = a;
+                    *s1.add(idx) = b;
                 }
             }
         }
@@ -668,7 +665,7 @@ unsafe fn scatter_regular<const S: usize>(
     conj: bool,
     dst: (*mut f64, usize, usize),
 ) {
-    let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+    let f: [usize; S] = std::array::from_fn(|q| *t.slot_index.get_unchecked(8 * c + q) as usize);
     let (h, ns) = (S / 2, sp.len());
     let mut rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
     for jj in 0..ns / 2 {
@@ -705,7 +702,7 @@ unsafe fn gather_regular<const S: usize>(
     ps: usize,
     gap: usize,
 ) {
-    let f: [usize; S] = std::array::from_fn(|q| *t.fi.get_unchecked(8 * c + q) as usize);
+    let f: [usize; S] = std::array::from_fn(|q| *t.slot_index.get_unchecked(8 * c + q) as usize);
     let h = S / 2;
     let rows = row as *const Complex64;
     let v = |z: Complex64| if conj { z.conj() } else { z };

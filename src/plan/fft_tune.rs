@@ -25,10 +25,9 @@ use std::time::Instant;
 /// Timed rounds per variant, at most (the fastest of them counts).
 const ROUNDS: usize = 5;
 
-/// Groups of slice pairs per worker in the timed sample, at most. With one, each worker
-/// had a single group: a worker delayed by another process then doubled the time of the
-/// slices-across-workers variant, and 3 of 10 plans at B = 256 kept FFTW's threads, whose
-/// inverse FFT stage is 15% slower here (forward: equal); none of 14 with four groups.
+/// Groups of slice pairs per worker in the timed sample, at most: with a single group per
+/// worker, one worker delayed by another process doubles the time of the
+/// slices-across-workers variant.
 const SAMPLE_GROUPS: usize = 4;
 
 /// Most bytes of the scratch sample grid (at least one group per worker is timed).
@@ -40,9 +39,7 @@ const CLEAR: f64 = 1.25;
 
 /// FFTW's threads are kept only when faster by at least this fraction: within the noise
 /// of the measurement, slices across workers are preferred, as they balance their load
-/// dynamically (a core taken by another process delays a worker, not every slice). With
-/// a margin of 3%, one of the plans made at B = 256 on the (shared) development machine
-/// kept FFTW's threads, whose whole FFT stage is 14% slower there.
+/// dynamically (a core taken by another process delays a worker, not every slice).
 const FFTW_MARGIN: f64 = 0.1;
 
 impl Plan {
@@ -162,10 +159,8 @@ impl Plan {
                     }
                     // A clear lead of the default needs no more rounds. A lead of FFTW's
                     // threads must survive every round: one round in which another
-                    // process delays a worker makes the default look slow (at B = 64,
-                    // with bursts of load on the other core, 10 of 90 plans kept FFTW's
-                    // threads, 1.5x slower there, when a single such round decided; none
-                    // since: `examples/tune_count.rs`).
+                    // process delays a worker makes the default look slow
+                    // (`examples/tune_count.rs` counts the choices under load).
                     if best[1] > CLEAR * best[0] {
                         break;
                     }

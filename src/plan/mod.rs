@@ -214,7 +214,7 @@ impl Plan {
         Ok(())
     }
 
-    /// Forward transform: samples (`(2B)^3`, SPEC layout) to coefficients (`(4B^3-B)/3`).
+    /// Forward transform: samples (`(2B)^3`, the sample layout of docs/conventions.md) to coefficients (`(4B^3-B)/3`).
     pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
         self.forward_timed(samples, coeffs).map(|_| ())
     }
@@ -238,9 +238,9 @@ impl Plan {
     /// their contents afterwards are unspecified. In return a plan whose chunk buffer
     /// holds fewer betas than the grid (see [`Plan::workspace_bytes`]) keeps the buffers
     /// of later chunks in the input slices it has read already and adds each cluster's
-    /// sums to the coefficients once per group of chunks instead of once per chunk: at
-    /// B = 512 under the 5% memory rule once instead of 22 times (all chunks in one
-    /// group). Same memory, same results up to rounding.
+    /// sums to the coefficients once per group of chunks instead of once per chunk (where
+    /// the buffers fit, all chunks form one group). Same memory, same results up to
+    /// rounding.
     pub fn forward_destroying_input(
         &self,
         samples: &mut [Complex64],

@@ -19,7 +19,7 @@ use num_complex::Complex64;
 use rayon::prelude::*;
 
 impl Plan {
-    /// Forward transform of a real signal: `(2B)^3` real samples (SPEC layout) to all
+    /// Forward transform of a real signal: `(2B)^3` real samples (the sample layout of docs/conventions.md) to all
     /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
     /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`].
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {

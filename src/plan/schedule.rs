@@ -113,9 +113,7 @@ impl Chunk {
 /// the betas of later chunks are free until then: a group of chunks whose buffers (all
 /// but the first, which uses the plan's buffer) fit there runs its DWT stage as one pass,
 /// reading each cluster's coefficients once for the whole group instead of once per
-/// chunk (the real inverse; at B = 512 the 22 chunks of the 5% memory rule became 6
-/// groups that way). A forward may
-/// likewise put the buffers of a group in the input slices of earlier groups (already
+/// chunk. A forward may likewise put the buffers of a group in the input slices of earlier groups (already
 /// read), and adds each cluster's sums over the group's chunks to the coefficients once
 /// (the real forward of real samples).
 ///
