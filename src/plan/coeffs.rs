@@ -20,21 +20,25 @@ pub(super) unsafe fn gather(
     sg: [f64; 2],
     s: &[f64],
 ) {
-    let s = &s[..n];
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        for (i, &si) in s.iter().enumerate() {
-            let z = _mm_loadu_pd(src.add(i) as *const f64);
-            _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, _mm_set1_pd(sg[i & 1] * si)));
+    // SAFETY: the caller's contract (see `# Safety`): reads of `src` below `n`, writes at
+    // `i * p` and `i * p + 1` of `dst` for `i < n`.
+    unsafe {
+        let s = &s[..n];
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            for (i, &si) in s.iter().enumerate() {
+                let z = _mm_loadu_pd(src.add(i) as *const f64);
+                _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, _mm_set1_pd(sg[i & 1] * si)));
+            }
         }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for (i, &si) in s.iter().enumerate() {
-        let z = *src.add(i);
-        let g = sg[i & 1] * si;
-        *dst.add(i * p) = z.re * g;
-        *dst.add(i * p + 1) = z.im * g;
+        #[cfg(not(target_arch = "x86_64"))]
+        for (i, &si) in s.iter().enumerate() {
+            let z = *src.add(i);
+            let g = sg[i & 1] * si;
+            *dst.add(i * p) = z.re * g;
+            *dst.add(i * p + 1) = z.im * g;
+        }
     }
 }
 
@@ -60,37 +64,41 @@ pub(super) unsafe fn scatter(
     add: bool,
     partner: Option<(*mut Complex64, f64)>,
 ) {
-    let s = &s[..n];
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        let d = dst as *mut f64;
-        let (d2, conj) = match partner {
-            Some((d2, ps)) => (d2 as *mut f64, _mm_set_pd(-ps, ps)),
-            None => (std::ptr::null_mut(), _mm_setzero_pd()),
-        };
+    // SAFETY: the caller's contract (see `# Safety`): `n` values of `dst` (and `d2`), reads
+    // at `i * p`, `i * p + 1` of `src`, no overlap.
+    unsafe {
+        let s = &s[..n];
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            let d = dst as *mut f64;
+            let (d2, conj) = match partner {
+                Some((d2, ps)) => (d2 as *mut f64, _mm_set_pd(-ps, ps)),
+                None => (std::ptr::null_mut(), _mm_setzero_pd()),
+            };
+            for (i, &si) in s.iter().enumerate() {
+                let g = _mm_set1_pd(sg[i & 1] * si);
+                let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g);
+                if add {
+                    z = _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z);
+                }
+                _mm_storeu_pd(d.add(2 * i), z);
+                if !d2.is_null() {
+                    _mm_storeu_pd(d2.add(2 * i), _mm_mul_pd(z, conj));
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
         for (i, &si) in s.iter().enumerate() {
-            let g = _mm_set1_pd(sg[i & 1] * si);
-            let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g);
+            let g = sg[i & 1] * si;
+            let mut z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
             if add {
-                z = _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z);
+                z += *dst.add(i);
             }
-            _mm_storeu_pd(d.add(2 * i), z);
-            if !d2.is_null() {
-                _mm_storeu_pd(d2.add(2 * i), _mm_mul_pd(z, conj));
+            *dst.add(i) = z;
+            if let Some((d2, ps)) = partner {
+                *d2.add(i) = z.conj() * ps;
             }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for (i, &si) in s.iter().enumerate() {
-        let g = sg[i & 1] * si;
-        let mut z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
-        if add {
-            z += *dst.add(i);
-        }
-        *dst.add(i) = z;
-        if let Some((d2, ps)) = partner {
-            *d2.add(i) = z.conj() * ps;
         }
     }
 }
@@ -101,8 +109,11 @@ pub(super) unsafe fn scatter(
 /// # Safety
 /// `src` valid for `n` reads, `d2` for `n` writes; no overlap.
 pub(super) unsafe fn partner_copy(d2: *mut Complex64, src: *const Complex64, n: usize, ps: f64) {
-    for i in 0..n {
-        *d2.add(i) = (*src.add(i)).conj() * ps;
+    // SAFETY: the caller's contract: `n` reads of `src`, `n` writes of `d2`, no overlap.
+    unsafe {
+        for i in 0..n {
+            *d2.add(i) = (*src.add(i)).conj() * ps;
+        }
     }
 }
 
@@ -121,6 +132,8 @@ mod tests {
         // Scales that are powers of two keep every product exact.
         let sc: Vec<f64> = (0..n).map(|i| [1.0, 0.5, 4.0][i % 3]).collect();
         let mut rows = vec![7.0; n * p];
+        // SAFETY: `n - 1` values of `z`; rows `i < n - 1` of `p` doubles from offset 4
+        // reach at most double `(n - 2) p + 5 < n p`.
         unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg, &sc) };
         for i in 0..n {
             for q in 0..p {
@@ -133,6 +146,7 @@ mod tests {
             }
         }
         let mut back = vec![Complex64::new(1.0, 1.0); n];
+        // SAFETY: `n - 1` values of `back` (`n` long); reads of `rows` as above.
         let back_from_rows = |back: &mut [Complex64], add: bool| unsafe {
             scatter(
                 back.as_mut_ptr(),
@@ -163,12 +177,15 @@ mod tests {
             for off in [0usize, 1] {
                 let mut a = vec![3.0f64; 2 * n + 2];
                 let mut b = vec![5.0f64; 2 * n + 2];
+                // SAFETY: `off <= 1` of `2n + 2` doubles.
                 let (pa, pb) = unsafe {
                     (
                         a.as_mut_ptr().add(off) as *mut Complex64,
                         b.as_mut_ptr().add(off) as *mut Complex64,
                     )
                 };
+                // SAFETY: `n - 1` complex values from `pa` and `pb` fit in the `2n + 1`
+                // doubles after `off`; reads of `rows` as above; `a`, `b`, `rows` distinct.
                 unsafe {
                     scatter(
                         pa,
@@ -182,6 +199,7 @@ mod tests {
                     )
                 };
                 for i in 0..n {
+                    // SAFETY: `i < n`: inside the `2n + 1` doubles after `off`.
                     let (x, y) = unsafe { (*pa.add(i), *pb.add(i)) };
                     if i == n - 1 {
                         assert_eq!((x, y), (Complex64::new(3.0, 3.0), Complex64::new(5.0, 5.0)));
@@ -197,6 +215,7 @@ mod tests {
             }
         }
         let mut d2 = vec![Complex64::new(0.0, 0.0); n];
+        // SAFETY: `n` values of `z` and of `d2`, distinct.
         unsafe { partner_copy(d2.as_mut_ptr(), z.as_ptr(), n, -1.0) };
         for i in 0..n {
             assert_eq!(d2[i], -z[i].conj());

@@ -202,16 +202,18 @@ impl Plan {
 /// # Safety
 /// `base` is valid for `2n` doubles.
 unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usize, threads: usize) {
-    #[derive(Clone, Copy)]
-    struct P(*mut f64);
-    // SAFETY: threads write disjoint ranges and read ranges nobody writes in that round.
-    unsafe impl Send for P {}
-    unsafe impl Sync for P {}
-    let spread = |p: P, lo: usize, hi: usize| {
+    // Entries `lo..hi` to doubles `2 lo..2 hi`, from the top down.
+    let spread = |p: SendPtr<f64>, lo: usize, hi: usize| {
         for i in (lo..hi).rev() {
-            let v = *p.0.add(i);
-            *p.0.add(2 * i + 1) = 0.0;
-            *p.0.add(2 * i) = v;
+            // SAFETY: `i < hi <= n` and `2i + 1 < 2n`: inside the caller's `2n` doubles.
+            // Within a round the pieces write disjoint ranges `[2a, 2a + 2 per)` at or
+            // above `2 lo >= hi` and read reals below `hi` that no piece of the round
+            // writes; the last (single) pass runs alone.
+            unsafe {
+                let v = *p.get().add(i);
+                *p.get().add(2 * i + 1) = 0.0;
+                *p.get().add(2 * i) = v;
+            }
         }
     };
     let mut hi = n;
@@ -221,7 +223,7 @@ unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usiz
             // another piece of this round still reads.
             let lo = hi.div_ceil(2);
             let per = (hi - lo).div_ceil(threads);
-            let p = P(base);
+            let p = SendPtr(base);
             pool.install(|| {
                 (lo..hi)
                     .step_by(per)
@@ -231,7 +233,7 @@ unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usiz
             hi = lo;
         }
     }
-    spread(P(base), 0, hi);
+    spread(SendPtr(base), 0, hi);
 }
 
 #[cfg(test)]
