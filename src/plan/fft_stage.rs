@@ -474,17 +474,16 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SendPtr<Complex64>], write:
     }
 }
 
-/// Write the rows of the pairs `j0 ..` (rows `2 j0 ..`, where `layout` puts them, see
-/// `plan/blocks.rs`) of the blocks of clusters `cs` from the transformed slices `s` (beta,
-/// then pi - beta, for each pair),
-/// scaled by their weights `w` (and conjugated with `conj`): the first row of a pair
-/// takes each slot from its own slice, the second from the other one; reversed slots the
-/// other way round. Unused slots are zero.
+/// Write the rows of the group's pairs (rows `2 first_pair ..`, where the buffer's layout
+/// puts them, see `plan/blocks.rs`) of the blocks of clusters `cs` from the group's
+/// transformed slices (beta, then pi - beta, for each pair), scaled by their weights (and
+/// conjugated with `conj`): the first row of a pair takes each slot from its own slice,
+/// the second from the other one; reversed slots the other way round. Unused slots are
+/// zero.
 ///
 /// # Safety
-/// `s` are valid for every index in the slot tables; `buf` holds the blocks of `t`,
-/// 64-byte aligned, and nobody else writes these rows.
-#[allow(clippy::too_many_arguments)]
+/// The group's slices are valid for every index in the slot tables; `buf` holds the blocks
+/// of `t`, 64-byte aligned, and nobody else writes these rows meanwhile.
 pub(super) unsafe fn scatter_group(
     t: &Blocks,
     group: &SliceGroup,
@@ -587,13 +586,14 @@ const PREFETCH_CLUSTERS: usize = 16;
 /// The hardware prefetchers follow the sequential reads, but not far enough ahead.
 const GATHER_AHEAD: usize = 4096;
 
-/// The reverse of [`scatter_group`] without weights, from a buffer of `layout` (blocks, or
-/// the half-major layout of a large inverse, see `plan/blocks.rs`): slots of the rows of
-/// the pairs `j0 ..` into the slices `s` (conjugated with `conj`; the real layout's
-/// second index (`Blocks::slot_neg_index`) gets the value itself).
+/// The reverse of [`scatter_group`] without weights, from a buffer of any layout (blocks,
+/// or the half-major layout of a large inverse, see `plan/blocks.rs`): slots of the rows of
+/// the group's pairs into its slices (conjugated with `conj`; the real layout's second
+/// index (`Blocks::slot_neg_index`) gets the value itself).
 ///
 /// # Safety
-/// As for [`scatter_group`], with `s` written.
+/// As for [`scatter_group`], with the slices written (their slots of clusters `cs` by no
+/// one else) and the rows read.
 pub(super) unsafe fn gather_group(
     t: &Blocks,
     group: &SliceGroup,
@@ -791,4 +791,81 @@ fn fence() {
     unsafe {
         std::arch::x86_64::_mm_sfence()
     };
+}
+
+/// The block copies of one group of pairs of slices over all clusters of the complex
+/// layout, on buffers of their own: for the measuring tools in `benches/` (feature
+/// `internals`).
+#[cfg(feature = "internals")]
+pub struct BlockCopies {
+    blocks: Blocks,
+    buf: AlignedBuf,
+    slices: AlignedBuf,
+    pairs: usize,
+    slice_len: usize,
+}
+
+#[cfg(feature = "internals")]
+impl BlockCopies {
+    /// Pairs per group the plans of bandwidth `b` use.
+    pub fn default_pairs(b: usize) -> usize {
+        pairs_per_group(16 * 4 * b * b)
+    }
+
+    /// Buffers for a group of `pairs` pairs (1 ..= 4) of padded slices at bandwidth `b` and
+    /// the blocks of a chunk of 8 pairs.
+    pub fn new(b: usize, pairs: usize) -> Result<BlockCopies> {
+        assert!((1..=MAX_GROUP).contains(&pairs));
+        let n = 2 * b;
+        let blocks = Blocks::complex(b, &crate::symmetry::cluster_pairs(b), 8);
+        let buf = AlignedBuf::new(blocks.total() / 2 + 8)?;
+        let slice_len = n * fft::slice_stride(n);
+        let slices = AlignedBuf::new(2 * pairs * slice_len)?;
+        Ok(BlockCopies {
+            blocks,
+            buf,
+            slices,
+            pairs,
+            slice_len,
+        })
+    }
+
+    /// Run `f` with the group of slices over the scratch slices.
+    fn with_group(&self, f: impl FnOnce(&SliceGroup, &Blocks, *mut f64)) {
+        let s: Vec<SendPtr<Complex64>> = (0..2 * self.pairs)
+            .map(|i| SendPtr(self.slices.as_mut_ptr().wrapping_add(i * self.slice_len)))
+            .collect();
+        let w = vec![1.0; 2 * self.pairs];
+        let group = SliceGroup {
+            slices: &s,
+            weights: &w,
+            first_pair: 0,
+        };
+        f(&group, &self.blocks, self.buf.as_mut_ptr() as *mut f64);
+    }
+
+    /// The forward's copy: the slices into the cluster-major blocks.
+    pub fn scatter(&self) {
+        self.with_group(|group, blocks, base| {
+            let buf = ChunkBuf {
+                base: SendPtr(base),
+                layout: BufLayout::Blocks,
+            };
+            // SAFETY: the slices hold every slot index (padded slices of bandwidth `b`);
+            // the buffer holds the blocks of a chunk of 8 pairs (at least `pairs`), all ours.
+            unsafe { scatter_group(blocks, group, false, buf, 0..blocks.len()) };
+        });
+    }
+
+    /// The inverse's copy as a large inverse runs it: the half-major blocks into the slices.
+    pub fn gather(&self) {
+        self.with_group(|group, blocks, base| {
+            let buf = ChunkBuf {
+                base: SendPtr(base),
+                layout: BufLayout::HalfMajor(blocks.total() / 2),
+            };
+            // SAFETY: as for `scatter`, with the slices written and the blocks read.
+            unsafe { gather_group(blocks, group, false, buf, 0..blocks.len()) };
+        });
+    }
 }

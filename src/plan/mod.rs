@@ -28,6 +28,11 @@ mod tests;
 
 pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDTH};
 
+#[cfg(feature = "internals")]
+pub use exec::fft_stage_alone;
+#[cfg(feature = "internals")]
+pub use fft_stage::BlockCopies;
+
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
