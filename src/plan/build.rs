@@ -3,6 +3,7 @@
 use super::blocks::Blocks;
 use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
+use super::schedule::Schedule;
 use super::{Plan, PlanOptions, MAX_BANDWIDTH};
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
@@ -125,9 +126,16 @@ impl Layout {
     }
 }
 
+/// A plan's options after the checks: worker threads, skip threshold and instruction set.
+pub(super) struct Checked {
+    pub(super) threads: usize,
+    pub(super) skip_bits: u32,
+    pub(super) isa: Isa,
+}
+
 impl Plan {
-    /// Checked threads, skip threshold and instruction set of a plan.
-    pub(super) fn validate(bandwidth: usize, options: &PlanOptions) -> Result<(usize, u32, Isa)> {
+    /// The options checked against the bandwidth and this machine.
+    pub(super) fn validate(bandwidth: usize, options: &PlanOptions) -> Result<Checked> {
         let b = bandwidth;
         if b == 0 || b > MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -163,7 +171,11 @@ impl Plan {
                 "instruction set {isa:?} not supported by this CPU"
             )));
         }
-        Ok((threads, skip_bits, isa))
+        Ok(Checked {
+            threads,
+            skip_bits,
+            isa,
+        })
     }
 
     /// How a plan's memory splits up (see [`Plan::workspace_bytes`]).
@@ -187,7 +199,11 @@ impl Plan {
     /// means slices across workers).
     pub(super) fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
         let b = bandwidth;
-        let (threads, skip_bits, isa) = Plan::validate(b, options)?;
+        let Checked {
+            threads,
+            skip_bits,
+            isa,
+        } = Plan::validate(b, options)?;
         let skip = options.skip_bits != Some(0);
         let layout = Plan::layout(b, threads, options);
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
@@ -248,10 +264,14 @@ impl Plan {
             blocks,
             blocks_real,
             memory: layout.total(),
-            plain_store_limit: plain_store_limit(),
+            schedule: Schedule {
+                b,
+                vector_lanes: isa.lanes(),
+                buf_bytes: layout.chunk_bytes,
+                plain_store_limit: plain_store_limit(),
+            },
             pid: std::process::id(),
             buf: Mutex::new(Some(buf)),
-            buf_bytes: layout.chunk_bytes,
         })
     }
 }

@@ -67,13 +67,13 @@ impl Plan {
         )
     }
 
-    /// Like [`Plan::inverse`], also returning the time of each stage.
-    pub fn inverse_timed(
+    /// The inverse of `coeffs` into the complex samples `samples` (lengths checked by the
+    /// caller), with chunk buffers in the output slices not yet written.
+    pub(super) fn inverse_impl(
         &self,
         coeffs: &[Complex64],
         samples: &mut [Complex64],
     ) -> Result<StageTimes> {
-        self.check(false, samples.len(), coeffs.len())?;
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SendPtr(samples.as_mut_ptr());
         let spare = Spare::over(out.get(), self.b);
@@ -93,7 +93,7 @@ impl Plan {
     }
 
     /// The chunk loop shared by every transform: for each group of chunks (see
-    /// [`Plan::chunk_groups`]), the FFT stage of each chunk and the DWT of every cluster of
+    /// [`Schedule::chunk_groups`]), the FFT stage of each chunk and the DWT of every cluster of
     /// layout `t` over the group's chunks, in the order of the direction (forward: FFT
     /// then DWT), timed. The cluster stage learns where the chunk stands ([`Pass`]).
     pub(super) fn run_chunks(
@@ -106,7 +106,8 @@ impl Plan {
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
-        let ChunkGroups { groups, chained } = self.chunk_groups(t, forward, spare.as_ref());
+        let ChunkGroups { groups, chained } =
+            self.schedule.chunk_groups(t, forward, spare.as_ref());
         self.with_buf(|buf| {
             let own = SendPtr(buf.as_mut_ptr() as *mut f64);
             let whole = t.total() / 2;
@@ -117,7 +118,7 @@ impl Plan {
                     // inverse's half-major.
                     let layout: fn(usize) -> BufLayout = if forward && chained {
                         BufLayout::Split
-                    } else if !forward && (chained || self.streams_blocks(group.len())) {
+                    } else if !forward && (chained || self.schedule.streams_blocks(group.len())) {
                         BufLayout::HalfMajor
                     } else {
                         |_| BufLayout::Blocks
@@ -197,7 +198,7 @@ pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Re
     let grid = SendPtr(grid.as_mut_ptr());
     plan.with_buf(|buf| {
         plan.pool().install(|| {
-            let layout = if !forward && plan.streams_blocks(1) {
+            let layout = if !forward && plan.schedule.streams_blocks(1) {
                 BufLayout::HalfMajor(plan.blocks.total() / 2)
             } else {
                 BufLayout::Blocks
@@ -206,7 +207,7 @@ pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Re
                 base: SendPtr(buf.as_mut_ptr() as *mut f64),
                 layout,
             };
-            for ch in plan.chunks(&plan.blocks) {
+            for ch in plan.schedule.chunks(&plan.blocks) {
                 plan.fft.chunk(&plan.blocks, &ch, forward, grid, buf)?;
             }
             Ok(())

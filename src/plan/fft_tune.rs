@@ -130,7 +130,7 @@ impl Plan {
                 }
                 let bp = buf.as_mut_ptr() as *mut f64;
                 // The inverse's layout for one chunk (see `plan/blocks.rs`).
-                let layout = if self.streams_blocks(1) {
+                let layout = if self.schedule.streams_blocks(1) {
                     BufLayout::HalfMajor(self.blocks.total() / 2)
                 } else {
                     BufLayout::Blocks

@@ -41,7 +41,7 @@ use blocks::Blocks;
 use dwt_stage::DwtStage;
 use fft_stage::FftStage;
 use num_complex::Complex64;
-use schedule::Spare;
+use schedule::{Schedule, Spare};
 use std::sync::Mutex;
 
 /// A precomputed SO(3) FFT of one bandwidth: weights, Wigner starting-value tables,
@@ -73,11 +73,8 @@ pub struct Plan {
     blocks_real: Option<Blocks>,
     /// The chunk buffer (taken by one execution at a time, see `Plan::with_buf`).
     buf: Mutex<Option<AlignedBuf>>,
-    /// Bytes of the chunk buffer.
-    buf_bytes: usize,
-    /// Most bytes of blocks an inverse group writes with ordinary stores (see
-    /// `build::plain_store_limit`).
-    plain_store_limit: usize,
+    /// How executions go through the chunks (and the chunk buffer's size).
+    schedule: Schedule,
 }
 
 /// Worker pools of plans dropped in a child made by `fork()` (see `Plan::drop`).
@@ -101,7 +98,7 @@ impl Plan {
     /// workspace depends on the memory available at the time of the call (at most half of
     /// it is used), so a plan made later may differ if that has changed.
     pub fn memory_needed(bandwidth: usize, options: &PlanOptions) -> Result<usize> {
-        let (threads, _, _) = Plan::validate(bandwidth, options)?;
+        let threads = Plan::validate(bandwidth, options)?.threads;
         Ok(Plan::layout(bandwidth, threads, options).total())
     }
 
@@ -177,7 +174,7 @@ impl Plan {
     /// tables leave of it. At B = 512 that keeps a complex transform within the caller's
     /// arrays plus 5%.
     pub fn workspace_bytes(&self) -> usize {
-        self.buf_bytes
+        self.schedule.buf_bytes
     }
 
     /// Whether the plan's worker threads exist in this process: `false` in a child made by
@@ -237,6 +234,16 @@ impl Plan {
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
         self.forward_impl(samples.as_ptr(), coeffs, None)
+    }
+
+    /// Like [`Plan::inverse`], also returning the time of each stage.
+    pub fn inverse_timed(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(false, samples.len(), coeffs.len())?;
+        self.inverse_impl(coeffs, samples)
     }
 
     /// [`Plan::forward`] that may overwrite `samples` (like FFTW's `FFTW_DESTROY_INPUT`):

@@ -2,7 +2,6 @@
 //! sharing one pass of the DWT stage, and where each chunk's buffer lives.
 
 use super::blocks::{Blocks, ChunkBuf};
-use super::Plan;
 use crate::symmetry::Cluster;
 
 /// A cluster of the processing order for the DWT stage: its index, the cluster, and the
@@ -25,7 +24,7 @@ pub(super) struct PlacedChunk {
 #[derive(Clone, Copy)]
 pub(super) struct Pass {
     /// The chunk and its buffer. The buffer's layout is cluster-major, split in two halves
-    /// (the forward's chain, [`Plan::chain`]), or half-major (an inverse whose blocks are
+    /// (the forward's chain, [`Schedule::chain`]), or half-major (an inverse whose blocks are
     /// too large to stay in the cache until the FFT stage reads them, written with
     /// non-temporal stores, see `build::plain_store_limit`); see `plan/blocks.rs`.
     pub(super) placed: PlacedChunk,
@@ -69,7 +68,7 @@ pub(super) struct ChunkPlace {
 /// The chunks of a transform in groups that share one pass of the DWT stage.
 pub(super) struct ChunkGroups {
     pub(super) groups: Vec<Vec<ChunkPlace>>,
-    /// Whether the groups are a chain ([`Plan::chain`]), whose buffers are in two pieces.
+    /// Whether the groups are a chain ([`Schedule::chain`]), whose buffers are in two pieces.
     pub(super) chained: bool,
 }
 
@@ -120,7 +119,7 @@ impl Chunk {
 /// Where the buffers fit, both go further: a buffer in two halves (half-major for the
 /// inverse, two cluster-major halves for the forward, see `plan/blocks.rs`) can live in
 /// the low-beta and the mirror slices of one other chunk, and all chunks run as one group
-/// (see [`Plan::chain`]).
+/// (see [`Schedule::chain`]).
 pub(super) struct Spare {
     /// Start of the array (`2B` slices of `slice_bytes`, beta slowest).
     pub(super) base: *mut u8,
@@ -191,7 +190,22 @@ impl Spare {
     }
 }
 
-impl Plan {
+/// What the schedule of a plan's executions depends on: the bandwidth, the kernels'
+/// vector width, and the size of the chunk buffer and the store limit of the inverse.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Schedule {
+    /// The bandwidth `B`.
+    pub(super) b: usize,
+    /// Lanes of the DWT kernels' vectors (each half of a chunk is padded to a multiple).
+    pub(super) vector_lanes: usize,
+    /// Bytes of the plan's chunk buffer.
+    pub(super) buf_bytes: usize,
+    /// Most bytes of blocks an inverse group writes with ordinary stores (see
+    /// `build::plain_store_limit`).
+    pub(super) plain_store_limit: usize,
+}
+
+impl Schedule {
     /// The chunks of layout `t` in groups that share one pass of the DWT stage, each with
     /// its buffer: `None` for the plan's chunk buffer, else a part of `spare` (the
     /// inverse's output, or the input of a forward that may overwrite it, see [`Spare`]).
@@ -267,7 +281,7 @@ impl Plan {
         Some(group)
     }
 
-    /// [`Plan::chunk_groups`] without the chain: every buffer in one piece.
+    /// [`Schedule::chunk_groups`] without the chain: every buffer in one piece.
     pub(super) fn chunk_groups_whole(
         &self,
         t: &Blocks,
@@ -323,7 +337,7 @@ impl Plan {
         let (b, chunk) = (self.b, t.chunk);
         (0..b).step_by(chunk).map(move |lo| {
             let h = chunk.min(b - lo);
-            let hp = h.next_multiple_of(self.dwt.isa().lanes());
+            let hp = h.next_multiple_of(self.vector_lanes);
             Chunk { lo, h, hp }
         })
     }

@@ -35,7 +35,7 @@ pub(super) struct SendConstPtr<T>(pub(super) *const T);
 // SAFETY: the pointed-to values are only read through it, by all tasks, while the array
 // is borrowed for the execution; a forward that may overwrite its input writes chunk
 // buffers only into slices whose reads are finished (see `Spare::consumed` and
-// `Plan::chain`), and never through this pointer.
+// `Schedule::chain`), and never through this pointer.
 unsafe impl<T> Send for SendConstPtr<T> {}
 // SAFETY: as for `Send`.
 unsafe impl<T> Sync for SendConstPtr<T> {}

@@ -26,7 +26,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
         };
         let mut plan = super::Plan::new(b, &opts).unwrap();
         // Blocks that would stay in the cache: no chain (ordinary stores, cluster-major).
-        plan.plain_store_limit = usize::MAX;
+        plan.schedule.plain_store_limit = usize::MAX;
         let t = if real {
             plan.blocks_real.as_ref().unwrap()
         } else {
@@ -39,7 +39,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
             base: out.as_ptr().wrapping_add(8) as *mut u8,
             slice_bytes,
         };
-        let chunks: Vec<_> = plan.chunks(t).map(|c| (c.lo, c.h)).collect();
+        let chunks: Vec<_> = plan.schedule.chunks(t).map(|c| (c.lo, c.h)).collect();
         // A chain's buffer halves `(a, gap)` of `half` bytes each: 64-byte aligned,
         // in the low-beta and the mirror slices of chunk `host`.
         let in_slices = |host: Chunk, buf: SpareBuf, half: usize| {
@@ -61,7 +61,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
         let ChunkGroups {
             groups: chain,
             chained,
-        } = plan.chunk_groups(t, true, Some(&spare));
+        } = plan.schedule.chunk_groups(t, true, Some(&spare));
         assert_eq!(chained, !real, "B={b} real={real}: forward chain");
         if chained {
             assert_eq!(chain.len(), 1);
@@ -74,7 +74,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
             }
         }
         // Otherwise: buffers in the slices of earlier groups only.
-        let groups = plan.chunk_groups_whole(t, true, Some(&spare));
+        let groups = plan.schedule.chunk_groups_whole(t, true, Some(&spare));
         let flat: Vec<_> = groups
             .iter()
             .flatten()
@@ -82,7 +82,10 @@ fn chunk_groups_keep_clear_of_written_slices() {
             .collect();
         assert_eq!(
             flat,
-            plan.chunks(t).map(|c| (c.lo, c.h)).collect::<Vec<_>>()
+            plan.schedule
+                .chunks(t)
+                .map(|c| (c.lo, c.h))
+                .collect::<Vec<_>>()
         );
         assert!(
             groups.len() < flat.len() || flat.len() < 3,
@@ -109,14 +112,14 @@ fn chunk_groups_keep_clear_of_written_slices() {
                 assert!(low || high, "B={b}: forward buffer outside the read slices");
             }
         }
-        assert!(!plan.chunk_groups(t, false, Some(&spare)).chained);
+        assert!(!plan.schedule.chunk_groups(t, false, Some(&spare)).chained);
         // Blocks too large for the cache (every limit below theirs): the complex
         // inverse runs as one group, equator first, each buffer's halves in the
         // low-beta and the mirror slices of the next chunk (written after its own FFT
         // stage read the buffer), the last one in the plan's buffer. The real one's
         // full buffers do not fit there: only two chunks, the first one short.
         let mut plan = plan;
-        plan.plain_store_limit = 0;
+        plan.schedule.plain_store_limit = 0;
         let t = if real {
             plan.blocks_real.as_ref().unwrap()
         } else {
@@ -125,7 +128,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
         let ChunkGroups {
             groups: chain,
             chained,
-        } = plan.chunk_groups(t, false, Some(&spare));
+        } = plan.schedule.chunk_groups(t, false, Some(&spare));
         let short_pair = chunks.len() == 2 && chunks[1].1 * 2 <= chunks[0].1;
         assert_eq!(chained, !real || short_pair, "B={b} real={real}");
         if chained {
@@ -139,7 +142,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
             }
             continue;
         }
-        let groups = plan.chunk_groups_whole(t, false, Some(&spare));
+        let groups = plan.schedule.chunk_groups_whole(t, false, Some(&spare));
         let flat: Vec<_> = groups
             .iter()
             .flatten()
@@ -233,7 +236,7 @@ fn block_stores_do_not_change_results() {
             }
             let mut runs = Vec::new();
             for limit in [0usize, usize::MAX] {
-                plan.plain_store_limit = limit;
+                plan.schedule.plain_store_limit = limit;
                 if real {
                     let mut f = vec![0.0; plan.num_samples()];
                     plan.inverse_real(&coefs, &mut f).unwrap();
@@ -313,7 +316,7 @@ fn real_parts_forward_chains_and_matches() {
             .collect();
         let spare = Spare::over(samples.as_mut_ptr(), b);
         assert!(
-            plan.chunk_groups(t, true, Some(&spare)).chained,
+            plan.schedule.chunk_groups(t, true, Some(&spare)).chained,
             "B={b}: no chain"
         );
         let mut want = vec![Complex64::new(f64::NAN, 0.0); plan.num_coeffs()];
