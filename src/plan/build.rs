@@ -3,8 +3,9 @@
 use super::blocks::Blocks;
 use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
+use super::options::{PlanOptions, MAX_BANDWIDTH};
 use super::schedule::Schedule;
-use super::{Plan, PlanOptions, MAX_BANDWIDTH};
+use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
@@ -195,7 +196,7 @@ impl Plan {
         }
     }
 
-    /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`] (which then
+    /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`](crate::FftThreading::Auto) (which then
     /// means slices across workers).
     pub(super) fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
         let b = bandwidth;

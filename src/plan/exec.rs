@@ -4,9 +4,10 @@
 use super::blocks::{Blocks, BufLayout, ChunkBuf};
 use super::build::mem_available;
 use super::dwt_stage::{DwtLayout, Scratch};
+use super::options::StageTimes;
 use super::schedule::{Chunk, ChunkGroups, ClusterStep, Pass, PlacedChunk, Spare};
 use super::shared::SendPtr;
-use super::{Plan, StageTimes};
+use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
 use num_complex::Complex64;
@@ -93,7 +94,7 @@ impl Plan {
     }
 
     /// The chunk loop shared by every transform: for each group of chunks (see
-    /// [`Schedule::chunk_groups`]), the FFT stage of each chunk and the DWT of every cluster of
+    /// `Schedule::chunk_groups`), the FFT stage of each chunk and the DWT of every cluster of
     /// layout `t` over the group's chunks, in the order of the direction (forward: FFT
     /// then DWT), timed. The cluster stage learns where the chunk stands ([`Pass`]).
     pub(super) fn run_chunks(

@@ -15,9 +15,10 @@
 use super::blocks::{BufLayout, ChunkBuf};
 use super::build::mem_available;
 use super::fft_stage::SliceRun;
+use super::options::{FftThreading, PlanOptions};
 use super::schedule::Chunk;
 use super::shared::SendPtr;
-use super::{FftThreading, Plan, PlanOptions};
+use super::Plan;
 use crate::error::Result;
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
 use std::time::Instant;

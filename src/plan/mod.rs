@@ -7,9 +7,19 @@
 //! buffer is the chunk buffer, which holds the `2h` transformed slices in the DWT
 //! kernels' own layout (`plan/blocks.rs`), never a copy of the grid.
 //!
-//! Modules: `blocks` (the chunk buffer's layout), `fft_stage` (FFTW and the moves in and
-//! out of the blocks), `dwt_stage` (kernels per cluster, coefficient signs and layout),
-//! `real` (the real-signal transforms), `fft_tune` (plan-time choice of FFT threading).
+//! Modules, lowest first (none imports one above it; the `impl Plan` blocks of `build`,
+//! `exec`, `real` and `fft_tune` import only the `Plan` type from here):
+//! - `shared`: pointer wrappers sent across rayon tasks, per-worker scratch pools;
+//! - `options`: [`PlanOptions`] and the other option and report types;
+//! - `members`, `coeffs`: which order pairs a layout holds; copies of coefficient rows;
+//! - `blocks`: the chunk buffer's layouts (slot tables, block offsets);
+//! - `schedule`: chunks, groups of chunks and where their buffers live;
+//! - `fft_stage`: [`FftStage`], FFTW and the moves between slices and blocks;
+//! - `dwt_stage`: [`DwtStage`], the kernels per cluster, coefficient signs and layout;
+//! - `build`: validation, memory layout and construction of a plan;
+//! - `exec`: the chunk loop every transform runs;
+//! - `real`: the real-signal transforms;
+//! - `fft_tune`: the plan-time choice of FFT threading ([`FftThreading::Auto`]).
 
 mod blocks;
 mod build;

@@ -18,7 +18,7 @@ pub enum Direction {
     Both,
 }
 
-/// Options for [`Plan::new`].
+/// Options for [`Plan::new`](crate::Plan::new).
 #[derive(Clone, Debug, Default)]
 pub struct PlanOptions {
     /// Which transforms the plan runs (default both).
@@ -27,7 +27,7 @@ pub struct PlanOptions {
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,
-    /// Cap on the chunk buffer in bytes (`None`: the library default, see [`Plan::workspace_bytes`]).
+    /// Cap on the chunk buffer in bytes (`None`: the library default, see [`Plan::workspace_bytes`](crate::Plan::workspace_bytes)).
     pub max_workspace_bytes: Option<usize>,
     /// Force an instruction set for the DWT kernels (`None`: the best this CPU has).
     pub isa: Option<Isa>,
@@ -46,8 +46,8 @@ pub struct PlanOptions {
     /// degree of every beta runs the full recurrence and accumulation (values below `2^-560`
     /// still enter as exact zeros), with the same results up to rounding, only slower.
     pub skip_bits: Option<u32>,
-    /// Also prepare the real-signal transforms [`Plan::forward_real`] and
-    /// [`Plan::inverse_real`] (real-to-complex FFTW plans; planning takes longer).
+    /// Also prepare the real-signal transforms [`Plan::forward_real`](crate::Plan::forward_real) and
+    /// [`Plan::inverse_real`](crate::Plan::inverse_real) (real-to-complex FFTW plans; planning takes longer).
     pub real: bool,
 }
 
@@ -60,7 +60,7 @@ pub enum FftThreading {
     /// FFT stage of the first slice groups of a chunk, for every direction the plan has, on
     /// a scratch array of at most 64 MiB and the plan's chunk buffer) in alternating rounds,
     /// and the faster one is kept; FFTW's threads must be at least 10% faster.
-    /// [`Plan::fft_threading`] tells which was kept. When the FFTW-threaded variant cannot be
+    /// [`Plan::fft_threading`](crate::Plan::fft_threading) tells which was kept. When the FFTW-threaded variant cannot be
     /// planned, or the scratch array would take more than a quarter of the available memory,
     /// slices across workers are kept.
     ///

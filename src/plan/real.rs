@@ -11,9 +11,10 @@
 use super::blocks::Blocks;
 use super::dwt_stage::DwtLayout;
 use super::fft_stage::RealInput;
+use super::options::StageTimes;
 use super::schedule::Spare;
 use super::shared::{SendConstPtr, SendPtr};
-use super::{Plan, StageTimes};
+use super::Plan;
 use crate::error::{Error, Result};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -21,14 +22,14 @@ use rayon::prelude::*;
 impl Plan {
     /// Forward transform of a real signal: `(2B)^3` real samples (the sample layout of docs/conventions.md) to all
     /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
-    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`].
+    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
         self.forward_real_timed(samples, coeffs).map(|_| ())
     }
 
     /// Inverse transform to a real signal: coefficients (only one of each pair
     /// `(M,M')`, `(-M,-M')` is read: those with `M' > 0`, or `M' = 0` and `M >= 0`) to
-    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`].
+    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
         self.inverse_real_timed(coeffs, samples).map(|_| ())
     }

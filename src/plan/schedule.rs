@@ -344,7 +344,7 @@ impl Schedule {
 
     /// Whether an inverse group of `chunks` chunks writes its blocks with non-temporal
     /// stores, half-major (see `plan/blocks.rs`): when they are too large to stay in the
-    /// cache until the FFT stage reads them ([`plain_store_limit`]).
+    /// cache until the FFT stage reads them (`build::plain_store_limit`).
     pub(super) fn streams_blocks(&self, chunks: usize) -> bool {
         chunks * self.buf_bytes > self.plain_store_limit
     }
