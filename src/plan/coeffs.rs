@@ -7,23 +7,25 @@
 
 use num_complex::Complex64;
 
-/// `dst[i * p .. i * p + 2] = src[i] * sg[i % 2] * s[i]` for `i < n` (`s`: the kernels'
-/// value scales, see `RecTables::coeffs`).
+/// The factor of degree offset `i < n` (`n = scales.len()`): `signs[i % 2] * scales[i]`,
+/// the order pair's sign for even and odd offsets times the kernels' value scale (see
+/// `RecTables::coeffs`).
+#[derive(Clone, Copy)]
+pub(super) struct DegreeFactors<'a> {
+    pub signs: [f64; 2],
+    pub scales: &'a [f64],
+}
+
+/// `dst[i * p .. i * p + 2] = src[i] * f(i)` for `i < n` (`f`: the factors, `n` their
+/// number).
 ///
 /// # Safety
 /// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
-pub(super) unsafe fn gather(
-    dst: *mut f64,
-    src: *const Complex64,
-    p: usize,
-    n: usize,
-    sg: [f64; 2],
-    s: &[f64],
-) {
+pub(super) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
+    let (sg, s) = (f.signs, f.scales);
     // SAFETY: the caller's contract (see `# Safety`): reads of `src` below `n`, writes at
     // `i * p` and `i * p + 1` of `dst` for `i < n`.
     unsafe {
-        let s = &s[..n];
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::*;
@@ -42,8 +44,8 @@ pub(super) unsafe fn gather(
     }
 }
 
-/// `dst[i] = src[i * p .. i * p + 2] * sg[i % 2] * s[i]` (or `+=` if `add`) for `i < n`
-/// (`s` as for [`gather`]); with
+/// `dst[i] = src[i * p .. i * p + 2] * f(i)` (or `+=` if `add`) for `i < n` (`f` as for
+/// [`gather`]); with
 /// `partner = Some((d2, ps))` also `d2[i] = ps * conj(dst[i])` (the real forward's partner
 /// pair, from the value in a register: no second pass over the coefficients).
 ///
@@ -53,21 +55,18 @@ pub(super) unsafe fn gather(
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
 /// `i * p` and `i * p + 1`, `i < n`; no overlap.
-#[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter(
     dst: *mut Complex64,
     src: *const f64,
     p: usize,
-    n: usize,
-    sg: [f64; 2],
-    s: &[f64],
+    f: DegreeFactors,
     add: bool,
     partner: Option<(*mut Complex64, f64)>,
 ) {
+    let (sg, s) = (f.signs, f.scales);
     // SAFETY: the caller's contract (see `# Safety`): `n` values of `dst` (and `d2`), reads
     // at `i * p`, `i * p + 1` of `src`, no overlap.
     unsafe {
-        let s = &s[..n];
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::*;
@@ -134,7 +133,17 @@ mod tests {
         let mut rows = vec![7.0; n * p];
         // SAFETY: `n - 1` values of `z`; rows `i < n - 1` of `p` doubles from offset 4
         // reach at most double `(n - 2) p + 5 < n p`.
-        unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg, &sc) };
+        unsafe {
+            gather(
+                rows[4..].as_mut_ptr(),
+                z.as_ptr(),
+                p,
+                DegreeFactors {
+                    signs: sg,
+                    scales: &sc[..n - 1],
+                },
+            )
+        };
         for i in 0..n {
             for q in 0..p {
                 let want = match q {
@@ -145,19 +154,14 @@ mod tests {
                 assert_eq!(rows[i * p + q], want, "i={i} q={q}");
             }
         }
+        let factors = DegreeFactors {
+            signs: sg,
+            scales: &sc[..n - 1],
+        };
         let mut back = vec![Complex64::new(1.0, 1.0); n];
         // SAFETY: `n - 1` values of `back` (`n` long); reads of `rows` as above.
         let back_from_rows = |back: &mut [Complex64], add: bool| unsafe {
-            scatter(
-                back.as_mut_ptr(),
-                rows[4..].as_ptr(),
-                p,
-                n - 1,
-                sg,
-                &sc,
-                add,
-                None,
-            )
+            scatter(back.as_mut_ptr(), rows[4..].as_ptr(), p, factors, add, None)
         };
         back_from_rows(&mut back, false);
         for i in 0..n - 1 {
@@ -186,18 +190,7 @@ mod tests {
                 };
                 // SAFETY: `n - 1` complex values from `pa` and `pb` fit in the `2n + 1`
                 // doubles after `off`; reads of `rows` as above; `a`, `b`, `rows` distinct.
-                unsafe {
-                    scatter(
-                        pa,
-                        rows[4..].as_ptr(),
-                        p,
-                        n - 1,
-                        sg,
-                        &sc,
-                        add,
-                        Some((pb, -2.0)),
-                    )
-                };
+                unsafe { scatter(pa, rows[4..].as_ptr(), p, factors, add, Some((pb, -2.0))) };
                 for i in 0..n {
                     // SAFETY: `i < n`: inside the `2n + 1` doubles after `off`.
                     let (x, y) = unsafe { (*pa.add(i), *pb.add(i)) };

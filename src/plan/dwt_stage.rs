@@ -3,7 +3,7 @@
 //! coefficients' signs and layout.
 
 use super::blocks::{BlockRows, Blocks, BufLayout};
-use super::coeffs;
+use super::coeffs::{self, DegreeFactors};
 use super::members::{all_members, neg_sign, representatives};
 use super::schedule::{Chunk, ClusterStep, Pass, PlacedChunk};
 use super::shared::{lock_free, SendPtr};
@@ -288,7 +288,13 @@ impl DwtStage {
             // SAFETY: `rows` has `to - from` rows of `p >= 2 members.len()` values, so
             // doubles `i * p + 2q` and `+ 1` are in it for `i < to - from`; `coef` has
             // `to - from` values.
-            unsafe { coeffs::gather(dst, coef.as_ptr(), p, to - from, sg, s) };
+            unsafe {
+                let factors = DegreeFactors {
+                    signs: sg,
+                    scales: s,
+                };
+                coeffs::gather(dst, coef.as_ptr(), p, factors)
+            };
         }
     }
 
@@ -481,7 +487,11 @@ impl DwtStage {
                 let src = sums.as_ptr().add(lo * p + 2 * q);
                 let s = &sc.rec.s[lo..n];
                 let add = !pass.first_group;
-                coeffs::scatter(dst.add(lo), src, p, n - lo, sg, s, add, partner);
+                let factors = DegreeFactors {
+                    signs: sg,
+                    scales: s,
+                };
+                coeffs::scatter(dst.add(lo), src, p, factors, add, partner);
             }
         }
     }
