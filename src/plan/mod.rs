@@ -14,13 +14,15 @@
 //! - `members`, `coeffs`: which order pairs a layout holds; copies of coefficient rows;
 //! - `blocks`: the chunk buffer's layouts (slot tables, block offsets);
 //! - `schedule`: chunks, groups of chunks and where their buffers live;
-//! - `fft_stage`: [`FftStage`], FFTW and the moves between slices and blocks;
+//! - `block_copies`: the moves between transformed slices and the rows of the blocks;
+//! - `fft_stage`: [`FftStage`], the slice FFTs of a chunk, a group of pairs at a time;
 //! - `dwt_stage`: [`DwtStage`], the kernels per cluster, coefficient signs and layout;
 //! - `build`: validation, memory layout and construction of a plan;
 //! - `exec`: the chunk loop every transform runs;
 //! - `real`: the real-signal transforms;
 //! - `fft_tune`: the plan-time choice of FFT threading ([`FftThreading::Auto`]).
 
+mod block_copies;
 mod blocks;
 mod build;
 mod coeffs;
