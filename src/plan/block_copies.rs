@@ -225,8 +225,8 @@ pub(super) unsafe fn gather_group(
             if t.regular[c] {
                 // The common case (`Blocks::regular`), written out.
                 match p {
-                    16 => gather_regular::<8>(t, c, &sp[..ns], conj, row, ps, gap),
-                    _ => gather_regular::<4>(t, c, &sp[..ns], conj, row, ps, gap),
+                    16 => gather_regular::<8>(t, c, &sp[..ns], conj, (row, ps, gap)),
+                    _ => gather_regular::<4>(t, c, &sp[..ns], conj, (row, ps, gap)),
                 }
                 continue;
             }
@@ -317,9 +317,7 @@ unsafe fn gather_regular<const S: usize>(
     c: usize,
     sp: &[*mut Complex64],
     conj: bool,
-    row: *const f64,
-    ps: usize,
-    gap: usize,
+    (row, ps, gap): (*const f64, usize, usize),
 ) {
     // SAFETY: `c < t.len()`, and the caller's contract for the slices and rows.
     unsafe {

@@ -183,35 +183,3 @@ impl Plan {
         Ok(times)
     }
 }
-
-/// The FFT stage alone, every chunk of the complex layout in one direction, with the sample
-/// array `grid` as its input (forward) or output (inverse): for the measuring tools in
-/// `benches/` (feature `internals`).
-#[cfg(feature = "internals")]
-pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Result<()> {
-    if grid.len() != plan.num_samples() {
-        return Err(Error::LengthMismatch {
-            what: "samples",
-            expected: plan.num_samples(),
-            got: grid.len(),
-        });
-    }
-    let grid = SendPtr(grid.as_mut_ptr());
-    plan.with_buf(|buf| {
-        plan.pool().install(|| {
-            let layout = if !forward && plan.schedule.streams_blocks(1) {
-                BufLayout::HalfMajor(plan.blocks.total() / 2)
-            } else {
-                BufLayout::Blocks
-            };
-            let buf = ChunkBuf {
-                base: SendPtr(buf.as_mut_ptr() as *mut f64),
-                layout,
-            };
-            for ch in plan.schedule.chunks(&plan.blocks) {
-                plan.fft.chunk(&plan.blocks, &ch, forward, grid, buf)?;
-            }
-            Ok(())
-        })
-    })
-}

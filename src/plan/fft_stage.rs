@@ -17,7 +17,9 @@
 //! whose half spectra fill the blocks of the real layout.
 
 use super::block_copies::{gather_group, scatter_group, SliceGroup, MAX_GROUP};
-use super::blocks::{Blocks, BufLayout, ChunkBuf};
+#[cfg(feature = "internals")]
+use super::blocks::BufLayout;
+use super::blocks::{Blocks, ChunkBuf};
 use super::options::{Direction, FftThreading, PlanOptions};
 use super::schedule::Chunk;
 use super::shared::{lock_free, SendConstPtr, SendPtr};

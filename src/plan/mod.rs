@@ -41,8 +41,6 @@ mod tests;
 pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDTH};
 
 #[cfg(feature = "internals")]
-pub use exec::fft_stage_alone;
-#[cfg(feature = "internals")]
 pub use fft_stage::BlockCopies;
 
 use crate::error::{Error, Result};
@@ -316,4 +314,36 @@ impl Drop for Plan {
             g = cv.wait(g).unwrap_or_else(|e| e.into_inner());
         }
     }
+}
+
+/// The FFT stage alone, every chunk of the complex layout in one direction, with the sample
+/// array `grid` as its input (forward) or output (inverse): for the measuring tools in
+/// `benches/` (feature `internals`).
+#[cfg(feature = "internals")]
+pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Result<()> {
+    if grid.len() != plan.num_samples() {
+        return Err(Error::LengthMismatch {
+            what: "samples",
+            expected: plan.num_samples(),
+            got: grid.len(),
+        });
+    }
+    let grid = shared::SendPtr(grid.as_mut_ptr());
+    plan.with_buf(|buf| {
+        plan.pool().install(|| {
+            let layout = if !forward && plan.schedule.streams_blocks(1) {
+                blocks::BufLayout::HalfMajor(plan.blocks.total() / 2)
+            } else {
+                blocks::BufLayout::Blocks
+            };
+            let buf = blocks::ChunkBuf {
+                base: shared::SendPtr(buf.as_mut_ptr() as *mut f64),
+                layout,
+            };
+            for ch in plan.schedule.chunks(&plan.blocks) {
+                plan.fft.chunk(&plan.blocks, &ch, forward, grid, buf)?;
+            }
+            Ok(())
+        })
+    })
 }
