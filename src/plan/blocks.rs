@@ -10,16 +10,14 @@
 //!
 //! That is the forward's layout, whose DWT kernel reads a whole block at a time. The
 //! inverse's FFT stage instead reads one pair of rows (a beta and its mirror) of every
-//! block at a time, and in that layout those reads are 256 bytes every block (64 KiB at
-//! B = 256), each a few lines from memory. So an inverse whose blocks do not stay in the
-//! cache (see `plain_store_limit` in `plan.rs`) uses the buffer "half-major": two halves,
-//! one with the low-beta rows and one with the mirror rows, each holding row `j` of every
-//! block, cluster after cluster, then row `j + 1` ([`BufLayout::HalfMajor`]); its DWT kernel writes its rows far apart with non-temporal
-//! stores, and its FFT stage reads two sequential runs. (The rows of a pair side by side,
-//! "pair-major", took the inverse's block reads at B = 256 from 0.6-0.65 s to 0.29-0.31 s
-//! on one thread.) The two halves need not be adjacent: a chunk's buffer can then live in
-//! the low-beta and the mirror slices of another chunk of the output (see `Spare` in
-//! `plan.rs`).
+//! block at a time, and in that layout those reads are 256 bytes every block, each a few
+//! lines from memory. So an inverse whose blocks do not stay in the cache (see
+//! `plain_store_limit` in `build.rs`) uses the buffer "half-major": two halves, one with the
+//! low-beta rows and one with the mirror rows, each holding row `j` of every block, cluster
+//! after cluster, then row `j + 1` ([`BufLayout::HalfMajor`]); its DWT kernel writes its
+//! rows far apart with non-temporal stores, and its FFT stage reads two sequential runs.
+//! The two halves need not be adjacent: a chunk's buffer can then live in the low-beta and
+//! the mirror slices of another chunk of the output (see `Spare` in `schedule.rs`).
 //!
 //! A forward allowed to overwrite its input splits its buffers the same way but keeps
 //! them cluster-major within each half ([`BufLayout::Split`]): its kernel reads a
@@ -27,10 +25,11 @@
 //! the other.
 //!
 //! Slot `q` of cluster `c` holds the value of order pair `(M, M')` at the row's beta, or,
-//! for a "reversed" member (see `symmetry.rs`), at the mirrored beta `pi - beta`: `fi[8c+q]`
-//! is where that value sits in a transformed slice, and bit `q` of `rev[c]` says whether it
+//! for a "reversed" member (see `symmetry.rs`), at the mirrored beta `pi - beta`: `slot_index[8c+q]`
+//! is where that value sits in a transformed slice, and bit `q` of `reversed[c]` says whether it
 //! is taken from the mirrored slice.
 
+use super::shared::SendPtr;
 use crate::symmetry::Cluster;
 
 /// How a chunk buffer holds the blocks (see the module documentation); the split layouts
@@ -47,21 +46,40 @@ pub(super) enum BufLayout {
     HalfMajor(usize),
 }
 
+/// A chunk buffer: where its blocks start and how they are laid out.
+#[derive(Clone, Copy)]
+pub(super) struct ChunkBuf {
+    /// Start of the buffer (64-byte aligned).
+    pub base: SendPtr<f64>,
+    /// How the buffer holds the blocks.
+    pub layout: BufLayout,
+}
+
+/// Where a cluster's block is in a chunk buffer: row `2j` at `base + j * pair_stride`,
+/// row `2j + 1` `row_gap` further, `width` doubles each (see [`Blocks::pair_rows`]).
+#[derive(Clone, Copy)]
+pub(super) struct BlockRows {
+    pub base: *mut f64,
+    pub width: usize,
+    pub pair_stride: usize,
+    pub row_gap: usize,
+}
+
 /// No slot (unused entry of a cluster with fewer than 8 members).
 pub(super) const NONE: u32 = u32::MAX;
 
 /// Slot tables and block offsets of one layout (complex or real-signal transforms).
 pub(super) struct Blocks {
     /// Doubles per lane row of each cluster's block.
-    p: Vec<u8>,
+    row_len: Vec<u8>,
     /// `pofs[c]`: doubles per lane of all blocks before cluster `c` (length `C + 1`).
     pofs: Vec<usize>,
     /// Source index of each slot in a transformed slice (`NONE` for unused slots).
-    pub fi: Vec<u32>,
+    pub slot_index: Vec<u32>,
     /// Real layout only: a second index the inverse writes the slot's value to (`NONE`).
-    pub fi2: Vec<u32>,
+    pub slot_neg_index: Vec<u32>,
     /// Bit `q` set: slot `q` reads and writes the mirrored slice.
-    pub rev: Vec<u8>,
+    pub reversed: Vec<u8>,
     /// Whether a cluster's block is regular: every slot used, the first half of the slots
     /// from the own slice and the second half from the mirrored one, no second index. All
     /// 8-member clusters are (complex layout: 8 slots; real: their 4 representatives); the
@@ -74,9 +92,7 @@ pub(super) struct Blocks {
     pub lanes: usize,
     /// Whether the block copies prefetch slice values ahead: only when a pair of
     /// transformed slices (unpadded) is larger than a core's L2 cache (assumed 2 MiB);
-    /// below that
-    /// the prefetches only cost instructions (measured: +10% in the real forward's FFT
-    /// stage at B = 128).
+    /// below that the prefetches only cost instructions.
     pub prefetch_slices: bool,
 }
 
@@ -94,8 +110,8 @@ impl Blocks {
         Blocks::build(clusters, chunk, pair_bytes, |cl| {
             let mut out = [(NONE, NONE, false); 8];
             for (q, mem) in cl.members().iter().enumerate() {
-                let fi = mem.m.rem_euclid(n) * rs + mem.mp.rem_euclid(n);
-                out[q] = (fi as u32, NONE, mem.reversed);
+                let idx = mem.m.rem_euclid(n) * rs + mem.mp.rem_euclid(n);
+                out[q] = (idx as u32, NONE, mem.reversed);
             }
             (out, cl.members().len())
         })
@@ -104,21 +120,21 @@ impl Blocks {
     /// BufLayout of the real-signal transforms: the representatives of each cluster (see
     /// `real.rs`), indexed in the half spectrum of `2B x (B+1)` values of an r2c transform,
     /// `(a, b')` at `(a mod 2B)(B+1) + b'`. For `M' = 0`, `M > 0` the inverse also writes
-    /// the value to `(-M, 0)` (`fi2`).
+    /// the value to `(-M, 0)` (`slot_neg_index`).
     pub fn real(b: usize, clusters: &[(u32, u32)], chunk: usize) -> Blocks {
         let n = 2 * b as isize;
         let half = |a: isize, bp: isize| (a.rem_euclid(n) * (b as isize + 1) + bp) as u32;
         let pair_bytes = 2 * (2 * b) * (b + 1) * 16;
         Blocks::build(clusters, chunk, pair_bytes, |cl| {
             let mut out = [(NONE, NONE, false); 8];
-            let (reps, nr) = super::real::representatives(cl);
+            let (reps, nr) = super::members::representatives(cl);
             for (q, mem) in reps[..nr].iter().enumerate() {
-                let fi2 = if mem.mp == 0 && mem.m != 0 {
+                let neg_idx = if mem.mp == 0 && mem.m != 0 {
                     half(-mem.m, 0)
                 } else {
                     NONE
                 };
-                out[q] = (half(mem.m, mem.mp), fi2, mem.reversed);
+                out[q] = (half(mem.m, mem.mp), neg_idx, mem.reversed);
             }
             (out, nr)
         })
@@ -132,11 +148,11 @@ impl Blocks {
     ) -> Blocks {
         let nc = clusters.len();
         let mut t = Blocks {
-            p: Vec::with_capacity(nc),
+            row_len: Vec::with_capacity(nc),
             pofs: Vec::with_capacity(nc + 1),
-            fi: vec![NONE; 8 * nc],
-            fi2: vec![NONE; 8 * nc],
-            rev: vec![0; nc],
+            slot_index: vec![NONE; 8 * nc],
+            slot_neg_index: vec![NONE; 8 * nc],
+            reversed: vec![0; nc],
             regular: vec![false; nc],
             chunk,
             lanes: Blocks::lanes_for(chunk),
@@ -147,17 +163,17 @@ impl Blocks {
             let cl = Cluster::new(m as usize, mp as usize);
             let (s, len) = slots(&cl);
             let p = if len > 4 { 16 } else { 8 };
-            t.p.push(p as u8);
+            t.row_len.push(p as u8);
             t.pofs.push(acc);
             acc += p;
-            for (q, &(fi, fi2, rev)) in s[..len].iter().enumerate() {
-                t.fi[8 * c + q] = fi;
-                t.fi2[8 * c + q] = fi2;
-                t.rev[c] |= (rev as u8) << q;
+            for (q, &(idx, neg_idx, reversed)) in s[..len].iter().enumerate() {
+                t.slot_index[8 * c + q] = idx;
+                t.slot_neg_index[8 * c + q] = neg_idx;
+                t.reversed[c] |= (reversed as u8) << q;
             }
             let half = p / 4;
             t.regular[c] = len == p / 2
-                && t.rev[c] as usize == ((1 << len) - 1) & !((1 << half) - 1)
+                && t.reversed[c] as usize == ((1 << len) - 1) & !((1 << half) - 1)
                 && s[..len].iter().all(|x| x.1 == NONE);
         }
         t.pofs.push(acc);
@@ -166,12 +182,12 @@ impl Blocks {
 
     /// Number of clusters.
     pub fn len(&self) -> usize {
-        self.p.len()
+        self.row_len.len()
     }
 
     /// Doubles per lane row of cluster `c`'s block.
-    pub fn p(&self, c: usize) -> usize {
-        self.p[c] as usize
+    pub fn row_len(&self, c: usize) -> usize {
+        self.row_len[c] as usize
     }
 
     /// Lanes of every block for chunks of `chunk` low betas (see [`Blocks::lanes`]).
@@ -197,7 +213,7 @@ impl Blocks {
     /// offset (in doubles) of row `2j`, the doubles from one pair's rows to the next, and
     /// from row `2j` to row `2j + 1`. The one place that knows the layouts.
     pub fn pair_rows(&self, c: usize, j: usize, layout: BufLayout) -> (usize, usize, usize) {
-        let p = self.p(c);
+        let p = self.row_len(c);
         match layout {
             BufLayout::Blocks => (self.offset(c) + 2 * j * p, 2 * p, p),
             BufLayout::Split(gap) => (self.pofs[c] * (self.lanes / 2) + j * p, p, gap),
@@ -205,6 +221,17 @@ impl Blocks {
                 let stride = self.pofs[self.len()];
                 (j * stride + self.pofs[c], stride, gap)
             }
+        }
+    }
+
+    /// Where cluster `c`'s block is in the chunk buffer `buf`.
+    pub fn rows(&self, c: usize, buf: ChunkBuf) -> BlockRows {
+        let (at, pair_stride, row_gap) = self.pair_rows(c, 0, buf.layout);
+        BlockRows {
+            base: buf.base.get().wrapping_add(at),
+            width: self.row_len(c),
+            pair_stride,
+            row_gap,
         }
     }
 
@@ -249,11 +276,11 @@ mod tests {
             let mut seen = HashSet::new();
             for c in 0..t.len() {
                 for q in 0..8 {
-                    let fi = t.fi[8 * c + q];
-                    if fi != NONE {
-                        assert!(2 * q < t.p(c));
-                        assert!(seen.insert(fi));
-                        let (a, g) = (fi as usize / rs, fi as usize % rs);
+                    let idx = t.slot_index[8 * c + q];
+                    if idx != NONE {
+                        assert!(2 * q < t.row_len(c));
+                        assert!(seen.insert(idx));
+                        let (a, g) = (idx as usize / rs, idx as usize % rs);
                         assert!(a < n && g < n, "outside the slice or in its padding");
                         assert!(a != b && g != b, "frequency B is out of band");
                     }
@@ -266,7 +293,7 @@ mod tests {
             let r = Blocks::real(b, &cl, 8);
             for (c, &(m, mp)) in cl.iter().enumerate() {
                 let cluster = Cluster::new(m as usize, mp as usize);
-                let (reps, nr) = crate::plan::real::representatives(&cluster);
+                let (reps, nr) = crate::plan::members::representatives(&cluster);
                 let slots = [(&t, cluster.members()), (&r, &reps[..nr])];
                 for (l, members) in slots {
                     let p = if members.len() > 4 { 16 } else { 8 };

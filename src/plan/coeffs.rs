@@ -3,96 +3,101 @@
 //! contiguous run of degrees per order pair. These copies move one pair's run between the
 //! two, with the pair's sign for even and odd degree offsets applied on the way.
 //!
-//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64): the scalar
-//! element-by-element loop this replaces took about a fifth of the inverse DWT stage
-//! with several chunks.
+//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64).
 
 use num_complex::Complex64;
 
-/// `dst[i * p .. i * p + 2] = src[i] * sg[i % 2] * s[i]` for `i < n` (`s`: the kernels'
-/// value scales, see `RecTables::coeffs`).
+/// The factor of degree offset `i < n` (`n = scales.len()`): `signs[i % 2] * scales[i]`,
+/// the order pair's sign for even and odd offsets times the kernels' value scale (see
+/// `RecTables::coeffs`).
+#[derive(Clone, Copy)]
+pub(super) struct DegreeFactors<'a> {
+    pub signs: [f64; 2],
+    pub scales: &'a [f64],
+}
+
+/// `dst[i * p .. i * p + 2] = src[i] * f(i)` for `i < n` (`f`: the factors, `n` their
+/// number).
 ///
 /// # Safety
 /// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
-pub(super) unsafe fn gather(
-    dst: *mut f64,
-    src: *const Complex64,
-    p: usize,
-    n: usize,
-    sg: [f64; 2],
-    s: &[f64],
-) {
-    let s = &s[..n];
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        for (i, &si) in s.iter().enumerate() {
-            let z = _mm_loadu_pd(src.add(i) as *const f64);
-            _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, _mm_set1_pd(sg[i & 1] * si)));
+pub(super) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
+    let (sg, s) = (f.signs, f.scales);
+    // SAFETY: the caller's contract (see `# Safety`): reads of `src` below `n`, writes at
+    // `i * p` and `i * p + 1` of `dst` for `i < n`.
+    unsafe {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            for (i, &si) in s.iter().enumerate() {
+                let z = _mm_loadu_pd(src.add(i) as *const f64);
+                _mm_storeu_pd(dst.add(i * p), _mm_mul_pd(z, _mm_set1_pd(sg[i & 1] * si)));
+            }
         }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for (i, &si) in s.iter().enumerate() {
-        let z = *src.add(i);
-        let g = sg[i & 1] * si;
-        *dst.add(i * p) = z.re * g;
-        *dst.add(i * p + 1) = z.im * g;
+        #[cfg(not(target_arch = "x86_64"))]
+        for (i, &si) in s.iter().enumerate() {
+            let z = *src.add(i);
+            let g = sg[i & 1] * si;
+            *dst.add(i * p) = z.re * g;
+            *dst.add(i * p + 1) = z.im * g;
+        }
     }
 }
 
-/// `dst[i] = src[i * p .. i * p + 2] * sg[i % 2] * s[i]` (or `+=` if `add`) for `i < n`
-/// (`s` as for [`gather`]); with
+/// `dst[i] = src[i * p .. i * p + 2] * f(i)` (or `+=` if `add`) for `i < n` (`f` as for
+/// [`gather`]); with
 /// `partner = Some((d2, ps))` also `d2[i] = ps * conj(dst[i])` (the real forward's partner
 /// pair, from the value in a register: no second pass over the coefficients).
 ///
-/// Plain stores: non-temporal ones made the B = 128 forward's DWT stage about 30% slower
-/// here, where the coefficients fit in the (large, shared) L3 cache.
+/// Plain stores: the coefficients are read back by the next group or stay in the
+/// last-level cache.
 ///
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
 /// `i * p` and `i * p + 1`, `i < n`; no overlap.
-#[allow(clippy::too_many_arguments)]
 pub(super) unsafe fn scatter(
     dst: *mut Complex64,
     src: *const f64,
     p: usize,
-    n: usize,
-    sg: [f64; 2],
-    s: &[f64],
+    f: DegreeFactors,
     add: bool,
     partner: Option<(*mut Complex64, f64)>,
 ) {
-    let s = &s[..n];
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::*;
-        let d = dst as *mut f64;
-        let (d2, conj) = match partner {
-            Some((d2, ps)) => (d2 as *mut f64, _mm_set_pd(-ps, ps)),
-            None => (std::ptr::null_mut(), _mm_setzero_pd()),
-        };
+    let (sg, s) = (f.signs, f.scales);
+    // SAFETY: the caller's contract (see `# Safety`): `n` values of `dst` (and `d2`), reads
+    // at `i * p`, `i * p + 1` of `src`, no overlap.
+    unsafe {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            let d = dst as *mut f64;
+            let (d2, conj) = match partner {
+                Some((d2, ps)) => (d2 as *mut f64, _mm_set_pd(-ps, ps)),
+                None => (std::ptr::null_mut(), _mm_setzero_pd()),
+            };
+            for (i, &si) in s.iter().enumerate() {
+                let g = _mm_set1_pd(sg[i & 1] * si);
+                let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g);
+                if add {
+                    z = _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z);
+                }
+                _mm_storeu_pd(d.add(2 * i), z);
+                if !d2.is_null() {
+                    _mm_storeu_pd(d2.add(2 * i), _mm_mul_pd(z, conj));
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
         for (i, &si) in s.iter().enumerate() {
-            let g = _mm_set1_pd(sg[i & 1] * si);
-            let mut z = _mm_mul_pd(_mm_loadu_pd(src.add(i * p)), g);
+            let g = sg[i & 1] * si;
+            let mut z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
             if add {
-                z = _mm_add_pd(_mm_loadu_pd(d.add(2 * i)), z);
+                z += *dst.add(i);
             }
-            _mm_storeu_pd(d.add(2 * i), z);
-            if !d2.is_null() {
-                _mm_storeu_pd(d2.add(2 * i), _mm_mul_pd(z, conj));
+            *dst.add(i) = z;
+            if let Some((d2, ps)) = partner {
+                *d2.add(i) = z.conj() * ps;
             }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    for (i, &si) in s.iter().enumerate() {
-        let g = sg[i & 1] * si;
-        let mut z = Complex64::new(*src.add(i * p) * g, *src.add(i * p + 1) * g);
-        if add {
-            z += *dst.add(i);
-        }
-        *dst.add(i) = z;
-        if let Some((d2, ps)) = partner {
-            *d2.add(i) = z.conj() * ps;
         }
     }
 }
@@ -103,8 +108,11 @@ pub(super) unsafe fn scatter(
 /// # Safety
 /// `src` valid for `n` reads, `d2` for `n` writes; no overlap.
 pub(super) unsafe fn partner_copy(d2: *mut Complex64, src: *const Complex64, n: usize, ps: f64) {
-    for i in 0..n {
-        *d2.add(i) = (*src.add(i)).conj() * ps;
+    // SAFETY: the caller's contract: `n` reads of `src`, `n` writes of `d2`, no overlap.
+    unsafe {
+        for i in 0..n {
+            *d2.add(i) = (*src.add(i)).conj() * ps;
+        }
     }
 }
 
@@ -123,7 +131,19 @@ mod tests {
         // Scales that are powers of two keep every product exact.
         let sc: Vec<f64> = (0..n).map(|i| [1.0, 0.5, 4.0][i % 3]).collect();
         let mut rows = vec![7.0; n * p];
-        unsafe { gather(rows[4..].as_mut_ptr(), z.as_ptr(), p, n - 1, sg, &sc) };
+        // SAFETY: `n - 1` values of `z`; rows `i < n - 1` of `p` doubles from offset 4
+        // reach at most double `(n - 2) p + 5 < n p`.
+        unsafe {
+            gather(
+                rows[4..].as_mut_ptr(),
+                z.as_ptr(),
+                p,
+                DegreeFactors {
+                    signs: sg,
+                    scales: &sc[..n - 1],
+                },
+            )
+        };
         for i in 0..n {
             for q in 0..p {
                 let want = match q {
@@ -134,18 +154,14 @@ mod tests {
                 assert_eq!(rows[i * p + q], want, "i={i} q={q}");
             }
         }
+        let factors = DegreeFactors {
+            signs: sg,
+            scales: &sc[..n - 1],
+        };
         let mut back = vec![Complex64::new(1.0, 1.0); n];
+        // SAFETY: `n - 1` values of `back` (`n` long); reads of `rows` as above.
         let back_from_rows = |back: &mut [Complex64], add: bool| unsafe {
-            scatter(
-                back.as_mut_ptr(),
-                rows[4..].as_ptr(),
-                p,
-                n - 1,
-                sg,
-                &sc,
-                add,
-                None,
-            )
+            scatter(back.as_mut_ptr(), rows[4..].as_ptr(), p, factors, add, None)
         };
         back_from_rows(&mut back, false);
         for i in 0..n - 1 {
@@ -165,25 +181,18 @@ mod tests {
             for off in [0usize, 1] {
                 let mut a = vec![3.0f64; 2 * n + 2];
                 let mut b = vec![5.0f64; 2 * n + 2];
+                // SAFETY: `off <= 1` of `2n + 2` doubles.
                 let (pa, pb) = unsafe {
                     (
                         a.as_mut_ptr().add(off) as *mut Complex64,
                         b.as_mut_ptr().add(off) as *mut Complex64,
                     )
                 };
-                unsafe {
-                    scatter(
-                        pa,
-                        rows[4..].as_ptr(),
-                        p,
-                        n - 1,
-                        sg,
-                        &sc,
-                        add,
-                        Some((pb, -2.0)),
-                    )
-                };
+                // SAFETY: `n - 1` complex values from `pa` and `pb` fit in the `2n + 1`
+                // doubles after `off`; reads of `rows` as above; `a`, `b`, `rows` distinct.
+                unsafe { scatter(pa, rows[4..].as_ptr(), p, factors, add, Some((pb, -2.0))) };
                 for i in 0..n {
+                    // SAFETY: `i < n`: inside the `2n + 1` doubles after `off`.
                     let (x, y) = unsafe { (*pa.add(i), *pb.add(i)) };
                     if i == n - 1 {
                         assert_eq!((x, y), (Complex64::new(3.0, 3.0), Complex64::new(5.0, 5.0)));
@@ -199,6 +208,7 @@ mod tests {
             }
         }
         let mut d2 = vec![Complex64::new(0.0, 0.0); n];
+        // SAFETY: `n` values of `z` and of `d2`, distinct.
         unsafe { partner_copy(d2.as_mut_ptr(), z.as_ptr(), n, -1.0) };
         for i in 0..n {
             assert_eq!(d2[i], -z[i].conj());

@@ -8,63 +8,28 @@
 //! `2B (B+1)` half-spectrum rows per slot. The inverse fills the c2r input
 //! `Y[M mod 2B][M'] = conj(G(M,M'))` for `M' >= 0`, which makes `f = c2r(Y)` the samples.
 
-use super::*;
-use crate::symmetry::Member;
-
-/// Whether `mem` is the representative of its negation pair.
-fn representative(mem: &Member) -> bool {
-    mem.mp > 0 || (mem.mp == 0 && mem.m >= 0)
-}
-
-/// The representatives of a cluster (1, 2 or 4 members, then padding) and their number.
-pub(super) fn representatives(cl: &Cluster) -> ([Member; 8], usize) {
-    let mut reps = [cl.members()[0]; 8];
-    let mut nr = 0;
-    for mem in cl.members().iter().filter(|m| representative(m)) {
-        reps[nr] = *mem;
-        nr += 1;
-    }
-    (reps, nr)
-}
-
-/// `(-1)^(M - M')`.
-pub(super) fn neg_sign(m: isize, mp: isize) -> f64 {
-    if (m - mp).rem_euclid(2) == 0 {
-        1.0
-    } else {
-        -1.0
-    }
-}
-
-/// Where the real samples of a forward transform come from.
-#[derive(Clone, Copy)]
-enum RealInput {
-    /// `(2B)^3` doubles.
-    Real(*const f64),
-    /// The real parts of `(2B)^3` complex values.
-    RealParts(*const Complex64),
-}
-
-/// `RealInput` shared by the FFT workers (read only through it).
-#[derive(Clone, Copy)]
-struct SyncInput(RealInput);
-// SAFETY: the pointed-to samples are only read through it, by all workers, during one
-// execution; a forward destroying its input writes chunk buffers only into slices whose
-// reads are finished (see `Spare::consumed` and `Plan::chain`).
-unsafe impl Send for SyncInput {}
-unsafe impl Sync for SyncInput {}
+use super::blocks::Blocks;
+use super::dwt_stage::DwtLayout;
+use super::fft_stage::RealInput;
+use super::options::StageTimes;
+use super::schedule::Spare;
+use super::shared::{SendConstPtr, SendPtr};
+use super::Plan;
+use crate::error::{Error, Result};
+use num_complex::Complex64;
+use rayon::prelude::*;
 
 impl Plan {
-    /// Forward transform of a real signal: `(2B)^3` real samples (SPEC layout) to all
+    /// Forward transform of a real signal: `(2B)^3` real samples (the sample layout of docs/conventions.md) to all
     /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
-    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`].
+    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
         self.forward_real_timed(samples, coeffs).map(|_| ())
     }
 
     /// Inverse transform to a real signal: coefficients (only one of each pair
     /// `(M,M')`, `(-M,-M')` is read: those with `M' > 0`, or `M' = 0` and `M >= 0`) to
-    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`].
+    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
         self.inverse_real_timed(coeffs, samples).map(|_| ())
     }
@@ -95,12 +60,6 @@ impl Plan {
         Ok(())
     }
 
-    fn real_fft(&self) -> Result<&SliceFftReal> {
-        self.real_fft.as_ref().ok_or_else(|| {
-            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
-    }
-
     /// Like [`Plan::forward_real`], also returning the time of each stage.
     pub fn forward_real_timed(
         &self,
@@ -108,7 +67,11 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::Real(samples.as_ptr()), coeffs, None)
+        self.forward_real_impl(
+            RealInput::Real(SendConstPtr(samples.as_ptr())),
+            coeffs,
+            None,
+        )
     }
 
     /// [`Plan::forward_real`] that may overwrite `samples`, for fewer passes over the
@@ -132,7 +95,7 @@ impl Plan {
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_real_impl(RealInput::Real(base), coeffs, Some(spare))
+        self.forward_real_impl(RealInput::Real(SendConstPtr(base)), coeffs, Some(spare))
     }
 
     /// Forward transform of the real parts of complex samples (the imaginary parts are not
@@ -143,7 +106,11 @@ impl Plan {
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(RealInput::RealParts(samples.as_ptr()), coeffs, None)
+        self.forward_real_impl(
+            RealInput::RealParts(SendConstPtr(samples.as_ptr())),
+            coeffs,
+            None,
+        )
     }
 
     /// [`Plan::forward_real_parts`] that may overwrite `samples`.
@@ -155,7 +122,11 @@ impl Plan {
         self.check(true, samples.len(), coeffs.len())?;
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_real_impl(RealInput::RealParts(base), coeffs, Some(spare))
+        self.forward_real_impl(
+            RealInput::RealParts(SendConstPtr(base)),
+            coeffs,
+            Some(spare),
+        )
     }
 
     fn forward_real_impl(
@@ -164,22 +135,27 @@ impl Plan {
         coeffs: &mut [Complex64],
         spare: Option<Spare>,
     ) -> Result<StageTimes> {
-        self.real_fft()?;
-        let input = SyncInput(input);
-        let coef = SyncPtr(coeffs.as_mut_ptr());
+        self.fft.real_fft()?;
+        let coef = SendPtr(coeffs.as_mut_ptr());
         let t = self.real_blocks()?;
+        let layout = DwtLayout {
+            blocks: t,
+            real: true,
+        };
         self.run_chunks(
             true,
             t,
             spare,
-            |ch, buf, layout| {
-                self.fft_chunk_real(ch, Some(input), std::ptr::null_mut(), buf, layout)
+            |ch, buf| {
+                let no_output = SendPtr(std::ptr::null_mut());
+                self.fft.chunk_real(t, ch, Some(input), no_output, buf)
             },
-            |sc, at, ch, buf, pass| unsafe {
-                // The chunks accumulate the representatives only (half the coefficient
-                // traffic per chunk); the last one also writes their partners.
-                self.forward_cluster(sc, t, representatives, true, at, ch, buf, coef, pass);
-            },
+            // The chunks accumulate the representatives only (half the coefficient traffic
+            // per chunk); the last one also writes their partners.
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer and coefficient rows (representatives and their partners) no
+            // other task touches; `coeffs` has `num_coeffs` entries (checked above).
+            |sc, step, pass| unsafe { self.dwt.forward_cluster(sc, &layout, step, coef, pass) },
         )
     }
 
@@ -190,100 +166,29 @@ impl Plan {
         samples: &mut [f64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.real_fft()?;
+        self.fft.real_fft()?;
         // One raw pointer for the output slices and for the buffers in the free ones.
-        let out = SyncPtr(samples.as_mut_ptr());
+        let out = SendPtr(samples.as_mut_ptr());
         let t = self.real_blocks()?;
+        let layout = DwtLayout {
+            blocks: t,
+            real: true,
+        };
         let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             t,
             Some(spare),
-            |ch, buf, layout| self.fft_chunk_real(ch, None, out.get(), buf, layout),
-            |sc, at, ch, buf, pass| unsafe {
-                self.inverse_cluster(sc, t, representatives, at, ch, buf, coeffs, pass)
-            },
+            |ch, buf| self.fft.chunk_real(t, ch, None, out, buf),
+            // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
+            // chunk buffer no other task touches.
+            |sc, step, pass| unsafe { self.dwt.inverse_cluster(sc, &layout, step, coeffs, pass) },
         )
     }
 
     fn real_blocks(&self) -> Result<&Blocks> {
         self.blocks_real.as_ref().ok_or_else(|| {
             Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
-    }
-
-    /// FFT stage of one chunk for real data (see the module documentation), one mirrored
-    /// pair of slices at a time: forward from `input` into the blocks (r2c, then the
-    /// conjugated half spectra, weighted), or (with `input = None`) inverse from the blocks
-    /// into `grid` (c2r), the buffer laid out as `layout` (see [`Plan::fft_chunk`]).
-    fn fft_chunk_real(
-        &self,
-        ch: &Chunk,
-        input: Option<SyncInput>,
-        grid: *mut f64,
-        buf: *mut f64,
-        layout: BufLayout,
-    ) -> Result<()> {
-        let fft = self.real_fft()?;
-        let t = self.real_blocks()?;
-        let (b, n) = (self.b, 2 * self.b);
-        let (nn, nh) = (n * n, n * (b + 1));
-        let (grid, buf) = (SyncPtr(grid), SyncPtr(buf));
-        (0..ch.h).into_par_iter().try_for_each(|j| -> Result<()> {
-            let (k0, k1) = ch.pair_betas(b, j);
-            self.with_fft_scratch(|scratch| {
-                let sp = scratch.as_mut_ptr();
-                // SAFETY: the scratch holds at least two padded slices, 2n(n + 4) complex
-                // values: two half spectra (nh = n^2/2 + n each) and n^2 packed reals
-                // (n^2/2 values) fit; pair `j` owns its two rows of every block and its two
-                // sample slices (n^2 reals each).
-                unsafe {
-                    let s = [sp, sp.add(nh)];
-                    if let Some(SyncInput(input)) = input {
-                        // Real parts of complex samples are first packed into the free
-                        // part of the scratch, one slice at a time.
-                        let packed = sp.add(2 * nh) as *mut f64;
-                        for (&dst, k) in s.iter().zip([k0, k1]) {
-                            let src = match input {
-                                RealInput::Real(p) => p.add(k * nn),
-                                RealInput::RealParts(p) => {
-                                    let slice = p.add(k * nn);
-                                    for i in 0..nn {
-                                        *packed.add(i) = (*slice.add(i)).re;
-                                    }
-                                    packed as *const f64
-                                }
-                            };
-                            fft.r2c(src, dst);
-                        }
-                        // S(M,M') = conj(R[M][M']) for M' >= 0.
-                        fft_stage::scatter_group(
-                            t,
-                            &[SyncPtr(s[0]), SyncPtr(s[1])],
-                            &[self.wq[k0], self.wq[k1]],
-                            true,
-                            buf.get(),
-                            layout,
-                            j,
-                            0..t.len(),
-                        );
-                    } else {
-                        let sc = [SyncPtr(s[0]), SyncPtr(s[1])];
-                        fft_stage::gather_group(t, &sc, true, buf.get(), layout, j, 0..t.len());
-                        for (&slot, k) in s.iter().zip([k0, k1]) {
-                            // Frequency B (alpha or gamma) is outside the band limit.
-                            for i in 0..=b {
-                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
-                            }
-                            for a in 0..n {
-                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
-                            }
-                            fft.c2r(slot, grid.get().add(k * nn));
-                        }
-                    }
-                }
-                Ok(())
-            })
         })
     }
 }
@@ -298,16 +203,18 @@ impl Plan {
 /// # Safety
 /// `base` is valid for `2n` doubles.
 unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usize, threads: usize) {
-    #[derive(Clone, Copy)]
-    struct P(*mut f64);
-    // SAFETY: threads write disjoint ranges and read ranges nobody writes in that round.
-    unsafe impl Send for P {}
-    unsafe impl Sync for P {}
-    let spread = |p: P, lo: usize, hi: usize| {
+    // Entries `lo..hi` to doubles `2 lo..2 hi`, from the top down.
+    let spread = |p: SendPtr<f64>, lo: usize, hi: usize| {
         for i in (lo..hi).rev() {
-            let v = *p.0.add(i);
-            *p.0.add(2 * i + 1) = 0.0;
-            *p.0.add(2 * i) = v;
+            // SAFETY: `i < hi <= n` and `2i + 1 < 2n`: inside the caller's `2n` doubles.
+            // Within a round the pieces write disjoint ranges `[2a, 2a + 2 per)` at or
+            // above `2 lo >= hi` and read reals below `hi` that no piece of the round
+            // writes; the last (single) pass runs alone.
+            unsafe {
+                let v = *p.get().add(i);
+                *p.get().add(2 * i + 1) = 0.0;
+                *p.get().add(2 * i) = v;
+            }
         }
     };
     let mut hi = n;
@@ -317,7 +224,7 @@ unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usiz
             // another piece of this round still reads.
             let lo = hi.div_ceil(2);
             let per = (hi - lo).div_ceil(threads);
-            let p = P(base);
+            let p = SendPtr(base);
             pool.install(|| {
                 (lo..hi)
                     .step_by(per)
@@ -327,7 +234,7 @@ unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usiz
             hi = lo;
         }
     }
-    spread(P(base), 0, hi);
+    spread(SendPtr(base), 0, hi);
 }
 
 #[cfg(test)]
