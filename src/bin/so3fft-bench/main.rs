@@ -12,25 +12,15 @@
 //! `cargo run --release --bin so3fft-bench -- --help` lists the options; `notes/bench.md`
 //! describes the columns and how each number is measured.
 
-#[path = "so3fft_bench/big.rs"]
 mod big;
-#[path = "so3fft_bench/cli.rs"]
 mod cli;
-#[path = "so3fft_bench/memory.rs"]
 mod memory;
-#[path = "so3fft_bench/naive.rs"]
 mod naive;
-#[path = "so3fft_bench/peak.rs"]
 mod peak;
-#[path = "so3fft_bench/plot.rs"]
 mod plot;
-#[path = "so3fft_bench/report.rs"]
 mod report;
-#[path = "so3fft_bench/seeded.rs"]
 mod seeded;
-#[path = "so3fft_bench/soft_cmp.rs"]
 mod soft_cmp;
-#[path = "so3fft_bench/workload.rs"]
 mod workload;
 
 use cli::{Command, Options};
