@@ -19,11 +19,13 @@ mod naive;
 mod peak;
 mod plot;
 mod report;
+mod scaling;
 mod seeded;
 mod soft_cmp;
+mod stages;
 mod workload;
 
-use cli::{Command, Options};
+use cli::{Command, Options, Tool};
 use report::{Memory, Row, Stages, Variant};
 use so3fft::{Complex64, Direction, Plan, PlanOptions, StageTimes};
 use std::process::ExitCode;
@@ -40,12 +42,43 @@ fn main() -> ExitCode {
             println!("{}", cli::USAGE);
             ExitCode::SUCCESS
         }
-        Ok(Command::Run(opts)) => run(&opts),
+        Ok(Command::Run(opts)) => match opts.tool {
+            Tool::Full => run(&opts),
+            Tool::Stages => report_failure("stages", stages::run(&opts)),
+            Tool::Scaling => report_failure("scaling", scaling::run(&opts)),
+            Tool::Real => report_failure("real", run_real(&opts)),
+        },
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
             ExitCode::from(2)
         }
     }
+}
+
+/// Exit code of a tool's result, with the error on stderr.
+fn report_failure(tool: &str, result: Result<(), so3fft::Error>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("so3fft-bench {tool}: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The `real` tool: the real-signal transforms against the complex ones at every bandwidth,
+/// on the last thread count (as in the full benchmark), as one table.
+fn run_real(opts: &Options) -> Result<(), so3fft::Error> {
+    let threads = *opts.threads.last().expect("at least one thread count");
+    let mut rows = Vec::new();
+    for &b in &opts.bandwidths {
+        rows.push(bench_real(b, threads, opts, f64::NAN)?);
+    }
+    println!(
+        "Real-signal transforms against the complex ones (same B, threads):\n{}",
+        report::real_table(&rows)
+    );
+    Ok(())
 }
 
 /// Runs the whole benchmark; fails if no configuration could be measured or the CSV not written.
@@ -365,6 +398,7 @@ fn bench_plan(
             rigor: opts.rigor,
             skip_bits: (variant == Variant::NoSkip).then_some(0),
             real: variant == Variant::Real,
+            fft_threading: opts.fft_threading,
             ..PlanOptions::default()
         },
     )?;
