@@ -64,10 +64,11 @@ impl Isa {
     fn run(self, iters: u64) -> f64 {
         let iters = black_box(iters);
         match self {
-            // SAFETY: the variant is only chosen after runtime detection of the features.
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Isa::detect` chose this variant after detecting AVX-512F at run time.
             Isa::Avx512 => unsafe { kernel_avx512(iters) },
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Isa::detect` chose this variant after detecting AVX2 and FMA at run time.
             Isa::Avx2Fma => unsafe { kernel_avx2(iters) },
             _ => kernel_scalar(iters),
         }

@@ -52,6 +52,16 @@ pub struct Memory {
 }
 
 impl Memory {
+    /// The figures of a measured `phase` with the plan's and the arrays' bytes.
+    pub fn of_phase(phase: crate::memory::Phase, plan: u64, arrays: u64) -> Memory {
+        Memory {
+            peak: phase.peak,
+            start: phase.start,
+            plan,
+            arrays,
+        }
+    }
+
     pub fn peak_over_arrays(&self) -> f64 {
         self.peak as f64 / self.arrays as f64
     }
