@@ -7,7 +7,7 @@
 //!    writes the grid, the forward writes its result over the coefficient array, and the
 //!    result is compared with coefficients generated again. The peak resident memory of the
 //!    forward (reset just before it) is compared with input + output = grid + coefficients:
-//!    the issue asks for at most 5% more.
+//!    the target is at most 5% more.
 //! 2. The same without skipping negligible Wigner-d prefixes (`skip_bits: Some(0)`), on the
 //!    same arrays (n/a while the library refuses that option).
 //! 3. Real-signal round trip (`forward_real` / `inverse_real`, real grid of 8.6 GB) on
@@ -19,7 +19,7 @@
 //! with its time, error and peak memory printed (not in the CSV).
 //!
 //! Each plan is dropped before the next is made (a plan holds a chunk buffer of about 1 GB
-//! here). Before each step the memory it needs is checked against `MemAvailable`; a step
+//! at B = 512). Before each step the memory it needs is checked against `MemAvailable`; a step
 //! that does not fit is skipped with a message. Everything runs once (a run takes minutes).
 
 use crate::cli::Options;

@@ -17,7 +17,7 @@ const QUICK_MAX_BANDWIDTH: usize = 64;
 pub const MAX_REGULAR_BANDWIDTH: usize = 256;
 /// Bandwidth `--big` adds.
 pub const BIG_BANDWIDTH: usize = 512;
-/// Largest bandwidth of the plain DWT by default (about 1 s per direction at 128 here).
+/// Largest bandwidth of the plain DWT by default (its cost grows as B^4).
 const DEFAULT_NAIVE_MAX: usize = 128;
 /// ... and under `--quick`.
 const QUICK_NAIVE_MAX: usize = 16;
@@ -150,9 +150,9 @@ impl Default for Options {
             threads: vec![1, 2],
             runs: None,
             csv: PathBuf::from("bench.csv"),
-            // Not the library's default (Estimate): FFTW_ESTIMATE plans made the FFT stage
-            // 6.3x slower at B = 256 on the development machine (6.9 s against 1.1 s, one
-            // thread), which would hide the DWT. Planning time is not part of any timing.
+            // Not the library's default (Estimate): FFTW_ESTIMATE plans make the FFT stage
+            // several times slower at large B, which would hide the DWT. Planning time is not
+            // part of any timing.
             rigor: Rigor::Measure,
             quick: false,
             soft: false,

@@ -5,9 +5,13 @@
 //! coefficients, relates the DWT stage's flop rate to the machine's FMA peak measured in the
 //! same run, and records the peak resident memory. Per bandwidth it also runs the transforms
 //! without skipping negligible Wigner-d prefixes, the real-signal transforms against the
-//! complex ones and, at small B, a plain one-thread DWT (`naive.rs`) as a yardstick. `--big`
-//! adds B = 512 in a memory-lean procedure (`big.rs`).
+//! complex ones and, at small B, a plain one-thread DWT (`naive.rs`) as a yardstick
+//! (`regular.rs`). `--big` adds B = 512 in a memory-lean procedure (`big.rs`).
 //! Prints tables, writes a CSV file and an SVG plot.
+//!
+//! Three narrower tools share the options: `stages` (stage times of repeated transforms, for
+//! profiling), `scaling` (thread scaling in windows undisturbed by other processes) and
+//! `real` (the real-signal against the complex transforms only).
 //!
 //! `cargo run --release --bin so3fft-bench -- --help` lists the options; `notes/bench.md`
 //! describes the columns and how each number is measured.
@@ -32,7 +36,7 @@ mod workload;
 
 use cli::{Command, Options, Tool};
 use regular::{Results, Setup};
-use report::Variant;
+use report::{Row, Variant};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -42,7 +46,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Ok(Command::Run(opts)) => match opts.tool {
-            Tool::Full => run(&opts),
+            Tool::Full => run_full(&opts),
             Tool::Stages => report_failure("stages", stages::run(&opts)),
             Tool::Scaling => report_failure("scaling", scaling::run(&opts)),
             Tool::Real => report_failure("real", run_real(&opts)),
@@ -86,7 +90,7 @@ fn run_real(opts: &Options) -> Result<(), so3fft::Error> {
 }
 
 /// Runs the whole benchmark; fails if no configuration could be measured or the CSV not written.
-fn run(opts: &Options) -> ExitCode {
+fn run_full(opts: &Options) -> ExitCode {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let peak = peak::measure(cores);
     print_header(opts, &peak);
@@ -112,57 +116,10 @@ fn run(opts: &Options) -> ExitCode {
             regular::bench_bandwidth(setup, &mut results);
         }
     }
-    let Results {
-        rows,
-        noskip_missing,
-    } = results;
-
-    let speedups = report::speedups(&rows);
-    if !speedups.is_empty() {
-        println!("\nSpeed-up (median wall time, 1 thread / N threads):\n{speedups}");
-    }
-    if rows.iter().any(|r| r.variant == Variant::NoSkip) || !noskip_missing.is_empty() {
-        println!(
-            "Skipping of negligible Wigner-d prefixes: default (skip below 2^-64) against \
-             skip_bits = Some(0) (every degree of every beta); DWT stage times, ratio = no-skip / skip:\n{}",
-            report::skip_table(&rows, &noskip_missing)
-        );
-    }
-    if rows.iter().any(|r| r.variant == Variant::Naive) {
-        println!(
-            "Plain DWT (naive.rs: one thread, scalar loops, textbook recurrence) against the \
-             library's one-thread DWT stage; round trip errors of the plain DWT:\n{}",
-            report::naive_table(&rows)
-        );
-    }
-    if rows.iter().any(|r| r.variant == Variant::Real) {
-        println!(
-            "Real-signal transforms against the complex ones (same B, threads):\n{}",
-            report::real_table(&rows)
-        );
-    }
-    if rows.iter().any(|r| r.memory.is_some()) {
-        println!(
-            "Peak resident memory of the timed phase (VmHWM after a reset; B > 256: the forward \
-             alone); growth = peak - resident at the start of the phase; in+out = samples + \
-             coefficients:\n{}",
-            report::memory_table(&rows)
-        );
-    }
+    let rows = results.rows;
+    print_summaries(&rows, &results.noskip_missing);
     if opts.soft {
-        let mut soft_rows = Vec::new();
-        // Not above 256: the SOFT entry points need several grid-sized workspaces.
-        for &b in opts
-            .bandwidths
-            .iter()
-            .filter(|&&b| b <= cli::MAX_REGULAR_BANDWIDTH)
-        {
-            match soft_cmp::compare(b, opts.runs_for(b)) {
-                Ok(r) => soft_rows.extend(r),
-                Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
-            }
-        }
-        print!("{}", soft_cmp::table(&soft_rows));
+        print_soft_comparison(opts);
     }
     if let Err(e) = report::write_csv(&opts.csv, &rows) {
         eprintln!("so3fft-bench: cannot write {}: {e}", opts.csv.display());
@@ -224,4 +181,57 @@ fn print_header(opts: &Options, peak: &peak::Peak) {
     );
     println!();
     println!("{}", report::table_header());
+}
+
+/// The tables after the main one: speed-ups, skipping, plain DWT, real signals, memory.
+fn print_summaries(rows: &[Row], noskip_missing: &[(usize, String)]) {
+    let speedups = report::speedups(rows);
+    if !speedups.is_empty() {
+        println!("\nSpeed-up (median wall time, 1 thread / N threads):\n{speedups}");
+    }
+    if rows.iter().any(|r| r.variant == Variant::NoSkip) || !noskip_missing.is_empty() {
+        println!(
+            "Skipping of negligible Wigner-d prefixes: default (skip below 2^-64) against \
+             skip_bits = Some(0) (every degree of every beta); DWT stage times, ratio = no-skip / skip:\n{}",
+            report::skip_table(rows, noskip_missing)
+        );
+    }
+    if rows.iter().any(|r| r.variant == Variant::Naive) {
+        println!(
+            "Plain DWT (naive.rs: one thread, scalar loops, textbook recurrence) against the \
+             library's one-thread DWT stage; round trip errors of the plain DWT:\n{}",
+            report::naive_table(rows)
+        );
+    }
+    if rows.iter().any(|r| r.variant == Variant::Real) {
+        println!(
+            "Real-signal transforms against the complex ones (same B, threads):\n{}",
+            report::real_table(rows)
+        );
+    }
+    if rows.iter().any(|r| r.memory.is_some()) {
+        println!(
+            "Peak resident memory of the timed phase (VmHWM after a reset; B > 256: the forward \
+             alone); growth = peak - resident at the start of the phase; in+out = samples + \
+             coefficients:\n{}",
+            report::memory_table(rows)
+        );
+    }
+}
+
+/// `--soft`: the SOFT 2.0 entry points against the native plan at every B <= 256.
+fn print_soft_comparison(opts: &Options) {
+    let mut soft_rows = Vec::new();
+    // Not above 256: the SOFT entry points need several grid-sized workspaces.
+    for &b in opts
+        .bandwidths
+        .iter()
+        .filter(|&&b| b <= cli::MAX_REGULAR_BANDWIDTH)
+    {
+        match soft_cmp::compare(b, opts.runs_for(b)) {
+            Ok(r) => soft_rows.extend(r),
+            Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
+        }
+    }
+    print!("{}", soft_cmp::table(&soft_rows));
 }

@@ -8,12 +8,12 @@
 //! with, `8B (4B^3 - B)/3` flops, so the time ratio is a fair measure of what the library's
 //! kernels, symmetries and skipping buy.
 //!
-//! Conventions are SPEC.md's: `d^1_{1,0}(b) = -sin(b)/sqrt 2`, `dt^l = sqrt((2l+1)/2) d^l`,
+//! Conventions are those of docs/conventions.md (Wigner d, sample grid): `d^1_{1,0}(b) = -sin(b)/sqrt 2`, `dt^l = sqrt((2l+1)/2) d^l`,
 //! `beta_k = pi (2k+1)/(4B)` and the weights `w_B(k)` of `so3fft::weights`.
 //!
 //! The data of the DWT stage are the 2-D Fourier coefficients of the beta slices,
 //! `G[k][M mod 2B][M' mod 2B]` (`2B` slices of `(2B)^2` complex values, frequencies `+-B`
-//! unused). With the SPEC's normalisation a band-limited signal has
+//! unused). With that normalisation a band-limited signal has
 //! `G(k, M, M') = sum_l fhat(l, M, M') dt^l_{M,M'}(beta_k)` (its slice DFT
 //! `sum_{j1,j2} e^{+i M alpha} e^{+i M' gamma} f` is `(2B)^2 / (2 pi)` times that), and the
 //! forward transform is `fhat(l, M, M') = sum_k w_B(k) dt^l_{M,M'}(beta_k) G(k, M, M')`.
@@ -291,7 +291,10 @@ mod tests {
     /// Against the mpmath reference table, where it is available (degrees < 256).
     #[test]
     fn matches_reference_csv() {
-        let path = "/work/shared/testdata/wigner_d_reference.csv";
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/wigner_d_reference.csv"
+        );
         let Ok(text) = std::fs::read_to_string(path) else {
             eprintln!("{path} not found: skipped");
             return;

@@ -108,8 +108,8 @@ impl Row {
         self.dwt_flops as f64 / self.inv.dwt / 1e9
     }
 
-    /// Peak available to this configuration: single-core peak times threads used. (The measured
-    /// all-core peak is printed too; on this machine it is within a few per cent of that.)
+    /// Peak available to this configuration: single-core peak times threads used (the measured
+    /// all-core peak is printed in the header for comparison).
     fn peak(&self) -> f64 {
         self.peak_1core * self.threads as f64
     }
@@ -381,8 +381,8 @@ fn num(x: f64) -> String {
     }
 }
 
-/// CSV text of all rows. The first 17 columns are those of earlier versions of the bench;
-/// `notes/bench.md` describes every column. Errors keep NaN (a NaN error is a result).
+/// CSV text of all rows; `notes/bench.md` describes every column (new columns go at the end,
+/// so readers of the first ones keep working). Errors keep NaN (a NaN error is a result).
 pub fn csv(rows: &[Row]) -> String {
     let mut out = String::from(CSV_HEADER);
     out.push('\n');

@@ -48,7 +48,7 @@ fn parity_sign(m: isize, mp: isize) -> f64 {
 /// Coefficient `(l, m, mp)` of a real signal: free values on the representatives (real on
 /// `(0, 0)`), the others from `fhat(l, -M, -M') = (-1)^(M-M') conj(fhat(l, M, M'))`.
 ///
-/// The sign follows from SPEC.md section 1: `conj(D^l_{M,M'}) = e^{iM alpha} d^l_{M,M'}
+/// The sign follows from the Wigner-D conventions of docs/conventions.md: `conj(D^l_{M,M'}) = e^{iM alpha} d^l_{M,M'}
 /// e^{iM' gamma}` and `d^l_{M,M'} = (-1)^(M-M') d^l_{-M,-M'}`, so `conj(Dt^l_{M,M'}) =
 /// (-1)^(M-M') Dt^l_{-M,-M'}`; `f = conj(f)` then requires the relation above.
 pub fn real_value(seed: u64, b: usize, l: usize, m: isize, mp: isize) -> Complex64 {
