@@ -467,7 +467,7 @@ fn phase_gb(p: Option<memory::Phase>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{run, Variant};
 
     /// The whole lean procedure at a small bandwidth: three rows, exact round trips.
     #[test]

@@ -397,3 +397,43 @@ pub fn rigor_name(rigor: Rigor) -> &'static str {
         Rigor::Exhaustive => "exhaustive",
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{parse, Command, FftThreading, StageMode, Tool};
+
+    fn options(args: &[&str]) -> super::Options {
+        match parse(args.iter().map(|a| a.to_string())) {
+            Ok(Command::Run(opts)) => opts,
+            Ok(Command::Help) => panic!("help"),
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn full_run_quick_defaults() {
+        let opts = options(&["--quick", "--csv", "target/x.csv"]);
+        assert_eq!(opts.tool, Tool::Full);
+        assert_eq!(opts.bandwidths, [16, 32, 64]);
+        assert_eq!(opts.runs, Some(3));
+        assert_eq!(opts.plot.to_str(), Some("target/x.svg"));
+    }
+
+    #[test]
+    fn tools_and_their_defaults() {
+        let opts = options(&["stages", "--mode", "rfwd", "--fft-threading=fftw"]);
+        assert_eq!(opts.tool, Tool::Stages);
+        assert_eq!((opts.bandwidths, opts.threads), (vec![256], vec![1]));
+        assert_eq!(opts.runs, Some(3));
+        assert_eq!(opts.stage_mode, StageMode::RealForward);
+        assert_eq!(opts.fft_threading, FftThreading::FftwThreads);
+        let opts = options(&["scaling", "--bandwidths", "32", "--runs", "2"]);
+        assert_eq!(opts.tool, Tool::Scaling);
+        assert_eq!((opts.bandwidths, opts.threads), (vec![32], vec![1, 2]));
+        assert_eq!(opts.runs, Some(2));
+        let opts = options(&["real"]);
+        assert_eq!((opts.tool, opts.runs), (Tool::Real, None));
+        assert_eq!(opts.bandwidths, [64, 128, 256]);
+        assert!(parse(["stages", "--mode", "sideways"].map(String::from)).is_err());
+    }
+}

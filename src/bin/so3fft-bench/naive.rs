@@ -230,8 +230,9 @@ pub fn inverse(b: usize, betas: &Betas, coeffs: &[Complex64], g: &mut [Complex64
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{forward, freq_index, inverse, orders, Betas, Column};
     use crate::workload::{random_coeffs, roundtrip_error};
+    use so3fft::Complex64;
     use std::f64::consts::PI;
 
     fn column(m: isize, mp: isize, lmax: usize, beta: f64) -> Vec<f64> {

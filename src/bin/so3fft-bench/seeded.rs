@@ -218,8 +218,12 @@ pub fn real_symmetry_check(b: usize, seed: u64) -> Result<(f64, f64), so3fft::Er
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{
+        compare_complex, compare_real, fill_complex, fill_real, real_symmetry_check,
+        representative, rows_mut, walk_row,
+    };
     use crate::workload::roundtrip_error;
+    use so3fft::{coef_index, Complex64};
 
     #[test]
     fn rows_cover_the_layout() {
