@@ -241,22 +241,22 @@ pub fn skip_table(rows: &[Row], missing: &[(usize, String)]) -> String {
     bandwidths.sort_unstable();
     bandwidths.dedup();
     for b in bandwidths {
-        if let Some(ns) = rows
+        if let Some(noskip) = rows
             .iter()
             .find(|r| r.variant == Variant::NoSkip && r.bandwidth == b)
         {
-            let (rf, ri) = ns.ratio.unwrap_or((f64::NAN, f64::NAN));
-            let sk = find(rows, Variant::Complex, b, ns.threads);
-            let err = |f: fn(&Row) -> f64| sk.map_or(f64::NAN, f);
+            let (rf, ri) = noskip.ratio.unwrap_or((f64::NAN, f64::NAN));
+            let skip_row = find(rows, Variant::Complex, b, noskip.threads);
+            let err = |f: fn(&Row) -> f64| skip_row.map_or(f64::NAN, f);
             let _ = writeln!(
                 out,
                 "{:>5} {:>3} | {:>9} {:>9.3e} {:>6} | {:>9} {:>9.3e} {:>6} | {:>8.2e} {:>8.2e} | {:>8.2e} {:>8.2e} | {:>4}",
-                b, ns.threads,
-                or_na!(ns.fwd.dwt / rf, "{:.3e}"), ns.fwd.dwt, or_na!(rf, "{:.3}"),
-                or_na!(ns.inv.dwt / ri, "{:.3e}"), ns.inv.dwt, or_na!(ri, "{:.3}"),
-                err(|r| r.max_abs_err), ns.max_abs_err,
-                err(|r| r.rel_l2_err), ns.rel_l2_err,
-                or_na!(ns.utilisation(), "{:.2}"),
+                b, noskip.threads,
+                or_na!(noskip.fwd.dwt / rf, "{:.3e}"), noskip.fwd.dwt, or_na!(rf, "{:.3}"),
+                or_na!(noskip.inv.dwt / ri, "{:.3e}"), noskip.inv.dwt, or_na!(ri, "{:.3}"),
+                err(|r| r.max_abs_err), noskip.max_abs_err,
+                err(|r| r.rel_l2_err), noskip.rel_l2_err,
+                or_na!(noskip.utilisation(), "{:.2}"),
             );
         } else if let Some((_, why)) = missing.iter().find(|m| m.0 == b) {
             let _ = writeln!(out, "{b:>5}     | no-skip run n/a: {why}");
