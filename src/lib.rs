@@ -24,8 +24,6 @@
 #![warn(clippy::undocumented_unsafe_blocks)]
 
 pub mod capi;
-#[cfg(all(test, target_arch = "x86_64"))]
-mod ceilings;
 mod dwt;
 mod error;
 mod ffi;

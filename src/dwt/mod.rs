@@ -30,12 +30,6 @@ mod tests;
 
 use crate::simd::Isa;
 
-/// The FMA peak under the path `src/ceilings.rs` uses (goes with that file's move to
-/// `benches/`).
-#[cfg(all(test, target_arch = "x86_64"))]
-pub(crate) mod kernel_speed {
-    pub(crate) use crate::simd::peak::fma_peak;
-}
 pub(crate) use inverse::Fill;
 pub(crate) use lanes::{Lanes, Prefetch, Rec};
 

@@ -48,7 +48,7 @@ fn parity_sign(m: isize, mp: isize) -> f64 {
 /// Coefficient `(l, m, mp)` of a real signal: free values on the representatives (real on
 /// `(0, 0)`), the others from `fhat(l, -M, -M') = (-1)^(M-M') conj(fhat(l, M, M'))`.
 ///
-/// The sign follows from SPEC.md section 1: `conj(D^l_{M,M'}) = e^{iM alpha} d^l_{M,M'}
+/// The sign follows from the Wigner-D conventions of docs/conventions.md: `conj(D^l_{M,M'}) = e^{iM alpha} d^l_{M,M'}
 /// e^{iM' gamma}` and `d^l_{M,M'} = (-1)^(M-M') d^l_{-M,-M'}`, so `conj(Dt^l_{M,M'}) =
 /// (-1)^(M-M') Dt^l_{-M,-M'}`; `f = conj(f)` then requires the relation above.
 pub fn real_value(seed: u64, b: usize, l: usize, m: isize, mp: isize) -> Complex64 {
@@ -218,8 +218,12 @@ pub fn real_symmetry_check(b: usize, seed: u64) -> Result<(f64, f64), so3fft::Er
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{
+        compare_complex, compare_real, fill_complex, fill_real, real_symmetry_check,
+        representative, rows_mut, walk_row,
+    };
     use crate::workload::roundtrip_error;
+    use so3fft::{coef_index, Complex64};
 
     #[test]
     fn rows_cover_the_layout() {

@@ -2,13 +2,18 @@
 //! `Rigor::Measure` and counts the choice (a check of the plan-time measurement's
 //! robustness; run it with and without load on the other core).
 //!
-//! `cargo run --release --example tune_count -- [B] [PLANS]` (defaults 128 and 20).
+//! `cargo bench --bench tune_count -- [B] [PLANS]` (defaults 128 and 20).
 
 use so3fft::{FftThreading, Plan, PlanOptions, Rigor};
 
 fn main() {
+    // `cargo bench` adds flags such as `--bench`: only the plain arguments count.
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
     let arg = |i: usize, default: usize| -> usize {
-        match std::env::args().nth(i) {
+        match args.get(i).cloned() {
             None => default,
             Some(s) => s.parse().unwrap_or_else(|_| {
                 eprintln!("usage: tune_count [B] [PLANS]  (got {s:?})");
@@ -16,7 +21,7 @@ fn main() {
             }),
         }
     };
-    let (b, n) = (arg(1, 128), arg(2, 20));
+    let (b, n) = (arg(0, 128), arg(1, 20));
     let options = PlanOptions {
         threads: 2,
         rigor: Rigor::Measure,

@@ -52,6 +52,16 @@ pub struct Memory {
 }
 
 impl Memory {
+    /// The figures of a measured `phase` with the plan's and the arrays' bytes.
+    pub fn of_phase(phase: crate::memory::Phase, plan: u64, arrays: u64) -> Memory {
+        Memory {
+            peak: phase.peak,
+            start: phase.start,
+            plan,
+            arrays,
+        }
+    }
+
     pub fn peak_over_arrays(&self) -> f64 {
         self.peak as f64 / self.arrays as f64
     }
@@ -98,8 +108,8 @@ impl Row {
         self.dwt_flops as f64 / self.inv.dwt / 1e9
     }
 
-    /// Peak available to this configuration: single-core peak times threads used. (The measured
-    /// all-core peak is printed too; on this machine it is within a few per cent of that.)
+    /// Peak available to this configuration: single-core peak times threads used (the measured
+    /// all-core peak is printed in the header for comparison).
     fn peak(&self) -> f64 {
         self.peak_1core * self.threads as f64
     }
@@ -231,22 +241,22 @@ pub fn skip_table(rows: &[Row], missing: &[(usize, String)]) -> String {
     bandwidths.sort_unstable();
     bandwidths.dedup();
     for b in bandwidths {
-        if let Some(ns) = rows
+        if let Some(noskip) = rows
             .iter()
             .find(|r| r.variant == Variant::NoSkip && r.bandwidth == b)
         {
-            let (rf, ri) = ns.ratio.unwrap_or((f64::NAN, f64::NAN));
-            let sk = find(rows, Variant::Complex, b, ns.threads);
-            let err = |f: fn(&Row) -> f64| sk.map_or(f64::NAN, f);
+            let (rf, ri) = noskip.ratio.unwrap_or((f64::NAN, f64::NAN));
+            let skip_row = find(rows, Variant::Complex, b, noskip.threads);
+            let err = |f: fn(&Row) -> f64| skip_row.map_or(f64::NAN, f);
             let _ = writeln!(
                 out,
                 "{:>5} {:>3} | {:>9} {:>9.3e} {:>6} | {:>9} {:>9.3e} {:>6} | {:>8.2e} {:>8.2e} | {:>8.2e} {:>8.2e} | {:>4}",
-                b, ns.threads,
-                or_na!(ns.fwd.dwt / rf, "{:.3e}"), ns.fwd.dwt, or_na!(rf, "{:.3}"),
-                or_na!(ns.inv.dwt / ri, "{:.3e}"), ns.inv.dwt, or_na!(ri, "{:.3}"),
-                err(|r| r.max_abs_err), ns.max_abs_err,
-                err(|r| r.rel_l2_err), ns.rel_l2_err,
-                or_na!(ns.utilisation(), "{:.2}"),
+                b, noskip.threads,
+                or_na!(noskip.fwd.dwt / rf, "{:.3e}"), noskip.fwd.dwt, or_na!(rf, "{:.3}"),
+                or_na!(noskip.inv.dwt / ri, "{:.3e}"), noskip.inv.dwt, or_na!(ri, "{:.3}"),
+                err(|r| r.max_abs_err), noskip.max_abs_err,
+                err(|r| r.rel_l2_err), noskip.rel_l2_err,
+                or_na!(noskip.utilisation(), "{:.2}"),
             );
         } else if let Some((_, why)) = missing.iter().find(|m| m.0 == b) {
             let _ = writeln!(out, "{b:>5}     | no-skip run n/a: {why}");
@@ -371,8 +381,8 @@ fn num(x: f64) -> String {
     }
 }
 
-/// CSV text of all rows. The first 17 columns are those of earlier versions of the bench;
-/// `notes/bench.md` describes every column. Errors keep NaN (a NaN error is a result).
+/// CSV text of all rows; `notes/bench.md` describes every column (new columns go at the end,
+/// so readers of the first ones keep working). Errors keep NaN (a NaN error is a result).
 pub fn csv(rows: &[Row]) -> String {
     let mut out = String::from(CSV_HEADER);
     out.push('\n');

@@ -1,8 +1,8 @@
 //! Double-precision FMA peak of this machine, measured in the same run as the transforms.
 //!
-//! The box is shared and its speed drifts by ±15 %, so a peak copied from a data sheet or an
-//! earlier run would make "fraction of peak" meaningless; measuring it next to the transform
-//! keeps the ratio honest.
+//! On a shared machine whose speed drifts, a peak copied from a data sheet or another run
+//! would make "fraction of peak" meaningless; measuring it next to the transform keeps the
+//! ratio honest.
 //!
 //! The kernel keeps many independent FMA chains in registers: with a 4-cycle FMA latency and two
 //! FMA pipes at least 8 chains are needed to fill the pipes, so we use 16 (AVX-512, 32 registers)
@@ -64,10 +64,11 @@ impl Isa {
     fn run(self, iters: u64) -> f64 {
         let iters = black_box(iters);
         match self {
-            // SAFETY: the variant is only chosen after runtime detection of the features.
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Isa::detect` chose this variant after detecting AVX-512F at run time.
             Isa::Avx512 => unsafe { kernel_avx512(iters) },
             #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Isa::detect` chose this variant after detecting AVX2 and FMA at run time.
             Isa::Avx2Fma => unsafe { kernel_avx2(iters) },
             _ => kernel_scalar(iters),
         }

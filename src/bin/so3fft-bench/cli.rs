@@ -3,7 +3,7 @@
 //! Hand-written parser: the binary may only depend on std and the crate's own dependencies,
 //! so no argument-parsing crate is available.
 
-use so3fft::Rigor;
+use so3fft::{FftThreading, Rigor};
 use std::path::PathBuf;
 
 /// Runs per configuration when `--runs` is not given (smaller at large B, see [`Options::runs_for`]).
@@ -17,13 +17,24 @@ const QUICK_MAX_BANDWIDTH: usize = 64;
 pub const MAX_REGULAR_BANDWIDTH: usize = 256;
 /// Bandwidth `--big` adds.
 pub const BIG_BANDWIDTH: usize = 512;
-/// Largest bandwidth of the plain DWT by default (about 1 s per direction at 128 here).
+/// Largest bandwidth of the plain DWT by default (its cost grows as B^4).
 const DEFAULT_NAIVE_MAX: usize = 128;
 /// ... and under `--quick`.
 const QUICK_NAIVE_MAX: usize = 16;
 
 pub const USAGE: &str = "\
-usage: so3fft-bench [options]
+usage: so3fft-bench [TOOL] [options]
+TOOL (default: the full benchmark described below):
+  stages              stage times of repeated transforms, one line per transform on stderr,
+                      for profiling (perf record) and for comparing two builds run
+                      alternately; defaults --bandwidths 256 --threads 1 --runs 3
+  scaling             thread scaling on a shared machine: windows of inverse + forward pairs
+                      (at least 0.3 s each) that count only while other processes use under
+                      3% of the machine, thread counts alternating; medians of --runs clean
+                      windows (default 5); defaults --bandwidths 64,128,256 --threads 1,2
+  real                only the real-signal transforms against the complex ones (round trips
+                      interleaved, last thread count); default --bandwidths 64,128,256
+options:
   --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
                       (default 16,32,64,128,256)
   --threads LIST      comma-separated thread counts, 0 = all cores (default 1,2)
@@ -43,6 +54,11 @@ usage: so3fft-bench [options]
                       with a message when MemAvailable is too small.
   --quick             CI smoke test: only B <= 64, 3 runs, plain DWT at B = 16 only
   --soft              also time the SOFT 2.0 entry points against the native plan (each B)
+  --fft-threading F   FFT-stage threading: auto | fftw | slices (default auto, the plan's
+                      choice by timing)
+  --mode M            stages: inv | fwd | both | dfwd (the forward that may overwrite its
+                      input) | rinv | rfwd | rboth (real signals); default both
+  --workspace-mib N   stages: cap on the plan's chunk buffer (default: the plan's default)
   -h, --help          print this help
 
 Each B <= 256 and thread count: inverse then forward on random coefficients, stage times
@@ -50,9 +66,59 @@ Each B <= 256 and thread count: inverse then forward on random coefficients, sta
 memory. Per B also: the transforms without skipping of negligible Wigner-d prefixes (first
 thread count) and the plain DWT. Columns and formulas: notes/bench.md.";
 
+/// Which measurement the command line asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tool {
+    /// The full benchmark: tables, CSV and plot.
+    Full,
+    /// Stage times of repeated transforms (`stages.rs`).
+    Stages,
+    /// Thread scaling in clean windows (`scaling.rs`).
+    Scaling,
+    /// Real-signal against complex transforms only.
+    Real,
+}
+
+/// Transforms the `stages` tool repeats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StageMode {
+    Inverse,
+    Forward,
+    Both,
+    /// The forward that may overwrite its input.
+    ForwardDestroying,
+    RealInverse,
+    RealForward,
+    RealBoth,
+}
+
+impl StageMode {
+    /// Whether the mode runs the real-signal transforms.
+    pub fn real(self) -> bool {
+        matches!(
+            self,
+            StageMode::RealInverse | StageMode::RealForward | StageMode::RealBoth
+        )
+    }
+
+    /// Whether the mode runs an inverse.
+    pub fn inverse(self) -> bool {
+        matches!(
+            self,
+            StageMode::Inverse | StageMode::Both | StageMode::RealInverse | StageMode::RealBoth
+        )
+    }
+
+    /// Whether the mode runs a forward.
+    pub fn forward(self) -> bool {
+        !matches!(self, StageMode::Inverse | StageMode::RealInverse)
+    }
+}
+
 /// Parsed benchmark options.
 #[derive(Debug, Clone)]
 pub struct Options {
+    pub tool: Tool,
     pub bandwidths: Vec<usize>,
     pub threads: Vec<usize>,
     /// `Some` when the user chose the run count (then it is used at every B).
@@ -68,24 +134,34 @@ pub struct Options {
     pub plot: PathBuf,
     /// Largest bandwidth of the plain DWT (0: none).
     pub naive_max: usize,
+    /// FFT-stage threading of the plans.
+    pub fft_threading: FftThreading,
+    /// Transforms of the `stages` tool.
+    pub stage_mode: StageMode,
+    /// Cap on the chunk buffer of the `stages` tool's plan (`None`: the plan's default).
+    pub workspace_bytes: Option<usize>,
 }
 
 impl Default for Options {
     fn default() -> Self {
         Options {
+            tool: Tool::Full,
             bandwidths: vec![16, 32, 64, 128, 256],
             threads: vec![1, 2],
             runs: None,
             csv: PathBuf::from("bench.csv"),
-            // Not the library's default (Estimate): FFTW_ESTIMATE plans made the FFT stage
-            // 6.3x slower at B = 256 on the development machine (6.9 s against 1.1 s, one
-            // thread), which would hide the DWT. Planning time is not part of any timing.
+            // Not the library's default (Estimate): FFTW_ESTIMATE plans make the FFT stage
+            // several times slower at large B, which would hide the DWT. Planning time is not
+            // part of any timing.
             rigor: Rigor::Measure,
             quick: false,
             soft: false,
             big: false,
             plot: PathBuf::from("bench.svg"),
             naive_max: DEFAULT_NAIVE_MAX,
+            fft_threading: FftThreading::Auto,
+            stage_mode: StageMode::Both,
+            workspace_bytes: None,
         }
     }
 }
@@ -119,7 +195,17 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
     let mut bandwidths_given = false;
     let mut plot_given = false;
     let mut naive_given = false;
-    let mut args = args.into_iter();
+    let mut threads_given = false;
+    let mut args = args.into_iter().peekable();
+    opts.tool = match args.peek().map(String::as_str) {
+        Some("stages") => Tool::Stages,
+        Some("scaling") => Tool::Scaling,
+        Some("real") => Tool::Real,
+        _ => Tool::Full,
+    };
+    if opts.tool != Tool::Full {
+        args.next();
+    }
     while let Some(arg) = args.next() {
         let (name, inline) = match arg.split_once('=') {
             Some((n, v)) if n.starts_with("--") => (n.to_string(), Some(v.to_string())),
@@ -152,13 +238,27 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
                 opts.bandwidths = parse_list(&value()?, "--bandwidths")?;
                 bandwidths_given = true;
             }
-            "--threads" => opts.threads = parse_list(&value()?, "--threads")?,
+            "--threads" => {
+                opts.threads = parse_list(&value()?, "--threads")?;
+                threads_given = true;
+            }
+            "--fft-threading" => opts.fft_threading = parse_fft_threading(&value()?)?,
+            "--mode" => opts.stage_mode = parse_stage_mode(&value()?)?,
+            "--workspace-mib" => {
+                let text = value()?;
+                let mib: usize = text
+                    .trim()
+                    .parse()
+                    .map_err(|e| format!("--workspace-mib: '{text}': {e}"))?;
+                opts.workspace_bytes = Some(mib << 20);
+            }
             "--runs" => opts.runs = Some(parse_positive(&value()?, "--runs")?),
             "--csv" => opts.csv = PathBuf::from(value()?),
             "--rigor" => opts.rigor = parse_rigor(&value()?)?,
             _ => return Err(format!("unknown option '{arg}'")),
         }
     }
+    apply_tool_defaults(&mut opts, bandwidths_given, threads_given);
     if !plot_given {
         opts.plot = opts.csv.with_extension("svg");
     }
@@ -193,6 +293,25 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         return Err("--threads: no thread count given".into());
     }
     Ok(Command::Run(opts))
+}
+
+/// Defaults of the tools other than the full benchmark, where not given.
+fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given: bool) {
+    let (bandwidths, threads, runs) = match opts.tool {
+        Tool::Full => return,
+        Tool::Stages => (vec![256], vec![1], Some(3)),
+        Tool::Scaling => (vec![64, 128, 256], vec![1, 2], Some(5)),
+        Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
+    };
+    if !bandwidths_given {
+        opts.bandwidths = bandwidths;
+    }
+    if !threads_given {
+        opts.threads = threads;
+    }
+    if opts.runs.is_none() {
+        opts.runs = runs;
+    }
 }
 
 /// `--quick` limits B to 64 (keeping a user list's small entries), uses 3 runs unless
@@ -243,6 +362,32 @@ fn parse_rigor(text: &str) -> Result<Rigor, String> {
     }
 }
 
+fn parse_fft_threading(text: &str) -> Result<FftThreading, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "auto" => Ok(FftThreading::Auto),
+        "fftw" => Ok(FftThreading::FftwThreads),
+        "slices" | "workers" => Ok(FftThreading::SlicesAcrossWorkers),
+        _ => Err(format!(
+            "--fft-threading: '{text}' is not auto, fftw or slices"
+        )),
+    }
+}
+
+fn parse_stage_mode(text: &str) -> Result<StageMode, String> {
+    match text {
+        "inv" => Ok(StageMode::Inverse),
+        "fwd" => Ok(StageMode::Forward),
+        "both" => Ok(StageMode::Both),
+        "dfwd" => Ok(StageMode::ForwardDestroying),
+        "rinv" => Ok(StageMode::RealInverse),
+        "rfwd" => Ok(StageMode::RealForward),
+        "rboth" => Ok(StageMode::RealBoth),
+        _ => Err(format!(
+            "--mode: '{text}' is not inv, fwd, both, dfwd, rinv, rfwd or rboth"
+        )),
+    }
+}
+
 /// Lower-case name of a rigour, as accepted by `--rigor`.
 pub fn rigor_name(rigor: Rigor) -> &'static str {
     match rigor {
@@ -250,5 +395,45 @@ pub fn rigor_name(rigor: Rigor) -> &'static str {
         Rigor::Measure => "measure",
         Rigor::Patient => "patient",
         Rigor::Exhaustive => "exhaustive",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{parse, Command, FftThreading, StageMode, Tool};
+
+    fn options(args: &[&str]) -> super::Options {
+        match parse(args.iter().map(|a| a.to_string())) {
+            Ok(Command::Run(opts)) => opts,
+            Ok(Command::Help) => panic!("help"),
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn full_run_quick_defaults() {
+        let opts = options(&["--quick", "--csv", "target/x.csv"]);
+        assert_eq!(opts.tool, Tool::Full);
+        assert_eq!(opts.bandwidths, [16, 32, 64]);
+        assert_eq!(opts.runs, Some(3));
+        assert_eq!(opts.plot.to_str(), Some("target/x.svg"));
+    }
+
+    #[test]
+    fn tools_and_their_defaults() {
+        let opts = options(&["stages", "--mode", "rfwd", "--fft-threading=fftw"]);
+        assert_eq!(opts.tool, Tool::Stages);
+        assert_eq!((opts.bandwidths, opts.threads), (vec![256], vec![1]));
+        assert_eq!(opts.runs, Some(3));
+        assert_eq!(opts.stage_mode, StageMode::RealForward);
+        assert_eq!(opts.fft_threading, FftThreading::FftwThreads);
+        let opts = options(&["scaling", "--bandwidths", "32", "--runs", "2"]);
+        assert_eq!(opts.tool, Tool::Scaling);
+        assert_eq!((opts.bandwidths, opts.threads), (vec![32], vec![1, 2]));
+        assert_eq!(opts.runs, Some(2));
+        let opts = options(&["real"]);
+        assert_eq!((opts.tool, opts.runs), (Tool::Real, None));
+        assert_eq!(opts.bandwidths, [64, 128, 256]);
+        assert!(parse(["stages", "--mode", "sideways"].map(String::from)).is_err());
     }
 }

@@ -87,28 +87,30 @@ pub fn svg(rows: &[Row]) -> String {
     out
 }
 
+/// Distinct bandwidths of the rows, ascending.
 fn bandwidths(rows: &[Row]) -> Vec<f64> {
-    let mut b: Vec<usize> = rows.iter().map(|r| r.bandwidth).collect();
-    b.sort_unstable();
-    b.dedup();
-    b.into_iter().map(|b| b as f64).collect()
+    let mut bandwidths: Vec<usize> = rows.iter().map(|r| r.bandwidth).collect();
+    bandwidths.sort_unstable();
+    bandwidths.dedup();
+    bandwidths.into_iter().map(|b| b as f64).collect()
 }
 
 /// Distinct thread counts of the complex rows, ascending.
 fn thread_counts(rows: &[Row]) -> Vec<usize> {
-    let mut t: Vec<usize> = rows
+    let mut counts: Vec<usize> = rows
         .iter()
         .filter(|r| r.variant == Variant::Complex)
         .map(|r| r.threads)
         .collect();
-    t.sort_unstable();
-    t.dedup();
-    t
+    counts.sort_unstable();
+    counts.dedup();
+    counts
 }
 
-fn push(s: &mut Series, b: usize, y: f64) {
+/// Adds the point (`b`, `y`) to `series` where it can be drawn on log axes.
+fn push(series: &mut Series, b: usize, y: f64) {
     if y.is_finite() && y > 0.0 {
-        s.points.push((b as f64, y));
+        series.points.push((b as f64, y));
     }
 }
 
@@ -116,8 +118,8 @@ fn time_panel(rows: &[Row]) -> Panel {
     let mut series = Vec::new();
     for (i, &t) in thread_counts(rows).iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
-        let mut f = Series::new(format!("forward, {t} thr"), color, None, Marker::Circle);
-        let mut v = Series::new(
+        let mut forward = Series::new(format!("forward, {t} thr"), color, None, Marker::Circle);
+        let mut inverse = Series::new(
             format!("inverse, {t} thr"),
             color,
             Some("6,4"),
@@ -127,44 +129,58 @@ fn time_panel(rows: &[Row]) -> Panel {
             .iter()
             .filter(|r| r.variant == Variant::Complex && r.threads == t)
         {
-            push(&mut f, r.bandwidth, r.fwd_median);
-            push(&mut v, r.bandwidth, r.inv_median);
+            push(&mut forward, r.bandwidth, r.fwd_median);
+            push(&mut inverse, r.bandwidth, r.inv_median);
         }
-        series.extend([f, v]);
+        series.extend([forward, inverse]);
     }
     let grey = "#555555";
-    let mut nf = Series::new("forward, no skipping", grey, Some("2,3"), Marker::Diamond);
-    let mut ni = Series::new(
-        "inverse, no skipping",
-        grey,
-        Some("8,3,2,3"),
-        Marker::Diamond,
-    );
-    let mut pf = Series::new("plain DWT forward, 1 thr", "black", None, Marker::Triangle);
-    let mut pi = Series::new(
-        "plain DWT inverse, 1 thr",
-        "black",
-        Some("6,4"),
-        Marker::Triangle,
-    );
-    let mut rf = Series::new("real forward", "#8B008B", None, Marker::Diamond);
-    let mut ri = Series::new("real inverse", "#8B008B", Some("6,4"), Marker::Diamond);
+    let real_colour = "#8B008B";
+    let mut variants = [
+        (
+            Variant::NoSkip,
+            Series::new("forward, no skipping", grey, Some("2,3"), Marker::Diamond),
+            Series::new(
+                "inverse, no skipping",
+                grey,
+                Some("8,3,2,3"),
+                Marker::Diamond,
+            ),
+        ),
+        (
+            Variant::Naive,
+            Series::new("plain DWT forward, 1 thr", "black", None, Marker::Triangle),
+            Series::new(
+                "plain DWT inverse, 1 thr",
+                "black",
+                Some("6,4"),
+                Marker::Triangle,
+            ),
+        ),
+        (
+            Variant::Real,
+            Series::new("real forward", real_colour, None, Marker::Diamond),
+            Series::new("real inverse", real_colour, Some("6,4"), Marker::Diamond),
+        ),
+    ];
     for r in rows {
-        let (f, i) = match r.variant {
-            Variant::Complex => continue,
-            Variant::NoSkip => (&mut nf, &mut ni),
-            Variant::Naive => (&mut pf, &mut pi),
-            Variant::Real => (&mut rf, &mut ri),
+        let Some((_, forward, inverse)) = variants.iter_mut().find(|v| v.0 == r.variant) else {
+            continue;
         };
-        let (tf, ti) = if r.variant == Variant::Naive {
+        // The plain DWT has no whole-transform time: its DWT stage is the transform.
+        let (forward_time, inverse_time) = if r.variant == Variant::Naive {
             (r.fwd.dwt, r.inv.dwt)
         } else {
             (r.fwd_median, r.inv_median)
         };
-        push(f, r.bandwidth, tf);
-        push(i, r.bandwidth, ti);
+        push(forward, r.bandwidth, forward_time);
+        push(inverse, r.bandwidth, inverse_time);
     }
-    series.extend([nf, ni, pf, pi, rf, ri]);
+    series.extend(
+        variants
+            .into_iter()
+            .flat_map(|(_, forward, inverse)| [forward, inverse]),
+    );
     Panel {
         title: "Time per transform (medians; plain DWT: DWT stage only)",
         y_label: "time [s]",
@@ -205,33 +221,40 @@ fn error_panel(rows: &[Row]) -> Panel {
 
 /// Maps data to pixels in one panel (log10 on both axes).
 struct Axes {
+    /// Left and top edge of the plot area, pixels.
     x0: f64,
     y0: f64,
+    /// Width and height of the plot area, pixels.
     w: f64,
     h: f64,
-    lx: (f64, f64),
-    ly: (f64, f64),
+    /// log10 range of each axis.
+    log_x: (f64, f64),
+    log_y: (f64, f64),
 }
 
 impl Axes {
-    fn px(&self, x: f64) -> f64 {
-        self.x0 + (x.log10() - self.lx.0) / (self.lx.1 - self.lx.0) * self.w
+    fn pixel_x(&self, x: f64) -> f64 {
+        self.x0 + (x.log10() - self.log_x.0) / (self.log_x.1 - self.log_x.0) * self.w
     }
 
-    fn py(&self, y: f64) -> f64 {
-        self.y0 + self.h - (y.log10() - self.ly.0) / (self.ly.1 - self.ly.0) * self.h
+    fn pixel_y(&self, y: f64) -> f64 {
+        self.y0 + self.h - (y.log10() - self.log_y.0) / (self.log_y.1 - self.log_y.0) * self.h
     }
 }
 
-fn draw_panel(out: &mut String, left: f64, p: &Panel, x_values: &[f64]) {
-    let series: Vec<&Series> = p.series.iter().filter(|s| !s.points.is_empty()).collect();
+fn draw_panel(out: &mut String, left: f64, panel: &Panel, x_values: &[f64]) {
+    let series: Vec<&Series> = panel
+        .series
+        .iter()
+        .filter(|s| !s.points.is_empty())
+        .collect();
     let x0 = left + MARGIN_L;
     let w = PANEL_W - MARGIN_L - MARGIN_R;
     let _ = writeln!(
         out,
         r#"<text x="{:.1}" y="22" text-anchor="middle" font-size="14" font-weight="bold">{}</text>"#,
         x0 + w / 2.0,
-        p.title
+        panel.title
     );
     if series.is_empty() || x_values.is_empty() {
         let _ = writeln!(
@@ -243,68 +266,68 @@ fn draw_panel(out: &mut String, left: f64, p: &Panel, x_values: &[f64]) {
         return;
     }
     let (xmin, xmax) = (x_values[0], x_values[x_values.len() - 1]);
-    let lx = (xmin.log10() - 0.08, xmax.log10() + 0.08);
+    let log_x = (xmin.log10() - 0.08, xmax.log10() + 0.08);
     let ys = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
     let (ymin, ymax) = ys.fold((f64::INFINITY, 0.0f64), |(a, b), y| (a.min(y), b.max(y)));
-    let mut ly = (ymin.log10().floor(), ymax.log10().ceil());
-    if ly.1 - ly.0 < 1.0 {
-        ly.1 = ly.0 + 1.0;
+    let mut log_y = (ymin.log10().floor(), ymax.log10().ceil());
+    if log_y.1 - log_y.0 < 1.0 {
+        log_y.1 = log_y.0 + 1.0;
     }
-    let ax = Axes {
+    let axes = Axes {
         x0,
         y0: MARGIN_T,
         w,
         h: PLOT_H,
-        lx,
-        ly,
+        log_x,
+        log_y,
     };
-    draw_axes(out, &ax, x_values, p.y_label);
+    draw_axes(out, &axes, x_values, panel.y_label);
     // Reverse order: the first legend entries end up on top where lines coincide (the
     // errors with and without skipping are usually identical).
     for s in series.iter().rev() {
-        draw_series(out, &ax, s);
+        draw_series(out, &axes, s);
     }
     draw_legend(out, left, &series);
 }
 
-fn draw_axes(out: &mut String, ax: &Axes, x_values: &[f64], y_label: &str) {
-    let (x1, y1) = (ax.x0 + ax.w, ax.y0 + ax.h);
+fn draw_axes(out: &mut String, axes: &Axes, x_values: &[f64], y_label: &str) {
+    let (x1, y1) = (axes.x0 + axes.w, axes.y0 + axes.h);
     // Decades: grid line, major tick, label; 2..9: minor tick.
-    let decades = (ax.ly.1 - ax.ly.0).round() as i32;
+    let decades = (axes.log_y.1 - axes.log_y.0).round() as i32;
     let label_every = (decades + 7) / 8;
-    for (i, e) in (ax.ly.0 as i32..=ax.ly.1 as i32).enumerate() {
-        let y = ax.py(10f64.powi(e));
+    for (i, e) in (axes.log_y.0 as i32..=axes.log_y.1 as i32).enumerate() {
+        let y = axes.pixel_y(10f64.powi(e));
         let _ = writeln!(
             out,
             "<line x1=\"{:.1}\" y1=\"{y:.1}\" x2=\"{x1:.1}\" y2=\"{y:.1}\" stroke=\"#e4e4e4\"/>\n\
              <line x1=\"{:.1}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"black\"/>",
-            ax.x0,
-            ax.x0 - 6.0,
-            ax.x0
+            axes.x0,
+            axes.x0 - 6.0,
+            axes.x0
         );
         if i as i32 % label_every == 0 {
             let _ = writeln!(
                 out,
                 r#"<text x="{:.1}" y="{:.1}" text-anchor="end">1e{e}</text>"#,
-                ax.x0 - 9.0,
+                axes.x0 - 9.0,
                 y + 4.0
             );
         }
-        if e < ax.ly.1 as i32 && decades <= 12 {
+        if e < axes.log_y.1 as i32 && decades <= 12 {
             for k in 2..10 {
-                let y = ax.py(k as f64 * 10f64.powi(e));
+                let y = axes.pixel_y(k as f64 * 10f64.powi(e));
                 let _ = writeln!(
                     out,
                     r#"<line x1="{:.1}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="black"/>"#,
-                    ax.x0 - 3.0,
-                    ax.x0
+                    axes.x0 - 3.0,
+                    axes.x0
                 );
                 // With few decades, label 2 and 5 too (else a panel may show two labels).
                 if decades <= 2 && (k == 2 || k == 5) {
                     let _ = writeln!(
                         out,
                         r##"<text x="{:.1}" y="{:.1}" text-anchor="end" fill="#555555">{k}e{e}</text>"##,
-                        ax.x0 - 9.0,
+                        axes.x0 - 9.0,
                         y + 4.0
                     );
                 }
@@ -314,12 +337,12 @@ fn draw_axes(out: &mut String, ax: &Axes, x_values: &[f64], y_label: &str) {
     // Bandwidths: one tick each, labels where there is room.
     let mut last_label = f64::NEG_INFINITY;
     for &b in x_values {
-        let x = ax.px(b);
+        let x = axes.pixel_x(b);
         let _ = writeln!(
             out,
             "<line x1=\"{x:.1}\" y1=\"{:.1}\" x2=\"{x:.1}\" y2=\"{y1:.1}\" stroke=\"#e4e4e4\"/>\n\
              <line x1=\"{x:.1}\" y1=\"{y1:.1}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"black\"/>",
-            ax.y0,
+            axes.y0,
             y1 + 6.0
         );
         if x - last_label >= 28.0 {
@@ -336,14 +359,14 @@ fn draw_axes(out: &mut String, ax: &Axes, x_values: &[f64], y_label: &str) {
         "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"black\"/>\n\
          <text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">bandwidth B (log scale)</text>\n\
          <text transform=\"translate({:.1},{:.1}) rotate(-90)\" text-anchor=\"middle\">{y_label} (log scale)</text>",
-        ax.x0,
-        ax.y0,
-        ax.w,
-        ax.h,
-        ax.x0 + ax.w / 2.0,
+        axes.x0,
+        axes.y0,
+        axes.w,
+        axes.h,
+        axes.x0 + axes.w / 2.0,
         y1 + 40.0,
-        ax.x0 - 58.0,
-        ax.y0 + ax.h / 2.0
+        axes.x0 - 58.0,
+        axes.y0 + axes.h / 2.0
     );
 }
 
@@ -389,11 +412,11 @@ fn marker(out: &mut String, m: Marker, x: f64, y: f64, color: &str) {
     };
 }
 
-fn draw_series(out: &mut String, ax: &Axes, s: &Series) {
+fn draw_series(out: &mut String, axes: &Axes, s: &Series) {
     let pts: Vec<String> = s
         .points
         .iter()
-        .map(|&(x, y)| format!("{:.1},{:.1}", ax.px(x), ax.py(y)))
+        .map(|&(x, y)| format!("{:.1},{:.1}", axes.pixel_x(x), axes.pixel_y(y)))
         .collect();
     let _ = writeln!(
         out,
@@ -403,7 +426,7 @@ fn draw_series(out: &mut String, ax: &Axes, s: &Series) {
         dash_attr(s.dash)
     );
     for &(x, y) in &s.points {
-        marker(out, s.marker, ax.px(x), ax.py(y), s.color);
+        marker(out, s.marker, axes.pixel_x(x), axes.pixel_y(y), s.color);
     }
 }
 

@@ -55,7 +55,7 @@ pub fn measure<R>(f: impl FnOnce() -> R) -> (R, Option<Phase>) {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::measure;
 
     #[test]
     fn peak_follows_a_large_allocation_and_resets() {

@@ -21,21 +21,24 @@ pub struct SoftRow {
     pub native_seconds: f64,
 }
 
-fn time_median(runs: usize, mut f: impl FnMut()) -> f64 {
-    let t: Vec<f64> = (0..runs)
+/// Median wall time of `runs` calls of `call`.
+fn time_median(runs: usize, mut call: impl FnMut()) -> f64 {
+    let seconds: Vec<f64> = (0..runs)
         .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64()
+            let start = Instant::now();
+            call();
+            start.elapsed().as_secs_f64()
         })
         .collect();
-    median(&t)
+    median(&seconds)
 }
 
-type Cx = [f64; 2];
+/// SOFT's complex type, `double[2]`.
+type SoftComplex = [f64; 2];
 
-fn as_cx(v: &mut [Complex64]) -> *mut Cx {
-    v.as_mut_ptr() as *mut Cx
+/// `v` as a SOFT complex array (`Complex64` has the same layout).
+fn as_soft(v: &mut [Complex64]) -> *mut SoftComplex {
+    v.as_mut_ptr() as *mut SoftComplex
 }
 
 /// Times forward and inverse through the SOFT layer (flags 0 and 1) and the native plan.
@@ -51,56 +54,59 @@ pub fn compare(b: usize, runs: usize) -> Result<Vec<SoftRow>, so3fft::Error> {
     let n = native.num_samples();
     let mut coeffs = random_coeffs(native.num_coeffs(), 7 + b as u64);
     let mut samples = vec![Complex64::new(0.0, 0.0); n];
-    let mut out_c = vec![Complex64::new(0.0, 0.0); native.num_coeffs()];
+    let mut coeffs_out = vec![Complex64::new(0.0, 0.0); native.num_coeffs()];
     native.inverse(&coeffs, &mut samples)?;
-    let t_inv = time_median(runs, || native.inverse(&coeffs, &mut samples).unwrap());
-    let t_fwd = time_median(runs, || native.forward(&samples, &mut out_c).unwrap());
+    let native_inverse = time_median(runs, || native.inverse(&coeffs, &mut samples).unwrap());
+    let native_forward = time_median(runs, || native.forward(&samples, &mut coeffs_out).unwrap());
     // Real-signal path on real data (real parts of the samples; real-symmetric coefficients
     // are what flag = 1 clients pass, and the timing does not depend on the values).
     let mut real = vec![0.0f64; n];
-    let t_inv_real = time_median(runs, || native.inverse_real(&coeffs, &mut real).unwrap());
-    let t_fwd_real = time_median(runs, || native.forward_real(&real, &mut out_c).unwrap());
+    let native_inverse_real =
+        time_median(runs, || native.inverse_real(&coeffs, &mut real).unwrap());
+    let native_forward_real = time_median(runs, || {
+        native.forward_real(&real, &mut coeffs_out).unwrap()
+    });
 
-    let bw = b as c_int;
-    let mut ws1 = vec![Complex64::new(0.0, 0.0); n];
-    let mut ws2 = vec![Complex64::new(0.0, 0.0); n];
-    let mut wre = vec![0.0f64; 24 * b + 2 * b * b];
+    let bandwidth = b as c_int;
+    let mut workspace1 = vec![Complex64::new(0.0, 0.0); n];
+    let mut workspace2 = vec![Complex64::new(0.0, 0.0); n];
+    let mut workspace_real = vec![0.0f64; 24 * b + 2 * b * b];
     let mut weights = vec![0.0f64; 2 * b];
-    let mut out_s = vec![Complex64::new(0.0, 0.0); n];
+    let mut samples_out = vec![Complex64::new(0.0, 0.0); n];
     // SAFETY: every array has the size SOFT documents; the plan argument may be NULL
     // for this layer (it never executes client plans).
     unsafe {
-        soft::makeweights2(bw, weights.as_mut_ptr());
+        soft::makeweights2(bandwidth, weights.as_mut_ptr());
         let mut fwd = |flag: c_int| {
             soft::Forward_SO3_Naive_fftw(
-                bw,
-                as_cx(&mut samples),
-                as_cx(&mut out_c),
-                as_cx(&mut ws1),
-                as_cx(&mut ws2),
-                wre.as_mut_ptr(),
+                bandwidth,
+                as_soft(&mut samples),
+                as_soft(&mut coeffs_out),
+                as_soft(&mut workspace1),
+                as_soft(&mut workspace2),
+                workspace_real.as_mut_ptr(),
                 weights.as_mut_ptr(),
                 std::ptr::null_mut(),
                 flag,
             )
         };
         fwd(0); // builds the cached plan
-        let f0 = time_median(runs, || fwd(0));
-        let f1 = time_median(runs, || fwd(1));
+        let forward_complex = time_median(runs, || fwd(0));
+        let forward_real = time_median(runs, || fwd(1));
         let mut inv = |flag: c_int| {
             soft::Inverse_SO3_Naive_fftw(
-                bw,
-                as_cx(&mut coeffs),
-                as_cx(&mut out_s),
-                as_cx(&mut ws1),
-                as_cx(&mut ws2),
-                wre.as_mut_ptr(),
+                bandwidth,
+                as_soft(&mut coeffs),
+                as_soft(&mut samples_out),
+                as_soft(&mut workspace1),
+                as_soft(&mut workspace2),
+                workspace_real.as_mut_ptr(),
                 std::ptr::null_mut(),
                 flag,
             )
         };
-        let i0 = time_median(runs, || inv(0));
-        let i1 = time_median(runs, || inv(1));
+        let inverse_complex = time_median(runs, || inv(0));
+        let inverse_real = time_median(runs, || inv(1));
         let row = |call, seconds, native_seconds| SoftRow {
             bandwidth: b,
             call,
@@ -108,10 +114,26 @@ pub fn compare(b: usize, runs: usize) -> Result<Vec<SoftRow>, so3fft::Error> {
             native_seconds,
         };
         Ok(vec![
-            row("Forward_SO3_Naive_fftw flag 0", f0, t_fwd),
-            row("Forward_SO3_Naive_fftw flag 1", f1, t_fwd_real),
-            row("Inverse_SO3_Naive_fftw flag 0", i0, t_inv),
-            row("Inverse_SO3_Naive_fftw flag 1", i1, t_inv_real),
+            row(
+                "Forward_SO3_Naive_fftw flag 0",
+                forward_complex,
+                native_forward,
+            ),
+            row(
+                "Forward_SO3_Naive_fftw flag 1",
+                forward_real,
+                native_forward_real,
+            ),
+            row(
+                "Inverse_SO3_Naive_fftw flag 0",
+                inverse_complex,
+                native_inverse,
+            ),
+            row(
+                "Inverse_SO3_Naive_fftw flag 1",
+                inverse_real,
+                native_inverse_real,
+            ),
         ])
     }
 }

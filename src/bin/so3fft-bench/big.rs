@@ -7,7 +7,7 @@
 //!    writes the grid, the forward writes its result over the coefficient array, and the
 //!    result is compared with coefficients generated again. The peak resident memory of the
 //!    forward (reset just before it) is compared with input + output = grid + coefficients:
-//!    the issue asks for at most 5% more.
+//!    the target is at most 5% more.
 //! 2. The same without skipping negligible Wigner-d prefixes (`skip_bits: Some(0)`), on the
 //!    same arrays (n/a while the library refuses that option).
 //! 3. Real-signal round trip (`forward_real` / `inverse_real`, real grid of 8.6 GB) on
@@ -19,12 +19,14 @@
 //! with its time, error and peak memory printed (not in the CSV).
 //!
 //! Each plan is dropped before the next is made (a plan holds a chunk buffer of about 1 GB
-//! here). Before each step the memory it needs is checked against `MemAvailable`; a step
+//! at B = 512). Before each step the memory it needs is checked against `MemAvailable`; a step
 //! that does not fit is skipped with a message. Everything runs once (a run takes minutes).
 
+use crate::cli::Options;
 use crate::memory;
-use crate::report::{Memory, Row, Stages, Variant};
+use crate::report::{self, Memory, Row, Stages, Variant};
 use crate::seeded;
+use crate::timing::{self, Timed};
 use crate::workload::{self, RoundTripError};
 use rayon::prelude::*;
 use so3fft::{Complex64, Direction, Plan, PlanOptions, StageTimes};
@@ -42,7 +44,7 @@ pub struct Outcome {
 }
 
 /// Runs the three steps at bandwidth `b` with `threads` workers.
-pub fn run(b: usize, threads: usize, opts: &crate::cli::Options, peak_1core: f64) -> Outcome {
+pub fn run(b: usize, threads: usize, opts: &Options, peak_1core: f64) -> Outcome {
     eprintln!(
         "  (B = {b}: memory-lean run, {threads} threads, each transform once; grid {:.2} GB, \
          coefficients {:.2} GB)",
@@ -66,10 +68,11 @@ pub fn run(b: usize, threads: usize, opts: &crate::cli::Options, peak_1core: f64
     }
 }
 
+/// The state of the lean run at one bandwidth.
 struct Lean<'a> {
     b: usize,
     threads: usize,
-    opts: &'a crate::cli::Options,
+    opts: &'a Options,
     peak_1core: f64,
     /// The coefficient array, shared by all steps once allocated.
     coeffs: Option<Vec<Complex64>>,
@@ -172,13 +175,11 @@ impl Lean<'_> {
             // The grid still holds the inverse's samples: the forward that may overwrite
             // them, on the same plan (the grid is rewritten by the next step's inverse).
             let arrays = workload::array_bytes(b, false);
-            let (d, mem) =
-                timed_phase(|| plan.forward_destroying_input_timed(&mut grid, &mut coeffs));
-            match d.2 {
-                Ok(t) => {
-                    let e = seeded::compare_complex(self.seed(), &coeffs);
-                    self.destroy_complex = Some(d.0);
-                    destroy_line("complex", d.0, t, e, row.fwd_median, mem, arrays);
+            match timed_phase(|| plan.forward_destroying_input_timed(&mut grid, &mut coeffs)) {
+                Ok(destroying) => {
+                    let error = seeded::compare_complex(self.seed(), &coeffs);
+                    self.destroy_complex = Some(destroying.timed.wall);
+                    print_destroying("complex", &destroying, error, row.fwd_median, arrays);
                 }
                 Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
             }
@@ -193,8 +194,11 @@ impl Lean<'_> {
             (Ok(_), Ok(plan)) => {
                 match self.complex_round_trip(&plan, Variant::NoSkip, &mut coeffs, &mut grid) {
                     Ok(mut row) => {
-                        let sk = skip.as_ref().expect("checked above");
-                        row.ratio = Some((row.fwd.dwt / sk.fwd.dwt, row.inv.dwt / sk.inv.dwt));
+                        let skip_row = skip.as_ref().expect("checked above");
+                        row.ratio = Some((
+                            row.fwd.dwt / skip_row.fwd.dwt,
+                            row.inv.dwt / skip_row.inv.dwt,
+                        ));
                         self.rows.push(row);
                         None
                     }
@@ -231,34 +235,24 @@ impl Lean<'_> {
             variant.name(),
             t.elapsed().as_secs_f64()
         );
-        let (inv, inv_mem) = timed_phase(|| plan.inverse_timed(coeffs, grid));
-        let inv: Timed = (inv.0, inv.1, inv.2?);
-        let (fwd, fwd_mem) = timed_phase(|| plan.forward_timed(grid, coeffs));
-        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
+        let inverse = timed_phase(|| plan.inverse_timed(coeffs, grid))?;
+        let forward = timed_phase(|| plan.forward_timed(grid, coeffs))?;
         let t = Instant::now();
         let error = seeded::compare_complex(self.seed(), coeffs);
-        let arrays = workload::array_bytes(b, false);
-        let row = self.row(
-            variant,
-            inv,
-            fwd,
-            error,
-            fwd_mem.map(|p| Memory {
-                peak: p.peak,
-                start: p.start,
-                plan: plan.memory_bytes() as u64,
-                arrays,
-            }),
-            workload::dwt_flops_exact(b),
-        );
+        let row = self.row(variant, plan, RoundTrip { inverse, forward }, error);
         eprintln!(
             "  ({}: compared in {:.1} s; {}; issue limit 1.05)",
             variant.name(),
             t.elapsed().as_secs_f64(),
-            memory_summary(inv_mem, fwd_mem, arrays, plan),
+            memory_summary(
+                inverse.phase,
+                forward.phase,
+                workload::array_bytes(b, false),
+                plan
+            ),
         );
         if variant == Variant::Complex {
-            println!("{}", crate::report::table_line(&row));
+            println!("{}", report::table_line(&row));
         }
         Ok(row)
     }
@@ -293,15 +287,18 @@ impl Lean<'_> {
         match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
             Ok(row) => {
                 let arrays = workload::array_bytes(b, true);
-                let (d, mem) = timed_phase(|| {
+                let destroying = timed_phase(|| {
                     plan.forward_real_destroying_input_timed(&mut grid, &mut coeffs)
                 });
-                match d.2 {
-                    Ok(t) => {
-                        let e = seeded::compare_real(self.real_seed(), b, &coeffs);
-                        destroy_line("real", d.0, t, e, row.fwd_median, mem, arrays);
-                        if let Some(c) = self.destroy_complex {
-                            println!("  destroying forwards, real over complex: {:.3}", d.0 / c);
+                match destroying {
+                    Ok(destroying) => {
+                        let error = seeded::compare_real(self.real_seed(), b, &coeffs);
+                        print_destroying("real", &destroying, error, row.fwd_median, arrays);
+                        if let Some(complex) = self.destroy_complex {
+                            println!(
+                                "  destroying forwards, real over complex: {:.3}",
+                                destroying.timed.wall / complex
+                            );
                         }
                     }
                     Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
@@ -321,25 +318,11 @@ impl Lean<'_> {
     ) -> Result<Row, so3fft::Error> {
         let b = self.b;
         seeded::fill_real(self.real_seed(), b, coeffs);
-        let (inv, inv_mem) = timed_phase(|| plan.inverse_real_timed(coeffs, grid));
-        let inv: Timed = (inv.0, inv.1, inv.2?);
-        let (fwd, fwd_mem) = timed_phase(|| plan.forward_real_timed(grid, coeffs));
-        let fwd: Timed = (fwd.0, fwd.1, fwd.2?);
+        let inverse = timed_phase(|| plan.inverse_real_timed(coeffs, grid))?;
+        let forward = timed_phase(|| plan.forward_real_timed(grid, coeffs))?;
         let error = seeded::compare_real(self.real_seed(), b, coeffs);
         let arrays = workload::array_bytes(b, true);
-        let mut row = self.row(
-            Variant::Real,
-            inv,
-            fwd,
-            error,
-            fwd_mem.map(|p| Memory {
-                peak: p.peak,
-                start: p.start,
-                plan: plan.memory_bytes() as u64,
-                arrays,
-            }),
-            workload::dwt_flops_real(b),
-        );
+        let mut row = self.row(Variant::Real, plan, RoundTrip { inverse, forward }, error);
         row.ratio = self
             .rows
             .iter()
@@ -347,80 +330,95 @@ impl Lean<'_> {
             .map(|c| (row.fwd_median / c.fwd_median, row.inv_median / c.inv_median));
         eprintln!(
             "  (real: {})",
-            memory_summary(inv_mem, fwd_mem, arrays, plan)
+            memory_summary(inverse.phase, forward.phase, arrays, plan)
         );
         Ok(row)
     }
 
-    fn row(
-        &self,
-        variant: Variant,
-        inv: Timed,
-        fwd: Timed,
-        error: RoundTripError,
-        memory: Option<Memory>,
-        dwt_flops: u64,
-    ) -> Row {
+    /// The row of one round trip of `plan` (`variant`: complex, no-skip or real), with the
+    /// peak memory of its forward.
+    fn row(&self, variant: Variant, plan: &Plan, trip: RoundTrip, error: RoundTripError) -> Row {
+        let real = variant == Variant::Real;
         let stages = |t: StageTimes| Stages {
             fft: t.fft,
             dwt: t.dwt,
         };
+        let (inv, fwd) = (trip.inverse.timed, trip.forward.timed);
+        let arrays = workload::array_bytes(self.b, real);
+        let plan_bytes = plan.memory_bytes() as u64;
         Row {
             variant,
             bandwidth: self.b,
             threads: self.threads,
             runs: 1,
-            fwd_median: fwd.0,
-            inv_median: inv.0,
-            fwd: stages(fwd.2),
-            inv: stages(inv.2),
-            dwt_flops,
+            fwd_median: fwd.wall,
+            inv_median: inv.wall,
+            fwd: stages(fwd.stages),
+            inv: stages(inv.stages),
+            dwt_flops: if real {
+                workload::dwt_flops_real(self.b)
+            } else {
+                workload::dwt_flops_exact(self.b)
+            },
             peak_1core: self.peak_1core,
             max_abs_err: error.max_abs,
             rel_l2_err: error.rel_l2,
-            memory,
+            memory: trip
+                .forward
+                .phase
+                .map(|p| Memory::of_phase(p, plan_bytes, arrays)),
             ratio: None,
-            cpu: Some((fwd.1, inv.1)),
+            cpu: Some((fwd.cpu, inv.cpu)),
         }
     }
 }
 
 /// Prints the result of a forward that may overwrite its input (`what`: complex or real):
 /// time, stages, error against the seeded coefficients, ratio to the preserving forward
-/// `fwd` of the same plan, and its peak memory against input + output.
-fn destroy_line(
+/// (`preserving` seconds) of the same plan, and its peak memory against input + output
+/// (`arrays` bytes).
+fn print_destroying(
     what: &str,
-    wall: f64,
-    t: StageTimes,
-    e: RoundTripError,
-    fwd: f64,
-    mem: Option<memory::Phase>,
+    destroying: &Measured,
+    error: RoundTripError,
+    preserving: f64,
     arrays: u64,
 ) {
-    let peak = mem.map_or("n/a".into(), |p| {
+    let peak = destroying.phase.map_or("n/a".into(), |p| {
         format!("{:.4}", p.peak as f64 / arrays as f64)
     });
+    let Timed { wall, stages, .. } = destroying.timed;
     println!(
         "  {what} forward destroying its input: {wall:.3e} s (FFT {:.3e} / DWT {:.3e}), \
          {:.3} x the preserving forward; errors {:.2e} / {:.2e}; peak {peak} x (input + output)",
-        t.fft,
-        t.dwt,
-        wall / fwd,
-        e.max_abs,
-        e.rel_l2,
+        stages.fft,
+        stages.dwt,
+        wall / preserving,
+        error.max_abs,
+        error.rel_l2,
     );
 }
 
-/// Wall and process CPU time of one transform, and the library's stage times.
-type Timed = (f64, f64, StageTimes);
+/// One transform timed in a phase of its own: its times and the phase's peak memory.
+#[derive(Clone, Copy)]
+struct Measured {
+    timed: Timed,
+    phase: Option<memory::Phase>,
+}
 
-/// Runs `f` with the peak-memory counter reset first; returns its wall and CPU time and
-/// result, and the peak of the phase.
-fn timed_phase<R>(f: impl FnOnce() -> R) -> ((f64, f64, R), Option<memory::Phase>) {
-    memory::measure(|| {
-        let (cpu, t) = (crate::cpu_seconds(), Instant::now());
-        let r = f();
-        (t.elapsed().as_secs_f64(), crate::cpu_seconds() - cpu, r)
+/// The inverse and the forward of one round trip.
+struct RoundTrip {
+    inverse: Measured,
+    forward: Measured,
+}
+
+/// Runs `transform` with the peak-memory counter reset first: its times and the peak of the
+/// phase.
+fn timed_phase(transform: impl FnOnce() -> so3fft::Result<StageTimes>) -> so3fft::Result<Measured> {
+    let (timed, phase) = memory::measure(|| timing::time(transform));
+    Ok(Measured {
+        timed: timed?,
+        phase,
     })
 }
 
@@ -469,7 +467,7 @@ fn phase_gb(p: Option<memory::Phase>) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{run, Variant};
 
     /// The whole lean procedure at a small bandwidth: three rows, exact round trips.
     #[test]

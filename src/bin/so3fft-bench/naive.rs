@@ -8,12 +8,12 @@
 //! with, `8B (4B^3 - B)/3` flops, so the time ratio is a fair measure of what the library's
 //! kernels, symmetries and skipping buy.
 //!
-//! Conventions are SPEC.md's: `d^1_{1,0}(b) = -sin(b)/sqrt 2`, `dt^l = sqrt((2l+1)/2) d^l`,
+//! Conventions are those of docs/conventions.md (Wigner d, sample grid): `d^1_{1,0}(b) = -sin(b)/sqrt 2`, `dt^l = sqrt((2l+1)/2) d^l`,
 //! `beta_k = pi (2k+1)/(4B)` and the weights `w_B(k)` of `so3fft::weights`.
 //!
 //! The data of the DWT stage are the 2-D Fourier coefficients of the beta slices,
 //! `G[k][M mod 2B][M' mod 2B]` (`2B` slices of `(2B)^2` complex values, frequencies `+-B`
-//! unused). With the SPEC's normalisation a band-limited signal has
+//! unused). With that normalisation a band-limited signal has
 //! `G(k, M, M') = sum_l fhat(l, M, M') dt^l_{M,M'}(beta_k)` (its slice DFT
 //! `sum_{j1,j2} e^{+i M alpha} e^{+i M' gamma} f` is `(2B)^2 / (2 pi)` times that), and the
 //! forward transform is `fhat(l, M, M') = sum_k w_B(k) dt^l_{M,M'}(beta_k) G(k, M, M')`.
@@ -37,8 +37,9 @@ use so3fft::Complex64;
 pub struct Column {
     pub l0: usize,
     prefactor: f64,
-    p: i32,
-    q: i32,
+    /// Powers of `cos(beta/2)` and `sin(beta/2)` in the starting value.
+    cos_power: i32,
+    sin_power: i32,
     /// `a_l`, `M M'/(l(l+1))`, `b_l`, `sqrt((2l+1)/2)` for `l = l0 ..= lmax`.
     a: Vec<f64>,
     c: Vec<f64>,
@@ -88,8 +89,8 @@ impl Column {
         Column {
             l0,
             prefactor: if negative { -root } else { root },
-            p: p as i32,
-            q: q as i32,
+            cos_power: p as i32,
+            sin_power: q as i32,
             a,
             c,
             b,
@@ -106,7 +107,7 @@ impl Column {
     /// normal range is returned as 0: the whole column is then negligible (below about 1e-290)
     /// and subnormal arithmetic would only make the recurrence crawl.
     pub fn start(&self, ch: f64, sh: f64) -> f64 {
-        let v = self.prefactor * ch.powi(self.p) * sh.powi(self.q);
+        let v = self.prefactor * ch.powi(self.cos_power) * sh.powi(self.sin_power);
         if v.abs() < f64::MIN_POSITIVE {
             0.0
         } else {
@@ -172,25 +173,25 @@ fn orders(b: usize) -> std::ops::RangeInclusive<isize> {
 }
 
 /// Forward DWT: `coeffs[(l, M, M')] = sum_k w_B(k) dt^l_{M,M'}(beta_k) G[k][M][M']` for
-/// every coefficient (SOFT layout). `g` holds `2B` slices of `(2B)^2` values.
-pub fn forward(b: usize, betas: &Betas, g: &[Complex64], coeffs: &mut [Complex64]) {
+/// every coefficient (SOFT layout). `spectra` holds `2B` slices of `(2B)^2` values.
+pub fn forward(b: usize, betas: &Betas, spectra: &[Complex64], coeffs: &mut [Complex64]) {
     let n = 2 * b;
-    assert_eq!(g.len(), n * n * n);
+    assert_eq!(spectra.len(), n * n * n);
     assert_eq!(coeffs.len(), so3fft::num_coeffs(b));
     for m in orders(b) {
         for mp in orders(b) {
-            let col = Column::new(m, mp, b - 1);
-            let start = so3fft::coef_index(b, col.l0, m, mp);
-            let out = &mut coeffs[start..start + col.len()];
+            let column = Column::new(m, mp, b - 1);
+            let start = so3fft::coef_index(b, column.l0, m, mp);
+            let out = &mut coeffs[start..start + column.len()];
             out.fill(Complex64::new(0.0, 0.0));
-            let fi = freq_index(b, m, mp);
+            let freq = freq_index(b, m, mp);
             for k in 0..n {
-                let x = g[k * n * n + fi] * betas.weight[k];
-                let cb = betas.cos[k];
-                let (mut prev, mut d) = (0.0, col.start(betas.half_cos[k], betas.half_sin[k]));
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o += x * (d * col.norm[i]);
-                    let next = col.a[i] * (cb - col.c[i]) * d - col.b[i] * prev;
+                let x = spectra[k * n * n + freq] * betas.weight[k];
+                let cos_beta = betas.cos[k];
+                let (mut prev, mut d) = (0.0, column.start(betas.half_cos[k], betas.half_sin[k]));
+                for (i, out_value) in out.iter_mut().enumerate() {
+                    *out_value += x * (d * column.norm[i]);
+                    let next = column.a[i] * (cos_beta - column.c[i]) * d - column.b[i] * prev;
                     prev = d;
                     d = next;
                 }
@@ -201,28 +202,28 @@ pub fn forward(b: usize, betas: &Betas, g: &[Complex64], coeffs: &mut [Complex64
 
 /// Inverse DWT: `G[k][M][M'] = sum_l fhat(l, M, M') dt^l_{M,M'}(beta_k)` (frequencies `+-B`
 /// are set to 0).
-pub fn inverse(b: usize, betas: &Betas, coeffs: &[Complex64], g: &mut [Complex64]) {
+pub fn inverse(b: usize, betas: &Betas, coeffs: &[Complex64], spectra: &mut [Complex64]) {
     let n = 2 * b;
-    assert_eq!(g.len(), n * n * n);
+    assert_eq!(spectra.len(), n * n * n);
     assert_eq!(coeffs.len(), so3fft::num_coeffs(b));
-    g.fill(Complex64::new(0.0, 0.0));
+    spectra.fill(Complex64::new(0.0, 0.0));
     for m in orders(b) {
         for mp in orders(b) {
-            let col = Column::new(m, mp, b - 1);
-            let start = so3fft::coef_index(b, col.l0, m, mp);
-            let fin = &coeffs[start..start + col.len()];
-            let fi = freq_index(b, m, mp);
+            let column = Column::new(m, mp, b - 1);
+            let start = so3fft::coef_index(b, column.l0, m, mp);
+            let row = &coeffs[start..start + column.len()];
+            let freq = freq_index(b, m, mp);
             for k in 0..n {
-                let cb = betas.cos[k];
-                let (mut prev, mut d) = (0.0, col.start(betas.half_cos[k], betas.half_sin[k]));
+                let cos_beta = betas.cos[k];
+                let (mut prev, mut d) = (0.0, column.start(betas.half_cos[k], betas.half_sin[k]));
                 let mut acc = Complex64::new(0.0, 0.0);
-                for (i, f) in fin.iter().enumerate() {
-                    acc += f * (d * col.norm[i]);
-                    let next = col.a[i] * (cb - col.c[i]) * d - col.b[i] * prev;
+                for (i, coeff) in row.iter().enumerate() {
+                    acc += coeff * (d * column.norm[i]);
+                    let next = column.a[i] * (cos_beta - column.c[i]) * d - column.b[i] * prev;
                     prev = d;
                     d = next;
                 }
-                g[k * n * n + fi] = acc;
+                spectra[k * n * n + freq] = acc;
             }
         }
     }
@@ -230,8 +231,9 @@ pub fn inverse(b: usize, betas: &Betas, coeffs: &[Complex64], g: &mut [Complex64
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use super::{forward, freq_index, inverse, orders, Betas, Column};
     use crate::workload::{random_coeffs, roundtrip_error};
+    use so3fft::Complex64;
     use std::f64::consts::PI;
 
     fn column(m: isize, mp: isize, lmax: usize, beta: f64) -> Vec<f64> {
@@ -291,7 +293,10 @@ mod tests {
     /// Against the mpmath reference table, where it is available (degrees < 256).
     #[test]
     fn matches_reference_csv() {
-        let path = "/work/shared/testdata/wigner_d_reference.csv";
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/wigner_d_reference.csv"
+        );
         let Ok(text) = std::fs::read_to_string(path) else {
             eprintln!("{path} not found: skipped");
             return;
