@@ -1,4 +1,4 @@
-/* Reference transforms (../shared/testdata) through the C API, both directions:
+/* Reference transforms (tests/data) through the C API, both directions:
  * forward(samples) = coefficients and inverse(coefficients) = samples to 1e-13.
  * Usage: test_reference <testdata dir> */
 #include "test_util.h"

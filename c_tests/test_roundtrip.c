@@ -49,7 +49,7 @@ static void helpers(void) {
     CHECK(so3fft_num_coeffs(256) == 22369536u);
     CHECK(so3fft_num_coeffs(SO3FFT_MAX_BANDWIDTH) > 0);
     CHECK_NO_ERR();
-    /* SPEC.md section 3 spot values (B = 256) */
+    /* spot values of docs/conventions.md, coefficient layout (B = 256) */
     CHECK(so3fft_coef_index(256, 0, 0, 0) == 0);
     CHECK(so3fft_coef_index(256, 255, 0, 0) == 255);
     CHECK(so3fft_coef_index(256, 1, 0, 1) == 256);

@@ -1,5 +1,5 @@
 //! Plan::inverse / Plan::forward against naive direct summation of the defining formulas
-//! (SPEC.md section 3) using an independent Wigner-d (explicit factorial sum, tests/common).
+//! (docs/conventions.md, forward and inverse transforms) using an independent Wigner-d (explicit factorial sum, tests/common).
 
 mod common;
 
@@ -95,7 +95,7 @@ fn weights_formula_and_library_weights() {
         // each weight is a sum of B terms bounded by 1, times 2/B: error ~ a few eps
         assert!(
             e <= 1e-14,
-            "B={b}: so3fft::weights differs from the SPEC formula by {e:e}"
+            "B={b}: so3fft::weights differs from the formula of docs/conventions.md by {e:e}"
         );
     }
 }

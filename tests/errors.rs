@@ -1,4 +1,4 @@
-//! Error reporting and index helpers (SPEC.md section 3 closed-form values).
+//! Error reporting and index helpers (closed-form values of docs/conventions.md, coefficient layout).
 
 mod common;
 
@@ -309,7 +309,7 @@ fn tiny_workspace_cap() {
 #[test]
 fn coef_index_spec_spot_values_b256() {
     let b = 256;
-    // (M, M', l) -> index, from SPEC.md section 3
+    // (M, M', l) -> index, from docs/conventions.md (coefficient layout)
     let cases: [(isize, isize, usize, usize); 7] = [
         (0, 0, 0, 0),
         (0, 0, 255, 255),

@@ -1,8 +1,8 @@
 //! Discrete orthonormality of the normalised Wigner-d on the quadrature grid:
 //!   sum_k w_B(k) dt^l_{m,m'}(beta_k) dt^{l'}_{m,m'}(beta_k) = delta_{l l'}   for max(|m|,|m'|) <= l, l' < B,
-//! which holds exactly for the SPEC weights (the products are band-limited below 2B), using the
-//! library's dt_on_grid (the DWT's own code path) and weights. Plus dt_on_grid against the mpmath
-//! reference values at grid angles.
+//! which holds exactly for the quadrature weights of docs/conventions.md (the products are
+//! band-limited below 2B), using the library's dt_on_grid (the DWT's own code path) and weights.
+//! Plus dt_on_grid against the mpmath reference values at grid angles.
 
 mod common;
 
@@ -136,7 +136,7 @@ fn library_weights_match_formula_large_b() {
         // each weight: (2/B) sin(beta) * (sum of B terms bounded by 1): error a few eps in absolute
         assert!(
             e <= 1e-14,
-            "B={b}: weights differ from the SPEC formula by {e:e}"
+            "B={b}: weights differ from the formula of docs/conventions.md by {e:e}"
         );
         assert!((s - 2.0).abs() <= 1e-12, "B={b}: sum of weights {s}");
     }

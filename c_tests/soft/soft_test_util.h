@@ -76,7 +76,7 @@ static inline double wigner_d(int l, int m, int mp, double beta) {
     return sqrt(fact(l + m) * fact(l - m) * fact(l + mp) * fact(l - mp)) * sum;
 }
 
-/* Direct inverse: f(alpha_j1, beta_k, gamma_j2) = sum fhat Dt^l_{m,mp}, SPEC.md layout. */
+/* Direct inverse: f(alpha_j1, beta_k, gamma_j2) = sum fhat Dt^l_{m,mp}, layout of docs/conventions.md. */
 static inline void direct_inverse(int bw, fftw_complex *coeffs, fftw_complex *out) {
     int n = 2 * bw, k, j1, j2, l, m, mp;
     for (k = 0; k < n; k++) {

@@ -1,5 +1,5 @@
-/* SOFT-style client test: index and size functions against their closed forms and SPEC.md's
- * spot values, makeweights against the weight formula, and the no-error-channel behaviour on
+/* SOFT-style client test: index and size functions against their closed forms and the spot
+ * values of docs/conventions.md, makeweights against the weight formula, and the no-error-channel behaviour on
  * invalid input (nothing written, one line on stderr). */
 #include <math.h>
 #include <stdio.h>
@@ -17,7 +17,7 @@
 
 #include "soft_test_util.h"
 
-/* so3CoefLoc by SPEC.md's closed form (64-bit). */
+/* so3CoefLoc by the closed form of docs/conventions.md (64-bit). */
 static long long closed_form(int m, int mp, int l, int bw) {
     long long B = bw, a = ABS(m), T = (4 * B * B * B - B) / 3, row, off = 0, k;
     if (m >= 0)
@@ -74,7 +74,7 @@ static void layout_checks(int bw) {
 int main(void) {
     int bw, m, l, k, i;
 
-    /* SPEC.md spot values, listed there as (M, M', l) */
+    /* docs/conventions.md spot values, listed there as (M, M', l) */
     CHECK(so3CoefLoc(0, 0, 0, 256) == 0);
     CHECK(so3CoefLoc(0, 0, 255, 256) == 255);
     CHECK(so3CoefLoc(0, 1, 1, 256) == 256);
@@ -96,7 +96,7 @@ int main(void) {
         CHECK(k == bw * bw);
     }
 
-    /* weights: the formula of SPEC.md, and they integrate sin(beta) exactly (sum = 2) */
+    /* weights: the formula of docs/conventions.md, and they integrate sin(beta) exactly (sum = 2) */
     for (bw = 1; bw <= 16; bw *= 2) {
         double *w = alloc_re((size_t)(4 * bw)), sum = 0.0;
         makeweights(bw, w);

@@ -1,5 +1,5 @@
 /* SOFT-style client test: every transform entry point (plain, _pc, _nt, _W; flag 0 and 1)
- * against the reference data of ../shared/testdata, with buffers sized exactly to SOFT's
+ * against the reference data of tests/data, with buffers sized exactly to SOFT's
  * documented minimum, inputs checked unchanged, and the real inverse fed NaN in the blocks it
  * must not read. Usage: test_soft_reference <testdata dir> */
 #include <math.h>
@@ -25,7 +25,7 @@
 enum variant { PLAIN, PC, NT, WRAP, NVARIANTS };
 static const char *variant_name[NVARIANTS] = {"plain", "_pc", "_nt", "_W"};
 
-/* Read coefficients and samples of a reference file (SPEC.md layouts). */
+/* Read coefficients and samples of a reference file (layouts of docs/conventions.md). */
 static int read_reference(const char *path, int *bw, fftw_complex **coeffs,
                           fftw_complex **samples) {
     char line[512];

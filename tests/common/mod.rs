@@ -1,8 +1,8 @@
 //! Shared helpers for the so3fft integration tests.
 //!
 //! Everything here is written independently of the library: a small PRNG, parsers for the
-//! reference files in ../shared/testdata, an independent Wigner-d (Wigner's explicit factorial
-//! sum, only meant for small degrees), quadrature weights from the formula in SPEC.md, and
+//! reference files in tests/data, an independent Wigner-d (Wigner's explicit factorial
+//! sum, only meant for small degrees), quadrature weights from the formula in docs/conventions.md, and
 //! direct (naive, FFT-free) summations of the inverse and forward transforms.
 #![allow(dead_code)]
 
@@ -49,7 +49,7 @@ impl Rng {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Sizes and layouts, written from SPEC.md (independently of the library's helpers).
+// Sizes and layouts, written from docs/conventions.md (independently of the library's helpers).
 // ---------------------------------------------------------------------------------------------
 pub fn n_samples(b: usize) -> usize {
     8 * b * b * b
@@ -116,7 +116,7 @@ pub fn triples(b: usize) -> Vec<(usize, isize, isize)> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Grid and weights from SPEC.md section 2/3.
+// Grid and weights from docs/conventions.md (sample grid, quadrature weights).
 // ---------------------------------------------------------------------------------------------
 pub fn grid_beta(b: usize, k: usize) -> f64 {
     PI * (2 * k + 1) as f64 / (4 * b) as f64
@@ -317,9 +317,8 @@ pub fn testdata_dir() -> PathBuf {
         }
     }
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("shared")
-        .join("testdata")
+        .join("tests")
+        .join("data")
 }
 
 fn num<T: std::str::FromStr>(tok: &str, path: &std::path::Path, lineno: usize, line: &str) -> T {
