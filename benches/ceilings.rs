@@ -17,9 +17,6 @@ fn main() {
     println!("ceilings: hand-written x86_64 AVX-512 loops; nothing to measure on this target");
 }
 
-/// FMA peak of one core in GFLOP/s, the yardstick of the ceilings.
-///
-
 /// The loops and their driver.
 #[cfg(target_arch = "x86_64")]
 mod x86 {

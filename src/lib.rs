@@ -3,7 +3,7 @@
 //! Fast Fourier transform on the rotation group SO(3) and its inverse, after Kostelec and
 //! Rockmore's FSOFT with the symmetry-clustered parallel discrete Wigner transform of
 //! Lux, Wülker and Chirikjian. Conventions, sample and coefficient layouts are SOFT 2.0's
-//! (see `SPEC.md`): samples `f(alpha_j1, beta_k, gamma_j2)` at index
+//! (see `docs/conventions.md`): samples `f(alpha_j1, beta_k, gamma_j2)` at index
 //! `k (2B)^2 + j1 (2B) + j2`, coefficients in `so3CoefLoc` order.
 //!
 //! ```
@@ -20,8 +20,8 @@
 //! ```
 
 #![warn(missing_docs)]
-#![warn(unsafe_op_in_unsafe_fn)]
-#![warn(clippy::undocumented_unsafe_blocks)]
+#![deny(unsafe_op_in_unsafe_fn)]
+#![deny(clippy::undocumented_unsafe_blocks)]
 
 pub mod capi;
 mod dwt;

@@ -239,8 +239,9 @@ impl Plan {
         let lanes = blocks
             .lanes
             .max(blocks_real.as_ref().map_or(0, |t| t.lanes));
-        let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
+        // The large, fallible mappings before the tables: a shortage shows as an error there.
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
+        let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
         let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
         let on_exit = live.clone();

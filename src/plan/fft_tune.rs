@@ -161,7 +161,7 @@ impl Plan {
                     // A clear lead of the default needs no more rounds. A lead of FFTW's
                     // threads must survive every round: one round in which another
                     // process delays a worker makes the default look slow
-                    // (`examples/tune_count.rs` counts the choices under load).
+                    // (`benches/tune_count.rs` counts the choices under load).
                     if best[1] > CLEAR * best[0] {
                         break;
                     }

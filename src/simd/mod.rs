@@ -9,7 +9,7 @@
 pub(crate) mod avx2;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512;
-#[cfg(any(test, feature = "internals"))]
+#[cfg(feature = "internals")]
 pub(crate) mod peak;
 pub(crate) mod scalar;
 #[cfg(all(test, target_arch = "x86_64"))]
