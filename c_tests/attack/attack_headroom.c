@@ -15,7 +15,11 @@
  *   attack_headroom range B estimate|measure|soft nthreads lo_MB hi_MB step_MB
  *                              any sweep (for measuring the margin; not a CTest case)
  * Each line of output gives the headroom and the outcome, so the margin FFTW needs can be
- * read off. */
+ * read off. Seen on main (FFTW 3.3.10): ESTIMATE B = 16 aborts at 22-154 kB (FFTW's alloc.c)
+ * and 172-271 kB (a Rust infallible allocation in plan/blocks.rs); B = 64 aborts at
+ * 0.84-1.06 MB; MEASURE 2 threads B = 64 aborts at 40.5 MB and hangs at 42-48 MB (FFTW's
+ * fftw_spawn_loop waiting for a thread it could not start); the SOFT `_W` calls hang at
+ * 9-13 MB (B = 16) and 42-48 MB (B = 64). */
 #define _POSIX_C_SOURCE 200809L
 #include <fcntl.h>
 #include <fftw3.h>
