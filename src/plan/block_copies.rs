@@ -88,6 +88,10 @@ pub(super) unsafe fn scatter_group(
             sp[i] = s[i].get();
             (wr[i], wi[i]) = (w[i], if conj { -w[i] } else { w[i] });
         }
+        // Rows of the irregular blocks (each block clears only the part it uses) and of the
+        // regular ones (written in full), made once per call, not per block.
+        let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
+        let mut regular_rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
         let end = cs.end;
         for c in cs {
             if t.prefetch_slices && c + PREFETCH_SLOTS < end {
@@ -100,12 +104,14 @@ pub(super) unsafe fn scatter_group(
             if t.regular[c] {
                 // The common case (`Blocks::regular`), written out.
                 match p {
-                    16 => scatter_regular::<8>(t, c, &sp[..ns], &wr, conj, dst),
-                    _ => scatter_regular::<4>(t, c, &sp[..ns], &wr, conj, dst),
+                    16 => {
+                        scatter_regular::<8>(t, c, (&sp[..ns], &wr), conj, dst, &mut regular_rows)
+                    }
+                    _ => scatter_regular::<4>(t, c, (&sp[..ns], &wr), conj, dst, &mut regular_rows),
                 }
                 continue;
             }
-            let mut rows = [0.0f64; 16 * 2 * MAX_GROUP];
+            rows[..ns * p].fill(0.0);
             for q in 0..p / 2 {
                 let idx = *t.slot_index.get_unchecked(8 * c + q);
                 if idx == NONE {
@@ -270,17 +276,16 @@ pub(super) unsafe fn gather_group(
 unsafe fn scatter_regular<const S: usize>(
     t: &Blocks,
     c: usize,
-    sp: &[*const Complex64],
-    w: &[f64],
+    (sp, w): (&[*const Complex64], &[f64]),
     conj: bool,
     dst: (*mut f64, usize, usize),
+    rows: &mut [Complex64; 8 * 2 * MAX_GROUP],
 ) {
     // SAFETY: `c < t.len()`, and the caller's contract for the slices and rows.
     unsafe {
         let f: [usize; S] =
             std::array::from_fn(|q| *t.slot_index.get_unchecked(8 * c + q) as usize);
         let (h, ns) = (S / 2, sp.len());
-        let mut rows = [Complex64::new(0.0, 0.0); 8 * 2 * MAX_GROUP];
         for jj in 0..ns / 2 {
             let (s0, s1) = (sp[2 * jj], sp[2 * jj + 1]);
             let (w0, w1) = (w[2 * jj], w[2 * jj + 1]);
