@@ -112,7 +112,11 @@ for mod, p in files.items():
     text = re.sub(r"//[^\n]*", "", strip_tests(open(p).read()))
     inline = re.findall(r"\bcrate(?:::[A-Za-z_][A-Za-z0-9_]*)+", text)
     # A module's `pub use` of its own descendants is its public face, not a dependency.
-    own_face = set(use_paths(text, public=True))
+    own_face = set()
+    for u in use_paths(text, public=True):
+        t = resolve(mod, u)
+        if t is not None and len(t) > len(mod) and t[: len(mod)] == mod:
+            own_face.add(u)
     for u in [u for u in use_paths(text) if u not in own_face] + inline:
         t = resolve(mod, u)
         if t is not None and t != mod and t in files:
