@@ -117,6 +117,14 @@ int so3fft_plan_with_max_workspace(size_t bytes);
 // The setting of `so3fft_plan_with_max_workspace` (0 = library default).
 size_t so3fft_planner_max_workspace(void);
 
+// Sets how plans made afterwards use their threads in the FFT stage (process-wide):
+// 0 = library's choice (timed with `SO3FFT_MEASURE`+), `SO3FFT_FFT_SLICES_ACROSS_WORKERS`
+// or `SO3FFT_FFT_FFTW_THREADS`. `SO3FFT_EINVAL` for other values.
+int so3fft_plan_with_fft_threading(int mode);
+
+// The setting of `so3fft_plan_with_fft_threading` (0 = library's choice).
+int so3fft_planner_fft_threading(void);
+
 // Plans the forward transform, samples `in` ((2B)^3) to coefficients `out` ((4B^3-B)/3);
 // `in`, `out` both NULL for new-array execute only. NULL on error.
 so3fft_plan so3fft_plan_forward(int B, so3fft_complex *in, so3fft_complex *out, unsigned int flags);
@@ -185,6 +193,23 @@ int so3fft_weights(int B, double *w);
 
 // `SO3FFT_MAX_BANDWIDTH` of the library linked.
 int so3fft_max_bandwidth(void);
+
+// Writes FFTW's wisdom to the file `filename` (replaced atomically). `SO3FFT_OK` or an
+// error code.
+int so3fft_export_wisdom_to_filename(const char *filename);
+
+// Loads FFTW wisdom from the file `filename`. `SO3FFT_OK` or an error code
+// (`SO3FFT_EINVAL`: unreadable file or not FFTW wisdom).
+int so3fft_import_wisdom_from_filename(const char *filename);
+
+// FFTW's wisdom as a NUL-terminated string to be released with `free()`; NULL on error.
+char *so3fft_export_wisdom_to_string(void);
+
+// Loads FFTW wisdom from the NUL-terminated string `wisdom`. `SO3FFT_OK` or an error code.
+int so3fft_import_wisdom_from_string(const char *wisdom);
+
+// Forgets FFTW's wisdom (plans already made are not affected).
+void so3fft_forget_wisdom(void);
 
 // The library version string (static; compare with `SO3FFT_VERSION`).
 const char *so3fft_version(void);

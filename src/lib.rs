@@ -37,10 +37,11 @@ mod plan;
 mod simd;
 pub mod soft;
 mod symmetry;
+mod system;
 pub mod wigner;
 
 pub use error::{Error, Result};
-pub use fft::Rigor;
+pub use fft::{wisdom, Rigor};
 pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };

@@ -37,6 +37,8 @@ mod execute;
 mod query;
 // Sizes, indices, angles, weights.
 mod grid;
+// FFTW wisdom.
+mod wisdom;
 // Version and errors.
 mod errors;
 
@@ -50,12 +52,17 @@ pub use grid::{
 };
 pub use planner::{
     so3fft_destroy_plan, so3fft_plan_both, so3fft_plan_forward, so3fft_plan_general,
-    so3fft_plan_inverse, so3fft_plan_with_max_workspace, so3fft_plan_with_nthreads,
-    so3fft_planner_max_workspace, so3fft_planner_nthreads,
+    so3fft_plan_inverse, so3fft_plan_with_fft_threading, so3fft_plan_with_max_workspace,
+    so3fft_plan_with_nthreads, so3fft_planner_fft_threading, so3fft_planner_max_workspace,
+    so3fft_planner_nthreads,
 };
 pub use query::{
     so3fft_get_bandwidth, so3fft_get_fft_threading, so3fft_get_memory, so3fft_get_nthreads,
     so3fft_plan_memory,
+};
+pub use wisdom::{
+    so3fft_export_wisdom_to_filename, so3fft_export_wisdom_to_string, so3fft_forget_wisdom,
+    so3fft_import_wisdom_from_filename, so3fft_import_wisdom_from_string,
 };
 
 use crate::ffi::last_error::LastErrorSink;

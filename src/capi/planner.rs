@@ -1,14 +1,14 @@
 //! Planners, `so3fft_destroy_plan`, and the process-wide planner settings (thread count,
-//! workspace cap).
+//! workspace cap, FFT threading).
 
 use super::{
     direction_of, guarded, guarded_code, rigor_of, so3fft_complex, so3fft_plan, so3fft_plan_s,
-    threads_of, SO3FFT_BOTH, SO3FFT_DESTROY_INPUT, SO3FFT_FORWARD, SO3FFT_INVERSE, SO3FFT_OK,
-    SO3FFT_REAL,
+    threads_of, SO3FFT_BOTH, SO3FFT_DESTROY_INPUT, SO3FFT_FFT_FFTW_THREADS,
+    SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_FORWARD, SO3FFT_INVERSE, SO3FFT_OK, SO3FFT_REAL,
 };
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{last_error, CallError, ErrorKind};
-use crate::{Direction, Plan, PlanOptions};
+use crate::{Direction, FftThreading, Plan, PlanOptions};
 use std::ffi::{c_int, c_uint};
 use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
 
@@ -66,6 +66,43 @@ pub(super) fn planner_workspace_cap() -> Option<usize> {
 }
 
 // ---------------------------------------------------------------------------------------
+// FFT threading
+// ---------------------------------------------------------------------------------------
+
+static PLANNER_FFT_THREADING: AtomicI32 = AtomicI32::new(0);
+
+/// Sets how plans made afterwards use their threads in the FFT stage (process-wide):
+/// 0 = library's choice (timed with `SO3FFT_MEASURE`+), `SO3FFT_FFT_SLICES_ACROSS_WORKERS`
+/// or `SO3FFT_FFT_FFTW_THREADS`. `SO3FFT_EINVAL` for other values.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_with_fft_threading(mode: c_int) -> c_int {
+    guarded_code(|| {
+        fft_threading_of(mode)?;
+        PLANNER_FFT_THREADING.store(mode, Ordering::Relaxed);
+        Ok(())
+    })
+}
+
+/// The setting of `so3fft_plan_with_fft_threading` (0 = library's choice).
+#[no_mangle]
+pub extern "C" fn so3fft_planner_fft_threading() -> c_int {
+    last_error::clear();
+    PLANNER_FFT_THREADING.load(Ordering::Relaxed)
+}
+
+/// The FFT threading of a `so3fft_plan_with_fft_threading` value.
+fn fft_threading_of(mode: c_int) -> Result<FftThreading, CallError> {
+    match mode {
+        0 => Ok(FftThreading::Auto),
+        SO3FFT_FFT_SLICES_ACROSS_WORKERS => Ok(FftThreading::SlicesAcrossWorkers),
+        SO3FFT_FFT_FFTW_THREADS => Ok(FftThreading::FftwThreads),
+        m => Err(CallError::invalid(format!(
+            "unknown FFT threading {m} (use 0, SO3FFT_FFT_SLICES_ACROSS_WORKERS or SO3FFT_FFT_FFTW_THREADS)"
+        ))),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
 // Planners
 // ---------------------------------------------------------------------------------------
 
@@ -114,6 +151,7 @@ fn make_plan(
             rigor,
             real,
             max_workspace_bytes: planner_workspace_cap(),
+            fft_threading: fft_threading_of(PLANNER_FFT_THREADING.load(Ordering::Relaxed))?,
             ..PlanOptions::default()
         };
         let plan = Plan::new(b, &options)?;

@@ -14,13 +14,16 @@
 //!
 //! - `planner`: the planner lock, FFTW's thread initialisation, owned FFTW plans;
 //! - `slices`: the slice transforms ([`SliceFft`], [`SliceFftReal`]);
-//! - `buf`: page-aligned buffers, the padded slice layout and row copies.
+//! - `buf`: page-aligned buffers, the padded slice layout and row copies;
+//! - `wisdom`: FFTW's wisdom, exported and imported.
 
 mod buf;
 mod planner;
 mod slices;
+pub mod wisdom;
 
 pub(crate) use buf::{copy_rows, slice_stride, AlignedBuf};
+pub(crate) use planner::planning_bytes;
 pub(crate) use slices::{SliceFft, SliceFftReal};
 
 use fftw_sys as fftw;

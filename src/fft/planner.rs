@@ -1,25 +1,74 @@
 //! FFTW's global state: the planner lock, the one-time initialisation of FFTW's threads, and
 //! owned FFTW plans (destroyed under the lock).
+//!
+//! When the library is loaded (before `main`, or at `dlopen`), FFTW's planner is made
+//! thread-safe process-wide and the planner lock's `fork()` handlers are registered: a host
+//! thread that is already planning with FFTW when so3fft plans for the first time would
+//! otherwise run its planner call unlocked. (Where the loader runs no constructors, the
+//! first planner call does the same.)
 
+use crate::error::{Error, Result};
+use crate::system::{check_headroom, thread_stack_bytes, ForkLock, ForkLockGuard};
 use fftw_sys as fftw;
 use std::ffi::c_int;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
-use std::sync::{Mutex, MutexGuard, Once};
+use std::sync::Once;
 
-/// Serialises every FFTW planner call (plan creation and destruction) of this crate.
-static PLANNER_LOCK: Mutex<()> = Mutex::new(());
-/// `fftw_make_planner_thread_safe()` is called once, before the first planner call.
-static PLANNER_THREAD_SAFE: Once = Once::new();
+/// Serialises every FFTW planner call (plan creation and destruction, wisdom) of this
+/// crate; free in a child made by `fork()`.
+static PLANNER_LOCK: ForkLock = ForkLock::new();
+/// The process-wide set-up below runs once.
+static SETUP: Once = Once::new();
 
-/// The global lock around FFTW planner calls. The first call also makes FFTW's planner
-/// thread-safe process-wide, so the host's own planner calls are serialised with ours.
-pub(crate) fn planner_lock() -> MutexGuard<'static, ()> {
-    PLANNER_THREAD_SAFE.call_once(|| {
+/// Makes FFTW's planner thread-safe and registers the planner lock's `fork()` handlers.
+fn setup() {
+    SETUP.call_once(|| {
         // SAFETY: takes no arguments; FFTW allows it at any time before or between planner
-        // calls, and `call_once` makes it run once.
-        unsafe { fftw::fftw_make_planner_thread_safe() }
+        // calls (it installs the planner's lock hooks).
+        unsafe { fftw::fftw_make_planner_thread_safe() };
+        extern "C" fn prepare() {
+            PLANNER_LOCK.before_fork();
+        }
+        extern "C" fn release() {
+            PLANNER_LOCK.after_fork();
+        }
+        // SAFETY: the handlers are plain functions that live as long as the process. If
+        // registration fails (ENOMEM), forking while planning stays unsafe, as without it.
+        unsafe { libc::pthread_atfork(Some(prepare), Some(release), Some(release)) };
     });
-    PLANNER_LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Runs [`setup`] when the library is loaded, so no host planner call can be in flight
+/// while FFTW's planner hooks are installed.
+#[cfg(target_os = "linux")]
+#[used]
+#[link_section = ".init_array"]
+static SETUP_AT_LOAD: extern "C" fn() = {
+    extern "C" fn at_load() {
+        setup();
+    }
+    at_load
+};
+
+/// The global lock around FFTW planner calls (see the module documentation).
+pub(crate) fn planner_lock() -> ForkLockGuard<'static> {
+    setup();
+    PLANNER_LOCK.lock()
+}
+
+/// Bytes FFTW's planner may allocate for one `n x n` slice plan on `nthreads` threads:
+/// 2 MiB plus 32 bytes per element (plans, twiddles, buffers), and per thread beyond the
+/// first the stack of a new POSIX thread plus 1 MiB (FFTW starts its worker threads while
+/// measuring, and waits forever for one it could not start).
+pub(crate) fn planning_bytes(n: usize, nthreads: usize) -> usize {
+    let threads = if nthreads > 1 {
+        nthreads.saturating_mul(thread_stack_bytes() + (1 << 20))
+    } else {
+        0
+    };
+    (2usize << 20)
+        .saturating_add(n.saturating_mul(n).saturating_mul(32))
+        .saturating_add(threads)
 }
 
 /// An FFTW plan owned by this crate, destroyed under the planner lock.
@@ -67,7 +116,7 @@ static THREADS_PID: AtomicU32 = AtomicU32::new(0);
 
 /// Whether FFTW's own threads can be used in this process (initialising them on the first
 /// call). Call with the planner lock held.
-fn fftw_threads_usable(_lock: &MutexGuard<'static, ()>) -> bool {
+fn fftw_threads_usable(_lock: &ForkLockGuard<'static>) -> bool {
     THREADS_INIT.call_once(|| {
         // SAFETY: called once per process, under the planner lock (no planner call runs).
         let ok = unsafe { fftw::fftw_init_threads() } != 0;
@@ -77,25 +126,36 @@ fn fftw_threads_usable(_lock: &MutexGuard<'static, ()>) -> bool {
     THREADS_OK.load(Ordering::Relaxed) && THREADS_PID.load(Ordering::Relaxed) == std::process::id()
 }
 
-/// Runs the FFTW planner call `plan` under the planner lock, with FFTW's thread count for
-/// new plans set to `nthreads` when that is more than 1 and FFTW's threads are usable here;
-/// the previous thread count is restored before the lock is released.
-pub(crate) fn with_nthreads(
+/// Runs the FFTW planner call `plan` for an `n x n` slice under the planner lock, with
+/// FFTW's thread count for new plans set to `nthreads` when that is more than 1 and FFTW's
+/// threads are usable here; the previous thread count is restored before the lock is
+/// released. FFTW aborts the process when an allocation fails inside its planner, so the
+/// call is not made without [`planning_bytes`] of headroom ([`Error::OutOfMemory`]); a
+/// null plan is [`Error::Fftw`].
+pub(crate) fn plan_slice(
+    n: usize,
     nthreads: usize,
     plan: impl FnOnce() -> fftw::fftw_plan,
-) -> fftw::fftw_plan {
+) -> Result<RawPlan> {
     let lock = planner_lock();
     let threaded = nthreads > 1 && fftw_threads_usable(&lock);
-    if !threaded {
-        return plan();
+    check_headroom(planning_bytes(n, if threaded { nthreads } else { 1 }))?;
+    let made = if threaded {
+        let host = fftw_planner_nthreads();
+        let count = c_int::try_from(nthreads).unwrap_or(c_int::MAX);
+        // SAFETY: FFTW's threads are initialised (fftw_threads_usable); the setting is
+        // changed under the planner lock and restored below, before the lock is released.
+        unsafe { fftw::fftw_plan_with_nthreads(count) };
+        let made = plan();
+        // SAFETY: as above.
+        unsafe { fftw::fftw_plan_with_nthreads(host) };
+        made
+    } else {
+        plan()
+    };
+    drop(lock);
+    if made.is_null() {
+        return Err(Error::Fftw(format!("could not plan an {n}x{n} DFT")));
     }
-    let host = fftw_planner_nthreads();
-    let count = c_int::try_from(nthreads).unwrap_or(c_int::MAX);
-    // SAFETY: FFTW's threads are initialised (fftw_threads_usable); the setting is changed
-    // under the planner lock and restored below, before the lock is released.
-    unsafe { fftw::fftw_plan_with_nthreads(count) };
-    let made = plan();
-    // SAFETY: as above.
-    unsafe { fftw::fftw_plan_with_nthreads(host) };
-    made
+    Ok(RawPlan(made))
 }

@@ -2,14 +2,14 @@
 //! real-data `r2c` / `c2r` pair.
 
 use super::buf::{slice_stride, AlignedBuf};
-use super::planner::{planner_lock, with_nthreads, RawPlan};
+use super::planner::{plan_slice, RawPlan};
 use super::Rigor;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use fftw_sys as fftw;
 use num_complex::Complex64;
 
 /// Plan one in-place `n x n` DFT of a slice with rows [`slice_stride`]`(n)` apart; with
-/// `nthreads > 1` the plan runs on FFTW's own threads (see [`with_nthreads`] for what that
+/// `nthreads > 1` the plan runs on FFTW's own threads (see [`plan_slice`] for what that
 /// does to FFTW's process-wide setting).
 fn plan_complex(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawPlan> {
     // Planning may write to the array (FFTW_MEASURE): plan on scratch memory.
@@ -28,8 +28,8 @@ fn plan_complex(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawP
         },
     ];
     let data = scratch.as_mut_ptr();
-    let plan = with_nthreads(nthreads, || {
-        // SAFETY: under the planner lock (with_nthreads); `dims` describes `n` rows of `n`
+    plan_slice(n, nthreads, || {
+        // SAFETY: under the planner lock (plan_slice); `dims` describes `n` rows of `n`
         // values `rs` apart, all inside the `n * rs` values of `scratch`, which outlives the
         // call; FFTW keeps no pointer to `dims` or the array after planning.
         unsafe {
@@ -44,11 +44,7 @@ fn plan_complex(n: usize, sign: i32, flags: u32, nthreads: usize) -> Result<RawP
                 flags,
             )
         }
-    });
-    if plan.is_null() {
-        return Err(Error::Fftw(format!("could not plan a {n}x{n} DFT")));
-    }
-    Ok(RawPlan(plan))
+    })
 }
 
 /// In-place `n x n` complex DFT of one beta slice in the FFT scratch, rows
@@ -99,9 +95,8 @@ fn plan_real(n: usize, r2c: bool, flags: u32) -> Result<RawPlan> {
     // Scratch for planning (FFTW_MEASURE writes): room for n^2 reals or n(n/2+1) complex.
     let input = AlignedBuf::new(n * n)?;
     let output = AlignedBuf::new(n * n)?;
-    let plan = {
-        let _lock = planner_lock();
-        // SAFETY: under the planner lock; both scratch buffers hold `n * n` complex values,
+    plan_slice(n, 1, || {
+        // SAFETY: under the planner lock (plan_slice); both scratch buffers hold `n * n` complex values,
         // more than either layout needs, and outlive the call.
         unsafe {
             if r2c {
@@ -123,11 +118,7 @@ fn plan_real(n: usize, r2c: bool, flags: u32) -> Result<RawPlan> {
                 )
             }
         }
-    };
-    if plan.is_null() {
-        return Err(Error::Fftw(format!("could not plan a real {n}x{n} DFT")));
-    }
-    Ok(RawPlan(plan))
+    })
 }
 
 /// Real-data slice transforms: `r2c` (FFTW sign -1, output `n x (n/2+1)`) and its

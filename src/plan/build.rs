@@ -3,29 +3,20 @@
 use super::blocks::Blocks;
 use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
-use super::options::{PlanOptions, MAX_BANDWIDTH};
+use super::options::{FftThreading, PlanOptions, MAX_BANDWIDTH};
 use super::schedule::Schedule;
 use super::Plan;
 use crate::error::{Error, Result};
-use crate::fft::AlignedBuf;
+use crate::fft::{planning_bytes, AlignedBuf};
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
+use crate::system::{check_headroom, mem_available, mem_total};
 use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 use std::sync::Mutex;
 
-/// A field of Linux's `/proc/meminfo` in bytes, if known.
-pub(super) fn meminfo(field: &str) -> Option<usize> {
-    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = s.lines().find(|l| l.starts_with(field))?;
-    let kb: usize = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// Bytes of memory the system can still give us (`MemAvailable`), if known.
-pub(crate) fn mem_available() -> Option<usize> {
-    meminfo("MemAvailable:")
-}
+/// Stack of each worker thread (the kernels keep their state in the per-worker scratch).
+const WORKER_STACK_BYTES: usize = 2 << 20;
 
 /// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.7%` of the
 /// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
@@ -210,7 +201,7 @@ impl Plan {
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
         // available memory, and plan plus the caller's arrays in the machine.
         let arrays = (num_samples(b) + num_coeffs(b)).saturating_mul(16);
-        let too_big = match (mem_available(), meminfo("MemTotal:")) {
+        let too_big = match (mem_available(), mem_total()) {
             (Some(avail), Some(total)) => {
                 layout.total() > avail || layout.total().saturating_add(arrays) > total
             }
@@ -221,6 +212,22 @@ impl Plan {
                 bytes: layout.total().saturating_add(arrays),
             });
         }
+        // Everything the plan maps (its memory, its workers' stacks, FFTW's planning) must
+        // fit under the address-space limit: an allocation that fails inside FFTW, or an
+        // ordinary Rust allocation, aborts the process.
+        // (`FftThreading::Auto` plans FFTW's threads only while tuning, which gives up
+        // the variant when the headroom is not there.)
+        let fftw_threads = if options.fft_threading == FftThreading::FftwThreads {
+            threads
+        } else {
+            1
+        };
+        check_headroom(
+            layout
+                .total()
+                .saturating_add(threads.saturating_mul(WORKER_STACK_BYTES))
+                .saturating_add(planning_bytes(2 * b, fftw_threads)),
+        )?;
         // The tables below are ordinary (aborting) allocations of O(B^2) bytes; reserving their
         // total once, fallibly, first turns a shortage (e.g. an address-space limit) into an
         // error. The large buffers are mapped fallibly in `AlignedBuf::new`.
@@ -248,6 +255,7 @@ impl Plan {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("so3fft-{i}"))
+            .stack_size(WORKER_STACK_BYTES)
             .exit_handler(move |_| {
                 let (n, cv) = &*on_exit;
                 *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;

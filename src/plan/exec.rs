@@ -2,7 +2,6 @@
 //! the clusters of the DWT stage.
 
 use super::blocks::{Blocks, BufLayout, ChunkBuf};
-use super::build::mem_available;
 use super::dwt_stage::{DwtLayout, Scratch};
 use super::options::StageTimes;
 use super::schedule::{Chunk, ChunkGroups, ClusterStep, Pass, PlacedChunk, Spare};
@@ -10,6 +9,7 @@ use super::shared::SendPtr;
 use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
+use crate::system::mem_available;
 use num_complex::Complex64;
 use std::time::Instant;
 

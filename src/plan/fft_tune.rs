@@ -13,7 +13,6 @@
 //! [`FFTW_MARGIN`]) and the other's FFTW plans are destroyed.
 
 use super::blocks::{BufLayout, ChunkBuf};
-use super::build::mem_available;
 use super::fft_stage::SliceRun;
 use super::options::{FftThreading, PlanOptions};
 use super::schedule::Chunk;
@@ -21,6 +20,7 @@ use super::shared::SendPtr;
 use super::Plan;
 use crate::error::Result;
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
+use crate::system::mem_available;
 use std::time::Instant;
 
 /// Timed rounds per variant, at most (the fastest of them counts).

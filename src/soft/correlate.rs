@@ -2,7 +2,7 @@
 //! S^2 coefficients into SO(3) coefficients).
 
 use super::real::parity;
-use super::{guarded, to_int, FftwComplex};
+use super::{guarded, soft_bandwidth, to_int, FftwComplex};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::CallError;
 use crate::{num_coeffs, Complex64};
@@ -28,6 +28,7 @@ fn sean_index(m: i64, l: i64, b: i64) -> i64 {
 #[no_mangle]
 pub extern "C" fn seanindex(m: c_int, l: c_int, bw: c_int) -> c_int {
     guarded("seanindex", -1, || {
+        soft_bandwidth(bw.into())?;
         if l < 0 || l >= bw || (m as i64).abs() > l as i64 {
             return Err(CallError::invalid(format!(
                 "coefficient (m={m}, l={l}) does not exist at bandwidth {bw}"

@@ -94,6 +94,13 @@ fn to_int(v: impl Into<i128> + Copy + std::fmt::Display) -> SoftResult<c_int> {
         .map_err(|_| CallError::invalid(format!("result {v} does not fit in a C int")))
 }
 
+/// `bw` when it is a bandwidth this layer accepts (`1..=MAX_BANDWIDTH`); wider than a C
+/// `int` for the functions that take the larger of two arguments.
+fn soft_bandwidth(bw: i64) -> SoftResult<i64> {
+    let bad = c_int::try_from(bw).unwrap_or(c_int::MAX);
+    crate::ffi::checks::bandwidth(bad).map(|b| b as i64)
+}
+
 // csecond.h
 
 /// Wall-clock time in seconds (since the Unix epoch), for timing as SOFT's clients do.
