@@ -34,11 +34,13 @@ mod grid;
 pub mod internals;
 mod numeric;
 mod plan;
+pub mod s2;
 mod simd;
 pub mod soft;
 mod symmetry;
 mod system;
 pub mod wigner;
+mod workers;
 
 pub use error::{Error, Result};
 pub use fft::{wisdom, Rigor};

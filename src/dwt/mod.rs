@@ -44,7 +44,6 @@ pub(crate) use lanes::{Lanes, Prefetch, Rec};
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
-#[cfg(any(test, feature = "internals"))]
 pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) -> usize {
     assert!(lanes.pair_stride == 0 && lanes.row_gap == 0);
     assert!(xin.len() >= lanes.tau.len() * p);
@@ -86,7 +85,6 @@ pub(crate) unsafe fn forward_raw(
 }
 
 /// [`inverse_raw`] into consecutive rows of `y` (bounds checked).
-#[cfg(any(test, feature = "internals"))]
 pub fn inverse(
     isa: Isa,
     p: usize,

@@ -23,7 +23,7 @@ mod slices;
 pub mod wisdom;
 
 pub(crate) use buf::{copy_rows, slice_stride, AlignedBuf};
-pub(crate) use planner::planning_bytes;
+pub(crate) use planner::{plan_guarded, planning_bytes, RawPlan};
 pub(crate) use slices::{SliceFft, SliceFftReal};
 
 use fftw_sys as fftw;
@@ -44,7 +44,7 @@ pub enum Rigor {
 
 impl Rigor {
     /// The FFTW planner flag of this rigour.
-    fn flags(self) -> u32 {
+    pub(crate) fn flags(self) -> u32 {
         match self {
             Rigor::Estimate => fftw::FFTW_ESTIMATE,
             Rigor::Measure => fftw::FFTW_MEASURE,

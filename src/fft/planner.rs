@@ -56,18 +56,18 @@ pub(crate) fn planner_lock() -> ForkLockGuard<'static> {
     PLANNER_LOCK.lock()
 }
 
-/// Bytes FFTW's planner may allocate for one `n x n` slice plan on `nthreads` threads:
-/// 2 MiB plus 32 bytes per element (plans, twiddles, buffers), and per thread beyond the
-/// first the stack of a new POSIX thread plus 1 MiB (FFTW starts its worker threads while
-/// measuring, and waits forever for one it could not start).
-pub(crate) fn planning_bytes(n: usize, nthreads: usize) -> usize {
+/// Bytes FFTW's planner may allocate for a plan of `elements` complex values on `nthreads`
+/// threads: 2 MiB plus 32 bytes per element (plans, twiddles, buffers), and with more than
+/// one thread, per thread the stack of a new POSIX thread plus 1 MiB (FFTW starts its
+/// worker threads while measuring, and waits forever for one it could not start).
+pub(crate) fn planning_bytes(elements: usize, nthreads: usize) -> usize {
     let threads = if nthreads > 1 {
         nthreads.saturating_mul(thread_stack_bytes() + (1 << 20))
     } else {
         0
     };
     (2usize << 20)
-        .saturating_add(n.saturating_mul(n).saturating_mul(32))
+        .saturating_add(elements.saturating_mul(32))
         .saturating_add(threads)
 }
 
@@ -126,20 +126,36 @@ fn fftw_threads_usable(_lock: &ForkLockGuard<'static>) -> bool {
     THREADS_OK.load(Ordering::Relaxed) && THREADS_PID.load(Ordering::Relaxed) == std::process::id()
 }
 
-/// Runs the FFTW planner call `plan` for an `n x n` slice under the planner lock, with
-/// FFTW's thread count for new plans set to `nthreads` when that is more than 1 and FFTW's
-/// threads are usable here; the previous thread count is restored before the lock is
-/// released. FFTW aborts the process when an allocation fails inside its planner, so the
-/// call is not made without [`planning_bytes`] of headroom ([`Error::OutOfMemory`]); a
-/// null plan is [`Error::Fftw`].
+/// Runs the FFTW planner call `plan` for an `n x n` slice under the planner lock (see
+/// [`plan_guarded`]).
 pub(crate) fn plan_slice(
     n: usize,
     nthreads: usize,
     plan: impl FnOnce() -> fftw::fftw_plan,
 ) -> Result<RawPlan> {
+    plan_guarded(n.saturating_mul(n), nthreads, plan).map_err(|e| match e {
+        Error::Fftw(_) => Error::Fftw(format!("could not plan an {n}x{n} DFT")),
+        other => other,
+    })
+}
+
+/// Runs the FFTW planner call `plan` for a transform of `elements` values under the planner lock, with
+/// FFTW's thread count for new plans set to `nthreads` when that is more than 1 and FFTW's
+/// threads are usable here; the previous thread count is restored before the lock is
+/// released. FFTW aborts the process when an allocation fails inside its planner, so the
+/// call is not made without [`planning_bytes`] of headroom ([`Error::OutOfMemory`]); a
+/// null plan is [`Error::Fftw`].
+pub(crate) fn plan_guarded(
+    elements: usize,
+    nthreads: usize,
+    plan: impl FnOnce() -> fftw::fftw_plan,
+) -> Result<RawPlan> {
     let lock = planner_lock();
     let threaded = nthreads > 1 && fftw_threads_usable(&lock);
-    check_headroom(planning_bytes(n, if threaded { nthreads } else { 1 }))?;
+    check_headroom(planning_bytes(
+        elements,
+        if threaded { nthreads } else { 1 },
+    ))?;
     let made = if threaded {
         let host = fftw_planner_nthreads();
         let count = c_int::try_from(nthreads).unwrap_or(c_int::MAX);
@@ -155,7 +171,9 @@ pub(crate) fn plan_slice(
     };
     drop(lock);
     if made.is_null() {
-        return Err(Error::Fftw(format!("could not plan an {n}x{n} DFT")));
+        return Err(Error::Fftw(format!(
+            "could not plan a DFT of {elements} values"
+        )));
     }
     Ok(RawPlan(made))
 }

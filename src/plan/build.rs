@@ -13,10 +13,8 @@ use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
 use crate::system::{check_headroom, mem_available, mem_total};
 use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
+use crate::workers::{WorkerPool, WORKER_STACK_BYTES};
 use std::sync::Mutex;
-
-/// Stack of each worker thread (the kernels keep their state in the per-worker scratch).
-const WORKER_STACK_BYTES: usize = 2 << 20;
 
 /// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.7%` of the
 /// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
@@ -226,7 +224,7 @@ impl Plan {
             layout
                 .total()
                 .saturating_add(threads.saturating_mul(WORKER_STACK_BYTES))
-                .saturating_add(planning_bytes(2 * b, fftw_threads)),
+                .saturating_add(planning_bytes(4 * b * b, fftw_threads)),
         )?;
         // The tables below are ordinary (aborting) allocations of O(B^2) bytes; reserving their
         // total once, fallibly, first turns a shortage (e.g. an address-space limit) into an
@@ -250,25 +248,12 @@ impl Plan {
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
         let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
-        let live = std::sync::Arc::new((Mutex::new(threads), std::sync::Condvar::new()));
-        let on_exit = live.clone();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .thread_name(|i| format!("so3fft-{i}"))
-            .stack_size(WORKER_STACK_BYTES)
-            .exit_handler(move |_| {
-                let (n, cv) = &*on_exit;
-                *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;
-                cv.notify_all();
-            })
-            .build()
-            .map_err(|e| Error::Resources(format!("cannot start {threads} worker threads: {e}")))?;
+        let workers = WorkerPool::new(threads, "so3fft")?;
         Ok(Plan {
             b,
             direction: options.direction,
             threads,
-            pool: Some(pool),
-            live,
+            workers,
             fft,
             dwt,
             blocks,
@@ -280,7 +265,6 @@ impl Plan {
                 buf_bytes: layout.chunk_bytes,
                 plain_store_limit: plain_store_limit(),
             },
-            pid: std::process::id(),
             buf: Mutex::new(Some(buf)),
         })
     }

@@ -47,6 +47,7 @@ use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
+use crate::workers::WorkerPool;
 use blocks::Blocks;
 use dwt_stage::DwtStage;
 use fft_stage::FftStage;
@@ -64,13 +65,8 @@ pub struct Plan {
     b: usize,
     direction: Direction,
     threads: usize,
-    /// Worker pool (an `Option` so `Drop` can release it before waiting for the workers).
-    pool: Option<rayon::ThreadPool>,
-    /// Number of pool threads still running; `Drop` waits for zero.
-    live: std::sync::Arc<(Mutex<usize>, std::sync::Condvar)>,
-    /// The process that made the plan: its worker threads exist only there (a child made
-    /// by `fork()` has none of them).
-    pid: u32,
+    /// Worker threads (exist only in the process that made the plan).
+    workers: WorkerPool,
     /// Bytes this plan holds.
     memory: usize,
     /// The FFT stage: slice FFTs, weights, per-worker FFT scratch.
@@ -86,9 +82,6 @@ pub struct Plan {
     /// How executions go through the chunks (and the chunk buffer's size).
     schedule: Schedule,
 }
-
-/// Worker pools of plans dropped in a child made by `fork()` (see `Plan::drop`).
-static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
 
 impl Plan {
     /// Make a plan for bandwidth `bandwidth` (1 ..= [`MAX_BANDWIDTH`]).
@@ -113,7 +106,7 @@ impl Plan {
     }
 
     fn pool(&self) -> &rayon::ThreadPool {
-        self.pool.as_ref().expect("pool lives until drop")
+        self.workers.pool()
     }
 
     /// The bandwidth `B`.
@@ -190,7 +183,7 @@ impl Plan {
     /// Whether the plan's worker threads exist in this process: `false` in a child made by
     /// `fork()` after the plan was made.
     pub(crate) fn in_own_process(&self) -> bool {
-        std::process::id() == self.pid
+        self.workers.in_own_process()
     }
 
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
@@ -283,36 +276,6 @@ impl Plan {
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
         self.forward_impl(base, coeffs, Some(spare))
-    }
-}
-
-impl Drop for Plan {
-    /// Release the worker pool and wait until its threads have finished, so that nothing
-    /// of the plan runs after it is gone (a C host may unload the library right after).
-    fn drop(&mut self) {
-        // Dropping a plan on one of its own workers would wait for itself. No code outside
-        // the library runs on these workers, so this cannot happen through the public API.
-        debug_assert!(self
-            .pool
-            .as_ref()
-            .is_none_or(|p| p.current_thread_index().is_none()));
-        if !self.in_own_process() {
-            // A child after fork(): the workers were the parent's. Dropping the pool would
-            // wait for them forever; it is kept (reachable) until the process ends.
-            if let Some(pool) = self.pool.take() {
-                ORPHAN_POOLS
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .push(pool);
-            }
-            return;
-        }
-        drop(self.pool.take());
-        let (n, cv) = &*self.live;
-        let mut g = n.lock().unwrap_or_else(|e| e.into_inner());
-        while *g > 0 {
-            g = cv.wait(g).unwrap_or_else(|e| e.into_inner());
-        }
     }
 }
 

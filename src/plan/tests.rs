@@ -177,7 +177,7 @@ fn drop_waits_for_workers() {
             },
         )
         .unwrap();
-        let live = plan.live.clone();
+        let live = plan.workers.live_count();
         drop(plan);
         assert_eq!(*live.0.lock().unwrap(), 0);
     }

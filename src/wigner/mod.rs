@@ -16,7 +16,9 @@ use crate::numeric::{sin_cos_dd, Dd};
 use crate::simd::Isa;
 use column::column;
 pub(crate) use recurrence::{RecCoeffs, RecTables, REC_PAD};
-pub(crate) use starts::{big, start_norms, BetaTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
+pub(crate) use starts::{
+    big, start_norm, start_norms, BetaTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
+};
 
 /// `d^l_{m,mp}(beta)` (standard, not normalised) for `l = max(|m|,|mp|) ..= lmax`.
 ///

@@ -34,6 +34,8 @@ TOOL (default: the full benchmark described below):
                       windows (default 5); defaults --bandwidths 64,128,256 --threads 1,2
   real                only the real-signal transforms against the complex ones (round trips
                       interleaved, last thread count); default --bandwidths 64,128,256
+  s2 (or --s2)        the S^2 transforms: real and complex synthesis and analysis, medians,
+                      GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
 options:
   --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
                       (default 16,32,64,128,256)
@@ -77,6 +79,8 @@ pub enum Tool {
     Scaling,
     /// Real-signal against complex transforms only.
     Real,
+    /// The S^2 (spherical-harmonic) transforms (`s2.rs`).
+    S2,
 }
 
 /// Transforms the `stages` tool repeats.
@@ -201,6 +205,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("stages") => Tool::Stages,
         Some("scaling") => Tool::Scaling,
         Some("real") => Tool::Real,
+        Some("s2" | "--s2") => Tool::S2,
         _ => Tool::Full,
     };
     if opts.tool != Tool::Full {
@@ -272,17 +277,15 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         return Err("no bandwidth left to run".into());
     }
     // Checked here because the memory estimate would overflow before the plan could refuse.
-    if let Some(&b) = opts
-        .bandwidths
-        .iter()
-        .find(|&&b| b == 0 || b > so3fft::MAX_BANDWIDTH)
-    {
-        return Err(format!(
-            "--bandwidths: {b} is not in 1..={}",
-            so3fft::MAX_BANDWIDTH
-        ));
+    let max_b = if opts.tool == Tool::S2 {
+        so3fft::s2::S2_MAX_BANDWIDTH
+    } else {
+        so3fft::MAX_BANDWIDTH
+    };
+    if let Some(&b) = opts.bandwidths.iter().find(|&&b| b == 0 || b > max_b) {
+        return Err(format!("--bandwidths: {b} is not in 1..={max_b}"));
     }
-    if !opts.big {
+    if !opts.big && opts.tool != Tool::S2 {
         if let Some(&b) = opts.bandwidths.iter().find(|&&b| b > MAX_REGULAR_BANDWIDTH) {
             return Err(format!(
                 "--bandwidths: B = {b} needs --big (minutes of run time, most of the memory)"
@@ -302,6 +305,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Stages => (vec![256], vec![1], Some(3)),
         Tool::Scaling => (vec![64, 128, 256], vec![1, 2], Some(5)),
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
+        Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
     };
     if !bandwidths_given {
         opts.bandwidths = bandwidths;

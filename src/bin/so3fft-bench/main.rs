@@ -27,6 +27,7 @@ mod peak;
 mod plot;
 mod regular;
 mod report;
+mod s2;
 mod scaling;
 mod seeded;
 mod soft_cmp;
@@ -50,6 +51,7 @@ fn main() -> ExitCode {
             Tool::Stages => report_failure("stages", stages::run(&opts)),
             Tool::Scaling => report_failure("scaling", scaling::run(&opts)),
             Tool::Real => report_failure("real", run_real(&opts)),
+            Tool::S2 => report_failure("s2", s2::run(&opts)),
         },
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);

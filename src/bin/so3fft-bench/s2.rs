@@ -1,0 +1,104 @@
+//! `so3fft-bench s2` (or `--s2`): the spherical-harmonic transforms. Per bandwidth and
+//! thread count: real and complex synthesis (inverse) and analysis (forward), medians of
+//! the runs, GFLOP/s of the Legendre sums against the FMA peak, and round-trip errors.
+
+use crate::cli::Options;
+use crate::workload::{median, random_coeffs};
+use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
+use so3fft::Complex64;
+use std::time::Instant;
+
+/// Flops of one Legendre stage (either direction): per order `m` and degree `l >= m`, the
+/// `B` northern rings times 8 columns of multiply-adds (2 flops), as the kernels run them.
+fn legendre_flops(b: usize) -> f64 {
+    let terms: usize = (0..b).map(|m| b - m).sum();
+    (terms * b * 16) as f64
+}
+
+/// Coefficients of a real function (Hermitian in `m`, real at `m = 0`).
+fn hermitian(b: usize, seed: u64) -> Vec<Complex64> {
+    let mut c = random_coeffs(b * b, seed);
+    for l in 0..b {
+        c[s2_coef_index(b, l, 0)].im = 0.0;
+        for m in 1..=l as isize {
+            let v = c[s2_coef_index(b, l, m)];
+            c[s2_coef_index(b, l, -m)] = if m % 2 == 0 { v.conj() } else { -v.conj() };
+        }
+    }
+    c
+}
+
+/// Relative L2 error of `got` against `want`.
+fn rel_l2(got: &[Complex64], want: &[Complex64]) -> f64 {
+    let num: f64 = got.iter().zip(want).map(|(a, b)| (a - b).norm_sqr()).sum();
+    let den: f64 = want.iter().map(|b| b.norm_sqr()).sum();
+    (num / den).sqrt()
+}
+
+/// Median seconds of `runs` calls of `f`.
+fn timed(runs: usize, mut f: impl FnMut() -> so3fft::Result<()>) -> so3fft::Result<f64> {
+    let mut t = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let start = Instant::now();
+        f()?;
+        t.push(start.elapsed().as_secs_f64());
+    }
+    Ok(median(&t))
+}
+
+/// Runs the S^2 measurement for every bandwidth and thread count of `opts`.
+pub fn run(opts: &Options) -> so3fft::Result<()> {
+    let peak1 = crate::peak::measure(1).one_core;
+    println!("S^2 transforms: medians of the runs in ms; GFLOP/s of the Legendre sums");
+    println!("FMA peak of one core: {peak1:.1} GFLOP/s");
+    println!(
+        "{:>5} {:>3} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6} {:>10} {:>10}",
+        "B",
+        "thr",
+        "re syn",
+        "re ana",
+        "cx syn",
+        "cx ana",
+        "GFLOP/s",
+        "%peak",
+        "err real",
+        "err cx"
+    );
+    for &b in &opts.bandwidths {
+        for &threads in &opts.threads {
+            let plan = S2Plan::new(
+                b,
+                &S2Options {
+                    threads,
+                    rigor: opts.rigor,
+                    ..Default::default()
+                },
+            )?;
+            let runs = opts.runs.unwrap_or(if b >= 1024 { 3 } else { 7 });
+            let (ns, nc) = (plan.num_samples(), plan.num_coeffs());
+            let real_coefs = hermitian(b, 7);
+            let coefs = random_coeffs(nc, 11);
+            let mut real = vec![0.0; ns];
+            let mut samples = vec![Complex64::default(); ns];
+            let mut back = vec![Complex64::default(); nc];
+            let re_syn = timed(runs, || plan.inverse_real(&real_coefs, &mut real))?;
+            let re_ana = timed(runs, || plan.forward_real(&real, &mut back))?;
+            let err_real = rel_l2(&back, &real_coefs);
+            let cx_syn = timed(runs, || plan.inverse(&coefs, &mut samples))?;
+            let cx_ana = timed(runs, || plan.forward(&samples, &mut back))?;
+            let err_cx = rel_l2(&back, &coefs);
+            let gflops = legendre_flops(b) / cx_ana.min(cx_syn) / 1e9;
+            let cores = plan.threads().min(2) as f64;
+            println!(
+                "{b:>5} {:>3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {gflops:>8.1} {:>5.0}% {err_real:>10.2e} {err_cx:>10.2e}",
+                plan.threads(),
+                re_syn * 1e3,
+                re_ana * 1e3,
+                cx_syn * 1e3,
+                cx_ana * 1e3,
+                100.0 * gflops / (peak1 * cores),
+            );
+        }
+    }
+    Ok(())
+}

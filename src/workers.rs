@@ -1,0 +1,92 @@
+//! The worker threads of a plan: a rayon pool that a plan's `Drop` waits for, and that a
+//! child made by `fork()` never waits for (its threads are the parent's).
+
+use crate::error::{Error, Result};
+use std::sync::{Arc, Condvar, Mutex};
+
+/// Stack of each worker thread (the kernels keep their state in per-worker scratch).
+pub(crate) const WORKER_STACK_BYTES: usize = 2 << 20;
+
+/// Pools of plans dropped in a child made by `fork()`: kept reachable until the process
+/// ends, since dropping them would wait for threads that do not exist there.
+static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
+
+/// A plan's worker threads.
+pub(crate) struct WorkerPool {
+    /// The pool (an `Option` so `Drop` can release it before waiting for the workers).
+    pool: Option<rayon::ThreadPool>,
+    /// Number of pool threads still running; `Drop` waits for zero.
+    live: Arc<(Mutex<usize>, Condvar)>,
+    /// The process that started the threads.
+    pid: u32,
+}
+
+impl WorkerPool {
+    /// Starts `threads` workers named `<name>-<i>`; [`Error::Resources`] if the system
+    /// refuses them.
+    pub(crate) fn new(threads: usize, name: &'static str) -> Result<WorkerPool> {
+        let live = Arc::new((Mutex::new(threads), Condvar::new()));
+        let on_exit = live.clone();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(move |i| format!("{name}-{i}"))
+            .stack_size(WORKER_STACK_BYTES)
+            .exit_handler(move |_| {
+                let (n, cv) = &*on_exit;
+                *n.lock().unwrap_or_else(|e| e.into_inner()) -= 1;
+                cv.notify_all();
+            })
+            .build()
+            .map_err(|e| Error::Resources(format!("cannot start {threads} worker threads: {e}")))?;
+        Ok(WorkerPool {
+            pool: Some(pool),
+            live,
+            pid: std::process::id(),
+        })
+    }
+
+    /// The rayon pool.
+    pub(crate) fn pool(&self) -> &rayon::ThreadPool {
+        self.pool.as_ref().expect("pool lives until drop")
+    }
+
+    /// Whether the worker threads exist in this process: `false` in a child made by
+    /// `fork()` after the pool was started.
+    pub(crate) fn in_own_process(&self) -> bool {
+        std::process::id() == self.pid
+    }
+
+    /// Number of worker threads still running (for tests).
+    #[cfg(test)]
+    pub(crate) fn live_count(&self) -> Arc<(Mutex<usize>, Condvar)> {
+        self.live.clone()
+    }
+}
+
+impl Drop for WorkerPool {
+    /// Releases the pool and waits until its threads have finished, so that nothing of the
+    /// plan runs after it is gone (a C host may unload the library right after).
+    fn drop(&mut self) {
+        // Dropping on one of its own workers would wait for itself; no code outside the
+        // library runs on these workers, so this cannot happen through the public API.
+        debug_assert!(self
+            .pool
+            .as_ref()
+            .is_none_or(|p| p.current_thread_index().is_none()));
+        if !self.in_own_process() {
+            if let Some(pool) = self.pool.take() {
+                ORPHAN_POOLS
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(pool);
+            }
+            return;
+        }
+        drop(self.pool.take());
+        let (n, cv) = &*self.live;
+        let mut g = n.lock().unwrap_or_else(|e| e.into_inner());
+        while *g > 0 {
+            g = cv.wait(g).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
