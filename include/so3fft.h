@@ -91,14 +91,23 @@
 // Internal error (a Rust panic caught at the boundary). Please report it.
 #define SO3FFT_EPANIC (-7)
 
+// Largest bandwidth of the S^2 transforms.
+#define SO3FFT_S2_MAX_BANDWIDTH 4096
+
 // Opaque plan object (made by a planner, released by `so3fft_destroy_plan`).
 typedef struct so3fft_plan_s so3fft_plan_s;
+
+// Opaque S^2 plan object (made by `so3fft_plan_s2`, released by `so3fft_destroy_s2_plan`).
+typedef struct so3fft_s2_plan_s so3fft_s2_plan_s;
 
 // A plan: a pointer to an opaque object (like `fftw_plan`).
 typedef struct so3fft_plan_s *so3fft_plan;
 
 // One complex number `{re, im}`, identical to `fftw_complex` (`double[2]`).
 typedef double so3fft_complex[2];
+
+// An S^2 plan: a pointer to an opaque object.
+typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
 
 #ifdef __cplusplus
 extern "C" {
@@ -193,6 +202,41 @@ int so3fft_weights(int B, double *w);
 
 // `SO3FFT_MAX_BANDWIDTH` of the library linked.
 int so3fft_max_bandwidth(void);
+
+// Plans the S^2 transforms of bandwidth `B` (both directions, complex and real samples),
+// `flags` a planner rigour (`SO3FFT_ESTIMATE` ...), `nthreads` workers (0 = all cores).
+// NULL on error.
+so3fft_s2_plan so3fft_plan_s2(int B, unsigned int flags, int nthreads);
+
+// Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
+void so3fft_destroy_s2_plan(so3fft_s2_plan p);
+
+// The bandwidth of an S^2 plan (`SO3FFT_ENULL` for NULL).
+int so3fft_s2_get_bandwidth(so3fft_s2_plan p);
+
+// Forward S^2 transform: `(2B)^2` complex samples (ring-major; only read) to `B^2`
+// coefficients (`seanindex` order). `SO3FFT_OK` or an error code.
+int so3fft_s2_execute_forward(so3fft_s2_plan p, so3fft_complex *samples, so3fft_complex *coeffs);
+
+// Inverse S^2 transform: `B^2` coefficients (only read) to `(2B)^2` complex samples.
+int so3fft_s2_execute_inverse(so3fft_s2_plan p, so3fft_complex *coeffs, so3fft_complex *samples);
+
+// Forward S^2 transform of `(2B)^2` real samples: all `B^2` coefficients, with
+// `fhat(l,-m) = (-1)^m conj(fhat(l,m))`.
+int so3fft_s2_execute_forward_real(so3fft_s2_plan p, const double *samples, so3fft_complex *coeffs);
+
+// Inverse S^2 transform to `(2B)^2` real samples: reads the orders `m >= 0` (the others
+// are taken as `(-1)^m conj(fhat(l,m))`; `Im fhat(l,0)` is ignored).
+int so3fft_s2_execute_inverse_real(so3fft_s2_plan p, so3fft_complex *coeffs, double *samples);
+
+// Number of S^2 samples `(2B)^2` (0 for an invalid `B`).
+size_t so3fft_s2_num_samples(int B);
+
+// Number of S^2 coefficients `B^2` (0 for an invalid `B`).
+size_t so3fft_s2_num_coeffs(int B);
+
+// Index of `fhat(l, m)` (SOFT's `seanindex(m, l, B)`), or -1.
+ptrdiff_t so3fft_s2_coef_index(int B, int l, int m);
 
 // Writes FFTW's wisdom to the file `filename` (replaced atomically). `SO3FFT_OK` or an
 // error code.

@@ -37,6 +37,8 @@ mod execute;
 mod query;
 // Sizes, indices, angles, weights.
 mod grid;
+// Spherical-harmonic transforms.
+mod s2;
 // FFTW wisdom.
 mod wisdom;
 // Version and errors.
@@ -59,6 +61,12 @@ pub use planner::{
 pub use query::{
     so3fft_get_bandwidth, so3fft_get_fft_threading, so3fft_get_memory, so3fft_get_nthreads,
     so3fft_plan_memory,
+};
+pub use s2::{
+    so3fft_destroy_s2_plan, so3fft_plan_s2, so3fft_s2_coef_index, so3fft_s2_execute_forward,
+    so3fft_s2_execute_forward_real, so3fft_s2_execute_inverse, so3fft_s2_execute_inverse_real,
+    so3fft_s2_get_bandwidth, so3fft_s2_num_coeffs, so3fft_s2_num_samples, so3fft_s2_plan,
+    so3fft_s2_plan_s, SO3FFT_S2_MAX_BANDWIDTH,
 };
 pub use wisdom::{
     so3fft_export_wisdom_to_filename, so3fft_export_wisdom_to_string, so3fft_forget_wisdom,

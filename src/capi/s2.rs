@@ -1,0 +1,240 @@
+//! Spherical-harmonic (S^2) transforms: planner, execute, destroy, sizes and index.
+
+use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_ENULL};
+use super::{SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
+use crate::ffi::checks::{input_output, Array};
+use crate::ffi::{CallError, ErrorKind};
+use crate::s2::{s2_num_coeffs, s2_num_samples, s2_try_coef_index, S2Options, S2Plan};
+use crate::Complex64;
+use std::ffi::{c_int, c_uint};
+
+/// Largest bandwidth of the S^2 transforms.
+pub const SO3FFT_S2_MAX_BANDWIDTH: c_int = 4096;
+const _: () = assert!(SO3FFT_S2_MAX_BANDWIDTH as usize == crate::s2::S2_MAX_BANDWIDTH);
+
+/// Opaque S^2 plan object (made by `so3fft_plan_s2`, released by `so3fft_destroy_s2_plan`).
+pub struct so3fft_s2_plan_s {
+    plan: S2Plan,
+}
+
+/// An S^2 plan: a pointer to an opaque object.
+pub type so3fft_s2_plan = *mut so3fft_s2_plan_s;
+
+/// The S^2 bandwidth `b` as a `usize`, or an error unless `1 <= b <= SO3FFT_S2_MAX_BANDWIDTH`.
+fn s2_bandwidth(b: c_int) -> Result<usize, CallError> {
+    match usize::try_from(b) {
+        Ok(bw) if (1..=SO3FFT_S2_MAX_BANDWIDTH as usize).contains(&bw) => Ok(bw),
+        _ => Err(CallError::new(
+            ErrorKind::Bandwidth,
+            format!("invalid S^2 bandwidth {b}: must be between 1 and {SO3FFT_S2_MAX_BANDWIDTH}"),
+        )),
+    }
+}
+
+/// Plans the S^2 transforms of bandwidth `B` (both directions, complex and real samples),
+/// `flags` a planner rigour (`SO3FFT_ESTIMATE` ...), `nthreads` workers (0 = all cores).
+/// NULL on error.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_s2(B: c_int, flags: c_uint, nthreads: c_int) -> so3fft_s2_plan {
+    guarded(std::ptr::null_mut(), || {
+        let b = s2_bandwidth(B)?;
+        if flags & (SO3FFT_DESTROY_INPUT | SO3FFT_REAL) != 0 {
+            return Err(CallError::invalid(format!(
+                "flags 0x{flags:x}: an S^2 plan takes only a planner rigour (real samples have their own execute functions)"
+            )));
+        }
+        let options = S2Options {
+            threads: threads_of(nthreads)?,
+            rigor: rigor_of(flags)?,
+            isa: None,
+        };
+        let plan = S2Plan::new(b, &options)?;
+        Ok(Box::into_raw(Box::new(so3fft_s2_plan_s { plan })))
+    })
+}
+
+/// Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_destroy_s2_plan(p: so3fft_s2_plan) {
+    guarded((), || {
+        if !p.is_null() {
+            // SAFETY: a non-NULL `p` came from Box::into_raw in `so3fft_plan_s2` and is
+            // destroyed once, while no other thread uses it (the caller's contract).
+            drop(unsafe { Box::from_raw(p) });
+        }
+        Ok(())
+    })
+}
+
+/// The plan behind a handle; an error for NULL.
+///
+/// # Safety
+/// `p` is NULL or a live S^2 plan, not destroyed during the returned reference's use.
+unsafe fn s2_plan_ref<'a>(p: so3fft_s2_plan) -> Result<&'a S2Plan, CallError> {
+    // SAFETY: non-NULL handles are live plans (this function's contract), only read.
+    unsafe { p.as_ref() }
+        .map(|s| &s.plan)
+        .ok_or_else(|| CallError::new(ErrorKind::Null, "the S^2 plan is NULL"))
+}
+
+/// The bandwidth of an S^2 plan (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_s2_get_bandwidth(p: so3fft_s2_plan) -> c_int {
+    guarded(SO3FFT_ENULL, || {
+        // SAFETY: `p` is NULL or a live plan (the API's contract).
+        Ok(unsafe { s2_plan_ref(p) }?.bandwidth() as c_int)
+    })
+}
+
+/// Checks the arrays of an S^2 execute and runs `f` on them as slices.
+///
+/// # Safety
+/// Non-NULL arrays hold the plan's sizes (`input_len`, `output_len` values), the input
+/// only read, the output accessed by no one else during the call.
+unsafe fn with_arrays<I, O>(
+    input: (*const I, usize, &'static str),
+    output: (*mut O, usize, &'static str),
+    f: impl FnOnce(&[I], &mut [O]) -> crate::Result<()>,
+) -> Result<(), CallError> {
+    input_output(
+        &Array::new(input.0, input.1, input.2),
+        &Array::new(output.0.cast_const(), output.1, output.2),
+    )?;
+    // SAFETY: checked non-NULL, aligned and disjoint; the extents are the caller's
+    // contract.
+    let (i, o) = unsafe {
+        (
+            std::slice::from_raw_parts(input.0, input.1),
+            std::slice::from_raw_parts_mut(output.0, output.1),
+        )
+    };
+    f(i, o).map_err(CallError::from)
+}
+
+/// Forward S^2 transform: `(2B)^2` complex samples (ring-major; only read) to `B^2`
+/// coefficients (`seanindex` order). `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_s2_execute_forward(
+    p: so3fft_s2_plan,
+    samples: *mut so3fft_complex,
+    coeffs: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: `p` is NULL or a live plan; the arrays per the API's contract.
+        // Complex64 is #[repr(C)] {re, im}: the layout of double[2].
+        unsafe {
+            let plan = s2_plan_ref(p)?;
+            with_arrays(
+                (
+                    samples.cast_const().cast::<Complex64>(),
+                    plan.num_samples(),
+                    "samples",
+                ),
+                (
+                    coeffs.cast::<Complex64>(),
+                    plan.num_coeffs(),
+                    "coefficients",
+                ),
+                |s, c| plan.forward(s, c),
+            )
+        }
+    })
+}
+
+/// Inverse S^2 transform: `B^2` coefficients (only read) to `(2B)^2` complex samples.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_s2_execute_inverse(
+    p: so3fft_s2_plan,
+    coeffs: *mut so3fft_complex,
+    samples: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: as in `so3fft_s2_execute_forward`.
+        unsafe {
+            let plan = s2_plan_ref(p)?;
+            with_arrays(
+                (
+                    coeffs.cast_const().cast::<Complex64>(),
+                    plan.num_coeffs(),
+                    "coefficients",
+                ),
+                (samples.cast::<Complex64>(), plan.num_samples(), "samples"),
+                |c, s| plan.inverse(c, s),
+            )
+        }
+    })
+}
+
+/// Forward S^2 transform of `(2B)^2` real samples: all `B^2` coefficients, with
+/// `fhat(l,-m) = (-1)^m conj(fhat(l,m))`.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_s2_execute_forward_real(
+    p: so3fft_s2_plan,
+    samples: *const f64,
+    coeffs: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: as in `so3fft_s2_execute_forward`.
+        unsafe {
+            let plan = s2_plan_ref(p)?;
+            with_arrays(
+                (samples, plan.num_samples(), "samples"),
+                (
+                    coeffs.cast::<Complex64>(),
+                    plan.num_coeffs(),
+                    "coefficients",
+                ),
+                |s, c| plan.forward_real(s, c),
+            )
+        }
+    })
+}
+
+/// Inverse S^2 transform to `(2B)^2` real samples: reads the orders `m >= 0` (the others
+/// are taken as `(-1)^m conj(fhat(l,m))`; `Im fhat(l,0)` is ignored).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_s2_execute_inverse_real(
+    p: so3fft_s2_plan,
+    coeffs: *mut so3fft_complex,
+    samples: *mut f64,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: as in `so3fft_s2_execute_forward`.
+        unsafe {
+            let plan = s2_plan_ref(p)?;
+            with_arrays(
+                (
+                    coeffs.cast_const().cast::<Complex64>(),
+                    plan.num_coeffs(),
+                    "coefficients",
+                ),
+                (samples, plan.num_samples(), "samples"),
+                |c, s| plan.inverse_real(c, s),
+            )
+        }
+    })
+}
+
+/// Number of S^2 samples `(2B)^2` (0 for an invalid `B`).
+#[no_mangle]
+pub extern "C" fn so3fft_s2_num_samples(B: c_int) -> usize {
+    guarded(0, || Ok(s2_num_samples(s2_bandwidth(B)?)))
+}
+
+/// Number of S^2 coefficients `B^2` (0 for an invalid `B`).
+#[no_mangle]
+pub extern "C" fn so3fft_s2_num_coeffs(B: c_int) -> usize {
+    guarded(0, || Ok(s2_num_coeffs(s2_bandwidth(B)?)))
+}
+
+/// Index of `fhat(l, m)` (SOFT's `seanindex(m, l, B)`), or -1.
+#[no_mangle]
+pub extern "C" fn so3fft_s2_coef_index(B: c_int, l: c_int, m: c_int) -> isize {
+    guarded(-1, || {
+        let b = s2_bandwidth(B)?;
+        let l = usize::try_from(l).map_err(|_| {
+            CallError::invalid(format!("S^2 coefficient (l={l}, m={m}) does not exist"))
+        })?;
+        Ok(s2_try_coef_index(b, l, m as isize)? as isize)
+    })
+}
