@@ -70,6 +70,30 @@ int main(void) {
     CHECK(so3fft_s2_execute_forward_real(p, r, c2) == SO3FFT_OK);
     CHECK(max_abs_diff(c, c2, nc) < 1e-13);
 
+    /* two real fields in one call: bitwise the same as one at a time */
+    {
+        so3fft_complex *c3 = alloc_cx(2 * nc);
+        double *r2 = (double *)malloc(2 * ns * sizeof(double));
+        CHECK(r2 != NULL);
+        memcpy(r2, r, ns * sizeof(double));
+        for (i = 0; i < ns; i++) r2[ns + i] = 0.5 * r[ns - 1 - i];
+        CHECK(so3fft_s2_execute_forward_real_many(p, 2, r2, c3) == SO3FFT_OK);
+        CHECK(memcmp(c3, c2, nc * sizeof *c2) == 0);
+        CHECK(so3fft_s2_execute_forward_real(p, r2 + ns, c2) == SO3FFT_OK);
+        CHECK(memcmp(c3 + nc, c2, nc * sizeof *c2) == 0);
+        CHECK(so3fft_s2_execute_inverse_real_many(p, 0, c3, r2) == SO3FFT_EINVAL);
+        CHECK_ERR(SO3FFT_EINVAL);
+        {
+            so3fft_complex *s2 = alloc_cx(2 * ns);
+            CHECK(so3fft_s2_execute_inverse_many(p, 2, c3, s2) == SO3FFT_OK);
+            CHECK(so3fft_s2_execute_inverse(p, c3 + nc, s) == SO3FFT_OK);
+            CHECK(memcmp(s2 + ns, s, ns * sizeof *s) == 0);
+            free(s2);
+        }
+        free(c3);
+        free(r2);
+    }
+
     /* the index is seanindex */
     for (m = -(b - 1); m < b; m++)
         for (l = m < 0 ? -m : m; l < b; l++)

@@ -229,6 +229,20 @@ int so3fft_s2_execute_forward_real(so3fft_s2_plan p, const double *samples, so3f
 // are taken as `(-1)^m conj(fhat(l,m))`; `Im fhat(l,0)` is ignored).
 int so3fft_s2_execute_inverse_real(so3fft_s2_plan p, so3fft_complex *coeffs, double *samples);
 
+// `so3fft_s2_execute_forward` of `howmany` fields stored one after another
+// (`howmany (2B)^2` samples, `howmany B^2` coefficients).
+int so3fft_s2_execute_forward_many(so3fft_s2_plan p, int howmany, so3fft_complex *samples, so3fft_complex *coeffs);
+
+// `so3fft_s2_execute_inverse` of `howmany` fields stored one after another.
+int so3fft_s2_execute_inverse_many(so3fft_s2_plan p, int howmany, so3fft_complex *coeffs, so3fft_complex *samples);
+
+// `so3fft_s2_execute_forward_real` of `howmany` fields (two per kernel pass: about twice
+// as fast per field as one at a time).
+int so3fft_s2_execute_forward_real_many(so3fft_s2_plan p, int howmany, const double *samples, so3fft_complex *coeffs);
+
+// `so3fft_s2_execute_inverse_real` of `howmany` fields (two per kernel pass).
+int so3fft_s2_execute_inverse_real_many(so3fft_s2_plan p, int howmany, so3fft_complex *coeffs, double *samples);
+
 // Number of S^2 samples `(2B)^2` (0 for an invalid `B`).
 size_t so3fft_s2_num_samples(int B);
 

@@ -64,9 +64,11 @@ pub use query::{
 };
 pub use s2::{
     so3fft_destroy_s2_plan, so3fft_plan_s2, so3fft_s2_coef_index, so3fft_s2_execute_forward,
-    so3fft_s2_execute_forward_real, so3fft_s2_execute_inverse, so3fft_s2_execute_inverse_real,
-    so3fft_s2_get_bandwidth, so3fft_s2_num_coeffs, so3fft_s2_num_samples, so3fft_s2_plan,
-    so3fft_s2_plan_s, SO3FFT_S2_MAX_BANDWIDTH,
+    so3fft_s2_execute_forward_many, so3fft_s2_execute_forward_real,
+    so3fft_s2_execute_forward_real_many, so3fft_s2_execute_inverse, so3fft_s2_execute_inverse_many,
+    so3fft_s2_execute_inverse_real, so3fft_s2_execute_inverse_real_many, so3fft_s2_get_bandwidth,
+    so3fft_s2_num_coeffs, so3fft_s2_num_samples, so3fft_s2_plan, so3fft_s2_plan_s,
+    SO3FFT_S2_MAX_BANDWIDTH,
 };
 pub use wisdom::{
     so3fft_export_wisdom_to_filename, so3fft_export_wisdom_to_string, so3fft_forget_wisdom,

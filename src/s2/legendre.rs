@@ -75,6 +75,29 @@ impl CoeffRows {
     }
 }
 
+/// Four kernel columns: the even and odd ring combinations of one order's spectra, and
+/// where that order's coefficients go (or come from).
+#[derive(Clone, Copy)]
+pub(super) struct Group {
+    pub spectra: Spectra,
+    pub coef: CoeffRows,
+    /// The order, `m` or `-m`.
+    pub order: isize,
+    /// Forward of a real function: also write `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
+    pub partner: bool,
+}
+
+impl Group {
+    /// `(-1)^m` for a negative order (`dt^l_{-m,0} = (-1)^m dt^l_{m,0}`), else 1.
+    fn sign(&self, m: usize) -> f64 {
+        if self.order < 0 && m % 2 == 1 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+}
+
 /// Per-worker scratch.
 pub(super) struct Scratch {
     rec: RecCoeffs,
@@ -195,34 +218,30 @@ impl LegendreStage {
         }
     }
 
-    /// Forward (analysis) of order `m >= 0` and, for complex rings and `m > 0`, of `-m`:
-    /// `fhat(l, +-m) = factor sum_k w_k dt^l_{m,0}(theta_k) F_{+-m}(theta_k)` (with
-    /// `(-1)^m` for `-m`); real rings also write `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
+    /// Forward (analysis) of order `m >= 0` for up to two column groups (see [`Group`]):
+    /// `fhat(l, g.order) = factor sign(g) sum_k w_k dt^l_{m,0}(theta_k) F_{g.order}(theta_k)`,
+    /// `sign = (-1)^m` for a negative order.
     ///
     /// # Safety
-    /// `spectra` holds the `2B` rings' spectra, `coef` the coefficient array; no other task
-    /// touches order `+-m`'s blocks meanwhile.
-    pub(super) unsafe fn analyse(&self, m: usize, spectra: Spectra, coef: CoeffRows, factor: f64) {
-        let (b, mi) = (self.b, m as isize);
-        let negative = m > 0 && !spectra.real;
+    /// Each group's spectra hold the `2B` rings, its coefficients the whole array; no other
+    /// task touches the groups' orders meanwhile.
+    pub(super) unsafe fn analyse(&self, m: usize, groups: &[Group], factor: f64) {
+        assert!(!groups.is_empty() && groups.len() <= 2);
+        let b = self.b;
         self.with_scratch(|sc| {
             let n = self.setup(sc, m);
-            // Rows: E and O of F_m and F_-m, weighted.
+            // Rows: E and O of each group's spectra, weighted.
             for k in 0..b {
                 let w = self.weights[k];
                 let mirror = 2 * b - 1 - k;
                 let row = &mut sc.rows[k * P..][..P];
-                // SAFETY: rings k and mirror < 2B hold order m's (and -m's) value; read only.
-                let (x, y) = unsafe { (*spectra.at(k, mi), *spectra.at(mirror, mi)) };
-                let (e, o) = ((x + y) * w, (x - y) * w);
-                row[..4].copy_from_slice(&[e.re, e.im, o.re, o.im]);
-                if negative {
-                    // SAFETY: as above, order -m.
-                    let (x, y) = unsafe { (*spectra.at(k, -mi), *spectra.at(mirror, -mi)) };
+                row.fill(0.0);
+                for (g, cols) in groups.iter().zip(row.chunks_exact_mut(4)) {
+                    // SAFETY: rings k and mirror < 2B hold the group's order; read only.
+                    let (x, y) =
+                        unsafe { (*g.spectra.at(k, g.order), *g.spectra.at(mirror, g.order)) };
                     let (e, o) = ((x + y) * w, (x - y) * w);
-                    row[4..].copy_from_slice(&[e.re, e.im, o.re, o.im]);
-                } else {
-                    row[4..].fill(0.0);
+                    cols.copy_from_slice(&[e.re, e.im, o.re, o.im]);
                 }
             }
             sc.rows[b * P..].fill(0.0);
@@ -230,33 +249,29 @@ impl LegendreStage {
             let mut sums = std::mem::take(&mut sc.sums);
             let lanes = self.lanes(sc);
             let lo = dwt::forward(self.isa, P, &rec, &lanes, &sc.rows, &mut sums);
-            let sign_neg = if m.is_multiple_of(2) { factor } else { -factor };
-            // SAFETY: |m| < b; order m's block (and -m's) has n = b - m entries, this
-            // task's alone (caller's contract).
-            let (pos, neg) = unsafe { (coef.block(mi), coef.block(-mi)) };
-            for i in 0..n {
-                let odd = i % 2;
-                let row = &sums[i * P..][..P];
-                let s = sc.rec.s[i];
-                let (f, g) = if i < lo {
-                    (Complex64::default(), Complex64::default())
-                } else {
-                    (
-                        Complex64::new(row[2 * odd], row[2 * odd + 1]) * (s * factor),
-                        Complex64::new(row[4 + 2 * odd], row[5 + 2 * odd]) * (s * sign_neg),
-                    )
-                };
-                // SAFETY: entry i < n of the blocks (above).
-                unsafe {
-                    *pos.add(i) = f;
-                    if negative {
-                        *neg.add(i) = g;
-                    } else if spectra.real && m > 0 {
-                        *neg.add(i) = if m.is_multiple_of(2) {
-                            f.conj()
-                        } else {
-                            -f.conj()
-                        };
+            for (q, g) in groups.iter().enumerate() {
+                let f = g.sign(m) * factor;
+                // SAFETY: |order| < b; the block has n = b - m entries, this task's alone
+                // (caller's contract), as has the partner block written below.
+                let (own, partner) = unsafe { (g.coef.block(g.order), g.coef.block(-g.order)) };
+                for i in 0..n {
+                    let odd = i % 2;
+                    let v = if i < lo {
+                        Complex64::default()
+                    } else {
+                        let c = &sums[i * P + 4 * q + 2 * odd..][..2];
+                        Complex64::new(c[0], c[1]) * (sc.rec.s[i] * f)
+                    };
+                    // SAFETY: entry i < n of the blocks (above).
+                    unsafe {
+                        *own.add(i) = v;
+                        if g.partner && m > 0 {
+                            *partner.add(i) = if m.is_multiple_of(2) {
+                                v.conj()
+                            } else {
+                                -v.conj()
+                            };
+                        }
                     }
                 }
             }
@@ -264,50 +279,38 @@ impl LegendreStage {
         });
     }
 
-    /// Inverse (synthesis) of order `m >= 0` and, for complex rings and `m > 0`, of `-m`:
-    /// `F_{+-m}(theta_k) = factor sum_l fhat(l, +-m) dt^l_{+-m,0}(theta_k)` into the ring
-    /// spectra (real rings: order `m` only).
+    /// Inverse (synthesis) of order `m >= 0` for up to two column groups:
+    /// `F_{g.order}(theta_k) = factor sign(g) sum_l fhat(l, g.order) dt^l_{m,0}(theta_k)` into
+    /// each group's spectra.
     ///
     /// # Safety
     /// As for [`LegendreStage::analyse`], with the roles of the arrays exchanged.
-    pub(super) unsafe fn synthesise(
-        &self,
-        m: usize,
-        coef: CoeffRows,
-        spectra: Spectra,
-        factor: f64,
-    ) {
-        let (b, mi) = (self.b, m as isize);
-        let negative = m > 0 && !spectra.real;
+    pub(super) unsafe fn synthesise(&self, m: usize, groups: &[Group], factor: f64) {
+        assert!(!groups.is_empty() && groups.len() <= 2);
+        let b = self.b;
         self.with_scratch(|sc| {
             let n = self.setup(sc, m);
-            let sign_neg = if m.is_multiple_of(2) { factor } else { -factor };
-            // SAFETY: |m| < b; the blocks have n entries, only read here.
-            let (pos, neg) = unsafe {
-                (
-                    coef.block(mi) as *const Complex64,
-                    coef.block(-mi) as *const Complex64,
-                )
-            };
+            let mut blocks = [(std::ptr::null::<Complex64>(), 0.0); 2];
+            for (slot, g) in blocks.iter_mut().zip(groups) {
+                // SAFETY: |order| < b; the block has n entries, only read here.
+                *slot = (
+                    unsafe { g.coef.block(g.order) }.cast_const(),
+                    g.sign(m) * factor,
+                );
+            }
+            let blocks = &blocks[..groups.len()];
             let scales = &sc.rec.s;
             let mut fill = |fin: &mut [f64], from: usize, to: usize| {
                 for i in from..to {
-                    let s = scales[i];
-                    // SAFETY: i < n (the kernel fills rows of its n degrees).
-                    let f = unsafe { *pos.add(i) } * (s * factor);
-                    let g = if negative {
-                        // SAFETY: as above.
-                        (unsafe { *neg.add(i) }) * (s * sign_neg)
-                    } else {
-                        Complex64::default()
-                    };
                     let row = &mut fin[i * P..][..P];
                     row.fill(0.0);
                     let odd = i % 2;
-                    row[2 * odd] = f.re;
-                    row[2 * odd + 1] = f.im;
-                    row[4 + 2 * odd] = g.re;
-                    row[5 + 2 * odd] = g.im;
+                    for (q, &(block, f)) in blocks.iter().enumerate() {
+                        // SAFETY: i < n (the kernel fills rows of its n degrees).
+                        let v = unsafe { *block.add(i) } * (scales[i] * f);
+                        row[4 * q + 2 * odd] = v.re;
+                        row[4 * q + 2 * odd + 1] = v.im;
+                    }
                 }
             };
             let rec = Rec::new(&sc.rec, n);
@@ -326,24 +329,12 @@ impl LegendreStage {
             for k in 0..b {
                 let row = &rows[k * P..][..P];
                 let mirror = 2 * b - 1 - k;
-                let (e, o) = (
-                    Complex64::new(row[0], row[1]),
-                    Complex64::new(row[2], row[3]),
-                );
-                // SAFETY: rings k and mirror, order m's column: this task's alone.
-                unsafe {
-                    *spectra.at(k, mi) = e + o;
-                    *spectra.at(mirror, mi) = e - o;
-                }
-                if negative {
-                    let (e, o) = (
-                        Complex64::new(row[4], row[5]),
-                        Complex64::new(row[6], row[7]),
-                    );
-                    // SAFETY: as above, order -m's column.
+                for (g, c) in groups.iter().zip(row.chunks_exact(4)) {
+                    let (e, o) = (Complex64::new(c[0], c[1]), Complex64::new(c[2], c[3]));
+                    // SAFETY: rings k and mirror, the group's order's column: this task's.
                     unsafe {
-                        *spectra.at(k, -mi) = e + o;
-                        *spectra.at(mirror, -mi) = e - o;
+                        *g.spectra.at(k, g.order) = e + o;
+                        *g.spectra.at(mirror, g.order) = e - o;
                     }
                 }
             }

@@ -1,7 +1,7 @@
 //! [`S2Plan`]: spherical-harmonic transforms of one bandwidth.
 
 use super::layout::{order_start, s2_num_coeffs, s2_num_samples};
-use super::legendre::{CoeffRows, LegendreStage, Spectra};
+use super::legendre::{CoeffRows, Group, LegendreStage, Spectra};
 use super::rings::RingFft;
 use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
@@ -47,6 +47,9 @@ pub struct S2Plan {
     starts: Vec<usize>,
     /// Ring spectra (`(2B)^2` values), taken by one execution at a time.
     scratch: Mutex<Option<AlignedBuf>>,
+    /// A second ring scratch for the real transforms of two fields at once (made on first
+    /// use).
+    spare: Mutex<Option<AlignedBuf>>,
 }
 
 impl S2Plan {
@@ -96,6 +99,7 @@ impl S2Plan {
             legendre,
             starts,
             scratch: Mutex::new(Some(scratch)),
+            spare: Mutex::new(None),
         })
     }
 
@@ -124,16 +128,21 @@ impl S2Plan {
         s2_num_coeffs(self.b)
     }
 
-    fn check(&self, samples: usize, coeffs: usize) -> Result<()> {
+    /// An error unless the arrays hold `howmany` fields of samples and coefficients.
+    fn check(&self, samples: usize, coeffs: usize, howmany: usize) -> Result<()> {
         if !self.workers.in_own_process() {
             return Err(Error::InvalidArgument(
                 "S^2 plan made in another process (before fork()): make a new plan here".into(),
             ));
         }
-        for (what, expected, got) in [
+        if howmany == 0 {
+            return Err(Error::InvalidArgument("howmany is 0".into()));
+        }
+        for (what, each, got) in [
             ("samples", self.num_samples(), samples),
             ("coefficients", self.num_coeffs(), coeffs),
         ] {
+            let expected = each.saturating_mul(howmany);
             if got != expected {
                 return Err(Error::LengthMismatch {
                     what,
@@ -145,17 +154,45 @@ impl S2Plan {
         Ok(())
     }
 
-    /// Runs `f` with the plan's ring scratch, or a new one when it is in use.
-    fn with_scratch<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
-        let guard = match self.scratch.try_lock() {
-            Ok(g) => Some(g),
-            Err(std::sync::TryLockError::Poisoned(e)) => Some(e.into_inner()),
-            Err(std::sync::TryLockError::WouldBlock) => None,
+    /// Runs `f` with the plan's ring scratch (and, with `two`, its second one, made on
+    /// first use), or with new ones when they are in use.
+    fn with_scratch<R>(
+        &self,
+        two: bool,
+        f: impl FnOnce(&AlignedBuf, Option<&AlignedBuf>) -> Result<R>,
+    ) -> Result<R> {
+        let len = scratch_len(self.b);
+        let mut first = try_take(&self.scratch);
+        let own = match first.as_mut() {
+            Some(g) => g.as_ref(),
+            None => None,
         };
-        match guard.as_ref().and_then(|g| g.as_ref()) {
-            Some(buf) => f(buf),
-            None => f(&AlignedBuf::new(scratch_len(self.b))?),
+        let tmp;
+        let a = match own {
+            Some(buf) => buf,
+            None => {
+                tmp = AlignedBuf::new(len)?;
+                &tmp
+            }
+        };
+        if !two {
+            return f(a, None);
         }
+        let mut second = try_take(&self.spare);
+        let tmp2;
+        let bbuf = match second.as_mut() {
+            Some(g) => {
+                if g.is_none() {
+                    **g = Some(AlignedBuf::new(len)?);
+                }
+                g.as_ref().expect("just made")
+            }
+            None => {
+                tmp2 = AlignedBuf::new(len)?;
+                &tmp2
+            }
+        };
+        f(a, Some(bbuf))
     }
 
     fn coeff_rows(&self, base: *mut Complex64) -> CoeffRows {
@@ -176,59 +213,98 @@ impl S2Plan {
         })
     }
 
+    /// The column groups of order `m` of a complex field: `m` and, for `m > 0`, `-m`.
+    fn complex_groups(m: usize, spectra: Spectra, coef: CoeffRows) -> ([Group; 2], usize) {
+        let g = |order: isize| Group {
+            spectra,
+            coef,
+            order,
+            partner: false,
+        };
+        ([g(m as isize), g(-(m as isize))], if m > 0 { 2 } else { 1 })
+    }
+
     /// Forward transform of complex samples (`(2B)^2`, ring-major) into `B^2` coefficients.
     pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.check(samples.len(), coeffs.len())?;
-        let (b, n) = (self.b, 2 * self.b);
+        self.forward_many(samples, coeffs, 1)
+    }
+
+    /// [`S2Plan::forward`] of `howmany` fields stored one after another (`howmany (2B)^2`
+    /// samples, `howmany B^2` coefficients).
+    pub fn forward_many(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        howmany: usize,
+    ) -> Result<()> {
+        self.check(samples.len(), coeffs.len(), howmany)?;
+        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = (2.0 * PI).sqrt() / n as f64;
-        self.with_scratch(|buf| {
-            // SAFETY: the scratch holds n*n values; nothing else uses it during the call.
-            unsafe { std::ptr::copy_nonoverlapping(samples.as_ptr(), buf.as_mut_ptr(), n * n) };
-            let spectra = Spectra {
-                base: buf.as_mut_ptr(),
-                row: n,
-                real: false,
-            };
-            let coef = self.coeff_rows(coeffs.as_mut_ptr());
-            self.workers.pool().install(|| {
-                self.rings_complex(buf, true)?;
-                (0..b).into_par_iter().for_each(|m| {
-                    // SAFETY: each task handles orders +-m only; the spectra and the
-                    // coefficient array are whole (lengths checked).
-                    unsafe { self.legendre.analyse(m, spectra, coef, factor) }
-                });
-                Ok(())
-            })
+        self.with_scratch(false, |buf, _| {
+            for (field, out) in samples.chunks_exact(n * n).zip(coeffs.chunks_exact_mut(nc)) {
+                // SAFETY: the scratch holds n*n values; nothing else uses it during the call.
+                unsafe { std::ptr::copy_nonoverlapping(field.as_ptr(), buf.as_mut_ptr(), n * n) };
+                let spectra = Spectra {
+                    base: buf.as_mut_ptr(),
+                    row: n,
+                    real: false,
+                };
+                let coef = self.coeff_rows(out.as_mut_ptr());
+                self.workers.pool().install(|| {
+                    self.rings_complex(buf, true)?;
+                    (0..b).into_par_iter().for_each(|m| {
+                        let (groups, count) = Self::complex_groups(m, spectra, coef);
+                        // SAFETY: each task handles orders +-m only; the spectra and the
+                        // coefficient array are whole (lengths checked).
+                        unsafe { self.legendre.analyse(m, &groups[..count], factor) }
+                    });
+                    Ok::<(), Error>(())
+                })?;
+            }
+            Ok(())
         })
     }
 
     /// Inverse transform of `B^2` coefficients into complex samples.
     pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
-        self.check(samples.len(), coeffs.len())?;
-        let (b, n) = (self.b, 2 * self.b);
+        self.inverse_many(coeffs, samples, 1)
+    }
+
+    /// [`S2Plan::inverse`] of `howmany` fields stored one after another.
+    pub fn inverse_many(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        howmany: usize,
+    ) -> Result<()> {
+        self.check(samples.len(), coeffs.len(), howmany)?;
+        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = 1.0 / (2.0 * PI).sqrt();
-        self.with_scratch(|buf| {
-            let spectra = Spectra {
-                base: buf.as_mut_ptr(),
-                row: n,
-                real: false,
-            };
-            let coef = self.coeff_rows(coeffs.as_ptr().cast_mut());
-            self.workers.pool().install(|| {
-                (0..b).into_par_iter().for_each(|m| {
-                    // SAFETY: each task writes the columns of orders +-m only and reads
-                    // their coefficient blocks (never written).
-                    unsafe { self.legendre.synthesise(m, coef, spectra, factor) }
-                });
-                // The frequency B is never used.
-                for k in 0..n {
-                    // SAFETY: column B of ring k, inside the scratch.
-                    unsafe { *buf.as_mut_ptr().add(k * n + b) = Complex64::default() };
-                }
-                self.rings_complex(buf, false)
-            })?;
-            // SAFETY: the scratch holds n*n values; `samples` as many (checked).
-            unsafe { std::ptr::copy_nonoverlapping(buf.as_mut_ptr(), samples.as_mut_ptr(), n * n) };
+        self.with_scratch(false, |buf, _| {
+            for (field, out) in coeffs.chunks_exact(nc).zip(samples.chunks_exact_mut(n * n)) {
+                let spectra = Spectra {
+                    base: buf.as_mut_ptr(),
+                    row: n,
+                    real: false,
+                };
+                let coef = self.coeff_rows(field.as_ptr().cast_mut());
+                self.workers.pool().install(|| {
+                    (0..b).into_par_iter().for_each(|m| {
+                        let (groups, count) = Self::complex_groups(m, spectra, coef);
+                        // SAFETY: each task writes the columns of orders +-m only and reads
+                        // their coefficient blocks (never written).
+                        unsafe { self.legendre.synthesise(m, &groups[..count], factor) }
+                    });
+                    // The frequency B is never used.
+                    for k in 0..n {
+                        // SAFETY: column B of ring k, inside the scratch.
+                        unsafe { *buf.as_mut_ptr().add(k * n + b) = Complex64::default() };
+                    }
+                    self.rings_complex(buf, false)
+                })?;
+                // SAFETY: the scratch holds n*n values; `out` as many.
+                unsafe { std::ptr::copy_nonoverlapping(buf.as_mut_ptr(), out.as_mut_ptr(), n * n) };
+            }
             Ok(())
         })
     }
@@ -236,38 +312,90 @@ impl S2Plan {
     /// Forward transform of real samples: all `B^2` coefficients, with
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.check(samples.len(), coeffs.len())?;
-        let (b, n) = (self.b, 2 * self.b);
-        let per = self.rings.per_call();
+        self.forward_real_many(samples, coeffs, 1)
+    }
+
+    /// [`S2Plan::forward_real`] of `howmany` fields stored one after another. Two fields
+    /// share each kernel call (the recurrence is run once for both).
+    pub fn forward_real_many(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        howmany: usize,
+    ) -> Result<()> {
+        self.check(samples.len(), coeffs.len(), howmany)?;
+        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = (2.0 * PI).sqrt() / n as f64;
-        let half = b + 1;
-        self.with_scratch(|buf| {
-            // Real rings in the first n*n/2 values of the scratch, their spectra after them.
-            let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
-            let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
-            // SAFETY: n*n reals fit in the first n*n/2 complex values of the scratch.
-            unsafe { std::ptr::copy_nonoverlapping(samples.as_ptr(), reals.get(), n * n) };
-            let spectra = Spectra {
+        self.with_scratch(howmany > 1, |first, second| {
+            let bufs = [Some(first), second];
+            for (fields, outs) in samples.chunks(2 * n * n).zip(coeffs.chunks_mut(2 * nc)) {
+                let mut groups = [None; 2];
+                for (i, (field, out)) in fields
+                    .chunks_exact(n * n)
+                    .zip(outs.chunks_exact_mut(nc))
+                    .enumerate()
+                {
+                    let buf = bufs[i].expect("a second scratch for two fields");
+                    groups[i] = Some(self.real_rings_forward(buf, field, out)?);
+                }
+                let used = groups.iter().flatten().count();
+                let first = groups[0].expect("at least one field");
+                let groups = groups.map(|g| g.unwrap_or(first));
+                let groups = &groups[..used];
+                self.workers.pool().install(|| {
+                    (0..b).into_par_iter().for_each(|m| {
+                        let mut g = [groups[0]; 2];
+                        for (slot, src) in g.iter_mut().zip(groups) {
+                            *slot = Group {
+                                order: m as isize,
+                                ..*src
+                            };
+                        }
+                        // SAFETY: as in `forward_many`; each field has its own spectra
+                        // and coefficient array.
+                        unsafe { self.legendre.analyse(m, &g[..groups.len()], factor) }
+                    })
+                });
+            }
+            Ok(())
+        })
+    }
+
+    /// The `r2c` of one real field's rings (copied into `buf` first); the field's column
+    /// group (order set per call).
+    fn real_rings_forward(
+        &self,
+        buf: &AlignedBuf,
+        field: &[f64],
+        out: &mut [Complex64],
+    ) -> Result<Group> {
+        let n = 2 * self.b;
+        let per = self.rings.per_call();
+        let half = self.b + 1;
+        // Real rings in the first n*n/2 values of the scratch, their spectra after them.
+        let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
+        let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        // SAFETY: n*n reals fit in the first n*n/2 complex values of the scratch.
+        unsafe { std::ptr::copy_nonoverlapping(field.as_ptr(), reals.get(), n * n) };
+        self.workers.pool().install(|| {
+            (0..n / per).into_par_iter().try_for_each(|c| {
+                // SAFETY: rings c*per.. of the reals (read) and of the spectra (n rows of
+                // B+1 values after n*n/2, within the n*n + n scratch): this task's.
+                unsafe {
+                    self.rings
+                        .r2c(reals.get().add(c * per * n), spec.get().add(c * per * half))
+                }
+            })
+        })?;
+        Ok(Group {
+            spectra: Spectra {
                 base: spec.get(),
                 row: half,
                 real: true,
-            };
-            let coef = self.coeff_rows(coeffs.as_mut_ptr());
-            self.workers.pool().install(|| {
-                (0..n / per).into_par_iter().try_for_each(|c| {
-                    // SAFETY: rings c*per.. of the reals (read) and of the spectra (n rows
-                    // of B+1 values after n*n/2, within the n*n + n scratch): this task's.
-                    unsafe {
-                        self.rings
-                            .r2c(reals.get().add(c * per * n), spec.get().add(c * per * half))
-                    }
-                })?;
-                (0..b).into_par_iter().for_each(|m| {
-                    // SAFETY: as in `forward`.
-                    unsafe { self.legendre.analyse(m, spectra, coef, factor) }
-                });
-                Ok(())
-            })
+            },
+            coef: self.coeff_rows(out.as_mut_ptr()),
+            order: 0,
+            partner: true,
         })
     }
 
@@ -275,41 +403,99 @@ impl S2Plan {
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))` (imaginary parts of `fhat(l, 0)` are
     /// ignored).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
-        self.check(samples.len(), coeffs.len())?;
-        let (b, n) = (self.b, 2 * self.b);
-        let per = self.rings.per_call();
+        self.inverse_real_many(coeffs, samples, 1)
+    }
+
+    /// [`S2Plan::inverse_real`] of `howmany` fields stored one after another, two fields
+    /// per kernel call.
+    pub fn inverse_real_many(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        howmany: usize,
+    ) -> Result<()> {
+        self.check(samples.len(), coeffs.len(), howmany)?;
+        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = 1.0 / (2.0 * PI).sqrt();
         let half = b + 1;
-        self.with_scratch(|buf| {
-            let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
-            let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
-            let spectra = Spectra {
-                base: spec.get(),
-                row: half,
-                real: true,
-            };
-            let coef = self.coeff_rows(coeffs.as_ptr().cast_mut());
-            self.workers.pool().install(|| {
-                (0..b).into_par_iter().for_each(|m| {
-                    // SAFETY: as in `inverse`.
-                    unsafe { self.legendre.synthesise(m, coef, spectra, factor) }
-                });
-                for k in 0..n {
-                    // SAFETY: column B of spectrum row k, inside the scratch.
-                    unsafe { *spec.get().add(k * half + b) = Complex64::default() };
+        self.with_scratch(howmany > 1, |first, second| {
+            let bufs = [Some(first), second];
+            for (fields, outs) in coeffs.chunks(2 * nc).zip(samples.chunks_mut(2 * n * n)) {
+                let count = fields.len() / nc;
+                let mut groups = [None; 2];
+                for (i, field) in fields.chunks_exact(nc).enumerate() {
+                    let buf = bufs[i].expect("a second scratch for two fields");
+                    groups[i] = Some(Group {
+                        spectra: Spectra {
+                            base: buf.as_mut_ptr().wrapping_add(n * n / 2),
+                            row: half,
+                            real: true,
+                        },
+                        coef: self.coeff_rows(field.as_ptr().cast_mut()),
+                        order: 0,
+                        partner: false,
+                    });
                 }
-                (0..n / per).into_par_iter().try_for_each(|c| {
-                    // SAFETY: as in `forward_real`, the other way.
-                    unsafe {
-                        self.rings
-                            .c2r(spec.get().add(c * per * half), reals.get().add(c * per * n))
-                    }
-                })
-            })?;
-            // SAFETY: n*n reals in the scratch; `samples` has as many (checked).
-            unsafe { std::ptr::copy_nonoverlapping(reals.get(), samples.as_mut_ptr(), n * n) };
+                let used = groups.iter().flatten().count();
+                let first = groups[0].expect("at least one field");
+                let groups = groups.map(|g| g.unwrap_or(first));
+                let groups = &groups[..used];
+                self.workers.pool().install(|| {
+                    (0..b).into_par_iter().for_each(|m| {
+                        let mut g = [groups[0]; 2];
+                        for (slot, src) in g.iter_mut().zip(groups) {
+                            *slot = Group {
+                                order: m as isize,
+                                ..*src
+                            };
+                        }
+                        // SAFETY: as in `inverse_many`; each field has its own spectra.
+                        unsafe { self.legendre.synthesise(m, &g[..groups.len()], factor) }
+                    })
+                });
+                for (i, out) in outs.chunks_exact_mut(n * n).enumerate().take(count) {
+                    let buf = bufs[i].expect("a second scratch for two fields");
+                    self.real_rings_inverse(buf, out)?;
+                }
+            }
             Ok(())
         })
+    }
+
+    /// The `c2r` of one field's spectra in `buf` into `out`.
+    fn real_rings_inverse(&self, buf: &AlignedBuf, out: &mut [f64]) -> Result<()> {
+        let (b, n) = (self.b, 2 * self.b);
+        let per = self.rings.per_call();
+        let half = b + 1;
+        let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
+        let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        self.workers.pool().install(|| {
+            for k in 0..n {
+                // SAFETY: column B of spectrum row k, inside the scratch.
+                unsafe { *spec.get().add(k * half + b) = Complex64::default() };
+            }
+            (0..n / per).into_par_iter().try_for_each(|c| {
+                // SAFETY: as in `real_rings_forward`, the other way.
+                unsafe {
+                    self.rings
+                        .c2r(spec.get().add(c * per * half), reals.get().add(c * per * n))
+                }
+            })
+        })?;
+        // SAFETY: n*n reals in the scratch; `out` has as many.
+        unsafe { std::ptr::copy_nonoverlapping(reals.get(), out.as_mut_ptr(), n * n) };
+        Ok(())
+    }
+}
+
+/// The scratch behind `m` if no other execution holds it.
+fn try_take(
+    m: &Mutex<Option<AlignedBuf>>,
+) -> Option<std::sync::MutexGuard<'_, Option<AlignedBuf>>> {
+    match m.try_lock() {
+        Ok(g) => Some(g),
+        Err(std::sync::TryLockError::Poisoned(e)) => Some(e.into_inner()),
+        Err(std::sync::TryLockError::WouldBlock) => None,
     }
 }
 

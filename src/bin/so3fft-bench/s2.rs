@@ -52,11 +52,13 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
     println!("S^2 transforms: medians of the runs in ms; GFLOP/s of the Legendre sums");
     println!("FMA peak of one core: {peak1:.1} GFLOP/s");
     println!(
-        "{:>5} {:>3} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6} {:>10} {:>10}",
+        "{:>5} {:>3} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6} {:>10} {:>10}",
         "B",
         "thr",
         "re syn",
         "re ana",
+        "re syn/2",
+        "re ana/2",
         "cx syn",
         "cx ana",
         "GFLOP/s",
@@ -64,6 +66,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         "err real",
         "err cx"
     );
+    println!("(re .../2: two real fields per call, time per field)");
     for &b in &opts.bandwidths {
         for &threads in &opts.threads {
             let plan = S2Plan::new(
@@ -84,16 +87,27 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             let re_syn = timed(runs, || plan.inverse_real(&real_coefs, &mut real))?;
             let re_ana = timed(runs, || plan.forward_real(&real, &mut back))?;
             let err_real = rel_l2(&back, &real_coefs);
+            let pair_coefs = [real_coefs.clone(), hermitian(b, 8)].concat();
+            let mut pair_real = vec![0.0; 2 * ns];
+            let mut pair_back = vec![Complex64::default(); 2 * nc];
+            let re_syn2 = timed(runs, || {
+                plan.inverse_real_many(&pair_coefs, &mut pair_real, 2)
+            })? / 2.0;
+            let re_ana2 = timed(runs, || {
+                plan.forward_real_many(&pair_real, &mut pair_back, 2)
+            })? / 2.0;
             let cx_syn = timed(runs, || plan.inverse(&coefs, &mut samples))?;
             let cx_ana = timed(runs, || plan.forward(&samples, &mut back))?;
             let err_cx = rel_l2(&back, &coefs);
             let gflops = legendre_flops(b) / cx_ana.min(cx_syn) / 1e9;
             let cores = plan.threads().min(2) as f64;
             println!(
-                "{b:>5} {:>3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {gflops:>8.1} {:>5.0}% {err_real:>10.2e} {err_cx:>10.2e}",
+                "{b:>5} {:>3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {gflops:>8.1} {:>5.0}% {err_real:>10.2e} {err_cx:>10.2e}",
                 plan.threads(),
                 re_syn * 1e3,
                 re_ana * 1e3,
+                re_syn2 * 1e3,
+                re_ana2 * 1e3,
                 cx_syn * 1e3,
                 cx_ana * 1e3,
                 100.0 * gflops / (peak1 * cores),
