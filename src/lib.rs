@@ -32,6 +32,7 @@ mod grid;
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 pub mod internals;
+pub mod matching;
 mod numeric;
 mod plan;
 pub mod s2;

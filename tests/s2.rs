@@ -9,35 +9,9 @@ use num_complex::Complex64;
 use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
 use std::f64::consts::PI;
 
-/// Sections of a reference file: `name -> rows of numbers`.
-fn read_reference(name: &str) -> std::collections::HashMap<String, Vec<Vec<f64>>> {
-    let path = format!("{}/tests/data/s2/{name}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let mut out = std::collections::HashMap::new();
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    while let Some(line) = lines.next() {
-        let words: Vec<&str> = line.split_whitespace().collect();
-        if words.first() == Some(&"section") {
-            let count: usize = words[2].parse().unwrap();
-            let rows = (0..count)
-                .map(|_| {
-                    lines
-                        .next()
-                        .unwrap()
-                        .split_whitespace()
-                        .map(|w| w.parse::<f64>().unwrap())
-                        .collect()
-                })
-                .collect();
-            out.insert(words[1].to_string(), rows);
-        }
-    }
-    out
-}
-
 /// Samples (`j k re im`) and coefficients (`index l m re im`) of a reference file.
 fn samples_and_coefs(name: &str, b: usize) -> (Vec<Complex64>, Vec<Complex64>) {
-    let r = read_reference(name);
+    let r = common::read_s2_reference(name);
     let n = 2 * b;
     let mut samples = vec![Complex64::default(); n * n];
     for row in &r["samples"] {

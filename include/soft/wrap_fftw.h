@@ -23,10 +23,20 @@ extern "C" {
  * Forward and inverse SO(3) transforms at bandwidth bw without caller-provided workspaces,
  * weights or plans: signal holds (2bw)^3 samples, coeffs (4bw^3-bw)/3 coefficients;
  * flag = 1 for real data (as in soft_fftw.h). Inputs are not modified.
- * (softFFTWCor2 and s2RotateFFTW of SOFT's wrap_fftw.h are not provided by so3fft.)
+ * (s2RotateFFTW of SOFT's wrap_fftw.h is not provided by so3fft yet.)
  */
 void Forward_SO3_Naive_fftw_W(int bw, fftw_complex *signal, fftw_complex *coeffs, int flag);
 void Inverse_SO3_Naive_fftw_W(int bw, fftw_complex *coeffs, fftw_complex *signal, int flag);
+
+/*
+ * Rotational matching at bandwidth bw: the rotation g = Rz(alpha) Ry(beta) Rz(gamma) of the
+ * SO(3) grid that maximises |C(g)|^2, C(g) = int sig(x) conj(pat(g^-1 x)) dx, i.e. the signal
+ * is about the pattern rotated by g. sig, pat: (2bw)^2 samples on the S^2 grid, interleaved
+ * complex (2 (2bw)^2 doubles) or, with isReal nonzero, real ((2bw)^2 doubles). Ties go to the
+ * lowest grid index. Inputs are not modified.
+ */
+void softFFTWCor2(int bw, double *sig, double *pat, double *alpha, double *beta, double *gamma,
+                  int isReal);
 
 #ifdef __cplusplus
 }

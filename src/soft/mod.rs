@@ -38,6 +38,7 @@
 mod cache;
 mod correlate;
 mod index;
+mod matching;
 mod real;
 mod so3;
 mod tables;
@@ -46,6 +47,7 @@ pub use correlate::{seanindex, so3CombineCoef_fftw};
 pub use index::{
     coefLoc_so3, howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3,
 };
+pub use matching::softFFTWCor2;
 pub use so3::{
     Forward_SO3_Naive_fftw, Forward_SO3_Naive_fftw_W, Forward_SO3_Naive_fftw_nt,
     Forward_SO3_Naive_fftw_pc, Inverse_SO3_Naive_fftw, Inverse_SO3_Naive_fftw_W,

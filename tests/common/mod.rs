@@ -477,3 +477,52 @@ pub fn wigner_tol(l: usize, beta: f64) -> f64 {
     };
     base + pole * f64::EPSILON
 }
+
+/// A reference file of `tests/data/s2/`: its scalar lines (`key value`) and its sections
+/// (`section NAME COUNT` followed by rows of numbers).
+pub struct S2Reference {
+    pub scalars: std::collections::HashMap<String, f64>,
+    pub sections: std::collections::HashMap<String, Vec<Vec<f64>>>,
+}
+
+impl std::ops::Index<&str> for S2Reference {
+    type Output = Vec<Vec<f64>>;
+    fn index(&self, name: &str) -> &Vec<Vec<f64>> {
+        &self.sections[name]
+    }
+}
+
+/// Reads `tests/data/s2/<name>`.
+pub fn read_s2_reference(name: &str) -> S2Reference {
+    let path = format!("{}/tests/data/s2/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut out = S2Reference {
+        scalars: Default::default(),
+        sections: Default::default(),
+    };
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    while let Some(line) = lines.next() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["section", name, count] => {
+                let count: usize = count.parse().unwrap();
+                let rows = (0..count)
+                    .map(|_| {
+                        lines
+                            .next()
+                            .unwrap()
+                            .split_whitespace()
+                            .map(|w| w.parse::<f64>().unwrap())
+                            .collect()
+                    })
+                    .collect();
+                out.sections.insert(name.to_string(), rows);
+            }
+            [key, value] => {
+                out.scalars.insert(key.to_string(), value.parse().unwrap());
+            }
+            _ => {}
+        }
+    }
+    out
+}

@@ -1,0 +1,59 @@
+//! SO(3) coefficients of a correlation from the S^2 coefficients of signal and pattern.
+
+use crate::error::{Error, Result};
+use crate::grid::{block_start, num_coeffs};
+use crate::s2::s2_coef_index;
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// The SO(3) coefficients (bandwidth `b_out`, `so3CoefLoc` order) of the correlation
+/// `C(g) = int f(x) conj(h(g^-1 x)) dx` of a signal `f` and a pattern `h` given by their S^2
+/// coefficients (bandwidth `b_in`, `seanindex` order):
+/// `Chat(l, m1, m2) = 2 pi sqrt(2/(2l+1)) (-1)^(m1+m2) fhat(l,-m1) conj(hhat(l,-m2))` for
+/// `l <= deg_lim`, zero for every other coefficient (SOFT's `so3CombineCoef_fftw`).
+/// `deg_lim < min(b_in, b_out)`.
+pub fn combine(
+    (sig, pat): (&[Complex64], &[Complex64]),
+    b_in: usize,
+    deg_lim: usize,
+    b_out: usize,
+    out: &mut [Complex64],
+) -> Result<()> {
+    if deg_lim >= b_in.min(b_out) {
+        return Err(Error::InvalidArgument(format!(
+            "degree limit {deg_lim} must be below both bandwidths ({b_in}, {b_out})"
+        )));
+    }
+    for (what, expected, got) in [
+        ("signal coefficients", b_in * b_in, sig.len()),
+        ("pattern coefficients", b_in * b_in, pat.len()),
+        ("SO(3) coefficients", num_coeffs(b_out), out.len()),
+    ] {
+        if expected != got {
+            return Err(Error::LengthMismatch {
+                what,
+                expected,
+                got,
+            });
+        }
+    }
+    out.fill(Complex64::default());
+    for l in 0..=deg_lim {
+        let li = l as isize;
+        let norm = 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
+        for m1 in -li..=li {
+            let f = sig[s2_coef_index(b_in, l, -m1)];
+            for m2 in -li..=li {
+                let h = pat[s2_coef_index(b_in, l, -m2)];
+                let sign = if (m1 + m2).rem_euclid(2) == 0 {
+                    norm
+                } else {
+                    -norm
+                };
+                out[block_start(b_out, m1, m2) + (l - m1.unsigned_abs().max(m2.unsigned_abs()))] =
+                    f * h.conj() * sign;
+            }
+        }
+    }
+    Ok(())
+}

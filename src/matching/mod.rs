@@ -1,0 +1,15 @@
+//! Rotational matching: the correlation of two functions on the sphere over the rotations
+//! of the SO(3) grid ([`Correlation`]), the combination of their S^2 coefficients
+//! ([`combine`]) and the grid's peak ([`grid_argmax`]).
+//!
+//! Conventions (`docs/conventions-s2.md`): `C(g) = int f(x) conj(h(g^-1 x)) dx`; its peak is
+//! the rotation `g = Rz(alpha) Ry(beta) Rz(gamma)` that maps the pattern `h` onto the
+//! signal `f`, `f(x) ~ h(g^-1 x)`.
+
+mod combine;
+mod correlation;
+mod peaks;
+
+pub use combine::combine;
+pub use correlation::{Correlation, CorrelationOptions};
+pub use peaks::{grid_argmax, grid_argmax_real, Peak};
