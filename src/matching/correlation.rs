@@ -131,6 +131,40 @@ impl Correlation {
         }
     }
 
+    /// The SO(3) coefficients of the correlation of complex samples (`(4 b_out^3 - b_out)/3`
+    /// values, for [`So3Series`](super::So3Series) and peak refinement).
+    pub fn coefficients(
+        &self,
+        signal: &[Complex64],
+        pattern: &[Complex64],
+        out: &mut [Complex64],
+    ) -> Result<()> {
+        let n = self.b_in * self.b_in;
+        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+        self.s2.forward(signal, &mut sig)?;
+        self.s2.forward(pattern, &mut pat)?;
+        combine((&sig, &pat), self.b_in, self.deg_lim, self.b_out, out)
+    }
+
+    /// [`Correlation::coefficients`] of real samples.
+    pub fn coefficients_real(
+        &self,
+        signal: &[f64],
+        pattern: &[f64],
+        out: &mut [Complex64],
+    ) -> Result<()> {
+        let n = self.b_in * self.b_in;
+        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+        self.s2.forward_real(signal, &mut sig)?;
+        self.s2.forward_real(pattern, &mut pat)?;
+        combine((&sig, &pat), self.b_in, self.deg_lim, self.b_out, out)
+    }
+
+    /// Highest degree combined.
+    pub fn deg_lim(&self) -> usize {
+        self.deg_lim
+    }
+
     /// The correlation of complex samples (`(2 b_in)^2` each) into `out` (`(2 b_out)^3`).
     /// For a plan made with `real`, use [`Correlation::correlate_real`].
     pub fn correlate(

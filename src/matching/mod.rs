@@ -1,6 +1,8 @@
 //! Rotational matching: the correlation of two functions on the sphere over the rotations
 //! of the SO(3) grid ([`Correlation`]), the combination of their S^2 coefficients
-//! ([`combine`]) and the grid's peak ([`grid_argmax`]).
+//! ([`combine`]), the grid's peak ([`grid_argmax`]), peaks refined off the grid
+//! ([`So3Series::maximise`]) and the rotation of functions on the sphere
+//! ([`rotate_s2_coeffs`]).
 //!
 //! Conventions (`docs/conventions-s2.md`): `C(g) = int f(x) conj(h(g^-1 x)) dx`; its peak is
 //! the rotation `g = Rz(alpha) Ry(beta) Rz(gamma)` that maps the pattern `h` onto the
@@ -9,7 +11,11 @@
 mod combine;
 mod correlation;
 mod peaks;
+mod refine;
+mod rotation;
 
 pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};
 pub use peaks::{grid_argmax, grid_argmax_real, Peak};
+pub use refine::So3Series;
+pub use rotation::{rotate_s2_coeffs, Rotation};

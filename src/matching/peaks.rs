@@ -19,6 +19,11 @@ pub struct Peak {
 }
 
 impl Peak {
+    /// The peak's rotation.
+    pub fn rotation(&self) -> super::Rotation {
+        super::Rotation::new(self.alpha, self.beta, self.gamma)
+    }
+
     /// The grid point `index` of bandwidth `b` with value `value`.
     pub fn at(b: usize, index: usize, value: f64) -> Peak {
         let n = 2 * b;

@@ -1,0 +1,184 @@
+//! Peaks refined off the grid: the band-limited correlation evaluated at any rotation from
+//! its SO(3) coefficients, and maximised by damped Newton steps.
+
+use super::rotation::Rotation;
+use crate::grid::coef_index;
+use crate::wigner::wigner_d_column;
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// A band-limited function on SO(3) given by its coefficients (bandwidth `b`, degrees up to
+/// `lmax`), in the normalisation of the inverse transform (`docs/conventions.md`):
+/// `C(g) = sum fhat(l,M,M') (1/2pi) sqrt((2l+1)/2) D^l_{M,M'}(g)`.
+pub struct So3Series<'a> {
+    b: usize,
+    lmax: usize,
+    coeffs: &'a [Complex64],
+}
+
+/// Value and derivatives in `alpha` and `gamma` at one rotation.
+#[derive(Clone, Copy, Default)]
+struct Local {
+    c: Complex64,
+    a: Complex64,
+    g: Complex64,
+    aa: Complex64,
+    ag: Complex64,
+    gg: Complex64,
+}
+
+impl<'a> So3Series<'a> {
+    /// The series of `coeffs` (`(4b^3 - b)/3` values, `so3CoefLoc` order), degrees `<= lmax`.
+    pub fn new(b: usize, lmax: usize, coeffs: &'a [Complex64]) -> So3Series<'a> {
+        assert!(lmax < b && coeffs.len() == crate::num_coeffs(b));
+        So3Series { b, lmax, coeffs }
+    }
+
+    /// `S[M][M'](beta) = sum_l fhat(l,M,M') (1/2pi) sqrt((2l+1)/2) d^l_{M,M'}(beta)`, row
+    /// `M + lmax`, column `M' + lmax`.
+    fn beta_sums(&self, beta: f64) -> Vec<Complex64> {
+        let top = self.lmax as isize;
+        let w = 2 * self.lmax + 1;
+        let mut s = vec![Complex64::default(); w * w];
+        for m in -top..=top {
+            for mp in -top..=top {
+                let d = wigner_d_column(m, mp, self.lmax, beta);
+                let l0 = m.unsigned_abs().max(mp.unsigned_abs());
+                let mut sum = Complex64::default();
+                for (i, dl) in d.iter().enumerate() {
+                    let l = l0 + i;
+                    let norm = ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI);
+                    sum += self.coeffs[coef_index(self.b, l, m, mp)] * (dl * norm);
+                }
+                s[(m + top) as usize * w + (mp + top) as usize] = sum;
+            }
+        }
+        s
+    }
+
+    /// Value and `alpha`, `gamma` derivatives from the beta sums `s`.
+    fn local(&self, s: &[Complex64], alpha: f64, gamma: f64) -> Local {
+        let top = self.lmax as isize;
+        let w = 2 * self.lmax + 1;
+        let mut out = Local::default();
+        for m in -top..=top {
+            let ea = Complex64::from_polar(1.0, -(m as f64) * alpha);
+            for mp in -top..=top {
+                let v = s[(m + top) as usize * w + (mp + top) as usize]
+                    * ea
+                    * Complex64::from_polar(1.0, -(mp as f64) * gamma);
+                let (fm, fmp) = (m as f64, mp as f64);
+                let i = Complex64::new(0.0, 1.0);
+                out.c += v;
+                out.a += v * (-i * fm);
+                out.g += v * (-i * fmp);
+                out.aa += v * (-fm * fm);
+                out.ag += v * (-fm * fmp);
+                out.gg += v * (-fmp * fmp);
+            }
+        }
+        out
+    }
+
+    /// The value at rotation `g`.
+    pub fn value(&self, g: &Rotation) -> Complex64 {
+        self.local(&self.beta_sums(g.beta), g.alpha, g.gamma).c
+    }
+
+    /// `|C|^2`, its gradient and Hessian in `(alpha, beta, gamma)` at `g` (the beta
+    /// derivatives by central differences of step `h`).
+    fn objective(&self, g: &Rotation, h: f64) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+        let at = |beta: f64| self.local(&self.beta_sums(beta), g.alpha, g.gamma);
+        let (lo, mid, hi) = (at(g.beta - h), at(g.beta), at(g.beta + h));
+        let c = mid.c;
+        let d = [mid.a, (hi.c - lo.c) / (2.0 * h), mid.g];
+        let dab = (hi.a - lo.a) / (2.0 * h);
+        let dgb = (hi.g - lo.g) / (2.0 * h);
+        let dbb = (hi.c - 2.0 * mid.c + lo.c) / (h * h);
+        let dd = [
+            [mid.aa, dab, mid.ag],
+            [dab, dbb, dgb],
+            [mid.ag, dgb, mid.gg],
+        ];
+        let f = c.norm_sqr();
+        let grad = d.map(|di| 2.0 * (c.conj() * di).re);
+        let mut hess = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                hess[i][j] = 2.0 * (d[i].conj() * d[j] + c.conj() * dd[i][j]).re;
+            }
+        }
+        (f, grad, hess)
+    }
+
+    /// The rotation near `start` where `|C|^2` is largest, by damped Newton steps
+    /// (Levenberg-Marquardt), and `|C|^2` there.
+    pub fn maximise(&self, start: &Rotation) -> (Rotation, f64) {
+        // Step of the beta differences: small enough that their error (h^2 l_max / 6 in
+        // the position of the maximum) is far below 1e-8 rad.
+        let h = 1e-5;
+        let mut g = *start;
+        let (mut f, mut grad, mut hess) = self.objective(&g, h);
+        let mut mu = 0.0f64;
+        for _ in 0..60 {
+            let scale = hess.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let mut moved = false;
+            for _ in 0..30 {
+                // Solve (mu I - H) s = grad.
+                let mut a = [[0.0; 3]; 3];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        a[i][j] = -hess[i][j] + if i == j { mu } else { 0.0 };
+                    }
+                }
+                let Some(s) = solve3(a, grad) else {
+                    mu = (2.0 * mu).max(1e-8 * scale.max(1e-300));
+                    continue;
+                };
+                let next = Rotation::new(g.alpha + s[0], g.beta + s[1], g.gamma + s[2]);
+                let (nf, ngrad, nhess) = self.objective(&next, h);
+                if nf >= f {
+                    let step = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    (g, f, grad, hess) = (next, nf, ngrad, nhess);
+                    mu /= 4.0;
+                    moved = true;
+                    if step < 1e-12 {
+                        return (g, f);
+                    }
+                    break;
+                }
+                mu = (4.0 * mu).max(1e-6 * scale.max(1e-300));
+            }
+            if !moved {
+                break;
+            }
+        }
+        (g, f)
+    }
+}
+
+/// Solves the 3 x 3 system `a s = r` (Gaussian elimination with pivoting); `None` if
+/// singular.
+fn solve3(mut a: [[f64; 3]; 3], mut r: [f64; 3]) -> Option<[f64; 3]> {
+    for col in 0..3 {
+        let p = (col..3).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[p][col].abs() < 1e-300 || !a[p][col].is_finite() {
+            return None;
+        }
+        a.swap(col, p);
+        r.swap(col, p);
+        for row in col + 1..3 {
+            let f = a[row][col] / a[col][col];
+            for k in col..3 {
+                a[row][k] -= f * a[col][k];
+            }
+            r[row] -= f * r[col];
+        }
+    }
+    let mut s = [0.0; 3];
+    for i in (0..3).rev() {
+        let tail: f64 = (i + 1..3).map(|k| a[i][k] * s[k]).sum();
+        s[i] = (r[i] - tail) / a[i][i];
+    }
+    s.iter().all(|v| v.is_finite()).then_some(s)
+}

@@ -1,0 +1,112 @@
+//! Rotations in SOFT's Euler convention, `g = Rz(alpha) Ry(beta) Rz(gamma)`, and the
+//! rotation of functions on the sphere, `(Lambda(g) f)(x) = f(g^-1 x)`.
+
+use crate::error::{Error, Result};
+use crate::s2::s2_coef_index;
+use crate::wigner::wigner_d_column;
+use num_complex::Complex64;
+
+/// A rotation `Rz(alpha) Ry(beta) Rz(gamma)` (z-y-z Euler angles, radians).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotation {
+    /// First angle (about z, applied last to a vector).
+    pub alpha: f64,
+    /// Second angle (about y).
+    pub beta: f64,
+    /// Third angle (about z, applied first).
+    pub gamma: f64,
+}
+
+/// Hamilton product of quaternions `(w, x, y, z)`.
+fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+impl Rotation {
+    /// The rotation with Euler angles `alpha, beta, gamma`.
+    pub fn new(alpha: f64, beta: f64, gamma: f64) -> Rotation {
+        Rotation { alpha, beta, gamma }
+    }
+
+    /// The unit quaternion `(w, x, y, z)` of the rotation (`w >= 0`).
+    pub fn quaternion(&self) -> [f64; 4] {
+        let z = |a: f64| [(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()];
+        let y = [(self.beta / 2.0).cos(), 0.0, (self.beta / 2.0).sin(), 0.0];
+        let q = qmul(qmul(z(self.alpha), y), z(self.gamma));
+        if q[0] < 0.0 {
+            q.map(|v| -v)
+        } else {
+            q
+        }
+    }
+
+    /// The rotation matrix (row-major), acting on column vectors.
+    pub fn matrix(&self) -> [[f64; 3]; 3] {
+        let [w, x, y, z] = self.quaternion();
+        [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+            ],
+            [
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+            ],
+            [
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ]
+    }
+
+    /// The angle of the rotation that takes `self` to `other` (geodesic distance on SO(3),
+    /// radians, accurate for small angles).
+    pub fn angle_to(&self, other: &Rotation) -> f64 {
+        let a = self.quaternion();
+        let b = other.quaternion();
+        let conj = [a[0], -a[1], -a[2], -a[3]];
+        let d = qmul(conj, b);
+        let v = (d[1] * d[1] + d[2] * d[2] + d[3] * d[3]).sqrt();
+        2.0 * v.atan2(d[0].abs())
+    }
+}
+
+/// The S^2 coefficients (bandwidth `b`, `seanindex` order) of `Lambda(g) f`,
+/// `(Lambda(g) f)(x) = f(g^-1 x)`: `fhat'(l, m) = sum_m' D^l_{m,m'}(g) fhat(l, m')` with
+/// `D^l_{m,m'}(alpha, beta, gamma) = e^{-i m alpha} d^l_{m,m'}(beta) e^{-i m' gamma}`.
+/// `O(b^3)` operations; any bandwidth.
+pub fn rotate_s2_coeffs(b: usize, coeffs: &[Complex64], g: &Rotation) -> Result<Vec<Complex64>> {
+    if coeffs.len() != b * b {
+        return Err(Error::LengthMismatch {
+            what: "S^2 coefficients",
+            expected: b * b,
+            got: coeffs.len(),
+        });
+    }
+    let mut out = vec![Complex64::default(); b * b];
+    if b == 0 {
+        return Ok(out);
+    }
+    let top = b as isize - 1;
+    for m in -top..=top {
+        let em = Complex64::from_polar(1.0, -(m as f64) * g.alpha);
+        for mp in -top..=top {
+            let phase = em * Complex64::from_polar(1.0, -(mp as f64) * g.gamma);
+            let d = wigner_d_column(m, mp, b - 1, g.beta);
+            let l0 = m.unsigned_abs().max(mp.unsigned_abs());
+            for (i, dl) in d.iter().enumerate() {
+                let l = l0 + i;
+                out[s2_coef_index(b, l, m)] += phase * *dl * coeffs[s2_coef_index(b, l, mp)];
+            }
+        }
+    }
+    Ok(out)
+}
