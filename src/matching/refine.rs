@@ -3,7 +3,11 @@
 
 use super::rotation::Rotation;
 use crate::grid::coef_index;
-use crate::wigner::wigner_d_column;
+use crate::numeric::{sin_cos_dd, Dd};
+use crate::simd::Isa;
+use crate::symmetry::Cluster;
+use crate::wigner::column::column;
+use crate::wigner::{BetaTables, RecTables};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -14,6 +18,8 @@ pub struct So3Series<'a> {
     b: usize,
     lmax: usize,
     coeffs: &'a [Complex64],
+    recurrence: RecTables,
+    isa: Isa,
 }
 
 /// Value and derivatives in `alpha` and `gamma` at one rotation.
@@ -31,7 +37,13 @@ impl<'a> So3Series<'a> {
     /// The series of `coeffs` (`(4b^3 - b)/3` values, `so3CoefLoc` order), degrees `<= lmax`.
     pub fn new(b: usize, lmax: usize, coeffs: &'a [Complex64]) -> So3Series<'a> {
         assert!(lmax < b && coeffs.len() == crate::num_coeffs(b));
-        So3Series { b, lmax, coeffs }
+        So3Series {
+            b,
+            lmax,
+            coeffs,
+            recurrence: RecTables::new(lmax + 1),
+            isa: Isa::detect(),
+        }
     }
 
     /// `S[M][M'](beta) = sum_l fhat(l,M,M') (1/2pi) sqrt((2l+1)/2) d^l_{M,M'}(beta)`, row
@@ -40,17 +52,38 @@ impl<'a> So3Series<'a> {
         let top = self.lmax as isize;
         let w = 2 * self.lmax + 1;
         let mut s = vec![Complex64::default(); w * w];
-        for m in -top..=top {
-            for mp in -top..=top {
-                let d = wigner_d_column(m, mp, self.lmax, beta);
-                let l0 = m.unsigned_abs().max(mp.unsigned_abs());
-                let mut sum = Complex64::default();
-                for (i, dl) in d.iter().enumerate() {
-                    let l = l0 + i;
-                    let norm = ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI);
-                    sum += self.coeffs[coef_index(self.b, l, m, mp)] * (dl * norm);
+        // The half-angle cosine and sine of beta, and (swapped) of pi - beta, for the
+        // members of a cluster that are reflected (see `symmetry`).
+        let (sn, cs) = if (0.0..=PI).contains(&beta) {
+            sin_cos_dd(Dd::new(beta / 2.0))
+        } else {
+            (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
+        };
+        let betas = BetaTables::new(&[(cs, sn), (sn, cs)], 2 * self.lmax);
+        for m in 0..=self.lmax {
+            for mp in 0..=m {
+                let cluster = Cluster::new(m, mp);
+                let mut cols: [Option<Vec<f64>>; 2] = [None, None];
+                for mem in cluster.members() {
+                    let k = usize::from(mem.reversed);
+                    let col = cols[k].get_or_insert_with(|| {
+                        column(
+                            self.isa,
+                            &betas,
+                            &self.recurrence,
+                            k,
+                            (m, mp),
+                            self.lmax + 1,
+                        )
+                    });
+                    let mut sum = Complex64::default();
+                    for (i, dt) in col.iter().enumerate() {
+                        let l = m + i;
+                        let c = self.coeffs[coef_index(self.b, l, mem.m, mem.mp)];
+                        sum += c * (mem.sign_at(l) * dt);
+                    }
+                    s[(mem.m + top) as usize * w + (mem.mp + top) as usize] = sum / (2.0 * PI);
                 }
-                s[(m + top) as usize * w + (mp + top) as usize] = sum;
             }
         }
         s
