@@ -94,6 +94,9 @@
 // Largest bandwidth of the S^2 transforms.
 #define SO3FFT_S2_MAX_BANDWIDTH 4096
 
+// Opaque correlation plan (made by `so3fft_plan_correlation`).
+typedef struct so3fft_correlation_s so3fft_correlation_s;
+
 // Opaque plan object (made by a planner, released by `so3fft_destroy_plan`).
 typedef struct so3fft_plan_s so3fft_plan_s;
 
@@ -108,6 +111,9 @@ typedef double so3fft_complex[2];
 
 // An S^2 plan: a pointer to an opaque object.
 typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
+
+// A correlation plan: a pointer to an opaque object.
+typedef struct so3fft_correlation_s *so3fft_correlation;
 
 #ifdef __cplusplus
 extern "C" {
@@ -251,6 +257,41 @@ size_t so3fft_s2_num_coeffs(int B);
 
 // Index of `fhat(l, m)` (SOFT's `seanindex(m, l, B)`), or -1.
 ptrdiff_t so3fft_s2_coef_index(int B, int l, int m);
+
+// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
+// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
+// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs.
+// NULL on error.
+so3fft_correlation so3fft_plan_correlation(int L, int B_out, int deg_lim, unsigned int flags, int nthreads);
+
+// Destroys a correlation plan; NULL is a no-op.
+void so3fft_destroy_correlation(so3fft_correlation p);
+
+// Number of values `(2 B_out)^3` of a plan's correlation grid (`SO3FFT_ENULL` for NULL).
+ptrdiff_t so3fft_correlation_grid_size(so3fft_correlation p);
+
+// The correlation of complex S^2 samples (`(2L)^2` each) into the grid `out`
+// (`(2 B_out)^3` values, SO(3) sample order). `SO3FFT_OK` or an error code.
+int so3fft_correlate(so3fft_correlation p, so3fft_complex *signal, so3fft_complex *pattern, so3fft_complex *out);
+
+// The correlation of real S^2 samples into the real grid `out` (plan made with
+// `SO3FFT_REAL`).
+int so3fft_correlate_real(so3fft_correlation p, const double *signal, const double *pattern, double *out);
+
+// Index of the largest `|C|^2` of a complex grid of bandwidth `B` (ties: the lowest index;
+// SOFT's rule), its Euler angles `(alpha, beta, gamma)` into `angles` (3 doubles, or NULL);
+// -1 on error.
+ptrdiff_t so3fft_grid_argmax(int B, so3fft_complex *grid, double *angles);
+
+// [`so3fft_grid_argmax`] of a real grid.
+ptrdiff_t so3fft_grid_argmax_real(int B, const double *grid, double *angles);
+
+// Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from
+// `so3fft_grid_argmax`), the nearby maximum of the band-limited `|C|^2` of `signal` and
+// `pattern` (complex samples as interleaved doubles, or real ones for a plan made with
+// `SO3FFT_REAL`), written
+// back to `angles`; `|C|^2` there into `value` (or NULL). `SO3FFT_OK` or an error code.
+int so3fft_correlation_refine(so3fft_correlation p, const double *signal, const double *pattern, double *angles, double *value);
 
 // Writes FFTW's wisdom to the file `filename` (replaced atomically). `SO3FFT_OK` or an
 // error code.

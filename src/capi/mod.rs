@@ -39,6 +39,8 @@ mod query;
 mod grid;
 // Spherical-harmonic transforms.
 mod s2;
+// Rotational matching.
+mod matching;
 // FFTW wisdom.
 mod wisdom;
 // Version and errors.
@@ -51,6 +53,11 @@ pub use execute::{so3fft_execute, so3fft_execute_forward, so3fft_execute_inverse
 pub use grid::{
     so3fft_alpha, so3fft_beta, so3fft_coef_index, so3fft_gamma, so3fft_max_bandwidth,
     so3fft_num_coeffs, so3fft_num_samples, so3fft_sample_index, so3fft_weights,
+};
+pub use matching::{
+    so3fft_correlate, so3fft_correlate_real, so3fft_correlation, so3fft_correlation_grid_size,
+    so3fft_correlation_refine, so3fft_correlation_s, so3fft_destroy_correlation,
+    so3fft_grid_argmax, so3fft_grid_argmax_real, so3fft_plan_correlation,
 };
 pub use planner::{
     so3fft_destroy_plan, so3fft_plan_both, so3fft_plan_forward, so3fft_plan_general,

@@ -160,6 +160,11 @@ impl Correlation {
         combine((&sig, &pat), self.b_in, self.deg_lim, self.b_out, out)
     }
 
+    /// Whether the plan takes real inputs.
+    pub fn is_real(&self) -> bool {
+        self.real
+    }
+
     /// Highest degree combined.
     pub fn deg_lim(&self) -> usize {
         self.deg_lim

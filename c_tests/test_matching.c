@@ -1,0 +1,71 @@
+/* Rotational matching through the C API against the reference correlations of
+ * tests/data/s2 (signals that are their pattern rotated by a grid rotation): grid peaks with
+ * their exact angles, refinement that stays on an exact peak, bad arguments.
+ * Usage: test_matching <dir with the s2/ reference files>. */
+#include "test_util.h"
+
+#include "s2_reference.h"
+
+int main(int argc, char **argv) {
+    static const char *cases[] = {"cor_B8_complex.txt", "cor_B8_real.txt", "cor_B16_complex.txt",
+                                  "cor_B16_real.txt"};
+    const char *dir = argc > 1 ? argv[1] : "tests/data";
+    size_t i;
+    for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        cor_case c;
+        so3fft_correlation p;
+        double angles[3], value = 0.0, *sig, *pat;
+        ptrdiff_t n, at;
+        if (read_case(dir, cases[i], &c) != 0) {
+            fprintf(stderr, "%s: unreadable\n", cases[i]);
+            g_failures++;
+            continue;
+        }
+        p = so3fft_plan_correlation(c.bw, 0, -1, c.is_real ? SO3FFT_REAL : 0, 2);
+        CHECK(p != NULL);
+        n = so3fft_correlation_grid_size(p);
+        CHECK(n == 8 * c.bw * c.bw * c.bw);
+        sig = c.is_real ? real_parts(c.sig, 4 * c.bw * c.bw) : c.sig;
+        pat = c.is_real ? real_parts(c.pat, 4 * c.bw * c.bw) : c.pat;
+        if (c.is_real) {
+            double *grid = (double *)malloc((size_t)n * sizeof(double));
+            CHECK(grid && so3fft_correlate_real(p, sig, pat, grid) == SO3FFT_OK);
+            at = so3fft_grid_argmax_real(c.bw, grid, angles);
+            free(grid);
+        } else {
+            so3fft_complex *grid = alloc_cx((size_t)n);
+            CHECK(so3fft_correlate(p, (so3fft_complex *)sig, (so3fft_complex *)pat, grid) ==
+                  SO3FFT_OK);
+            at = so3fft_grid_argmax(c.bw, grid, angles);
+            free(grid);
+        }
+        CHECK(at == (ptrdiff_t)(c.ii * 4 * c.bw * c.bw + c.jj * 2 * c.bw + c.kk));
+        CHECK(angles[0] == c.alpha && angles[1] == c.beta && angles[2] == c.gamma);
+        /* the rotation is exactly on the grid: refinement stays there */
+        CHECK(so3fft_correlation_refine(p, sig, pat, angles, &value) == SO3FFT_OK);
+        CHECK(fabs(angles[0] - c.alpha) < 1e-9 && fabs(angles[1] - c.beta) < 1e-9 &&
+              fabs(angles[2] - c.gamma) < 1e-9);
+        CHECK(value > 0.0);
+        /* bad arguments */
+        CHECK(so3fft_correlation_refine(p, sig, pat, NULL, &value) == SO3FFT_ENULL);
+        CHECK_ERR(SO3FFT_ENULL);
+        CHECK(so3fft_correlate_real(NULL, sig, pat, sig) == SO3FFT_ENULL);
+        CHECK(so3fft_grid_argmax(0, NULL, angles) == -1);
+        CHECK_ERR(SO3FFT_EBANDWIDTH);
+        if (c.is_real) {
+            free(sig);
+            free(pat);
+        }
+        so3fft_destroy_correlation(p);
+        free(c.sig);
+        free(c.pat);
+    }
+    CHECK(so3fft_plan_correlation(8, 4, 7, 0, 1) == NULL);
+    CHECK_ERR(SO3FFT_EINVAL);
+    CHECK(so3fft_plan_correlation(8, 0, -2, 0, 1) == NULL);
+    CHECK_ERR(SO3FFT_EINVAL);
+    CHECK(so3fft_plan_correlation(0, 0, -1, 0, 1) == NULL);
+    CHECK_ERR(SO3FFT_EBANDWIDTH);
+    so3fft_destroy_correlation(NULL);
+    return finish("test_matching");
+}

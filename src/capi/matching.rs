@@ -1,0 +1,269 @@
+//! Rotational matching: correlation plans, the grid peak and its refinement off the grid.
+
+use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_REAL};
+use super::{SO3FFT_DESTROY_INPUT, SO3FFT_ENULL};
+use crate::ffi::checks::{self, input_output, Array};
+use crate::ffi::{CallError, ErrorKind};
+use crate::matching::{
+    grid_argmax, grid_argmax_real, Correlation, CorrelationOptions, Peak, Rotation, So3Series,
+};
+use crate::Complex64;
+use std::ffi::{c_double, c_int, c_uint};
+
+/// Opaque correlation plan (made by `so3fft_plan_correlation`).
+pub struct so3fft_correlation_s {
+    plan: Correlation,
+}
+
+/// A correlation plan: a pointer to an opaque object.
+pub type so3fft_correlation = *mut so3fft_correlation_s;
+
+/// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
+/// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
+/// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs.
+/// NULL on error.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_correlation(
+    L: c_int,
+    B_out: c_int,
+    deg_lim: c_int,
+    flags: c_uint,
+    nthreads: c_int,
+) -> so3fft_correlation {
+    guarded(std::ptr::null_mut(), || {
+        let l = checks::bandwidth(L)?;
+        let b_out = match B_out {
+            0 => None,
+            b => Some(checks::bandwidth(b)?),
+        };
+        let deg_lim = match deg_lim {
+            -1 => None,
+            d => Some(usize::try_from(d).map_err(|_| {
+                CallError::invalid(format!("degree limit {d}: must be >= 0 (or -1)"))
+            })?),
+        };
+        if flags & SO3FFT_DESTROY_INPUT != 0 {
+            return Err(CallError::invalid(
+                "SO3FFT_DESTROY_INPUT does not apply to correlation plans",
+            ));
+        }
+        let options = CorrelationOptions {
+            b_out,
+            deg_lim,
+            real: flags & SO3FFT_REAL != 0,
+            threads: threads_of(nthreads)?,
+            rigor: rigor_of(flags & !SO3FFT_REAL)?,
+        };
+        let plan = Correlation::new(l, &options)?;
+        Ok(Box::into_raw(Box::new(so3fft_correlation_s { plan })))
+    })
+}
+
+/// Destroys a correlation plan; NULL is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_destroy_correlation(p: so3fft_correlation) {
+    guarded((), || {
+        if !p.is_null() {
+            // SAFETY: a non-NULL `p` came from Box::into_raw in `so3fft_plan_correlation` and
+            // is destroyed once, while no other thread uses it (the caller's contract).
+            drop(unsafe { Box::from_raw(p) });
+        }
+        Ok(())
+    })
+}
+
+/// The plan behind a handle; an error for NULL.
+///
+/// # Safety
+/// `p` is NULL or a live correlation plan.
+unsafe fn plan_ref<'a>(p: so3fft_correlation) -> Result<&'a Correlation, CallError> {
+    // SAFETY: non-NULL handles are live plans (this function's contract), only read.
+    unsafe { p.as_ref() }
+        .map(|s| &s.plan)
+        .ok_or_else(|| CallError::new(ErrorKind::Null, "the correlation plan is NULL"))
+}
+
+/// Number of values `(2 B_out)^3` of a plan's correlation grid (`SO3FFT_ENULL` for NULL).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_grid_size(p: so3fft_correlation) -> isize {
+    guarded(SO3FFT_ENULL as isize, || {
+        // SAFETY: `p` is NULL or a live plan (the API's contract).
+        Ok(unsafe { plan_ref(p) }?.num_grid() as isize)
+    })
+}
+
+/// Input slices of a correlation call, checked (non-NULL, aligned, and disjoint from `out`
+/// when given).
+///
+/// # Safety
+/// Non-NULL pointers hold `n` values each, only read during the call.
+unsafe fn inputs<'a, T>(
+    signal: *const T,
+    pattern: *const T,
+    n: usize,
+    out: Option<&Array<u8>>,
+) -> Result<(&'a [T], &'a [T]), CallError> {
+    for input in [
+        Array::new(signal, n, "signal"),
+        Array::new(pattern, n, "pattern"),
+    ] {
+        match out {
+            Some(out) => input_output(&input, out)?,
+            None => input.check()?,
+        }
+    }
+    // SAFETY: checked non-NULL and aligned; `n` values each (this function's contract).
+    Ok(unsafe {
+        (
+            std::slice::from_raw_parts(signal, n),
+            std::slice::from_raw_parts(pattern, n),
+        )
+    })
+}
+
+/// The correlation of complex S^2 samples (`(2L)^2` each) into the grid `out`
+/// (`(2 B_out)^3` values, SO(3) sample order). `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlate(
+    p: so3fft_correlation,
+    signal: *mut so3fft_complex,
+    pattern: *mut so3fft_complex,
+    out: *mut so3fft_complex,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: `p` NULL or live; arrays of the documented sizes (the API's contract).
+        unsafe {
+            let plan = plan_ref(p)?;
+            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
+            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 16, "out");
+            let (s, h) = inputs(
+                signal.cast_const().cast::<Complex64>(),
+                pattern.cast_const().cast(),
+                ns,
+                Some(&grid),
+            )?;
+            let out = std::slice::from_raw_parts_mut(out.cast::<Complex64>(), ng);
+            Ok(plan.correlate(s, h, out)?)
+        }
+    })
+}
+
+/// The correlation of real S^2 samples into the real grid `out` (plan made with
+/// `SO3FFT_REAL`).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlate_real(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    out: *mut c_double,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: as in `so3fft_correlate`.
+        unsafe {
+            let plan = plan_ref(p)?;
+            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
+            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 8, "out");
+            let (s, h) = inputs(signal, pattern, ns, Some(&grid))?;
+            let out = std::slice::from_raw_parts_mut(out, ng);
+            Ok(plan.correlate_real(s, h, out)?)
+        }
+    })
+}
+
+/// Writes a peak's angles and returns its index.
+///
+/// # Safety
+/// `angles` is NULL or holds 3 doubles.
+unsafe fn put_angles(peak: Peak, angles: *mut c_double) -> isize {
+    if !angles.is_null() {
+        // SAFETY: 3 doubles (this function's contract).
+        unsafe {
+            *angles = peak.alpha;
+            *angles.add(1) = peak.beta;
+            *angles.add(2) = peak.gamma;
+        }
+    }
+    peak.index as isize
+}
+
+/// Index of the largest `|C|^2` of a complex grid of bandwidth `B` (ties: the lowest index;
+/// SOFT's rule), its Euler angles `(alpha, beta, gamma)` into `angles` (3 doubles, or NULL);
+/// -1 on error.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_grid_argmax(
+    B: c_int,
+    grid: *mut so3fft_complex,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        let b = checks::bandwidth(B)?;
+        let n = crate::num_samples(b);
+        Array::new(grid.cast_const(), n, "grid").check()?;
+        // SAFETY: checked non-NULL and aligned; (2B)^3 values (the API's contract).
+        let values =
+            unsafe { std::slice::from_raw_parts(grid.cast_const().cast::<Complex64>(), n) };
+        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
+        Ok(unsafe { put_angles(grid_argmax(b, values), angles) })
+    })
+}
+
+/// [`so3fft_grid_argmax`] of a real grid.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_grid_argmax_real(
+    B: c_int,
+    grid: *const c_double,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        let b = checks::bandwidth(B)?;
+        let n = crate::num_samples(b);
+        Array::new(grid, n, "grid").check()?;
+        // SAFETY: as in `so3fft_grid_argmax`.
+        let values = unsafe { std::slice::from_raw_parts(grid, n) };
+        // SAFETY: as in `so3fft_grid_argmax`.
+        Ok(unsafe { put_angles(grid_argmax_real(b, values), angles) })
+    })
+}
+
+/// Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from
+/// `so3fft_grid_argmax`), the nearby maximum of the band-limited `|C|^2` of `signal` and
+/// `pattern` (complex samples as interleaved doubles, or real ones for a plan made with
+/// `SO3FFT_REAL`), written
+/// back to `angles`; `|C|^2` there into `value` (or NULL). `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_refine(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    angles: *mut c_double,
+    value: *mut c_double,
+) -> c_int {
+    guarded_code(|| {
+        if angles.is_null() {
+            return Err(CallError::new(ErrorKind::Null, "angles is NULL"));
+        }
+        // SAFETY: as in `so3fft_correlate`; `angles` holds 3 doubles, `value` NULL or one.
+        unsafe {
+            let plan = plan_ref(p)?;
+            let b_out = plan.b_out();
+            let mut coeffs = vec![Complex64::default(); crate::num_coeffs(b_out)];
+            let ns = 4 * plan.b_in() * plan.b_in();
+            if plan.is_real() {
+                let (s, h) = inputs(signal, pattern, ns, None)?;
+                plan.coefficients_real(s, h, &mut coeffs)?;
+            } else {
+                let (s, h) = inputs(signal.cast::<Complex64>(), pattern.cast(), ns, None)?;
+                plan.coefficients(s, h, &mut coeffs)?;
+            }
+            let start = Rotation::new(*angles, *angles.add(1), *angles.add(2));
+            let (g, v) = So3Series::new(b_out, plan.deg_lim(), &coeffs).maximise(&start);
+            *angles = g.alpha;
+            *angles.add(1) = g.beta;
+            *angles.add(2) = g.gamma;
+            if !value.is_null() {
+                *value = v;
+            }
+            Ok(())
+        }
+    })
+}
