@@ -288,3 +288,31 @@ fn off_grid_rotations_recovered_and_refined() {
         assert!(value >= peak.value);
     }
 }
+
+/// Planted maxima on a flat grid come back largest first; one within the separation angle
+/// of a larger one is dropped.
+#[test]
+fn top_peaks_are_separated_local_maxima() {
+    use so3fft::matching::top_peaks;
+    let b = 4;
+    let n = 2 * b;
+    let mut grid = vec![Complex64::new(0.1, 0.0); n * n * n];
+    let at = |k: usize, a: usize, g: usize| (k * n + a) * n + g;
+    grid[at(1, 2, 3)] = Complex64::new(3.0, 0.0);
+    grid[at(6, 5, 0)] = Complex64::new(0.0, 2.0);
+    grid[at(1, 2, 5)] = Complex64::new(1.0, 0.0); // 2 grid steps in gamma from the first
+    let peaks = top_peaks(b, &grid, 5, 0.1);
+    assert_eq!(peaks[0].index, at(1, 2, 3));
+    assert_eq!(peaks[1].index, at(6, 5, 0));
+    assert_eq!(peaks[2].index, at(1, 2, 5));
+    assert_eq!((peaks[0].value, peaks[1].value), (9.0, 4.0));
+    // The third is pi/2 (gamma) from the first: dropped with a separation of 2 rad.
+    let separated = top_peaks(b, &grid, 5, 2.0);
+    assert_eq!(separated[0].index, at(1, 2, 3));
+    assert!(separated.iter().all(|p| p.index != at(1, 2, 5)));
+    for (i, p) in separated.iter().enumerate() {
+        for q in &separated[..i] {
+            assert!(q.rotation().angle_to(&p.rotation()) >= 2.0);
+        }
+    }
+}

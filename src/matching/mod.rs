@@ -16,6 +16,6 @@ mod rotation;
 
 pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};
-pub use peaks::{grid_argmax, grid_argmax_real, Peak};
+pub use peaks::{grid_argmax, grid_argmax_real, top_peaks, Peak};
 pub use refine::So3Series;
 pub use rotation::{rotate_s2_coeffs, Rotation};

@@ -59,3 +59,58 @@ fn argmax_by(b: usize, values: impl Iterator<Item = f64>) -> Peak {
     }
     Peak::at(b, at, best)
 }
+
+/// Up to `k` peaks of `|C|^2` on the grid `values` (bandwidth `b`), largest first: grid
+/// points at least as large as their 26 neighbours (`alpha`, `gamma` periodic), each at
+/// least `min_angle` radians (geodesic) from every larger peak taken.
+pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
+    let n = 2 * b;
+    assert_eq!(values.len(), n * n * n);
+    let v = |kb: usize, ja: usize, jg: usize| values[(kb * n + ja) * n + jg].norm_sqr();
+    let mut maxima = Vec::new();
+    for kb in 0..n {
+        for ja in 0..n {
+            for jg in 0..n {
+                let x = v(kb, ja, jg);
+                if x.is_nan() || x <= 0.0 {
+                    continue;
+                }
+                let mut local = true;
+                'around: for db in -1isize..=1 {
+                    let kk = kb as isize + db;
+                    if kk < 0 || kk >= n as isize {
+                        continue;
+                    }
+                    for da in [n - 1, 0, 1] {
+                        for dg in [n - 1, 0, 1] {
+                            if db == 0 && da == 0 && dg == 0 {
+                                continue;
+                            }
+                            if v(kk as usize, (ja + da) % n, (jg + dg) % n) > x {
+                                local = false;
+                                break 'around;
+                            }
+                        }
+                    }
+                }
+                if local {
+                    maxima.push(Peak::at(b, (kb * n + ja) * n + jg, x));
+                }
+            }
+        }
+    }
+    maxima.sort_by(|a, c| c.value.total_cmp(&a.value).then(a.index.cmp(&c.index)));
+    let mut taken: Vec<Peak> = Vec::new();
+    for p in maxima {
+        if taken.len() == k {
+            break;
+        }
+        if taken
+            .iter()
+            .all(|t| t.rotation().angle_to(&p.rotation()) >= min_angle)
+        {
+            taken.push(p);
+        }
+    }
+    taken
+}
