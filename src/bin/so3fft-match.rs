@@ -50,7 +50,8 @@ fn shape(count: usize) -> Option<(usize, bool)> {
     if let Some(b) = side(count) {
         return Some((b, true));
     }
-    count.is_multiple_of(2)
+    count
+        .is_multiple_of(2)
         .then(|| side(count / 2))
         .flatten()
         .map(|b| (b, false))

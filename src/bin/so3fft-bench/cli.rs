@@ -36,6 +36,8 @@ TOOL (default: the full benchmark described below):
                       interleaved, last thread count); default --bandwidths 64,128,256
   s2 (or --s2)        the S^2 transforms: real and complex synthesis and analysis, medians,
                       GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
+  match (or --match)  rotational matching: a rotated random function recovered; pipeline
+                      medians (complex, real), ten refinements, grid and refined angle errors
 options:
   --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
                       (default 16,32,64,128,256)
@@ -81,6 +83,8 @@ pub enum Tool {
     Real,
     /// The S^2 (spherical-harmonic) transforms (`s2.rs`).
     S2,
+    /// Rotational matching (`matching.rs`).
+    Match,
 }
 
 /// Transforms the `stages` tool repeats.
@@ -206,6 +210,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("scaling") => Tool::Scaling,
         Some("real") => Tool::Real,
         Some("s2" | "--s2") => Tool::S2,
+        Some("match" | "--match") => Tool::Match,
         _ => Tool::Full,
     };
     if opts.tool != Tool::Full {
@@ -306,6 +311,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Scaling => (vec![64, 128, 256], vec![1, 2], Some(5)),
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
+        Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
     };
     if !bandwidths_given {
         opts.bandwidths = bandwidths;

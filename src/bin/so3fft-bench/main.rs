@@ -21,6 +21,7 @@
 
 mod big;
 mod cli;
+mod matching;
 mod memory;
 mod naive;
 mod peak;
@@ -52,6 +53,7 @@ fn main() -> ExitCode {
             Tool::Scaling => report_failure("scaling", scaling::run(&opts)),
             Tool::Real => report_failure("real", run_real(&opts)),
             Tool::S2 => report_failure("s2", s2::run(&opts)),
+            Tool::Match => report_failure("match", matching::run(&opts)),
         },
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
