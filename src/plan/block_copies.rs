@@ -68,6 +68,9 @@ unsafe fn prefetch_slots(t: &Blocks, c: usize, sp: &[SendPtr<Complex64>], write:
 /// # Safety
 /// The group's slices are valid for every index in the slot tables; `buf` holds the blocks
 /// of `t`, 64-byte aligned, and nobody else writes these rows meanwhile.
+// Always inlined: the real path's call (one pair, conjugated, every cluster) then compiles
+// for its fixed slice count and `conj`, without the general loops' bookkeeping.
+#[inline(always)]
 pub(super) unsafe fn scatter_group(
     t: &Blocks,
     group: &SliceGroup,
@@ -184,6 +187,8 @@ const GATHER_AHEAD: usize = 4096;
 /// # Safety
 /// As for [`scatter_group`], with the slices written (their slots of clusters `cs` by no
 /// one else) and the rows read.
+// Always inlined, for the reason given at `scatter_group`.
+#[inline(always)]
 pub(super) unsafe fn gather_group(
     t: &Blocks,
     group: &SliceGroup,
