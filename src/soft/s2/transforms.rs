@@ -15,8 +15,9 @@ use std::sync::{Mutex, TryLockError};
 /// with the cached plan.
 const KEEP_BUFFERS_BYTES: usize = 128 << 20;
 
-/// Arrays shorter than this are converted on the calling thread only.
-const PARALLEL_MIN_LEN: usize = 1 << 15;
+/// Arrays shorter than this are converted on the calling thread only: a copy of 16 MiB
+/// takes about as long as starting threads on a busy machine.
+const PARALLEL_MIN_LEN: usize = 1 << 20;
 
 /// Interleaved samples and coefficients between the caller's split arrays and the plan.
 struct Buffers {
@@ -166,19 +167,23 @@ fn piece_len(len: usize, threads: usize) -> usize {
     }
 }
 
-/// Runs `work` on every item, the first on the calling thread and the others on scoped
-/// threads.
+/// Runs `work` on every item: a single item on the calling thread, several on scoped
+/// threads (the first on the calling thread).
 fn run_pieces<T: Send>(items: impl Iterator<Item = T>, work: impl Fn(T) + Sync) {
+    let mut items = items.peekable();
+    let Some(first) = items.next() else {
+        return;
+    };
+    if items.peek().is_none() {
+        work(first);
+        return;
+    }
     let work = &work;
     std::thread::scope(|scope| {
-        let mut items = items;
-        let first = items.next();
         for item in items {
             scope.spawn(move || work(item));
         }
-        if let Some(item) = first {
-            work(item);
-        }
+        work(first);
     });
 }
 
