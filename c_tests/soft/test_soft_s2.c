@@ -18,31 +18,10 @@
 #include "s2_semi_memo.h"
 
 #include "../check.h"
+#include "s2_test_util.h"
 
-#define GUARD 64
-#define CANARY 1234.5678
 #define FWD_TOL 1e-13 /* absolute (coefficients are O(1)) */
 #define INV_TOL 1e-13 /* relative to the largest sample */
-
-/* n doubles followed by GUARD canaries (malloc, as SOFT's clients do). */
-static double *guarded_alloc(size_t n) {
-    double *p = (double *)malloc((n + GUARD) * sizeof(double));
-    size_t i;
-    if (!p) {
-        fprintf(stderr, "malloc failed\n");
-        exit(EXIT_FAILURE);
-    }
-    for (i = 0; i < n + GUARD; i++) p[i] = CANARY;
-    return p;
-}
-
-/* Are the n values and the guard after them all still CANARY (from index `from` on)? */
-static int canaries_intact(const double *p, size_t from, size_t n) {
-    size_t i;
-    for (i = from; i < n + GUARD; i++)
-        if (p[i] != CANARY) return 0;
-    return 1;
-}
 
 static double *dup_doubles(const double *a, size_t n) {
     double *c = guarded_alloc(n);
@@ -151,9 +130,9 @@ static void client_setup(struct client *c, int bw, int cutoff, double *rdata, do
     c->table = SemiNaive_Naive_Pml_Table(bw, cutoff, c->space, c->table_ws);
     c->ttable = Transpose_SemiNaive_Naive_Pml_Table(c->table, bw, cutoff, c->tspace, c->table_ws);
     CHECK(c->table != NULL && c->ttable != NULL);
-    CHECK(canaries_intact(c->space, tsize, tsize));
-    CHECK(canaries_intact(c->tspace, tsize, tsize));
-    CHECK(canaries_intact(c->table_ws, 0, (size_t)(16 * bw)));
+    CHECK(canaries_intact(c->space, tsize, tsize + GUARD));
+    CHECK(canaries_intact(c->tspace, tsize, tsize + GUARD));
+    CHECK(canaries_intact(c->table_ws, 0, (size_t)(16 * bw) + GUARD));
     c->plan_in = guarded_alloc((size_t)(2 * bw));
     c->plan_out = guarded_alloc((size_t)(2 * bw));
     c->dct = fftw_plan_r2r_1d(2 * bw, c->plan_in, c->plan_out, FFTW_REDFT10, FFTW_ESTIMATE);
@@ -239,13 +218,14 @@ static void check_forward(const char *dir, const char *file, int dataformat) {
                     g_failures++;
                 }
             }
-            CHECK(canaries_intact(rc, nc, nc));
-            CHECK(canaries_intact(icf, nc, nc));
-            CHECK(canaries_intact(ws, 0, nws)); /* the workspace is not even written */
+            CHECK(canaries_intact(rc, nc, nc + GUARD));
+            CHECK(canaries_intact(icf, nc, nc + GUARD));
+            CHECK(canaries_intact(ws, 0, nws + GUARD)); /* the workspace is not even written */
             CHECK(memcmp(rdata, ref.sre, ns * sizeof(double)) == 0);
             CHECK(memcmp(idata, ref.sim, ns * sizeof(double)) == 0);
             CHECK(memcmp(w_copy, cl.weights, (size_t)(4 * ref.bw) * sizeof(double)) == 0);
-            CHECK(canaries_intact(rdata, ns, ns) && canaries_intact(idata, ns, ns));
+            CHECK(canaries_intact(rdata, ns, ns + GUARD));
+            CHECK(canaries_intact(idata, ns, ns + GUARD));
             if (dataformat == 1) { /* negative orders exactly (-1)^m conj(fhat(l, m)) */
                 int l, m;
                 for (m = 1; m < ref.bw; m++)
@@ -312,9 +292,9 @@ static void check_inverse(const char *dir, const char *file, int dataformat) {
                 fprintf(stderr, "%s: relative error %.3e\n", what, err);
                 g_failures++;
             }
-            CHECK(canaries_intact(rdata, ns, ns));
-            CHECK(canaries_intact(idata, ns, ns));
-            CHECK(canaries_intact(ws, 0, nws));
+            CHECK(canaries_intact(rdata, ns, ns + GUARD));
+            CHECK(canaries_intact(idata, ns, ns + GUARD));
+            CHECK(canaries_intact(ws, 0, nws + GUARD));
             /* inputs unchanged (NaN poison compared bitwise) */
             CHECK(memcmp(rc, ref.cre, nc * sizeof(double)) == 0);
             CHECK(memcmp(icf, ref.cim, nc * sizeof(double)) == 0);
@@ -363,9 +343,9 @@ static void check_bad_arguments(void) {
     /* one output array for both parts */
     FST_semi_fly(rdata, idata, rc, rc, bw, ws, 0, bw, NULL, NULL, weights);
     InvFST_semi_fly(rc, icf, rdata, rdata, bw, ws, 0, bw, NULL, NULL);
-    CHECK(canaries_intact(rdata, 0, ns) && canaries_intact(idata, 0, ns));
-    CHECK(canaries_intact(rc, 0, nc) && canaries_intact(icf, 0, nc));
-    CHECK(canaries_intact(ws, 0, fst_workspace(bw, 0) + inv_workspace(bw, 0)));
+    CHECK(canaries_intact(rdata, 0, ns + GUARD) && canaries_intact(idata, 0, ns + GUARD));
+    CHECK(canaries_intact(rc, 0, nc + GUARD) && canaries_intact(icf, 0, nc + GUARD));
+    CHECK(canaries_intact(ws, 0, fst_workspace(bw, 0) + inv_workspace(bw, 0) + GUARD));
     free(weights);
     free(ws);
     free(rc);

@@ -16,28 +16,9 @@
 #include "s2_primitive.h"
 
 #include "../check.h"
+#include "s2_test_util.h"
 
-#define GUARD 64
-#define CANARY -777.25
 #define EXACT_PI 3.14159265358979323846
-
-static double *guarded_alloc(size_t n) {
-    double *p = (double *)malloc((n + GUARD) * sizeof(double));
-    size_t i;
-    if (!p) {
-        fprintf(stderr, "malloc failed\n");
-        exit(EXIT_FAILURE);
-    }
-    for (i = 0; i < n + GUARD; i++) p[i] = CANARY;
-    return p;
-}
-
-static int canaries_intact(const double *p, size_t from, size_t to) {
-    size_t i;
-    for (i = from; i < to; i++)
-        if (p[i] != CANARY) return 0;
-    return 1;
-}
 
 /* The formulas of docs/conventions-s2.md (SOFT's sizes), written out as sums. */
 static int row_size(int m, int l) {

@@ -1,8 +1,7 @@
-//! The plan caches of the SOFT layer: one SO(3) [`Plan`] and one S^2 entry
-//! ([`S2Entry`]) per bandwidth, made on first use and kept for the life of the process,
-//! and the optional wisdom file (`SO3FFT_SOFT_WISDOM`).
+//! The plan caches of the SOFT layer: a [`Cache`] per plan type (the SO(3) [`Plan`]s here,
+//! the S^2 plans in `s2::transforms`), one plan per bandwidth made on first use and kept
+//! for the life of the process, and the optional wisdom file (`SO3FFT_SOFT_WISDOM`).
 
-use super::s2::S2Entry;
 use super::SoftResult;
 use crate::ffi::CallError;
 use crate::s2::S2Options;
@@ -23,8 +22,8 @@ static MAP_LOCK: ForkLock = ForkLock::new();
 
 /// The slots of one plan type, keyed by process id and bandwidth: a child made by `fork()`
 /// never touches a slot whose lock a thread of its parent held at the fork (it would wait
-/// forever).
-struct Cache<P> {
+/// forever). Lives in a `static`.
+pub(super) struct Cache<P> {
     map: UnsafeCell<BTreeMap<(u32, usize), Slot<P>>>,
 }
 
@@ -33,7 +32,8 @@ struct Cache<P> {
 unsafe impl<P: Send + Sync> Sync for Cache<P> {}
 
 impl<P> Cache<P> {
-    const fn new() -> Cache<P> {
+    /// An empty cache.
+    pub(super) const fn new() -> Cache<P> {
         Cache {
             map: UnsafeCell::new(BTreeMap::new()),
         }
@@ -50,9 +50,6 @@ impl<P> Cache<P> {
 
 /// SO(3) plans (`Direction::Both`).
 static SO3_PLANS: Cache<Plan> = Cache::new();
-
-/// S^2 plans with their conversion buffers.
-static S2_PLANS: Cache<S2Entry> = Cache::new();
 
 /// Registers the map lock's `fork()` handlers (once, before the first use).
 fn register_fork_handlers() {
@@ -140,7 +137,7 @@ fn cache_options() -> &'static PlanOptions {
 /// The cached plan of bandwidth `b` in `cache`, made by `make` on first use (with the
 /// wisdom file imported before the first plan and exported after each new one). A failed
 /// creation is not cached.
-fn cached<P>(
+pub(super) fn cached<P>(
     cache: &'static Cache<P>,
     b: usize,
     make: impl FnOnce() -> crate::Result<P>,
@@ -179,16 +176,11 @@ pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
     cached(&SO3_PLANS, b, || Plan::new(b, cache_options()))
 }
 
-/// The cached S^2 plan (and buffers) of bandwidth `b`, created on first use.
-pub(super) fn s2_plan_for(b: usize) -> SoftResult<Arc<S2Entry>> {
-    cached(&S2_PLANS, b, || {
-        S2Entry::new(
-            b,
-            &S2Options {
-                threads: env_threads(),
-                rigor: env_rigor(),
-                isa: None,
-            },
-        )
-    })
+/// Options of the cached S^2 plans (threads and rigour as for the SO(3) plans).
+pub(super) fn s2_options() -> S2Options {
+    S2Options {
+        threads: env_threads(),
+        rigor: env_rigor(),
+        isa: None,
+    }
 }

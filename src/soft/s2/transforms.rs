@@ -1,7 +1,7 @@
 //! `FST_semi_memo`, `InvFST_semi_memo`, `FST_semi_fly`, `InvFST_semi_fly`: SOFT's split-array
 //! spherical-harmonic transforms on one cached [`S2Plan`] per bandwidth.
 
-use super::super::cache::s2_plan_for;
+use super::super::cache::{cached, s2_options, Cache};
 use super::super::real::try_zeroed;
 use super::super::{guarded, SoftResult};
 use crate::ffi::checks::{self, input_output, Array};
@@ -9,7 +9,7 @@ use crate::ffi::CallError;
 use crate::s2::{s2_coef_index, S2Options, S2Plan};
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_void};
-use std::sync::{Mutex, TryLockError};
+use std::sync::{Arc, Mutex, TryLockError};
 
 /// Conversion buffers larger than this many bytes are made per call instead of being kept
 /// with the cached plan.
@@ -36,8 +36,16 @@ impl Buffers {
     }
 }
 
+/// The S^2 plans of the layer, one per bandwidth.
+static S2_PLANS: Cache<S2Entry> = Cache::new();
+
+/// The cached S^2 plan (and buffers) of bandwidth `b`, created on first use.
+fn s2_plan_for(b: usize) -> SoftResult<Arc<S2Entry>> {
+    cached(&S2_PLANS, b, || S2Entry::new(b, &s2_options()))
+}
+
 /// A cached S^2 plan of the SOFT layer with its conversion buffers.
-pub(crate) struct S2Entry {
+struct S2Entry {
     plan: S2Plan,
     /// Kept buffers (small bandwidths), taken by one call at a time.
     buffers: Mutex<Option<Buffers>>,
@@ -45,7 +53,7 @@ pub(crate) struct S2Entry {
 
 impl S2Entry {
     /// The plan of bandwidth `b` with `options`.
-    pub(crate) fn new(b: usize, options: &S2Options) -> crate::Result<S2Entry> {
+    fn new(b: usize, options: &S2Options) -> crate::Result<S2Entry> {
         Ok(S2Entry {
             plan: S2Plan::new(b, options)?,
             buffers: Mutex::new(None),
@@ -228,6 +236,16 @@ struct SplitArrays {
     output: (*mut f64, *mut f64),
 }
 
+impl SplitArrays {
+    /// The input `(re, im)` and output `(re, im)` arrays of a call.
+    fn new(input: (*mut f64, *mut f64), output: (*mut f64, *mut f64)) -> SplitArrays {
+        SplitArrays {
+            input: (input.0.cast_const(), input.1.cast_const()),
+            output,
+        }
+    }
+}
+
 /// Names of the split arrays of the forward and the inverse (input, then output).
 const FORWARD_NAMES: [&str; 4] = ["rdata", "idata", "rcoeffs", "icoeffs"];
 const INVERSE_NAMES: [&str; 4] = ["rcoeffs", "icoeffs", "rdata", "idata"];
@@ -325,10 +343,7 @@ pub unsafe extern "C" fn FST_semi_memo(
     _weights: *mut c_double,
 ) {
     guarded("FST_semi_memo", (), || {
-        let arrays = SplitArrays {
-            input: (rdata.cast_const(), idata.cast_const()),
-            output: (rcoeffs, icoeffs),
-        };
+        let arrays = SplitArrays::new((rdata, idata), (rcoeffs, icoeffs));
         // SAFETY: the arrays have SOFT's sizes (the module's safety contract).
         unsafe { transform(bw, arrays, dataformat, cutoff, true) }
     })
@@ -360,10 +375,7 @@ pub unsafe extern "C" fn InvFST_semi_memo(
     _ifft_plan: *mut c_void,
 ) {
     guarded("InvFST_semi_memo", (), || {
-        let arrays = SplitArrays {
-            input: (rcoeffs.cast_const(), icoeffs.cast_const()),
-            output: (rdata, idata),
-        };
+        let arrays = SplitArrays::new((rcoeffs, icoeffs), (rdata, idata));
         // SAFETY: the arrays have SOFT's sizes (the module's safety contract).
         unsafe { transform(bw, arrays, dataformat, cutoff, false) }
     })
@@ -390,10 +402,7 @@ pub unsafe extern "C" fn FST_semi_fly(
     _weights: *mut c_double,
 ) {
     guarded("FST_semi_fly", (), || {
-        let arrays = SplitArrays {
-            input: (rdata.cast_const(), idata.cast_const()),
-            output: (rcoeffs, icoeffs),
-        };
+        let arrays = SplitArrays::new((rdata, idata), (rcoeffs, icoeffs));
         // SAFETY: the arrays have SOFT's sizes (the module's safety contract).
         unsafe { transform(bw, arrays, dataformat, cutoff, true) }
     })
@@ -417,10 +426,7 @@ pub unsafe extern "C" fn InvFST_semi_fly(
     _ifft_plan: *mut c_void,
 ) {
     guarded("InvFST_semi_fly", (), || {
-        let arrays = SplitArrays {
-            input: (rcoeffs.cast_const(), icoeffs.cast_const()),
-            output: (rdata, idata),
-        };
+        let arrays = SplitArrays::new((rcoeffs, icoeffs), (rdata, idata));
         // SAFETY: the arrays have SOFT's sizes (the module's safety contract).
         unsafe { transform(bw, arrays, dataformat, cutoff, false) }
     })
