@@ -4,6 +4,11 @@
 #include "csecond.h"
 #include "makeWigner.h"
 #include "makeweights.h"
+#include "s2_cospmls.h"
+#include "s2_legendreTransforms.h"
+#include "s2_primitive.h"
+#include "s2_semi_fly.h"
+#include "s2_semi_memo.h"
 #include "so3_correlate_fftw.h"
 #include "soft_fftw.h"
 #include "soft_fftw_nt.h"
@@ -14,6 +19,11 @@
 #include "csecond.h"
 #include "makeWigner.h"
 #include "makeweights.h"
+#include "s2_cospmls.h"
+#include "s2_legendreTransforms.h"
+#include "s2_primitive.h"
+#include "s2_semi_fly.h"
+#include "s2_semi_memo.h"
 #include "so3_correlate_fftw.h"
 #include "soft_fftw.h"
 #include "soft_fftw_nt.h"
@@ -22,4 +32,4 @@
 #include "wrap_fftw.h"
 
 int soft_header_check();
-int soft_header_check() { return MAX(1, 2) + MIN(1, 2) + ABS(-1) + (M_PI > 3.0); }
+int soft_header_check() { return MAX(1, 2) + MIN(1, 2) + ABS(-1) + (M_PI > 3.0) + (PI > 3.0); }

@@ -1,8 +1,10 @@
-//! The plan cache of the SOFT layer: one plan per bandwidth, made on first use and kept for
-//! the life of the process, and the optional wisdom file (`SO3FFT_SOFT_WISDOM`).
+//! The plan caches of the SOFT layer: a [`Cache`] per plan type (the SO(3) [`Plan`]s here,
+//! the S^2 plans in `s2::transforms`), one plan per bandwidth made on first use and kept
+//! for the life of the process, and the optional wisdom file (`SO3FFT_SOFT_WISDOM`).
 
 use super::SoftResult;
 use crate::ffi::CallError;
+use crate::s2::S2Options;
 use crate::system::ForkLock;
 use crate::{wisdom, Direction, FftThreading, Plan, PlanOptions, Rigor};
 use std::cell::UnsafeCell;
@@ -12,42 +14,52 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex, Once, OnceLock, PoisonError};
 
 /// One slot per bandwidth; the slot's own lock serialises creation of that plan only.
-type Slot = Arc<Mutex<Option<Arc<Plan>>>>;
+type Slot<P> = Arc<Mutex<Option<Arc<P>>>>;
 
-/// The slots, keyed by process id and bandwidth: a child made by `fork()` never touches a
-/// slot whose lock a thread of its parent held at the fork (it would wait forever).
-struct Cache {
-    lock: ForkLock,
-    map: UnsafeCell<BTreeMap<(u32, usize), Slot>>,
+/// The lock of every cache's map (slot look-ups are short; one lock keeps the `fork()`
+/// handlers simple).
+static MAP_LOCK: ForkLock = ForkLock::new();
+
+/// The slots of one plan type, keyed by process id and bandwidth: a child made by `fork()`
+/// never touches a slot whose lock a thread of its parent held at the fork (it would wait
+/// forever). Lives in a `static`.
+pub(super) struct Cache<P> {
+    map: UnsafeCell<BTreeMap<(u32, usize), Slot<P>>>,
 }
 
-// SAFETY: `map` is only accessed while `lock` is held (`Cache::slot`).
-unsafe impl Sync for Cache {}
+// SAFETY: `map` is only accessed while `MAP_LOCK` is held (`Cache::slot`); the plans it
+// holds are shared between threads through `Arc`, hence `P: Send + Sync`.
+unsafe impl<P: Send + Sync> Sync for Cache<P> {}
 
-impl Cache {
+impl<P> Cache<P> {
+    /// An empty cache.
+    pub(super) const fn new() -> Cache<P> {
+        Cache {
+            map: UnsafeCell::new(BTreeMap::new()),
+        }
+    }
+
     /// The slot of bandwidth `b` in this process, made empty on first use.
-    fn slot(&self, b: usize) -> Slot {
-        let _guard = self.lock.lock();
+    fn slot(&self, b: usize) -> Slot<P> {
+        let _guard = MAP_LOCK.lock();
         // SAFETY: the lock is held, so no other reference to the map exists.
         let map = unsafe { &mut *self.map.get() };
         map.entry((std::process::id(), b)).or_default().clone()
     }
 }
 
-static CACHE: Cache = Cache {
-    lock: ForkLock::new(),
-    map: UnsafeCell::new(BTreeMap::new()),
-};
+/// SO(3) plans (`Direction::Both`).
+static SO3_PLANS: Cache<Plan> = Cache::new();
 
-/// Registers the cache lock's `fork()` handlers (once, before the first use).
+/// Registers the map lock's `fork()` handlers (once, before the first use).
 fn register_fork_handlers() {
     static REGISTERED: Once = Once::new();
     REGISTERED.call_once(|| {
         extern "C" fn prepare() {
-            CACHE.lock.before_fork();
+            MAP_LOCK.before_fork();
         }
         extern "C" fn release() {
-            CACHE.lock.after_fork();
+            MAP_LOCK.after_fork();
         }
         // SAFETY: plain functions living as long as the process. If registration fails,
         // a fork at the moment a thread looks up a slot may leave the child's lock held.
@@ -71,15 +83,22 @@ fn wisdom_warning(what: &str, err: &crate::Error) {
     let _ = writeln!(std::io::stderr(), "so3fft (SOFT layer): {what}: {err}");
 }
 
-/// Plan options of the cached plans (environment read once).
-fn cache_options() -> &'static PlanOptions {
-    static OPTS: OnceLock<PlanOptions> = OnceLock::new();
-    OPTS.get_or_init(|| {
-        let threads = std::env::var("SO3FFT_SOFT_THREADS")
+/// Worker threads of the cached plans: `SO3FFT_SOFT_THREADS` (read once), 0 = all cores.
+fn env_threads() -> usize {
+    static THREADS: OnceLock<usize> = OnceLock::new();
+    *THREADS.get_or_init(|| {
+        std::env::var("SO3FFT_SOFT_THREADS")
             .ok()
             .and_then(|s| s.trim().parse::<usize>().ok())
-            .unwrap_or(0);
-        let rigor = match std::env::var("SO3FFT_SOFT_RIGOR")
+            .unwrap_or(0)
+    })
+}
+
+/// FFTW rigour of the cached plans: `SO3FFT_SOFT_RIGOR` (read once), default `measure`.
+fn env_rigor() -> Rigor {
+    static RIGOR: OnceLock<Rigor> = OnceLock::new();
+    *RIGOR.get_or_init(|| {
+        match std::env::var("SO3FFT_SOFT_RIGOR")
             .unwrap_or_default()
             .trim()
             .to_ascii_lowercase()
@@ -89,11 +108,18 @@ fn cache_options() -> &'static PlanOptions {
             "patient" => Rigor::Patient,
             "exhaustive" => Rigor::Exhaustive,
             _ => Rigor::Measure,
-        };
+        }
+    })
+}
+
+/// Plan options of the cached SO(3) plans.
+fn cache_options() -> &'static PlanOptions {
+    static OPTS: OnceLock<PlanOptions> = OnceLock::new();
+    OPTS.get_or_init(|| {
         PlanOptions {
             direction: Direction::Both,
-            threads,
-            rigor,
+            threads: env_threads(),
+            rigor: env_rigor(),
             // flag = 1 calls use the engine's real-signal path.
             real: true,
             // With a wisdom file the FFT plans are recorded, and the FFT stage's threading
@@ -108,10 +134,16 @@ fn cache_options() -> &'static PlanOptions {
     })
 }
 
-/// The cached plan of bandwidth `b`, created on first use. A failed creation is not cached.
-pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
+/// The cached plan of bandwidth `b` in `cache`, made by `make` on first use (with the
+/// wisdom file imported before the first plan and exported after each new one). A failed
+/// creation is not cached.
+pub(super) fn cached<P>(
+    cache: &'static Cache<P>,
+    b: usize,
+    make: impl FnOnce() -> crate::Result<P>,
+) -> SoftResult<Arc<P>> {
     register_fork_handlers();
-    let slot = CACHE.slot(b);
+    let slot = cache.slot(b);
     let mut g = slot.lock().unwrap_or_else(PoisonError::into_inner);
     if let Some(p) = g.as_ref() {
         return Ok(Arc::clone(p));
@@ -128,8 +160,7 @@ pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
         });
     }
     let p = Arc::new(
-        Plan::new(b, cache_options())
-            .map_err(|e| CallError::from(e).context(&format!("cannot plan bandwidth {b}")))?,
+        make().map_err(|e| CallError::from(e).context(&format!("cannot plan bandwidth {b}")))?,
     );
     if let Some(path) = file {
         if let Err(e) = wisdom::export_to_file(path) {
@@ -138,4 +169,18 @@ pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
     }
     *g = Some(Arc::clone(&p));
     Ok(p)
+}
+
+/// The cached SO(3) plan of bandwidth `b`, created on first use.
+pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
+    cached(&SO3_PLANS, b, || Plan::new(b, cache_options()))
+}
+
+/// Options of the cached S^2 plans (threads and rigour as for the SO(3) plans).
+pub(super) fn s2_options() -> S2Options {
+    S2Options {
+        threads: env_threads(),
+        rigor: env_rigor(),
+        isa: None,
+    }
 }

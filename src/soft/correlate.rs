@@ -16,9 +16,14 @@ fn sean_index(m: i64, l: i64, b: i64) -> i64 {
     if m >= 0 {
         m * b - m * (m - 1) / 2 + (l - m)
     } else {
-        let big_l = b - 1;
-        big_l * (big_l + 3) / 2 + 1 + (big_l + m) * (big_l + m + 1) / 2 + (l + m)
+        negative_order_index(m, l, b)
     }
+}
+
+/// The `m < 0` branch of [`sean_index`] (for `m <= 0`).
+fn negative_order_index(m: i64, l: i64, b: i64) -> i64 {
+    let big_l = b - 1;
+    big_l * (big_l + 3) / 2 + 1 + (big_l + m) * (big_l + m + 1) / 2 + (l + m)
 }
 
 /// Index of the S^2 coefficient `(l, m)` at bandwidth `bw` in S2kit's layout (see docs/conventions.md,
@@ -35,6 +40,40 @@ pub extern "C" fn seanindex(m: c_int, l: c_int, bw: c_int) -> c_int {
             )));
         }
         to_int(sean_index(m as i64, l as i64, bw as i64))
+    })
+}
+
+/// Both indices of the S^2 coefficients `(l, m)` and `(l, -m)` at bandwidth `bw`:
+/// `loc[0] = seanindex(m, l, bw)`, `loc[1] = seanindex(-m, l, bw)`, meant for `m > 0`. As in
+/// SOFT, `m = 0` gives `loc[1] = bw^2 + l` (the negative-order formula at `m = 0`, past
+/// the end of the array). Nothing is written if `|m| > l`, `l >= bw` or `loc` is NULL.
+///
+/// cbindgen:ignore
+#[no_mangle]
+pub unsafe extern "C" fn seanindex2(m: c_int, l: c_int, bw: c_int, loc: *mut c_int) {
+    guarded("seanindex2", (), || {
+        soft_bandwidth(bw.into())?;
+        if l < 0 || l >= bw || (m as i64).abs() > l as i64 {
+            return Err(CallError::invalid(format!(
+                "coefficient (m={m}, l={l}) does not exist at bandwidth {bw}"
+            )));
+        }
+        Array::new(loc.cast_const(), 2, "loc").check()?;
+        let (m, l, b) = (m as i64, l as i64, bw as i64);
+        let first = to_int(sean_index(m, l, b))?;
+        // The negative-order formula also for m = 0 (SOFT's value).
+        let second = to_int(if m >= 0 {
+            negative_order_index(-m, l, b)
+        } else {
+            sean_index(-m, l, b)
+        })?;
+        // SAFETY: `loc` is non-NULL and aligned (checked) and holds 2 ints (the module's
+        // safety contract).
+        unsafe {
+            *loc = first;
+            *loc.add(1) = second;
+        }
+        Ok(())
     })
 }
 

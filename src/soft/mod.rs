@@ -2,13 +2,16 @@
 //! semantics of Kostelec and Rockmore's SOFT 2.0 (docs/conventions.md: layouts, normalisation,
 //! SOFT compatibility), running on the so3fft engine. The C declarations are the hand-written headers in `include/soft/`
 //! (`soft_fftw.h`, `soft_fftw_pc.h`, `soft_fftw_nt.h`, `wrap_fftw.h`, `utils_so3.h`,
-//! `makeweights.h`, `makeWigner.h`, `so3_correlate_fftw.h`, `csecond.h`); none of these
+//! `makeweights.h`, `makeWigner.h`, `so3_correlate_fftw.h`, `csecond.h`, and for S^2
+//! (docs/conventions-s2.md) `s2_semi_memo.h`, `s2_semi_fly.h`, `s2_cospmls.h`,
+//! `s2_primitive.h`, `s2_legendreTransforms.h`); none of these
 //! functions belongs to the native API in `so3fft.h` (every item carries `cbindgen:ignore`).
 //!
 //! Behaviour shared by all transform entry points:
 //!
 //! - **Plans.** One [`Plan`](crate::Plan) per bandwidth is created on first use and cached for the life of
-//!   the process (a global map, [`Direction::Both`](crate::Direction::Both)), so repeated calls at the same bandwidth
+//!   the process (a global map, [`Direction::Both`](crate::Direction::Both); likewise one
+//!   [`S2Plan`](crate::s2::S2Plan) per bandwidth for the S^2 transforms), so repeated calls at the same bandwidth
 //!   pay set-up once. Plans use all cores and FFTW's `MEASURE` rigour by default; the
 //!   environment variables `SO3FFT_SOFT_THREADS` (a positive number) and `SO3FFT_SOFT_RIGOR`
 //!   (`estimate`, `measure`, `patient`, `exhaustive`), read once, override that. Calls from
@@ -40,14 +43,23 @@ mod correlate;
 mod index;
 mod matching;
 mod real;
+mod s2;
 mod so3;
 mod tables;
 
-pub use correlate::{seanindex, so3CombineCoef_fftw};
+pub use correlate::{seanindex, seanindex2, so3CombineCoef_fftw};
 pub use index::{
     coefLoc_so3, howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3,
 };
 pub use matching::softFFTWCor2;
+pub use s2::{
+    transpose, vec_add, vec_mul, vec_pt_mul, ArcCosEvalPts, CosPmlTableGen, EvalPts, FST_semi_fly,
+    FST_semi_memo, InvFST_semi_fly, InvFST_semi_memo, L2_an, L2_cn, Naive_AnalysisX,
+    Naive_SynthesizeX, NewTableOffset, PmlTableGen, Pmm_L2, Reduced_Naive_TableSize,
+    Reduced_SpharmonicTableSize, RowSize, SemiNaive_Naive_Pml_Table, Spharmonic_Pml_Table,
+    Spharmonic_TableSize, TableSize, Transpose_CosPmlTableGen, Transpose_RowSize,
+    Transpose_SemiNaive_Naive_Pml_Table, Transpose_Spharmonic_Pml_Table,
+};
 pub use so3::{
     Forward_SO3_Naive_fftw, Forward_SO3_Naive_fftw_W, Forward_SO3_Naive_fftw_nt,
     Forward_SO3_Naive_fftw_pc, Inverse_SO3_Naive_fftw, Inverse_SO3_Naive_fftw_W,
