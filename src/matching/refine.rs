@@ -2,12 +2,12 @@
 //! its SO(3) coefficients, and maximised by damped Newton steps.
 
 use super::rotation::Rotation;
-use crate::grid::coef_index;
-use crate::numeric::{sin_cos_dd, Dd};
+use crate::grid::block_start;
+use crate::numeric::{sin_cos_dd, Dd, Ext};
 use crate::simd::Isa;
 use crate::symmetry::Cluster;
-use crate::wigner::column::column;
-use crate::wigner::{BetaTables, RecTables};
+use crate::wigner::column::column_with;
+use crate::wigner::{start_norms, BetaTables, RecCoeffs, RecTables};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -19,6 +19,8 @@ pub struct So3Series<'a> {
     lmax: usize,
     coeffs: &'a [Complex64],
     recurrence: RecTables,
+    /// Norms of the starting values per base pair `(m, m')`, index `m(m+1)/2 + m'`.
+    norms: Vec<Ext>,
     isa: Isa,
 }
 
@@ -42,6 +44,7 @@ impl<'a> So3Series<'a> {
             lmax,
             coeffs,
             recurrence: RecTables::new(lmax + 1),
+            norms: start_norms(lmax + 1),
             isa: Isa::detect(),
         }
     }
@@ -60,27 +63,26 @@ impl<'a> So3Series<'a> {
             (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
         };
         let betas = BetaTables::new(&[(cs, sn), (sn, cs)], 2 * self.lmax);
+        let mut rec = RecCoeffs::new(self.lmax + 1);
         for m in 0..=self.lmax {
             for mp in 0..=m {
                 let cluster = Cluster::new(m, mp);
+                rec.resize(self.lmax + 1 - m);
+                self.recurrence.coeffs(m, mp, &mut rec);
+                let norm = self.norms[m * (m + 1) / 2 + mp];
                 let mut cols: [Option<Vec<f64>>; 2] = [None, None];
                 for mem in cluster.members() {
                     let k = usize::from(mem.reversed);
                     let col = cols[k].get_or_insert_with(|| {
-                        column(
-                            self.isa,
-                            &betas,
-                            &self.recurrence,
-                            k,
-                            (m, mp),
-                            self.lmax + 1,
-                        )
+                        column_with(self.isa, &betas, k, (m, mp, norm), &rec)
                     });
+                    // Degree l = m + i is at block_start + i.
+                    let block = &self.coeffs[block_start(self.b, mem.m, mem.mp)..][..col.len()];
+                    let (even, odd) = (mem.sign_at(m), mem.sign_at(m + 1));
                     let mut sum = Complex64::default();
-                    for (i, dt) in col.iter().enumerate() {
-                        let l = m + i;
-                        let c = self.coeffs[coef_index(self.b, l, mem.m, mem.mp)];
-                        sum += c * (mem.sign_at(l) * dt);
+                    for (i, (dt, c)) in col.iter().zip(block).enumerate() {
+                        let sign = if i % 2 == 0 { even } else { odd };
+                        sum += c * (sign * dt);
                     }
                     s[(mem.m + top) as usize * w + (mem.mp + top) as usize] = sum / (2.0 * PI);
                 }
@@ -94,12 +96,17 @@ impl<'a> So3Series<'a> {
         let top = self.lmax as isize;
         let w = 2 * self.lmax + 1;
         let mut out = Local::default();
+        let phases = |angle: f64| -> Vec<Complex64> {
+            (-top..=top)
+                .map(|m| Complex64::from_polar(1.0, -(m as f64) * angle))
+                .collect()
+        };
+        let (pa, pg) = (phases(alpha), phases(gamma));
         for m in -top..=top {
-            let ea = Complex64::from_polar(1.0, -(m as f64) * alpha);
+            let ea = pa[(m + top) as usize];
             for mp in -top..=top {
-                let v = s[(m + top) as usize * w + (mp + top) as usize]
-                    * ea
-                    * Complex64::from_polar(1.0, -(mp as f64) * gamma);
+                let v =
+                    s[(m + top) as usize * w + (mp + top) as usize] * ea * pg[(mp + top) as usize];
                 let (fm, fmp) = (m as f64, mp as f64);
                 let i = Complex64::new(0.0, 1.0);
                 out.c += v;

@@ -24,8 +24,27 @@ pub(crate) fn column(
     let n = lend - m;
     let mut coeffs = RecCoeffs::new(n);
     tables.coeffs(m, mp, &mut coeffs);
+    column_with(
+        isa,
+        betas,
+        k,
+        (m, mp, super::starts::start_norm(m, mp)),
+        &coeffs,
+    )
+}
+
+/// [`column`] with the recurrence coefficients of `(m, mp)` and the norm of its starting
+/// value given (`RecTables::coeffs`, `start_norm`), for callers that evaluate many columns.
+pub(crate) fn column_with(
+    isa: Isa,
+    betas: &BetaTables,
+    k: usize,
+    (m, mp, norm): (usize, usize, crate::numeric::Ext),
+    coeffs: &RecCoeffs,
+) -> Vec<f64> {
+    let n = coeffs.len();
     let bits = *SKIP_BITS_RANGE.end();
-    let base = BaseStart::new(m, mp, super::starts::start_norm(m, mp), bits);
+    let base = BaseStart::new(m, mp, norm, bits);
     let (start, mut scale_index) = betas.start(k, &base, 1.0);
     // The recurrence multiplier `A x + C` as `(A + C) - A tau` below pi/2 and as
     // `A tau + (C - A)` above (see `BetaTables`).
