@@ -316,3 +316,41 @@ fn top_peaks_are_separated_local_maxima() {
         }
     }
 }
+
+/// The combination of S^2 coefficients against the mpmath reference (`combine_B8_*`), for
+/// `bwOut` below, equal to the input bandwidth and degree limits below the top.
+#[test]
+fn combine_matches_reference() {
+    use so3fft::matching::combine;
+    for name in [
+        "combine_B8_to_B4_deg3.txt",
+        "combine_B8_to_B8_deg4.txt",
+        "combine_B8_to_B8_deg7.txt",
+    ] {
+        let r = common::read_s2_reference(name);
+        let (b_in, b_out, deg) = (
+            r.scalars["bwIn"] as usize,
+            r.scalars["bwOut"] as usize,
+            r.scalars["degLim"] as usize,
+        );
+        let coefs = |section: &str, n: usize| {
+            let mut v = vec![Complex64::default(); n];
+            for row in &r[section] {
+                let k = row.len();
+                v[row[0] as usize] = Complex64::new(row[k - 2], row[k - 1]);
+            }
+            v
+        };
+        let (sig, pat) = (coefs("sig", b_in * b_in), coefs("pat", b_in * b_in));
+        let want = coefs("so3coef", so3fft::num_coeffs(b_out));
+        let mut got = vec![Complex64::new(9.0, 9.0); so3fft::num_coeffs(b_out)];
+        combine((&sig, &pat), b_in, deg, b_out, &mut got).unwrap();
+        let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        let err = got
+            .iter()
+            .zip(&want)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-14 * scale, "{name}: error {err:e}");
+    }
+}

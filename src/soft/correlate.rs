@@ -1,12 +1,10 @@
 //! The correlation helpers of `so3_correlate_fftw.h` (S^2 coefficient index, combination of
 //! S^2 coefficients into SO(3) coefficients).
 
-use super::real::parity;
 use super::{guarded, soft_bandwidth, to_int, FftwComplex};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::CallError;
 use crate::{num_coeffs, Complex64};
-use std::f64::consts::PI;
 use std::ffi::{c_double, c_int};
 
 /// Index of the spherical-harmonic coefficient of degree `l` and order `m` at bandwidth `b`
@@ -128,27 +126,15 @@ pub unsafe extern "C" fn so3CombineCoef_fftw(
         // SAFETY: each input is non-NULL, aligned and disjoint from the output (checked)
         // and holds bwIn^2 doubles (the module's safety contract); only read.
         let read = |p: *mut c_double| unsafe { std::slice::from_raw_parts(p.cast_const(), nin) };
-        let (sig_re, sig_im, pat_re, pat_im) = (
-            read(sigCoefR),
-            read(sigCoefI),
-            read(patCoefR),
-            read(patCoefI),
-        );
-        let bw_in = bin as i64;
-        for l in 0..=degLim as i64 {
-            let norm = 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
-            for m1 in -l..=l {
-                let sig_at = sean_index(-m1, l, bw_in) as usize;
-                let sig = Complex64::new(sig_re[sig_at], sig_im[sig_at]);
-                for m2 in -l..=l {
-                    let pat_at = sean_index(-m2, l, bw_in) as usize;
-                    let pat = Complex64::new(pat_re[pat_at], pat_im[pat_at]);
-                    let scale = norm * parity(m1 as isize, m2 as isize);
-                    let at = crate::coef_index(bout, l as usize, m1 as isize, m2 as isize);
-                    out[at] = sig * pat.conj() * scale;
-                }
-            }
-        }
+        let join = |re: &[f64], im: &[f64]| -> Vec<Complex64> {
+            re.iter()
+                .zip(im)
+                .map(|(&r, &i)| Complex64::new(r, i))
+                .collect()
+        };
+        let sig = join(read(sigCoefR), read(sigCoefI));
+        let pat = join(read(patCoefR), read(patCoefI));
+        crate::matching::combine((&sig, &pat), bin, degLim as usize, bout, out)?;
         Ok(())
     })
 }
