@@ -23,7 +23,6 @@ extern "C" {
  * Forward and inverse SO(3) transforms at bandwidth bw without caller-provided workspaces,
  * weights or plans: signal holds (2bw)^3 samples, coeffs (4bw^3-bw)/3 coefficients;
  * flag = 1 for real data (as in soft_fftw.h). Inputs are not modified.
- * (s2RotateFFTW of SOFT's wrap_fftw.h is not provided by so3fft yet.)
  */
 void Forward_SO3_Naive_fftw_W(int bw, fftw_complex *signal, fftw_complex *coeffs, int flag);
 void Inverse_SO3_Naive_fftw_W(int bw, fftw_complex *coeffs, fftw_complex *signal, int flag);
@@ -36,6 +35,14 @@ void Inverse_SO3_Naive_fftw_W(int bw, fftw_complex *coeffs, fftw_complex *signal
  * lowest grid index. Inputs are not modified.
  */
 void softFFTWCor2(int bw, double *sig, double *pat, double *alpha, double *beta, double *gamma,
+                  int isReal);
+
+/*
+ * Rotation of a function on the sphere at bandwidth bw: sigOut(x) = sigIn(g^-1 x),
+ * g = Rz(alpha) Ry(beta) Rz(gamma). Samples as in softFFTWCor2 (interleaved complex, or real
+ * with isReal nonzero; a real result keeps the real part). Works at every bandwidth.
+ */
+void s2RotateFFTW(int bw, double *sigIn, double *sigOut, double alpha, double beta, double gamma,
                   int isReal);
 
 #ifdef __cplusplus

@@ -18,4 +18,4 @@ pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};
 pub use peaks::{grid_argmax, grid_argmax_real, top_peaks, Peak};
 pub use refine::So3Series;
-pub use rotation::{rotate_s2_coeffs, Rotation};
+pub use rotation::{rotate_s2_coeffs, rotate_s2_coeffs_to, Rotation};

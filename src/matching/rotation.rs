@@ -84,27 +84,43 @@ impl Rotation {
 /// `D^l_{m,m'}(alpha, beta, gamma) = e^{-i m alpha} d^l_{m,m'}(beta) e^{-i m' gamma}`.
 /// `O(b^3)` operations; any bandwidth.
 pub fn rotate_s2_coeffs(b: usize, coeffs: &[Complex64], g: &Rotation) -> Result<Vec<Complex64>> {
-    if coeffs.len() != b * b {
+    rotate_s2_coeffs_to(b, coeffs, g, (b, b.saturating_sub(1)))
+}
+
+/// [`rotate_s2_coeffs`] from bandwidth `b_in` to `b_out`: degrees up to
+/// `min(deg_out, b_in - 1)` rotated, all others zero (`deg_out < b_out`; SOFT's
+/// `rotateCoefAll`).
+pub fn rotate_s2_coeffs_to(
+    b_in: usize,
+    coeffs: &[Complex64],
+    g: &Rotation,
+    (b_out, deg_out): (usize, usize),
+) -> Result<Vec<Complex64>> {
+    if coeffs.len() != b_in * b_in {
         return Err(Error::LengthMismatch {
             what: "S^2 coefficients",
-            expected: b * b,
+            expected: b_in * b_in,
             got: coeffs.len(),
         });
     }
-    let mut out = vec![Complex64::default(); b * b];
-    if b == 0 {
-        return Ok(out);
+    if b_in == 0 || deg_out >= b_out {
+        return Err(Error::InvalidArgument(format!(
+            "rotation from bandwidth {b_in} to {b_out} with degree limit {deg_out}: need \
+             bandwidths >= 1 and degree limit < {b_out}"
+        )));
     }
-    let top = b as isize - 1;
+    let mut out = vec![Complex64::default(); b_out * b_out];
+    let lmax = deg_out.min(b_in - 1);
+    let top = lmax as isize;
     for m in -top..=top {
         let em = Complex64::from_polar(1.0, -(m as f64) * g.alpha);
         for mp in -top..=top {
             let phase = em * Complex64::from_polar(1.0, -(mp as f64) * g.gamma);
-            let d = wigner_d_column(m, mp, b - 1, g.beta);
+            let d = wigner_d_column(m, mp, lmax, g.beta);
             let l0 = m.unsigned_abs().max(mp.unsigned_abs());
             for (i, dl) in d.iter().enumerate() {
                 let l = l0 + i;
-                out[s2_coef_index(b, l, m)] += phase * *dl * coeffs[s2_coef_index(b, l, mp)];
+                out[s2_coef_index(b_out, l, m)] += phase * *dl * coeffs[s2_coef_index(b_in, l, mp)];
             }
         }
     }

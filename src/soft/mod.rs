@@ -43,6 +43,7 @@ mod correlate;
 mod index;
 mod matching;
 mod real;
+mod rotate;
 mod s2;
 mod so3;
 mod tables;
@@ -52,6 +53,7 @@ pub use index::{
     coefLoc_so3, howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3,
 };
 pub use matching::softFFTWCor2;
+pub use rotate::{rotateCoefAll, rotateFctFFTW, rotateFctFFTWS, rotateFctFFTWS_mem, s2RotateFFTW};
 pub use s2::{
     transpose, vec_add, vec_mul, vec_pt_mul, ArcCosEvalPts, CosPmlTableGen, EvalPts, FST_semi_fly,
     FST_semi_memo, InvFST_semi_fly, InvFST_semi_memo, L2_an, L2_cn, Naive_AnalysisX,

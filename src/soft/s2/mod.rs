@@ -25,4 +25,5 @@ pub use tables::{
     Spharmonic_TableSize, TableSize, Transpose_CosPmlTableGen, Transpose_RowSize,
     Transpose_SemiNaive_Naive_Pml_Table, Transpose_Spharmonic_Pml_Table,
 };
+pub(in crate::soft) use transforms::s2_plan_for;
 pub use transforms::{FST_semi_fly, FST_semi_memo, InvFST_semi_fly, InvFST_semi_memo};

@@ -40,18 +40,23 @@ impl Buffers {
 static S2_PLANS: Cache<S2Entry> = Cache::new();
 
 /// The cached S^2 plan (and buffers) of bandwidth `b`, created on first use.
-fn s2_plan_for(b: usize) -> SoftResult<Arc<S2Entry>> {
+pub(in crate::soft) fn s2_plan_for(b: usize) -> SoftResult<Arc<S2Entry>> {
     cached(&S2_PLANS, b, || S2Entry::new(b, &s2_options()))
 }
 
 /// A cached S^2 plan of the SOFT layer with its conversion buffers.
-struct S2Entry {
+pub(in crate::soft) struct S2Entry {
     plan: S2Plan,
     /// Kept buffers (small bandwidths), taken by one call at a time.
     buffers: Mutex<Option<Buffers>>,
 }
 
 impl S2Entry {
+    /// The plan.
+    pub(in crate::soft) fn plan(&self) -> &S2Plan {
+        &self.plan
+    }
+
     /// The plan of bandwidth `b` with `options`.
     fn new(b: usize, options: &S2Options) -> crate::Result<S2Entry> {
         Ok(S2Entry {
