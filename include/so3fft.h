@@ -94,6 +94,10 @@
 // Largest bandwidth of the S^2 transforms.
 #define SO3FFT_S2_MAX_BANDWIDTH 4096
 
+// Correlation planner flag: normalised cross-correlation (means left out, divided by the
+// norms; `|C| <= 1`).
+#define SO3FFT_NORMALIZED 64
+
 // Opaque correlation plan (made by `so3fft_plan_correlation`).
 typedef struct so3fft_correlation_s so3fft_correlation_s;
 
@@ -260,7 +264,8 @@ ptrdiff_t so3fft_s2_coef_index(int B, int l, int m);
 
 // Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
 // on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
-// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs.
+// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
+// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
 // NULL on error.
 so3fft_correlation so3fft_plan_correlation(int L, int B_out, int deg_lim, unsigned int flags, int nthreads);
 

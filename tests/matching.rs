@@ -354,3 +354,133 @@ fn combine_matches_reference() {
         assert!(err < 1e-14 * scale, "{name}: error {err:e}");
     }
 }
+
+fn random_s2_samples(l: usize, seed: u64) -> (Vec<Complex64>, Vec<Complex64>) {
+    let mut rng = common::Rng::new(seed);
+    let hat = rng.complex_vec(l * l);
+    let mut s = vec![Complex64::default(); 4 * l * l];
+    s2_plan(l).inverse(&hat, &mut s).unwrap();
+    (hat, s)
+}
+
+/// Normalised cross-correlation: a rotated copy of the pattern, scaled by 2.5 and shifted
+/// by a constant, correlates to 1 at the rotation (refined), and nowhere above 1.
+#[test]
+fn normalized_correlation_peaks_at_one() {
+    let l = 10;
+    let (hat, pat) = random_s2_samples(l, 31);
+    let truth = Rotation::new(1.1, 0.7, 2.9);
+    let mut rotated = rotate_s2_coeffs(l, &hat, &truth).unwrap();
+    for c in rotated.iter_mut() {
+        *c *= 2.5;
+    }
+    rotated[s2_coef_index(l, 0, 0)] += Complex64::new(3.0, -1.0);
+    let mut sig = vec![Complex64::default(); 4 * l * l];
+    s2_plan(l).inverse(&rotated, &mut sig).unwrap();
+    let plan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            normalized: true,
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut grid = vec![Complex64::default(); plan.num_grid()];
+    plan.correlate(&sig, &pat, &mut grid).unwrap();
+    let top = grid.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    assert!(top <= 1.0 + 1e-12 && top > 0.5, "largest |C| {top}");
+    let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
+    plan.coefficients(&sig, &pat, &mut coeffs).unwrap();
+    let (g, value) =
+        So3Series::new(l, plan.deg_lim(), &coeffs).maximise(&grid_argmax(l, &grid).rotation());
+    assert!((value - 1.0).abs() < 1e-10, "refined |C|^2 = {value}");
+    assert!(g.angle_to(&truth) < 1e-8);
+}
+
+/// Shells: the weighted sum of the shells' correlations, from one inverse transform.
+#[test]
+fn shells_add_up_with_their_weights() {
+    let l = 8;
+    let (_, s1) = random_s2_samples(l, 1);
+    let (_, p1) = random_s2_samples(l, 2);
+    let (_, s2) = random_s2_samples(l, 3);
+    let (_, p2) = random_s2_samples(l, 4);
+    let plan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let n = plan.num_grid();
+    let (mut c1, mut c2, mut both) = (
+        vec![Complex64::default(); n],
+        vec![Complex64::default(); n],
+        vec![Complex64::default(); n],
+    );
+    plan.correlate(&s1, &p1, &mut c1).unwrap();
+    plan.correlate(&s2, &p2, &mut c2).unwrap();
+    plan.correlate_shells(&[(&s1, &p1, 0.7), (&s2, &p2, -1.3)], &mut both)
+        .unwrap();
+    let scale = both.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    for ((a, b), c) in c1.iter().zip(&c2).zip(&both) {
+        assert!((a * 0.7 - b * 1.3 - c).norm() < 1e-12 * scale);
+    }
+    assert!(plan.correlate_shells(&[], &mut both).is_err());
+    assert!(plan
+        .correlate_shells(&[(&s1, &p1, f64::NAN)], &mut both)
+        .is_err());
+}
+
+/// Many patterns against one signal: bitwise the results of single correlations (the
+/// signal's transform is reused), complex and real.
+#[test]
+fn many_patterns_equal_single_correlations() {
+    let l = 6;
+    let (_, sig) = random_s2_samples(l, 5);
+    let pats: Vec<Complex64> = (0..3)
+        .flat_map(|k| random_s2_samples(l, 10 + k).1)
+        .collect();
+    let plan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (ns, ng) = (4 * l * l, plan.num_grid());
+    let mut many = vec![Complex64::default(); 3 * ng];
+    plan.correlate_many(&sig, &pats, &mut many).unwrap();
+    for k in 0..3 {
+        let mut one = vec![Complex64::default(); ng];
+        plan.correlate(&sig, &pats[k * ns..][..ns], &mut one)
+            .unwrap();
+        assert!(one == many[k * ng..][..ng], "pattern {k}");
+    }
+    let re = |v: &[Complex64]| v.iter().map(|z| z.re).collect::<Vec<f64>>();
+    let rplan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            real: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut rmany = vec![0.0; 3 * ng];
+    rplan
+        .correlate_many_real(&re(&sig), &re(&pats), &mut rmany)
+        .unwrap();
+    for k in 0..3 {
+        let mut one = vec![0.0; ng];
+        rplan
+            .correlate_real(&re(&sig), &re(&pats[k * ns..][..ns]), &mut one)
+            .unwrap();
+        assert!(one == rmany[k * ng..][..ng], "real pattern {k}");
+    }
+    assert!(plan
+        .correlate_many(&sig, &pats[..ns - 1], &mut many)
+        .is_err());
+}

@@ -10,6 +10,10 @@ use crate::matching::{
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_uint};
 
+/// Correlation planner flag: normalised cross-correlation (means left out, divided by the
+/// norms; `|C| <= 1`).
+pub const SO3FFT_NORMALIZED: c_uint = 64;
+
 /// Opaque correlation plan (made by `so3fft_plan_correlation`).
 pub struct so3fft_correlation_s {
     plan: Correlation,
@@ -20,7 +24,8 @@ pub type so3fft_correlation = *mut so3fft_correlation_s;
 
 /// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
 /// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
-/// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs.
+/// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
+/// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
 /// NULL on error.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_correlation(
@@ -51,8 +56,9 @@ pub extern "C" fn so3fft_plan_correlation(
             b_out,
             deg_lim,
             real: flags & SO3FFT_REAL != 0,
+            normalized: flags & SO3FFT_NORMALIZED != 0,
             threads: threads_of(nthreads)?,
-            rigor: rigor_of(flags & !SO3FFT_REAL)?,
+            rigor: rigor_of(flags & !(SO3FFT_REAL | SO3FFT_NORMALIZED))?,
         };
         let plan = Correlation::new(l, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_correlation_s { plan })))

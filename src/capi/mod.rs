@@ -57,7 +57,7 @@ pub use grid::{
 pub use matching::{
     so3fft_correlate, so3fft_correlate_real, so3fft_correlation, so3fft_correlation_grid_size,
     so3fft_correlation_refine, so3fft_correlation_s, so3fft_destroy_correlation,
-    so3fft_grid_argmax, so3fft_grid_argmax_real, so3fft_plan_correlation,
+    so3fft_grid_argmax, so3fft_grid_argmax_real, so3fft_plan_correlation, SO3FFT_NORMALIZED,
 };
 pub use planner::{
     so3fft_destroy_plan, so3fft_plan_both, so3fft_plan_forward, so3fft_plan_general,

@@ -19,15 +19,28 @@ pub fn combine(
     b_out: usize,
     out: &mut [Complex64],
 ) -> Result<()> {
+    check(sig.len(), pat.len(), (b_in, deg_lim, b_out), out.len())?;
+    out.fill(Complex64::default());
+    add_combined((sig, pat), b_in, (0, deg_lim), b_out, (1.0, out));
+    Ok(())
+}
+
+/// An error unless the lengths fit the bandwidths and `deg_lim < min(b_in, b_out)`.
+pub(super) fn check(
+    sig: usize,
+    pat: usize,
+    (b_in, deg_lim, b_out): (usize, usize, usize),
+    out: usize,
+) -> Result<()> {
     if deg_lim >= b_in.min(b_out) {
         return Err(Error::InvalidArgument(format!(
             "degree limit {deg_lim} must be below both bandwidths ({b_in}, {b_out})"
         )));
     }
     for (what, expected, got) in [
-        ("signal coefficients", b_in * b_in, sig.len()),
-        ("pattern coefficients", b_in * b_in, pat.len()),
-        ("SO(3) coefficients", num_coeffs(b_out), out.len()),
+        ("signal coefficients", b_in * b_in, sig),
+        ("pattern coefficients", b_in * b_in, pat),
+        ("SO(3) coefficients", num_coeffs(b_out), out),
     ] {
         if expected != got {
             return Err(Error::LengthMismatch {
@@ -37,10 +50,21 @@ pub fn combine(
             });
         }
     }
-    out.fill(Complex64::default());
-    for l in 0..=deg_lim {
+    Ok(())
+}
+
+/// Adds `scale` times the combination of degrees `from..=to` to `out` (lengths checked by
+/// the caller with [`check`]).
+pub(super) fn add_combined(
+    (sig, pat): (&[Complex64], &[Complex64]),
+    b_in: usize,
+    (from, to): (usize, usize),
+    b_out: usize,
+    (scale, out): (f64, &mut [Complex64]),
+) {
+    for l in from..=to {
         let li = l as isize;
-        let norm = 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
+        let norm = scale * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
         for m1 in -li..=li {
             let f = sig[s2_coef_index(b_in, l, -m1)];
             for m2 in -li..=li {
@@ -50,10 +74,9 @@ pub fn combine(
                 } else {
                     -norm
                 };
-                out[block_start(b_out, m1, m2) + (l - m1.unsigned_abs().max(m2.unsigned_abs()))] =
+                out[block_start(b_out, m1, m2) + (l - m1.unsigned_abs().max(m2.unsigned_abs()))] +=
                     f * h.conj() * sign;
             }
         }
     }
-    Ok(())
 }

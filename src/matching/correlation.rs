@@ -2,7 +2,7 @@
 //! grid, by two S^2 forward transforms, the combination of their coefficients and one
 //! inverse SO(3) transform.
 
-use super::combine::combine;
+use super::combine::add_combined;
 use crate::error::{Error, Result};
 use crate::grid::num_coeffs;
 use crate::s2::{S2Options, S2Plan};
@@ -24,6 +24,11 @@ pub struct CorrelationOptions {
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,
+    /// Normalised cross-correlation: the degree-0 terms (the means) left out and the result
+    /// divided by the norms of signal and pattern over degrees `1..=deg_lim`, so that
+    /// `|C| <= 1`, with 1 where the signal is an exactly rotated, scaled and shifted copy
+    /// of the pattern.
+    pub normalized: bool,
 }
 
 /// Coefficient arrays of one correlation (signal, pattern, SO(3)).
@@ -43,6 +48,7 @@ pub struct Correlation {
     b_out: usize,
     deg_lim: usize,
     real: bool,
+    normalized: bool,
     s2: S2Plan,
     so3: Plan,
     buffers: Mutex<Option<Buffers>>,
@@ -82,6 +88,7 @@ impl Correlation {
             b_out,
             deg_lim,
             real: options.real,
+            normalized: options.normalized,
             s2,
             so3,
             buffers: Mutex::new(None),
@@ -131,6 +138,79 @@ impl Correlation {
         }
     }
 
+    /// Adds shell `(signal, pattern, weight)`'s combined coefficients to `buf.so3` (with
+    /// `forward` the S^2 transform of the samples); with `normalized`, from degree 1 on,
+    /// and the weighted squared norms of degrees `1..=deg_lim` added to `norms`.
+    fn add_shell<T>(
+        &self,
+        (signal, pattern, weight): (&[T], &[T], f64),
+        forward: &impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        buf: &mut Buffers,
+        norms: &mut [f64; 2],
+    ) -> Result<()> {
+        if !weight.is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "shell weight {weight} is not finite"
+            )));
+        }
+        forward(signal, &mut buf.sig)?;
+        forward(pattern, &mut buf.pat)?;
+        let from = usize::from(self.normalized);
+        if self.normalized {
+            for (norm, c) in norms.iter_mut().zip([&buf.sig, &buf.pat]) {
+                let sq: f64 = c.iter().map(|z| z.norm_sqr()).sum::<f64>()
+                    - (0..self.b_in)
+                        .filter(|&l| l > self.deg_lim || l == 0)
+                        .map(|l| {
+                            let li = l as isize;
+                            (-li..=li)
+                                .map(|m| c[crate::s2::s2_coef_index(self.b_in, l, m)].norm_sqr())
+                                .sum::<f64>()
+                        })
+                        .sum::<f64>();
+                *norm += weight.abs() * sq.max(0.0);
+            }
+        }
+        if from <= self.deg_lim {
+            add_combined(
+                (&buf.sig, &buf.pat),
+                self.b_in,
+                (from, self.deg_lim),
+                self.b_out,
+                (weight, &mut buf.so3),
+            );
+        }
+        Ok(())
+    }
+
+    /// The SO(3) coefficients of the weighted sum over `shells` into `buf.so3` (normalised
+    /// if the plan says so).
+    fn combine_shells<T>(
+        &self,
+        shells: &[(&[T], &[T], f64)],
+        forward: impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        buf: &mut Buffers,
+    ) -> Result<()> {
+        if shells.is_empty() {
+            return Err(Error::InvalidArgument("no shells given".into()));
+        }
+        buf.so3.fill(Complex64::default());
+        let mut norms = [0.0; 2];
+        for &shell in shells {
+            self.add_shell(shell, &forward, buf, &mut norms)?;
+        }
+        if self.normalized {
+            let denominator = (norms[0] * norms[1]).sqrt();
+            let scale = if denominator > 0.0 {
+                1.0 / denominator
+            } else {
+                0.0
+            };
+            buf.so3.iter_mut().for_each(|c| *c *= scale);
+        }
+        Ok(())
+    }
+
     /// The SO(3) coefficients of the correlation of complex samples (`(4 b_out^3 - b_out)/3`
     /// values, for [`So3Series`](super::So3Series) and peak refinement).
     pub fn coefficients(
@@ -139,11 +219,13 @@ impl Correlation {
         pattern: &[Complex64],
         out: &mut [Complex64],
     ) -> Result<()> {
-        let n = self.b_in * self.b_in;
-        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
-        self.s2.forward(signal, &mut sig)?;
-        self.s2.forward(pattern, &mut pat)?;
-        combine((&sig, &pat), self.b_in, self.deg_lim, self.b_out, out)
+        self.with_buffers(|buf| {
+            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
+            check_len("SO(3) coefficients", buf.so3.len(), out.len())?;
+            out.copy_from_slice(&buf.so3);
+            Ok(())
+        })
     }
 
     /// [`Correlation::coefficients`] of real samples.
@@ -153,11 +235,13 @@ impl Correlation {
         pattern: &[f64],
         out: &mut [Complex64],
     ) -> Result<()> {
-        let n = self.b_in * self.b_in;
-        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
-        self.s2.forward_real(signal, &mut sig)?;
-        self.s2.forward_real(pattern, &mut pat)?;
-        combine((&sig, &pat), self.b_in, self.deg_lim, self.b_out, out)
+        self.with_buffers(|buf| {
+            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
+            check_len("SO(3) coefficients", buf.so3.len(), out.len())?;
+            out.copy_from_slice(&buf.so3);
+            Ok(())
+        })
     }
 
     /// Whether the plan takes real inputs.
@@ -170,6 +254,17 @@ impl Correlation {
         self.deg_lim
     }
 
+    fn need(&self, real: bool) -> Result<()> {
+        if real != self.real {
+            return Err(Error::InvalidArgument(format!(
+                "{} correlation asked of a plan made for {} inputs",
+                if real { "real" } else { "complex" },
+                if self.real { "real" } else { "complex" }
+            )));
+        }
+        Ok(())
+    }
+
     /// The correlation of complex samples (`(2 b_in)^2` each) into `out` (`(2 b_out)^3`).
     /// For a plan made with `real`, use [`Correlation::correlate_real`].
     pub fn correlate(
@@ -178,43 +273,124 @@ impl Correlation {
         pattern: &[Complex64],
         out: &mut [Complex64],
     ) -> Result<()> {
-        if self.real {
-            return Err(Error::InvalidArgument(
-                "complex correlation asked of a plan made for real inputs".into(),
-            ));
-        }
-        self.with_buffers(|buf| {
-            self.s2.forward(signal, &mut buf.sig)?;
-            self.s2.forward(pattern, &mut buf.pat)?;
-            combine(
-                (&buf.sig, &buf.pat),
-                self.b_in,
-                self.deg_lim,
-                self.b_out,
-                &mut buf.so3,
-            )?;
-            self.so3.inverse(&buf.so3, out)
-        })
+        self.correlate_shells(&[(signal, pattern, 1.0)], out)
     }
 
     /// The correlation of real samples into the real grid `out` (plan made with `real`).
     pub fn correlate_real(&self, signal: &[f64], pattern: &[f64], out: &mut [f64]) -> Result<()> {
-        if !self.real {
-            return Err(Error::InvalidArgument(
-                "real correlation asked of a plan made for complex inputs".into(),
-            ));
-        }
+        self.correlate_shells_real(&[(signal, pattern, 1.0)], out)
+    }
+
+    /// The weighted sum `sum_s w_s C_s` of the correlations of several shells (pairs of
+    /// signal and pattern samples, e.g. the radial shells of two volumes): one pair of S^2
+    /// transforms per shell and one inverse SO(3) transform.
+    pub fn correlate_shells(
+        &self,
+        shells: &[(&[Complex64], &[Complex64], f64)],
+        out: &mut [Complex64],
+    ) -> Result<()> {
+        self.need(false)?;
         self.with_buffers(|buf| {
-            self.s2.forward_real(signal, &mut buf.sig)?;
-            self.s2.forward_real(pattern, &mut buf.pat)?;
-            combine(
-                (&buf.sig, &buf.pat),
-                self.b_in,
-                self.deg_lim,
-                self.b_out,
-                &mut buf.so3,
-            )?;
+            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
+            self.combine_shells(shells, fwd, buf)?;
+            self.so3.inverse(&buf.so3, out)
+        })
+    }
+
+    /// [`Correlation::correlate_shells`] of real samples.
+    pub fn correlate_shells_real(
+        &self,
+        shells: &[(&[f64], &[f64], f64)],
+        out: &mut [f64],
+    ) -> Result<()> {
+        self.need(true)?;
+        self.with_buffers(|buf| {
+            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
+            self.combine_shells(shells, fwd, buf)?;
             self.so3.inverse_real(&buf.so3, out)
         })
     }
+
+    /// One signal against `howmany` patterns stored one after another (`howmany (2 b_in)^2`
+    /// samples) into `howmany` grids stored one after another: the signal is transformed
+    /// once.
+    pub fn correlate_many(
+        &self,
+        signal: &[Complex64],
+        patterns: &[Complex64],
+        out: &mut [Complex64],
+    ) -> Result<()> {
+        self.need(false)?;
+        let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
+        check_many(patterns.len(), ns, out.len(), ng)?;
+        self.with_buffers(|buf| {
+            let mut sig = vec![Complex64::default(); self.b_in * self.b_in];
+            self.s2.forward(signal, &mut sig)?;
+            let known = |x: &[Complex64], c: &mut [Complex64]| {
+                if std::ptr::eq(x, signal) {
+                    c.copy_from_slice(&sig);
+                    Ok(())
+                } else {
+                    self.s2.forward(x, c)
+                }
+            };
+            for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
+                self.combine_shells(&[(signal, pattern, 1.0)], known, buf)?;
+                self.so3.inverse(&buf.so3, grid)?;
+            }
+            Ok(())
+        })
+    }
+
+    /// [`Correlation::correlate_many`] of real samples.
+    pub fn correlate_many_real(
+        &self,
+        signal: &[f64],
+        patterns: &[f64],
+        out: &mut [f64],
+    ) -> Result<()> {
+        self.need(true)?;
+        let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
+        check_many(patterns.len(), ns, out.len(), ng)?;
+        self.with_buffers(|buf| {
+            let mut sig = vec![Complex64::default(); self.b_in * self.b_in];
+            self.s2.forward_real(signal, &mut sig)?;
+            let known = |x: &[f64], c: &mut [Complex64]| {
+                if std::ptr::eq(x, signal) {
+                    c.copy_from_slice(&sig);
+                    Ok(())
+                } else {
+                    self.s2.forward_real(x, c)
+                }
+            };
+            for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
+                self.combine_shells(&[(signal, pattern, 1.0)], known, buf)?;
+                self.so3.inverse_real(&buf.so3, grid)?;
+            }
+            Ok(())
+        })
+    }
+}
+
+/// An error unless `got == expected`.
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
+    if got != expected {
+        return Err(Error::LengthMismatch {
+            what,
+            expected,
+            got,
+        });
+    }
+    Ok(())
+}
+
+/// An error unless `patterns` holds a positive number of fields of `ns` and `out` as many
+/// of `ng`.
+fn check_many(patterns: usize, ns: usize, out: usize, ng: usize) -> Result<()> {
+    if patterns == 0 || !patterns.is_multiple_of(ns) {
+        return Err(Error::InvalidArgument(format!(
+            "{patterns} pattern samples are not a positive multiple of {ns}"
+        )));
+    }
+    check_len("correlation grids", patterns / ns * ng, out)
 }
