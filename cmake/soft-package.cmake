@@ -14,7 +14,7 @@ if(NOT TARGET so3fft::soft AND TARGET so3fft::so3fft)
   endif()
   add_library(so3fft::soft INTERFACE IMPORTED)
   set_target_properties(so3fft::soft PROPERTIES
-    INTERFACE_INCLUDE_DIRECTORIES "${so3fft_INCLUDE_DIR}/so3fft/soft"
+    INTERFACE_INCLUDE_DIRECTORIES "${so3fft_INCLUDE_DIR}/so3fft/soft;${so3fft_INCLUDE_DIR}/so3fft"
     INTERFACE_LINK_LIBRARIES "so3fft::so3fft;${_so3fft_soft_fftw};m")
   unset(_so3fft_soft_fftw)
 endif()

@@ -4,6 +4,8 @@
 #   KIND=cmake      separate CMake project: find_package(so3fft CONFIG REQUIRED), links
 #                   so3fft::so3fft and so3fft::so3fft_static; the static executable must still
 #                   run once the prefix is gone.
+#   KIND=soft20     a SOFT 2.0 client project: find_package(soft20), headers included bare, as
+#                   soft/... and as soft20/...
 #   KIND=pkgconfig  `pkg-config --cflags --libs so3fft` (shared) and
 #                   `pkg-config --static --cflags --libs so3fft` with -static (fully static).
 # Inputs: KIND, BUILD_DIR, WORK_DIR, SOURCE_DIR, C_COMPILER, GENERATOR.
@@ -66,6 +68,13 @@ if(KIND STREQUAL "cmake")
     message(FATAL_ERROR "use_shared ran without the installed libso3fft.so: not linked dynamically?")
   endif()
   message(STATUS "downstream CMake project: OK")
+elseif(KIND STREQUAL "soft20")
+  run("${CMAKE_COMMAND}" -S "${SOURCE_DIR}/soft20" -B "${WORK_DIR}/build" -G "${GENERATOR}"
+      "-DCMAKE_C_COMPILER=${C_COMPILER}" "-DCMAKE_PREFIX_PATH=${prefix}"
+      -DCMAKE_BUILD_TYPE=Release)
+  run("${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
+  run("${CMAKE_CTEST_COMMAND}" --test-dir "${WORK_DIR}/build" --output-on-failure)
+  message(STATUS "downstream soft20 client: OK")
 elseif(KIND STREQUAL "pkgconfig")
   find_program(PKG_CONFIG pkg-config REQUIRED)
   get_filename_component(pcdir "${pcfile}" DIRECTORY)
