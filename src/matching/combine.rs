@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::grid::{block_start, num_coeffs};
-use crate::s2::s2_coef_index;
+use crate::s2::order_start;
 use num_complex::Complex64;
 use std::f64::consts::PI;
 
@@ -54,7 +54,8 @@ pub(super) fn check(
 }
 
 /// Adds `scale` times the combination of degrees `from..=to` to `out` (lengths checked by
-/// the caller with [`check`]).
+/// the caller with [`check`]). For each order pair the degrees are consecutive in all three
+/// arrays, so the inner loop runs over contiguous runs.
 pub(super) fn add_combined(
     (sig, pat): (&[Complex64], &[Complex64]),
     b_in: usize,
@@ -62,20 +63,31 @@ pub(super) fn add_combined(
     b_out: usize,
     (scale, out): (f64, &mut [Complex64]),
 ) {
-    for l in from..=to {
-        let li = l as isize;
-        let norm = scale * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt();
-        for m1 in -li..=li {
-            let f = sig[s2_coef_index(b_in, l, -m1)];
-            for m2 in -li..=li {
-                let h = pat[s2_coef_index(b_in, l, -m2)];
-                let sign = if (m1 + m2).rem_euclid(2) == 0 {
-                    norm
-                } else {
-                    -norm
-                };
-                out[block_start(b_out, m1, m2) + (l - m1.unsigned_abs().max(m2.unsigned_abs()))] +=
-                    f * h.conj() * sign;
+    if from > to {
+        return;
+    }
+    let norms: Vec<f64> = (0..=to)
+        .map(|l| scale * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt())
+        .collect();
+    let top = to as isize;
+    for m1 in -top..=top {
+        // fhat(l, -m1) for l = |m1|.. is consecutive from order_start(-m1).
+        let f_row = &sig[order_start(b_in, -m1)..];
+        for m2 in -top..=top {
+            let h_row = &pat[order_start(b_in, -m2)..];
+            let (a1, a2) = (m1.unsigned_abs(), m2.unsigned_abs());
+            let l0 = a1.max(a2).max(from);
+            if l0 > to {
+                continue;
+            }
+            let sign = if (m1 + m2).rem_euclid(2) == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            let base = block_start(b_out, m1, m2) - a1.max(a2);
+            for l in l0..=to {
+                out[base + l] += f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
             }
         }
     }

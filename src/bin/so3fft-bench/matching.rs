@@ -57,6 +57,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                 l,
                 &CorrelationOptions {
                     threads,
+                    rigor: opts.rigor,
                     ..Default::default()
                 },
             )?;
@@ -80,6 +81,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                 &CorrelationOptions {
                     real: true,
                     threads,
+                    rigor: opts.rigor,
                     ..Default::default()
                 },
             )?;
