@@ -292,3 +292,84 @@ fn bandwidth_2048() {
         assert!(err < 1e-11, "B = 2048, (l, m) = ({l}, {m}): error {err:e}");
     }
 }
+
+/// Degree and order limits: the limited transforms equal the full ones on coefficients with
+/// the absent degrees and orders zeroed (the forward writes those as 0), complex and real.
+#[test]
+fn degree_and_order_limits_equal_zeroed_full_transforms() {
+    let mut rng = Rng::new(44);
+    for (b, lim, mmax) in [(16usize, 9usize, 16usize), (16, 16, 3), (21, 12, 5)] {
+        let full = plan(b, 2);
+        let limited = S2Plan::new(
+            b,
+            &S2Options {
+                threads: 2,
+                degree_limit: Some(lim),
+                order_limit: Some(mmax),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let keep = |l: usize, m: isize| l < lim && m.unsigned_abs() <= mmax;
+        let mut coefs = rng.complex_vec(b * b);
+        let mut zeroed = coefs.clone();
+        for l in 0..b {
+            for m in -(l as isize)..=l as isize {
+                if !keep(l, m) {
+                    zeroed[s2_coef_index(b, l, m)] = Complex64::default();
+                }
+            }
+        }
+        let n = 4 * b * b;
+        let (mut a, mut c) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+        limited.inverse(&coefs, &mut a).unwrap();
+        full.inverse(&zeroed, &mut c).unwrap();
+        let err = max_diff(&a, &c) / max_abs(&c);
+        assert!(err < 1e-14, "B {b} L {lim} M {mmax}: inverse {err:e}");
+        let (mut fa, mut fc) = (
+            vec![Complex64::default(); b * b],
+            vec![Complex64::default(); b * b],
+        );
+        let samples = rng.complex_vec(n);
+        limited.forward(&samples, &mut fa).unwrap();
+        full.forward(&samples, &mut fc).unwrap();
+        for l in 0..b {
+            for m in -(l as isize)..=l as isize {
+                let i = s2_coef_index(b, l, m);
+                if keep(l, m) {
+                    assert!((fa[i] - fc[i]).norm() < 1e-13, "B {b}: forward ({l}, {m})");
+                } else {
+                    assert_eq!(fa[i], Complex64::default());
+                }
+            }
+        }
+        // Real: the round trip of a band- and order-limited real function.
+        for l in 0..b {
+            zeroed[s2_coef_index(b, l, 0)].im = 0.0;
+            for m in 1..=l as isize {
+                let v = zeroed[s2_coef_index(b, l, m)];
+                zeroed[s2_coef_index(b, l, -m)] = if m % 2 == 0 { v.conj() } else { -v.conj() };
+            }
+        }
+        let mut real = vec![0.0; n];
+        limited.inverse_real(&zeroed, &mut real).unwrap();
+        limited.forward_real(&real, &mut coefs).unwrap();
+        assert!(
+            relative_l2(&coefs, &zeroed) < 1e-14,
+            "B {b}: limited real round trip"
+        );
+    }
+    let bad = |d, o| {
+        S2Plan::new(
+            8,
+            &S2Options {
+                degree_limit: d,
+                order_limit: o,
+                ..Default::default()
+            },
+        )
+    };
+    assert!(bad(Some(0), None).is_err());
+    assert!(bad(Some(9), None).is_err());
+    assert!(bad(None, Some(0)).is_ok());
+}

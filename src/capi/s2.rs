@@ -46,7 +46,7 @@ pub extern "C" fn so3fft_plan_s2(B: c_int, flags: c_uint, nthreads: c_int) -> so
         let options = S2Options {
             threads: threads_of(nthreads)?,
             rigor: rigor_of(flags)?,
-            isa: None,
+            ..S2Options::default()
         };
         let plan = S2Plan::new(b, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_s2_plan_s { plan })))

@@ -70,7 +70,9 @@ impl Correlation {
             &S2Options {
                 threads: options.threads,
                 rigor: options.rigor,
-                isa: None,
+                // Only the combined degrees are needed.
+                degree_limit: Some(deg_lim + 1),
+                ..S2Options::default()
             },
         )?;
         let so3 = Plan::new(

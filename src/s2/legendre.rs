@@ -126,6 +126,8 @@ impl Scratch {
 /// Tables and scratch of the Legendre stage for one bandwidth.
 pub(super) struct LegendreStage {
     b: usize,
+    /// Degrees computed: `l < lend` (`lend <= b`; the others are zero).
+    lend: usize,
     isa: Isa,
     /// Lanes: the `B` northern rings, padded to the vector width.
     lanes: usize,
@@ -140,10 +142,12 @@ pub(super) struct LegendreStage {
 
 impl LegendreStage {
     /// The stage for bandwidth `b` with `workers` scratches.
-    pub(super) fn new(b: usize, isa: Isa, workers: usize) -> LegendreStage {
+    pub(super) fn new(b: usize, lend: usize, isa: Isa, workers: usize) -> LegendreStage {
+        assert!(0 < lend && lend <= b);
         let lanes = b.next_multiple_of(isa.lanes());
         LegendreStage {
             b,
+            lend,
             isa,
             lanes,
             recurrence: RecTables::new(b),
@@ -181,7 +185,7 @@ impl LegendreStage {
 
     /// Recurrence coefficients and lane inputs of order `m`; the number of degrees.
     fn setup(&self, sc: &mut Scratch, m: usize) -> usize {
-        let n = self.b - m;
+        let n = self.lend - m;
         sc.rec.resize(n);
         self.recurrence.coeffs(m, 0, &mut sc.rec);
         let b = self.b;
@@ -251,9 +255,18 @@ impl LegendreStage {
             let lo = dwt::forward(self.isa, P, &rec, &lanes, &sc.rows, &mut sums);
             for (q, g) in groups.iter().enumerate() {
                 let f = g.sign(m) * factor;
-                // SAFETY: |order| < b; the block has n = b - m entries, this task's alone
+                // SAFETY: |order| < b; the block has b - m >= n entries, this task's alone
                 // (caller's contract), as has the partner block written below.
                 let (own, partner) = unsafe { (g.coef.block(g.order), g.coef.block(-g.order)) };
+                for i in n..b - m {
+                    // SAFETY: entry i < b - m of the blocks: degrees beyond the limit are 0.
+                    unsafe {
+                        *own.add(i) = Complex64::default();
+                        if g.partner && m > 0 {
+                            *partner.add(i) = Complex64::default();
+                        }
+                    }
+                }
                 for i in 0..n {
                     let odd = i % 2;
                     let v = if i < lo {
@@ -277,6 +290,37 @@ impl LegendreStage {
             }
             sc.sums = sums;
         });
+    }
+
+    /// Zeros for order `m` (not computed: beyond a degree or order limit): the groups'
+    /// coefficient blocks (and partners) with `coeffs`, else their ring spectra.
+    ///
+    /// # Safety
+    /// As for [`LegendreStage::analyse`].
+    pub(super) unsafe fn zero_order(&self, m: usize, groups: &[Group], coeffs: bool) {
+        let b = self.b;
+        for g in groups {
+            if coeffs {
+                // SAFETY: |order| < b: blocks of b - m entries, this task's (caller's contract).
+                unsafe {
+                    let own = g.coef.block(g.order);
+                    std::ptr::write_bytes(own, 0, b - m);
+                    if g.partner && m > 0 {
+                        std::ptr::write_bytes(g.coef.block(-g.order), 0, b - m);
+                    }
+                }
+            } else {
+                for k in 0..2 * b {
+                    // SAFETY: ring k's value of the order, this task's column.
+                    unsafe { *g.spectra.at(k, g.order) = Complex64::default() };
+                }
+            }
+        }
+    }
+
+    /// Whether order `m` is computed (within the degree limit).
+    pub(super) fn computes(&self, m: usize) -> bool {
+        m < self.lend
     }
 
     /// Inverse (synthesis) of order `m >= 0` for up to two column groups:

@@ -25,6 +25,12 @@ pub struct S2Options {
     pub rigor: Rigor,
     /// Instruction set of the kernels (`None`: the best this CPU has).
     pub isa: Option<Isa>,
+    /// Degree limit `L <= B`: only degrees `l < L` are computed (forward: the others are
+    /// written as 0; inverse: they are not read). `None`: `B`.
+    pub degree_limit: Option<usize>,
+    /// Order limit: only orders `|m| <= Mmax` are computed (as for the degree limit).
+    /// `None`: all.
+    pub order_limit: Option<usize>,
 }
 
 /// Spherical-harmonic transforms of bandwidth `B` on SOFT's grid
@@ -45,6 +51,8 @@ pub struct S2Plan {
     legendre: LegendreStage,
     /// Start of each order's coefficient block, indexed by `m + B - 1`.
     starts: Vec<usize>,
+    /// Orders `|m| <= order_limit` are computed.
+    order_limit: usize,
     /// Ring spectra (`(2B)^2` values), taken by one execution at a time.
     scratch: Mutex<Option<AlignedBuf>>,
     /// A second ring scratch for the real transforms of two fields at once (made on first
@@ -86,7 +94,13 @@ impl S2Plan {
         )?;
         let scratch = AlignedBuf::new(scratch_len(b))?;
         let rings = RingFft::new(n, options.rigor)?;
-        let legendre = LegendreStage::new(b, isa, threads);
+        let lend = options.degree_limit.unwrap_or(b);
+        if lend == 0 || lend > b {
+            return Err(Error::InvalidArgument(format!(
+                "degree limit {lend} outside 1..={b} (degrees l < L are computed)"
+            )));
+        }
+        let legendre = LegendreStage::new(b, lend, isa, threads);
         let starts = (-(b as isize - 1)..b as isize)
             .map(|m| order_start(b, m))
             .collect();
@@ -98,6 +112,7 @@ impl S2Plan {
             rings,
             legendre,
             starts,
+            order_limit: options.order_limit.unwrap_or(b),
             scratch: Mutex::new(Some(scratch)),
             spare: Mutex::new(None),
         })
@@ -213,6 +228,36 @@ impl S2Plan {
         })
     }
 
+    /// The Legendre analysis of order `m`, or zeros beyond the degree and order limits.
+    ///
+    /// # Safety
+    /// As for `LegendreStage::analyse`.
+    unsafe fn analyse(&self, m: usize, groups: &[Group], factor: f64) {
+        // SAFETY: the caller's contract is the stage's.
+        unsafe {
+            if m <= self.order_limit && self.legendre.computes(m) {
+                self.legendre.analyse(m, groups, factor)
+            } else {
+                self.legendre.zero_order(m, groups, true)
+            }
+        }
+    }
+
+    /// The Legendre synthesis of order `m`, or zero spectra beyond the limits.
+    ///
+    /// # Safety
+    /// As for `LegendreStage::synthesise`.
+    unsafe fn synthesise(&self, m: usize, groups: &[Group], factor: f64) {
+        // SAFETY: the caller's contract is the stage's.
+        unsafe {
+            if m <= self.order_limit && self.legendre.computes(m) {
+                self.legendre.synthesise(m, groups, factor)
+            } else {
+                self.legendre.zero_order(m, groups, false)
+            }
+        }
+    }
+
     /// The column groups of order `m` of a complex field: `m` and, for `m > 0`, `-m`.
     fn complex_groups(m: usize, spectra: Spectra, coef: CoeffRows) -> ([Group; 2], usize) {
         let g = |order: isize| Group {
@@ -256,7 +301,7 @@ impl S2Plan {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
                         // SAFETY: each task handles orders +-m only; the spectra and the
                         // coefficient array are whole (lengths checked).
-                        unsafe { self.legendre.analyse(m, &groups[..count], factor) }
+                        unsafe { self.analyse(m, &groups[..count], factor) }
                     });
                     Ok::<(), Error>(())
                 })?;
@@ -293,7 +338,7 @@ impl S2Plan {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
                         // SAFETY: each task writes the columns of orders +-m only and reads
                         // their coefficient blocks (never written).
-                        unsafe { self.legendre.synthesise(m, &groups[..count], factor) }
+                        unsafe { self.synthesise(m, &groups[..count], factor) }
                     });
                     // The frequency B is never used.
                     for k in 0..n {
@@ -353,7 +398,7 @@ impl S2Plan {
                         }
                         // SAFETY: as in `forward_many`; each field has its own spectra
                         // and coefficient array.
-                        unsafe { self.legendre.analyse(m, &g[..groups.len()], factor) }
+                        unsafe { self.analyse(m, &g[..groups.len()], factor) }
                     })
                 });
             }
@@ -450,7 +495,7 @@ impl S2Plan {
                             };
                         }
                         // SAFETY: as in `inverse_many`; each field has its own spectra.
-                        unsafe { self.legendre.synthesise(m, &g[..groups.len()], factor) }
+                        unsafe { self.synthesise(m, &g[..groups.len()], factor) }
                     })
                 });
                 for (i, out) in outs.chunks_exact_mut(n * n).enumerate().take(count) {

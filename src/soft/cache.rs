@@ -181,6 +181,6 @@ pub(super) fn s2_options() -> S2Options {
     S2Options {
         threads: env_threads(),
         rigor: env_rigor(),
-        isa: None,
+        ..S2Options::default()
     }
 }
