@@ -484,3 +484,85 @@ fn many_patterns_equal_single_correlations() {
         .correlate_many(&sig, &pats[..ns - 1], &mut many)
         .is_err());
 }
+
+/// The whole correlation grid against its definition, `C(g) = int f(x) conj(h(g^-1 x)) dx`,
+/// at small L: f and h summed directly from their coefficients with the explicit `Y_l^m`,
+/// `h` at the rotated points `g^-1 x` (rotation matrix), the integral by the exact S^2
+/// quadrature of bandwidth 2L (the product has degree < 2L - 1).
+#[test]
+fn correlation_grid_matches_direct_integration() {
+    let l = 4usize;
+    let mut rng = common::Rng::new(8);
+    let (fhat, hhat) = (rng.complex_vec(l * l), rng.complex_vec(l * l));
+    let y = |deg: usize, m: isize, theta: f64, phi: f64| {
+        Complex64::from_polar(
+            common::dt_explicit(deg, m, 0, theta) / (2.0 * std::f64::consts::PI).sqrt(),
+            m as f64 * phi,
+        )
+    };
+    let eval = |hat: &[Complex64], theta: f64, phi: f64| {
+        let mut v = Complex64::default();
+        for deg in 0..l {
+            for m in -(deg as isize)..=deg as isize {
+                v += hat[s2_coef_index(l, deg, m)] * y(deg, m, theta, phi);
+            }
+        }
+        v
+    };
+    // Samples for the plan (grid of bandwidth L).
+    let grid_samples = |hat: &[Complex64]| {
+        let n = 2 * l;
+        let mut s = vec![Complex64::default(); n * n];
+        for j in 0..n {
+            for k in 0..n {
+                let (theta, phi) = (so3fft::beta(l, j), so3fft::alpha(l, k));
+                s[j * n + k] = eval(hat, theta, phi);
+            }
+        }
+        s
+    };
+    let plan = Correlation::new(l, &CorrelationOptions::default()).unwrap();
+    let mut grid = vec![Complex64::default(); plan.num_grid()];
+    plan.correlate(&grid_samples(&fhat), &grid_samples(&hhat), &mut grid)
+        .unwrap();
+
+    let bq = 2 * l; // quadrature bandwidth
+    let wq = so3fft::weights(bq);
+    let nq = 2 * bq;
+    let points: Vec<(f64, [f64; 3], Complex64)> = (0..nq * nq)
+        .map(|i| {
+            let (j, k) = (i / nq, i % nq);
+            let (theta, phi) = (so3fft::beta(bq, j), so3fft::alpha(bq, k));
+            let x = [
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ];
+            let w = wq[j] * std::f64::consts::PI / bq as f64;
+            (w, x, eval(&fhat, theta, phi))
+        })
+        .collect();
+    let n = 2 * l;
+    let scale = grid.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    for (index, got) in grid.iter().enumerate() {
+        let peak = so3fft::matching::Peak::at(l, index, 0.0);
+        let r = peak.rotation().matrix();
+        let mut want = Complex64::default();
+        for &(w, x, fx) in &points {
+            // g^-1 x = R^T x
+            let v = [
+                r[0][0] * x[0] + r[1][0] * x[1] + r[2][0] * x[2],
+                r[0][1] * x[0] + r[1][1] * x[1] + r[2][1] * x[2],
+                r[0][2] * x[0] + r[1][2] * x[1] + r[2][2] * x[2],
+            ];
+            let theta = v[2].clamp(-1.0, 1.0).acos();
+            let phi = v[1].atan2(v[0]);
+            want += fx * eval(&hhat, theta, phi).conj() * w;
+        }
+        assert!(
+            (got - want).norm() < 1e-12 * scale,
+            "grid point {index} of {}: {got} against {want}",
+            n * n * n
+        );
+    }
+}
