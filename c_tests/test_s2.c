@@ -94,6 +94,32 @@ int main(void) {
         free(r2);
     }
 
+    /* a limited plan: degrees < 9, orders |m| <= 3; the other coefficients come out 0 and the
+     * kept ones as from the full plan */
+    {
+        so3fft_s2_plan q = so3fft_plan_s2_limited(b, 9, 3, SO3FFT_ESTIMATE, 1);
+        so3fft_complex *c3 = alloc_cx(nc);
+        CHECK(q != NULL);
+        fill_random((so3fft_complex *)s, ns, 17);
+        CHECK(so3fft_s2_execute_forward(q, s, c3) == SO3FFT_OK);
+        CHECK(so3fft_s2_execute_forward(p, s, c2) == SO3FFT_OK);
+        for (l = 0; l < b; l++)
+            for (m = -l; m <= l; m++) {
+                ptrdiff_t at = so3fft_s2_coef_index(b, l, m);
+                if (l < 9 && m >= -3 && m <= 3)
+                    CHECK(hypot(c3[at][0] - c2[at][0], c3[at][1] - c2[at][1]) < 1e-13);
+                else
+                    CHECK(c3[at][0] == 0.0 && c3[at][1] == 0.0);
+            }
+        CHECK(so3fft_plan_s2_limited(b, 0, 3, SO3FFT_ESTIMATE, 1) == NULL);
+        CHECK_ERR(SO3FFT_EINVAL);
+        CHECK(so3fft_plan_s2_limited(b, b + 1, 3, SO3FFT_ESTIMATE, 1) == NULL);
+        CHECK(so3fft_plan_s2_limited(b, 4, -1, SO3FFT_ESTIMATE, 1) == NULL);
+        CHECK_ERR(SO3FFT_EINVAL);
+        so3fft_destroy_s2_plan(q);
+        free(c3);
+    }
+
     /* the index is seanindex */
     for (m = -(b - 1); m < b; m++)
         for (l = m < 0 ? -m : m; l < b; l++)

@@ -218,6 +218,11 @@ int so3fft_max_bandwidth(void);
 // NULL on error.
 so3fft_s2_plan so3fft_plan_s2(int B, unsigned int flags, int nthreads);
 
+// As `so3fft_plan_s2`, computing only degrees `l < L` (`1 <= L <= B`) of orders
+// `|m| <= Mmax` (`Mmax >= 0`): the forward writes the other coefficients as 0, the inverse
+// does not read them. NULL on error.
+so3fft_s2_plan so3fft_plan_s2_limited(int B, int L, int Mmax, unsigned int flags, int nthreads);
+
 // Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
 void so3fft_destroy_s2_plan(so3fft_s2_plan p);
 

@@ -70,8 +70,8 @@ pub use query::{
     so3fft_plan_memory,
 };
 pub use s2::{
-    so3fft_destroy_s2_plan, so3fft_plan_s2, so3fft_s2_coef_index, so3fft_s2_execute_forward,
-    so3fft_s2_execute_forward_many, so3fft_s2_execute_forward_real,
+    so3fft_destroy_s2_plan, so3fft_plan_s2, so3fft_plan_s2_limited, so3fft_s2_coef_index,
+    so3fft_s2_execute_forward, so3fft_s2_execute_forward_many, so3fft_s2_execute_forward_real,
     so3fft_s2_execute_forward_real_many, so3fft_s2_execute_inverse, so3fft_s2_execute_inverse_many,
     so3fft_s2_execute_inverse_real, so3fft_s2_execute_inverse_real_many, so3fft_s2_get_bandwidth,
     so3fft_s2_num_coeffs, so3fft_s2_num_samples, so3fft_s2_plan, so3fft_s2_plan_s,

@@ -53,6 +53,39 @@ pub extern "C" fn so3fft_plan_s2(B: c_int, flags: c_uint, nthreads: c_int) -> so
     })
 }
 
+/// As `so3fft_plan_s2`, computing only degrees `l < L` (`1 <= L <= B`) of orders
+/// `|m| <= Mmax` (`Mmax >= 0`): the forward writes the other coefficients as 0, the inverse
+/// does not read them. NULL on error.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_s2_limited(
+    B: c_int,
+    L: c_int,
+    Mmax: c_int,
+    flags: c_uint,
+    nthreads: c_int,
+) -> so3fft_s2_plan {
+    guarded(std::ptr::null_mut(), || {
+        let b = s2_bandwidth(B)?;
+        let limit = |v: c_int, what: &str| {
+            usize::try_from(v).map_err(|_| CallError::invalid(format!("{what} {v} must be >= 0")))
+        };
+        if flags & (SO3FFT_DESTROY_INPUT | SO3FFT_REAL) != 0 {
+            return Err(CallError::invalid(format!(
+                "flags 0x{flags:x}: an S^2 plan takes only a planner rigour"
+            )));
+        }
+        let options = S2Options {
+            threads: threads_of(nthreads)?,
+            rigor: rigor_of(flags)?,
+            degree_limit: Some(limit(L, "degree limit L")?),
+            order_limit: Some(limit(Mmax, "order limit Mmax")?),
+            ..S2Options::default()
+        };
+        let plan = S2Plan::new(b, &options)?;
+        Ok(Box::into_raw(Box::new(so3fft_s2_plan_s { plan })))
+    })
+}
+
 /// Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_destroy_s2_plan(p: so3fft_s2_plan) {
