@@ -6,8 +6,8 @@
 //!
 //! `cargo run --release --example demo [-- B1,B2,... [L]]`
 
+use so3fft::matching::Rotation;
 use so3fft::matching::{grid_argmax_real, rotate_s2_coeffs, Correlation, CorrelationOptions};
-use so3fft::matching::{Rotation, So3Series};
 use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
 use so3fft::{Complex64, Plan, PlanOptions};
 use std::time::Instant;
@@ -151,8 +151,7 @@ fn matching(l: usize, threads: usize) -> Result<(), Box<dyn std::error::Error>> 
     let t = Instant::now();
     let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(plan.b_out())];
     plan.coefficients_real(&sig, &pat, &mut coeffs)?;
-    let (refined, _) =
-        So3Series::new(plan.b_out(), plan.deg_lim(), &coeffs).maximise(&peak.rotation());
+    let (refined, _) = plan.refine(&coeffs, &peak.rotation())?;
     let t_refine = t.elapsed().as_secs_f64();
     let show = |g: &Rotation| format!("({:.9}, {:.9}, {:.9})", g.alpha, g.beta, g.gamma);
     println!(

@@ -6,7 +6,7 @@
 //! correlation value and the time of each stage.
 
 use so3fft::matching::{
-    grid_argmax, grid_argmax_real, top_peaks, Correlation, CorrelationOptions, Peak, So3Series,
+    grid_argmax, grid_argmax_real, top_peaks, Correlation, CorrelationOptions, Peak,
 };
 use so3fft::Complex64;
 use std::process::ExitCode;
@@ -184,8 +184,7 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
         plan.coefficients(&to_c(&sig), &to_c(&pat), &mut coeffs)
             .map_err(fail)?;
     }
-    let series = So3Series::new(bo, plan.deg_lim(), &coeffs);
-    let (refined, value) = series.maximise(&best.rotation());
+    let (refined, value) = plan.refine(&coeffs, &best.rotation()).map_err(fail)?;
     let t_refine = t.elapsed().as_secs_f64();
     println!(
         "input: B = {b}, {} samples; SO(3) grid of bandwidth {bo} (step {:.3e} rad)",
@@ -201,7 +200,7 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
         refined.angle_to(&best.rotation())
     );
     for (i, p) in peaks.iter().enumerate() {
-        let (g, v) = series.maximise(&p.rotation());
+        let (g, v) = plan.refine(&coeffs, &p.rotation()).map_err(fail)?;
         println!(
             "peak {}: grid {}  refined alpha {:.10} beta {:.10} gamma {:.10}  |C|^2 = {v:.6e}",
             i + 1,

@@ -5,7 +5,7 @@ use super::{SO3FFT_DESTROY_INPUT, SO3FFT_ENULL};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
 use crate::matching::{
-    grid_argmax, grid_argmax_real, Correlation, CorrelationOptions, Peak, Rotation, So3Series,
+    grid_argmax, grid_argmax_real, Correlation, CorrelationOptions, Peak, Rotation,
 };
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_uint};
@@ -262,7 +262,7 @@ pub unsafe extern "C" fn so3fft_correlation_refine(
                 plan.coefficients(s, h, &mut coeffs)?;
             }
             let start = Rotation::new(*angles, *angles.add(1), *angles.add(2));
-            let (g, v) = So3Series::new(b_out, plan.deg_lim(), &coeffs).maximise(&start);
+            let (g, v) = plan.refine(&coeffs, &start)?;
             *angles = g.alpha;
             *angles.add(1) = g.beta;
             *angles.add(2) = g.gamma;

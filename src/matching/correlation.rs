@@ -246,6 +246,19 @@ impl Correlation {
         })
     }
 
+    /// The rotation near `start` where `|C|^2` of the correlation with SO(3) coefficients
+    /// `coeffs` (from [`Correlation::coefficients`]) is largest, and `|C|^2` there
+    /// ([`So3Series::maximise`](super::So3Series::maximise) on the plan's threads).
+    pub fn refine(
+        &self,
+        coeffs: &[Complex64],
+        start: &super::Rotation,
+    ) -> Result<(super::Rotation, f64)> {
+        check_len("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
+        let series = super::So3Series::new(self.b_out, self.deg_lim, coeffs);
+        Ok(self.s2.install(|| series.maximise(start)))
+    }
+
     /// Whether the plan takes real inputs.
     pub fn is_real(&self) -> bool {
         self.real

@@ -9,6 +9,7 @@ use crate::symmetry::Cluster;
 use crate::wigner::column::column_with;
 use crate::wigner::{start_norms, BetaTables, RecCoeffs, RecTables};
 use num_complex::Complex64;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// A band-limited function on SO(3) given by its coefficients (bandwidth `b`, degrees up to
@@ -63,8 +64,10 @@ impl<'a> So3Series<'a> {
             (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
         };
         let betas = BetaTables::new(&[(cs, sn), (sn, cs)], 2 * self.lmax);
-        let mut rec = RecCoeffs::new(self.lmax + 1);
-        for m in 0..=self.lmax {
+        // The members' sums of the clusters with base order `m`, as (index in `s`, value).
+        let row = |m: usize| -> Vec<(usize, Complex64)> {
+            let mut rec = RecCoeffs::new(self.lmax + 1);
+            let mut out = Vec::with_capacity(8 * (m + 1));
             for mp in 0..=m {
                 let cluster = Cluster::new(m, mp);
                 rec.resize(self.lmax + 1 - m);
@@ -84,9 +87,21 @@ impl<'a> So3Series<'a> {
                         let sign = if i % 2 == 0 { even } else { odd };
                         sum += c * (sign * dt);
                     }
-                    s[(mem.m + top) as usize * w + (mem.mp + top) as usize] = sum / (2.0 * PI);
+                    let at = (mem.m + top) as usize * w + (mem.mp + top) as usize;
+                    out.push((at, sum / (2.0 * PI)));
                 }
             }
+            out
+        };
+        // On a worker pool (`Correlation::refine`), the base orders are spread over its
+        // threads; elsewhere they run on the calling thread.
+        let rows: Vec<Vec<(usize, Complex64)>> = if rayon::current_thread_index().is_some() {
+            (0..=self.lmax).into_par_iter().map(row).collect()
+        } else {
+            (0..=self.lmax).map(row).collect()
+        };
+        for (at, v) in rows.into_iter().flatten() {
+            s[at] = v;
         }
         s
     }

@@ -123,6 +123,11 @@ impl S2Plan {
         16 * scratch_len(b) + LegendreStage::bytes(b, threads) + 8 * 2 * b
     }
 
+    /// Runs `f` on the plan's worker threads (rayon parallel iterators in `f` use them).
+    pub(crate) fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        self.workers.pool().install(f)
+    }
+
     /// The bandwidth `B`.
     pub fn bandwidth(&self) -> usize {
         self.b

@@ -7,7 +7,6 @@ use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
 use so3fft::matching::{
     grid_argmax, grid_argmax_real, rotate_s2_coeffs, Correlation, CorrelationOptions, Rotation,
-    So3Series,
 };
 use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
 use so3fft::Complex64;
@@ -98,11 +97,10 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             let peak = peak.expect("at least one run");
             let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
             plan.coefficients(&sig, &pat, &mut coeffs)?;
-            let series = So3Series::new(l, plan.deg_lim(), &coeffs);
             let t = Instant::now();
             let mut refined = peak.rotation();
             for _ in 0..10 {
-                refined = series.maximise(&peak.rotation()).0;
+                refined = plan.refine(&coeffs, &peak.rotation())?.0;
             }
             let t_refine = t.elapsed().as_secs_f64();
             println!(
