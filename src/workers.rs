@@ -1,5 +1,6 @@
 //! The worker threads of a plan: a rayon pool that a plan's `Drop` waits for, and that a
-//! child made by `fork()` never waits for (its threads are the parent's).
+//! child made by `fork()` never waits for (its threads are the parent's); and [`SendPtr`],
+//! the address the tasks of one execution share.
 
 use crate::error::{Error, Result};
 use std::sync::{Arc, Condvar, Mutex};
@@ -88,5 +89,24 @@ impl Drop for WorkerPool {
         while *g > 0 {
             g = cv.wait(g).unwrap_or_else(|e| e.into_inner());
         }
+    }
+}
+
+/// A pointer to memory that the tasks of one execution write (and read) at disjoint
+/// places.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SendPtr<T>(pub(crate) *mut T);
+
+// SAFETY: a `SendPtr` is only an address. It is dereferenced only inside one execution,
+// while the array it points into is borrowed for that execution by the public entry point,
+// and the tasks that receive copies of it write disjoint index sets (or only read).
+unsafe impl<T> Send for SendPtr<T> {}
+// SAFETY: as for `Send`: shared references give only copies of the address.
+unsafe impl<T> Sync for SendPtr<T> {}
+
+impl<T> SendPtr<T> {
+    /// The pointer (a method, so closures capture the whole `Send` wrapper).
+    pub(crate) fn get(self) -> *mut T {
+        self.0
     }
 }

@@ -29,13 +29,25 @@ static int measured_forward(so3fft_complex *s, so3fft_complex *c) {
 }
 
 static so3fft_complex *g_samples, *g_parent;
+static size_t g_wisdom_len;
+
+/* Length of the exported wisdom text (0 on failure). */
+static size_t wisdom_len(void) {
+    char *t = so3fft_export_wisdom_to_string();
+    size_t n = t ? strlen(t) : 0;
+    free(t);
+    return n;
+}
 
 static int child_with_wisdom(void *arg) {
     size_t nc = so3fft_num_coeffs(B);
     so3fft_complex *c = alloc_cx(nc);
     (void)arg;
     so3fft_forget_wisdom();
+    /* forgotten: less than the parent's; imported: all of it again */
+    if (wisdom_len() >= g_wisdom_len) return 6;
     if (so3fft_import_wisdom_from_filename(g_file) != SO3FFT_OK) return 3;
+    if (wisdom_len() != g_wisdom_len) return 7;
     if (measured_forward(g_samples, c) != 0) return 4;
     return memcmp(c, g_parent, nc * sizeof *c) == 0 ? 0 : 5;
 }
@@ -85,6 +97,7 @@ int main(void) {
     CHECK(measured_forward(g_samples, g_parent) == 0);
     text = so3fft_export_wisdom_to_string();
     CHECK(text != NULL && strncmp(text, "(fftw-3", 7) == 0);
+    g_wisdom_len = text ? strlen(text) : 0;
     if (text) {
         CHECK(so3fft_import_wisdom_from_string(text) == SO3FFT_OK);
         CHECK_NO_ERR();
@@ -96,7 +109,8 @@ int main(void) {
     /* the same wisdom in another process gives the same bits */
     o = run_forked(child_with_wisdom, NULL, 30);
     if (o != 0) {
-        fprintf(stderr, "child with imported wisdom: %s (3 import, 4 plan, 5 bits differ)\n",
+        fprintf(stderr, "child with imported wisdom: %s (3 import, 4 plan, 5 bits differ, 6 not forgotten, "
+                "7 not imported)\n",
                 outcome_name(o, buf, sizeof buf));
         g_failures++;
     }

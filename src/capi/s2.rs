@@ -2,7 +2,7 @@
 
 use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_ENULL};
 use super::{SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
-use crate::ffi::checks::{input_output, Array};
+use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
 use crate::s2::{s2_num_coeffs, s2_num_samples, s2_try_coef_index, S2Options, S2Plan};
 use crate::Complex64;
@@ -22,13 +22,7 @@ pub type so3fft_s2_plan = *mut so3fft_s2_plan_s;
 
 /// The S^2 bandwidth `b` as a `usize`, or an error unless `1 <= b <= SO3FFT_S2_MAX_BANDWIDTH`.
 fn s2_bandwidth(b: c_int) -> Result<usize, CallError> {
-    match usize::try_from(b) {
-        Ok(bw) if (1..=SO3FFT_S2_MAX_BANDWIDTH as usize).contains(&bw) => Ok(bw),
-        _ => Err(CallError::new(
-            ErrorKind::Bandwidth,
-            format!("invalid S^2 bandwidth {b}: must be between 1 and {SO3FFT_S2_MAX_BANDWIDTH}"),
-        )),
-    }
+    checks::bandwidth_up_to(b, SO3FFT_S2_MAX_BANDWIDTH as usize)
 }
 
 /// Plans the S^2 transforms of bandwidth `B` (both directions, complex and real samples),
@@ -152,26 +146,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward(
     samples: *mut so3fft_complex,
     coeffs: *mut so3fft_complex,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: `p` is NULL or a live plan; the arrays per the API's contract.
-        // Complex64 is #[repr(C)] {re, im}: the layout of double[2].
-        unsafe {
-            let plan = s2_plan_ref(p)?;
-            with_arrays(
-                (
-                    samples.cast_const().cast::<Complex64>(),
-                    plan.num_samples(),
-                    "samples",
-                ),
-                (
-                    coeffs.cast::<Complex64>(),
-                    plan.num_coeffs(),
-                    "coefficients",
-                ),
-                |s, c| plan.forward(s, c),
-            )
-        }
-    })
+    // SAFETY: the same contract as the `_many` function with one field.
+    unsafe { so3fft_s2_execute_forward_many(p, 1, samples, coeffs) }
 }
 
 /// Inverse S^2 transform: `B^2` coefficients (only read) to `(2B)^2` complex samples.
@@ -181,21 +157,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse(
     coeffs: *mut so3fft_complex,
     samples: *mut so3fft_complex,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: as in `so3fft_s2_execute_forward`.
-        unsafe {
-            let plan = s2_plan_ref(p)?;
-            with_arrays(
-                (
-                    coeffs.cast_const().cast::<Complex64>(),
-                    plan.num_coeffs(),
-                    "coefficients",
-                ),
-                (samples.cast::<Complex64>(), plan.num_samples(), "samples"),
-                |c, s| plan.inverse(c, s),
-            )
-        }
-    })
+    // SAFETY: the same contract as the `_many` function with one field.
+    unsafe { so3fft_s2_execute_inverse_many(p, 1, coeffs, samples) }
 }
 
 /// Forward S^2 transform of `(2B)^2` real samples: all `B^2` coefficients, with
@@ -206,21 +169,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward_real(
     samples: *const f64,
     coeffs: *mut so3fft_complex,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: as in `so3fft_s2_execute_forward`.
-        unsafe {
-            let plan = s2_plan_ref(p)?;
-            with_arrays(
-                (samples, plan.num_samples(), "samples"),
-                (
-                    coeffs.cast::<Complex64>(),
-                    plan.num_coeffs(),
-                    "coefficients",
-                ),
-                |s, c| plan.forward_real(s, c),
-            )
-        }
-    })
+    // SAFETY: the same contract as the `_many` function with one field.
+    unsafe { so3fft_s2_execute_forward_real_many(p, 1, samples, coeffs) }
 }
 
 /// Inverse S^2 transform to `(2B)^2` real samples: reads the orders `m >= 0` (the others
@@ -231,21 +181,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse_real(
     coeffs: *mut so3fft_complex,
     samples: *mut f64,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: as in `so3fft_s2_execute_forward`.
-        unsafe {
-            let plan = s2_plan_ref(p)?;
-            with_arrays(
-                (
-                    coeffs.cast_const().cast::<Complex64>(),
-                    plan.num_coeffs(),
-                    "coefficients",
-                ),
-                (samples, plan.num_samples(), "samples"),
-                |c, s| plan.inverse_real(c, s),
-            )
-        }
-    })
+    // SAFETY: the same contract as the `_many` function with one field.
+    unsafe { so3fft_s2_execute_inverse_real_many(p, 1, coeffs, samples) }
 }
 
 /// The field count of a `_many` call; an error unless positive.
@@ -269,7 +206,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward_many(
 ) -> c_int {
     guarded_code(|| {
         let k = fields(howmany)?;
-        // SAFETY: as in `so3fft_s2_execute_forward`, for `howmany` fields.
+        // SAFETY: `p` is NULL or a live plan; the arrays hold `howmany` fields (the API's
+        // contract). Complex64 is #[repr(C)] {re, im}: the layout of double[2].
         unsafe {
             let plan = s2_plan_ref(p)?;
             with_arrays(
@@ -299,7 +237,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse_many(
 ) -> c_int {
     guarded_code(|| {
         let k = fields(howmany)?;
-        // SAFETY: as in `so3fft_s2_execute_forward`, for `howmany` fields.
+        // SAFETY: `p` is NULL or a live plan; the arrays hold `howmany` fields (the API's
+        // contract). Complex64 is #[repr(C)] {re, im}: the layout of double[2].
         unsafe {
             let plan = s2_plan_ref(p)?;
             with_arrays(
@@ -330,7 +269,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward_real_many(
 ) -> c_int {
     guarded_code(|| {
         let k = fields(howmany)?;
-        // SAFETY: as in `so3fft_s2_execute_forward`, for `howmany` fields.
+        // SAFETY: `p` is NULL or a live plan; the arrays hold `howmany` fields (the API's
+        // contract). Complex64 is #[repr(C)] {re, im}: the layout of double[2].
         unsafe {
             let plan = s2_plan_ref(p)?;
             with_arrays(
@@ -356,7 +296,8 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse_real_many(
 ) -> c_int {
     guarded_code(|| {
         let k = fields(howmany)?;
-        // SAFETY: as in `so3fft_s2_execute_forward`, for `howmany` fields.
+        // SAFETY: `p` is NULL or a live plan; the arrays hold `howmany` fields (the API's
+        // contract). Complex64 is #[repr(C)] {re, im}: the layout of double[2].
         unsafe {
             let plan = s2_plan_ref(p)?;
             with_arrays(

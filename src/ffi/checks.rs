@@ -7,11 +7,16 @@ use std::ffi::c_int;
 
 /// The bandwidth `b` as a `usize`, or an error unless `1 <= b <= MAX_BANDWIDTH`.
 pub(crate) fn bandwidth(b: c_int) -> Result<usize, CallError> {
+    bandwidth_up_to(b, MAX_BANDWIDTH)
+}
+
+/// The bandwidth `b` as a `usize`, or an error unless `1 <= b <= max`.
+pub(crate) fn bandwidth_up_to(b: c_int, max: usize) -> Result<usize, CallError> {
     match usize::try_from(b) {
-        Ok(bw) if (1..=MAX_BANDWIDTH).contains(&bw) => Ok(bw),
+        Ok(bw) if (1..=max).contains(&bw) => Ok(bw),
         _ => Err(CallError::new(
             ErrorKind::Bandwidth,
-            format!("invalid bandwidth {b}: must be between 1 and {MAX_BANDWIDTH}"),
+            format!("invalid bandwidth {b}: must be between 1 and {max}"),
         )),
     }
 }

@@ -336,25 +336,9 @@ impl Correlation {
         out: &mut [Complex64],
     ) -> Result<()> {
         self.need(false)?;
-        let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
-        check_many(patterns.len(), ns, out.len(), ng)?;
-        self.with_buffers(|buf| {
-            let mut sig = vec![Complex64::default(); self.b_in * self.b_in];
-            self.s2.forward(signal, &mut sig)?;
-            let known = |x: &[Complex64], c: &mut [Complex64]| {
-                if std::ptr::eq(x, signal) {
-                    c.copy_from_slice(&sig);
-                    Ok(())
-                } else {
-                    self.s2.forward(x, c)
-                }
-            };
-            for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
-                self.combine_shells(&[(signal, pattern, 1.0)], known, buf)?;
-                self.so3.inverse(&buf.so3, grid)?;
-            }
-            Ok(())
-        })
+        let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
+        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
+        self.many((signal, patterns, out), forward, inverse)
     }
 
     /// [`Correlation::correlate_many`] of real samples.
@@ -365,22 +349,36 @@ impl Correlation {
         out: &mut [f64],
     ) -> Result<()> {
         self.need(true)?;
+        let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
+        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
+        self.many((signal, patterns, out), forward, inverse)
+    }
+
+    /// The body of the `correlate_many` functions, with the S^2 forward and SO(3) inverse
+    /// of the plan's kind of samples.
+    fn many<T, G>(
+        &self,
+        (signal, patterns, out): (&[T], &[T], &mut [G]),
+        forward: impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<()>,
+    ) -> Result<()> {
         let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
         check_many(patterns.len(), ns, out.len(), ng)?;
         self.with_buffers(|buf| {
             let mut sig = vec![Complex64::default(); self.b_in * self.b_in];
-            self.s2.forward_real(signal, &mut sig)?;
-            let known = |x: &[f64], c: &mut [Complex64]| {
+            forward(signal, &mut sig)?;
+            // The signal's transform is made once; the patterns' each time.
+            let known = |x: &[T], c: &mut [Complex64]| {
                 if std::ptr::eq(x, signal) {
                     c.copy_from_slice(&sig);
                     Ok(())
                 } else {
-                    self.s2.forward_real(x, c)
+                    forward(x, c)
                 }
             };
             for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
                 self.combine_shells(&[(signal, pattern, 1.0)], known, buf)?;
-                self.so3.inverse_real(&buf.so3, grid)?;
+                inverse(&buf.so3, grid)?;
             }
             Ok(())
         })

@@ -9,24 +9,7 @@
 
 use std::sync::Mutex;
 
-/// A pointer to memory that the tasks of one execution write (and read) at disjoint
-/// places.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct SendPtr<T>(pub(super) *mut T);
-
-// SAFETY: a `SendPtr` is only an address. It is dereferenced only inside one execution,
-// while the array it points into is borrowed for that execution by the public entry point,
-// and the tasks that receive copies of it write disjoint index sets (or only read).
-unsafe impl<T> Send for SendPtr<T> {}
-// SAFETY: as for `Send`: shared references give only copies of the address.
-unsafe impl<T> Sync for SendPtr<T> {}
-
-impl<T> SendPtr<T> {
-    /// The pointer (a method, so closures capture the whole `Send` wrapper).
-    pub(super) fn get(self) -> *mut T {
-        self.0
-    }
-}
+pub(super) use crate::workers::SendPtr;
 
 /// A pointer to memory that the tasks of one execution only read (a transform's input).
 #[derive(Clone, Copy, Debug)]

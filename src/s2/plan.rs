@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
 use crate::simd::Isa;
 use crate::system::check_headroom;
-use crate::workers::{WorkerPool, WORKER_STACK_BYTES};
+use crate::workers::{SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -226,7 +226,7 @@ impl S2Plan {
     /// Ring DFTs of all rings in parallel: complex in place (`analysis`: sign -1).
     fn rings_complex(&self, buf: &AlignedBuf, analysis: bool) -> Result<()> {
         let (n, per) = (self.rings.len(), self.rings.per_call());
-        let base = SendMut(buf.as_mut_ptr());
+        let base = SendPtr(buf.as_mut_ptr());
         (0..n / per).into_par_iter().try_for_each(|c| {
             // SAFETY: rings c*per .. (c+1)*per of the (2B)^2 scratch: this task's alone.
             unsafe { self.rings.complex(base.get().add(c * per * n), analysis) }
@@ -374,7 +374,7 @@ impl S2Plan {
         howmany: usize,
     ) -> Result<()> {
         self.check(samples.len(), coeffs.len(), howmany)?;
-        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
+        let (n, nc) = (2 * self.b, self.num_coeffs());
         let factor = (2.0 * PI).sqrt() / n as f64;
         self.with_scratch(howmany > 1, |first, second| {
             let bufs = [Some(first), second];
@@ -388,27 +388,38 @@ impl S2Plan {
                     let buf = bufs[i].expect("a second scratch for two fields");
                     groups[i] = Some(self.real_rings_forward(buf, field, out)?);
                 }
-                let used = groups.iter().flatten().count();
-                let first = groups[0].expect("at least one field");
-                let groups = groups.map(|g| g.unwrap_or(first));
-                let groups = &groups[..used];
-                self.workers.pool().install(|| {
-                    (0..b).into_par_iter().for_each(|m| {
-                        let mut g = [groups[0]; 2];
-                        for (slot, src) in g.iter_mut().zip(groups) {
-                            *slot = Group {
-                                order: m as isize,
-                                ..*src
-                            };
-                        }
-                        // SAFETY: as in `forward_many`; each field has its own spectra
-                        // and coefficient array.
-                        unsafe { self.analyse(m, &g[..groups.len()], factor) }
-                    })
-                });
+                // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
+                unsafe { self.real_orders(groups, factor, true) };
             }
             Ok(())
         })
+    }
+
+    /// The Legendre stage of every order for one or two real fields (`groups[1]` `None` for
+    /// one), analysis or synthesis: two fields share each kernel call.
+    ///
+    /// # Safety
+    /// As for `LegendreStage::analyse` / `synthesise`, for each field.
+    unsafe fn real_orders(&self, groups: [Option<Group>; 2], factor: f64, analyse: bool) {
+        let used = groups.iter().flatten().count();
+        let first = groups[0].expect("at least one field");
+        let groups = groups.map(|g| g.unwrap_or(first));
+        self.workers.pool().install(|| {
+            (0..self.b).into_par_iter().for_each(|m| {
+                let g = groups.map(|src| Group {
+                    order: m as isize,
+                    ..src
+                });
+                // SAFETY: each task handles order m of each field only (caller's contract).
+                unsafe {
+                    if analyse {
+                        self.analyse(m, &g[..used], factor)
+                    } else {
+                        self.synthesise(m, &g[..used], factor)
+                    }
+                }
+            })
+        });
     }
 
     /// The `r2c` of one real field's rings (copied into `buf` first); the field's column
@@ -423,8 +434,8 @@ impl S2Plan {
         let per = self.rings.per_call();
         let half = self.b + 1;
         // Real rings in the first n*n/2 values of the scratch, their spectra after them.
-        let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
-        let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        let reals = SendPtr(buf.as_mut_ptr().cast::<f64>());
+        let spec = SendPtr(buf.as_mut_ptr().wrapping_add(n * n / 2));
         // SAFETY: n*n reals fit in the first n*n/2 complex values of the scratch.
         unsafe { std::ptr::copy_nonoverlapping(field.as_ptr(), reals.get(), n * n) };
         self.workers.pool().install(|| {
@@ -486,23 +497,8 @@ impl S2Plan {
                         partner: false,
                     });
                 }
-                let used = groups.iter().flatten().count();
-                let first = groups[0].expect("at least one field");
-                let groups = groups.map(|g| g.unwrap_or(first));
-                let groups = &groups[..used];
-                self.workers.pool().install(|| {
-                    (0..b).into_par_iter().for_each(|m| {
-                        let mut g = [groups[0]; 2];
-                        for (slot, src) in g.iter_mut().zip(groups) {
-                            *slot = Group {
-                                order: m as isize,
-                                ..*src
-                            };
-                        }
-                        // SAFETY: as in `inverse_many`; each field has its own spectra.
-                        unsafe { self.synthesise(m, &g[..groups.len()], factor) }
-                    })
-                });
+                // SAFETY: as in `inverse_many`; each field has its own spectra.
+                unsafe { self.real_orders(groups, factor, false) };
                 for (i, out) in outs.chunks_exact_mut(n * n).enumerate().take(count) {
                     let buf = bufs[i].expect("a second scratch for two fields");
                     self.real_rings_inverse(buf, out)?;
@@ -517,8 +513,8 @@ impl S2Plan {
         let (b, n) = (self.b, 2 * self.b);
         let per = self.rings.per_call();
         let half = b + 1;
-        let reals = SendMut(buf.as_mut_ptr().cast::<f64>());
-        let spec = SendMut(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        let reals = SendPtr(buf.as_mut_ptr().cast::<f64>());
+        let spec = SendPtr(buf.as_mut_ptr().wrapping_add(n * n / 2));
         self.workers.pool().install(|| {
             for k in 0..n {
                 // SAFETY: column B of spectrum row k, inside the scratch.
@@ -554,19 +550,4 @@ fn try_take(
 fn scratch_len(b: usize) -> usize {
     let n = 2 * b;
     n * n + n
-}
-
-/// A pointer the tasks of one execution use at disjoint places.
-#[derive(Clone, Copy)]
-struct SendMut<T>(*mut T);
-
-// SAFETY: an address only; every dereference says why the tasks' accesses are disjoint.
-unsafe impl<T> Send for SendMut<T> {}
-// SAFETY: as for Send.
-unsafe impl<T> Sync for SendMut<T> {}
-
-impl<T> SendMut<T> {
-    fn get(self) -> *mut T {
-        self.0
-    }
 }

@@ -1,9 +1,11 @@
 //! `softFFTWCor2` of `wrap_fftw.h`: rotational matching of two functions on the sphere.
 
+use super::cache::plan_for;
 use super::guarded;
+use super::s2::s2_plan_for;
 use crate::ffi::checks::{self, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::matching::{grid_argmax, grid_argmax_real, Correlation, CorrelationOptions};
+use crate::matching::{combine, grid_argmax, grid_argmax_real};
 use crate::Complex64;
 use std::ffi::{c_double, c_int};
 
@@ -38,13 +40,14 @@ pub unsafe extern "C" fn softFFTWCor2(
                 return Err(CallError::new(ErrorKind::Null, format!("{what} is NULL")));
             }
         }
-        let plan = Correlation::new(
-            b,
-            &CorrelationOptions {
-                real,
-                ..CorrelationOptions::default()
-            },
-        )?;
+        // The layer's cached plans of this bandwidth (no planning after the first call).
+        let (s2, so3) = (s2_plan_for(b)?, plan_for(b)?);
+        let (s2, nc) = (s2.plan(), b * b);
+        let (mut sig_hat, mut pat_hat) = (
+            vec![Complex64::default(); nc],
+            vec![Complex64::default(); nc],
+        );
+        let mut so3_hat = vec![Complex64::default(); so3.num_coeffs()];
         let peak = if real {
             // SAFETY: non-NULL, aligned (checked); (2bw)^2 doubles each (SOFT's contract);
             // only read.
@@ -54,8 +57,11 @@ pub unsafe extern "C" fn softFFTWCor2(
                     std::slice::from_raw_parts(pat.cast_const(), n),
                 )
             };
-            let mut out = vec![0.0; plan.num_grid()];
-            plan.correlate_real(s, p, &mut out)?;
+            s2.forward_real(s, &mut sig_hat)?;
+            s2.forward_real(p, &mut pat_hat)?;
+            combine((&sig_hat, &pat_hat), b, b - 1, b, &mut so3_hat)?;
+            let mut out = vec![0.0; so3.num_samples()];
+            so3.inverse_real(&so3_hat, &mut out)?;
             grid_argmax_real(b, &out)
         } else {
             // SAFETY: as above, 2 (2bw)^2 doubles each, read as (2bw)^2 complex values
@@ -66,8 +72,11 @@ pub unsafe extern "C" fn softFFTWCor2(
                     std::slice::from_raw_parts(pat.cast_const().cast::<Complex64>(), n),
                 )
             };
-            let mut out = vec![Complex64::default(); plan.num_grid()];
-            plan.correlate(s, p, &mut out)?;
+            s2.forward(s, &mut sig_hat)?;
+            s2.forward(p, &mut pat_hat)?;
+            combine((&sig_hat, &pat_hat), b, b - 1, b, &mut so3_hat)?;
+            let mut out = vec![Complex64::default(); so3.num_samples()];
+            so3.inverse(&so3_hat, &mut out)?;
             grid_argmax(b, &out)
         };
         // SAFETY: non-NULL (checked); single doubles the caller owns.
