@@ -34,6 +34,7 @@ mod grid;
 pub mod internals;
 pub mod matching;
 mod numeric;
+pub mod partial;
 mod plan;
 pub mod s2;
 mod simd;
@@ -49,5 +50,6 @@ pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
 pub use num_complex::Complex64;
+pub use partial::{Batch, Betas, PartialOptions, PartialPlan, Shape};
 pub use plan::{Direction, FftThreading, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
 pub use simd::Isa;

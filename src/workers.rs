@@ -110,3 +110,33 @@ impl<T> SendPtr<T> {
         self.0
     }
 }
+
+/// A pointer to memory that the tasks of one execution only read (a transform's input).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SendConstPtr<T>(pub(crate) *const T);
+
+// SAFETY: the pointed-to values are only read through it, by all tasks, while the array
+// is borrowed for the execution; writers of the same memory (a forward that may overwrite
+// its input) say at their dereferences why those writes come after every read.
+unsafe impl<T> Send for SendConstPtr<T> {}
+// SAFETY: as for `Send`.
+unsafe impl<T> Sync for SendConstPtr<T> {}
+
+impl<T> SendConstPtr<T> {
+    /// The pointer (a method, so closures capture the whole `Send` wrapper).
+    pub(crate) fn get(self) -> *const T {
+        self.0
+    }
+}
+
+/// Lock a free entry of `pool`, trying the current worker's own first; `None` if all are
+/// in use (possible only when one plan is executed from several threads at once).
+pub(crate) fn lock_free<T>(pool: &[Mutex<T>]) -> Option<std::sync::MutexGuard<'_, T>> {
+    let n = pool.len();
+    let tid = rayon::current_thread_index().unwrap_or(0);
+    (0..n).find_map(|i| match pool[(tid + i) % n].try_lock() {
+        Ok(g) => Some(g),
+        Err(std::sync::TryLockError::Poisoned(e)) => Some(e.into_inner()),
+        Err(std::sync::TryLockError::WouldBlock) => None,
+    })
+}

@@ -95,6 +95,19 @@ impl AlignedBuf {
     pub fn as_mut_ptr(&self) -> *mut Complex64 {
         self.ptr
     }
+
+    /// Number of complex values the buffer holds (at least the `len` asked for).
+    pub fn len(&self) -> usize {
+        self.bytes / 16
+    }
+
+    /// The first `len` values (`len <= self.len()`).
+    pub fn slice_mut(&mut self, len: usize) -> &mut [Complex64] {
+        assert!(len <= self.len());
+        // SAFETY: `len` values from `ptr` lie in the mapping this value owns, initialised
+        // (zero-filled at creation); `&mut self` makes the borrow exclusive.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr, len) }
+    }
 }
 
 impl Drop for AlignedBuf {

@@ -1,0 +1,127 @@
+//! Which betas a partial plan evaluates ([`Betas`]) and how they become kernel lanes: pairs
+//! of a beta and its mirror `pi - beta` ([`LanePairs`]), since a cluster's "reversed"
+//! members (see `symmetry.rs`) at one beta are its base function at the mirror.
+
+use super::shape::Shape;
+use crate::error::{Error, Result};
+use crate::numeric::{sin_cos_dd, Dd, PI_DD};
+use crate::wigner::BetaTables;
+use std::f64::consts::PI;
+
+/// The betas an inverse evaluates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Betas {
+    /// Every beta of the grid (`2 B_grid` slices).
+    #[default]
+    All,
+    /// The grid betas of these indices (each `< 2 B_grid`), in this order: output slice
+    /// `i` is `beta_{k_i}`.
+    Indices(Vec<usize>),
+    /// These beta values in `[0, pi]` (not necessarily on the grid), in this order.
+    Values(Vec<f64>),
+}
+
+/// Kernel lanes in pairs: point `j` (`j < pairs`) is a beta `<= pi/2` and point
+/// `pairs + j` its mirror. Each output slice is one point of a pair.
+pub(super) struct LanePairs {
+    /// Recurrence arguments and starting-value tables of the `2 pairs` points.
+    pub tables: BetaTables,
+    pub pairs: usize,
+    /// Number of output slices.
+    pub n_slices: usize,
+    /// Per pair: the output slices of its lower and upper point (`usize::MAX`: not written).
+    pub outputs: Vec<[usize; 2]>,
+}
+
+/// `(cos(x), sin(x))` of a half angle `x` in double-double.
+fn half_angle_point(x: Dd) -> (Dd, Dd) {
+    let (s, c) = sin_cos_dd(x);
+    (c, s)
+}
+
+impl LanePairs {
+    /// The lanes of `betas` on `shape`'s grid.
+    pub fn new(shape: &Shape, betas: &Betas) -> Result<LanePairs> {
+        let bg = shape.grid_bandwidth;
+        let nb = 2 * bg;
+        // Half angles of the lower points, and which slices each pair writes.
+        let mut half: Vec<Dd> = Vec::new();
+        let mut outputs: Vec<[usize; 2]> = Vec::new();
+        let mut n_slices = 0;
+        let grid_half = |k: usize| {
+            PI_DD
+                .mul_f((2 * k + 1) as f64)
+                .div(Dd::new((8 * bg) as f64))
+        };
+        match betas {
+            Betas::All => {
+                for j in 0..bg {
+                    half.push(grid_half(j));
+                    outputs.push([j, nb - 1 - j]);
+                }
+                n_slices = nb;
+            }
+            Betas::Indices(ks) => {
+                let mut pair_of = vec![usize::MAX; bg];
+                for (s, &k) in ks.iter().enumerate() {
+                    if k >= nb {
+                        return Err(Error::InvalidArgument(format!(
+                            "beta index {k} outside the grid (0..{nb})"
+                        )));
+                    }
+                    let (low, upper) = (k.min(nb - 1 - k), k >= bg);
+                    if pair_of[low] == usize::MAX {
+                        pair_of[low] = half.len();
+                        half.push(grid_half(low));
+                        outputs.push([usize::MAX; 2]);
+                    }
+                    let pair = pair_of[low];
+                    let o = &mut outputs[pair][upper as usize];
+                    if *o != usize::MAX {
+                        return Err(Error::InvalidArgument(format!(
+                            "beta index {k} given twice"
+                        )));
+                    }
+                    *o = s;
+                    n_slices += 1;
+                }
+            }
+            Betas::Values(vs) => {
+                for (s, &b) in vs.iter().enumerate() {
+                    if !(0.0..=PI).contains(&b) {
+                        return Err(Error::InvalidArgument(format!(
+                            "beta value {b} outside [0, pi]"
+                        )));
+                    }
+                    let upper = b > PI / 2.0;
+                    // The lower point's half angle: b/2, or (pi - b)/2 = pi/2 - b/2.
+                    let x = Dd::new(b).mul_f(0.5);
+                    let x = if upper { PI_DD.mul_f(0.5).sub(x) } else { x };
+                    half.push(x);
+                    let mut o = [usize::MAX; 2];
+                    o[upper as usize] = s;
+                    outputs.push(o);
+                    n_slices += 1;
+                }
+            }
+        }
+        if half.is_empty() {
+            return Err(Error::InvalidArgument("no betas selected".into()));
+        }
+        let pairs = half.len();
+        // Lower points, then their mirrors: the mirror's half angle is pi/2 - x, whose
+        // cosine and sine are the sine and cosine of x.
+        let mut points: Vec<(Dd, Dd)> = half.iter().map(|&x| half_angle_point(x)).collect();
+        for j in 0..pairs {
+            let (c, s) = points[j];
+            points.push((s, c));
+        }
+        let maxpow = 2 * shape.degree_limit;
+        Ok(LanePairs {
+            tables: BetaTables::new(&points, maxpow),
+            pairs,
+            n_slices,
+            outputs,
+        })
+    }
+}

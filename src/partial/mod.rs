@@ -1,0 +1,21 @@
+//! Partial plans: SO(3) transforms that compute only what a [`Shape`] holds (degree and
+//! order limits, other sample grids), at selected betas ([`Betas`]), several at once
+//! ([`Batch`]), complex or real. See `docs/partial-plans.md`.
+//!
+//! - `shape`: [`Shape`], its validation and coefficient layout;
+//! - `betas`: [`Betas`] and the kernels' lane pairs of a beta and its mirror;
+//! - `dwt_stage`: the clusters of a shape and their kernel calls;
+//! - `fft_stage`: pruned slice DFTs;
+//! - `plan`: [`PartialPlan`], construction and the chunk loop.
+
+mod betas;
+mod dwt_stage;
+mod fft_stage;
+mod plan;
+mod shape;
+#[cfg(test)]
+mod tests;
+
+pub use betas::Betas;
+pub use plan::{Batch, PartialOptions, PartialPlan};
+pub use shape::{Shape, MAX_GRID_SIDE};

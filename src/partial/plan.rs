@@ -1,0 +1,933 @@
+//! [`PartialPlan`]: building a plan for a [`Shape`] and running its transforms, one chunk
+//! of lane pairs at a time (the DWT stage over all clusters, then the FFT stage over the
+//! chunk's slices).
+
+use super::betas::{Betas, LanePairs};
+use super::dwt_stage::{ChunkLanes, DwtStage};
+use super::fft_stage::{FftStage, Work};
+use super::shape::{CoefLayout, Shape};
+use crate::error::{Error, Result};
+use crate::fft::{AlignedBuf, Rigor};
+use crate::plan::{Direction, Plan, PlanOptions, StageTimes};
+use crate::simd::Isa;
+use crate::system::check_headroom;
+use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
+use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
+use num_complex::Complex64;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Options of a [`PartialPlan`].
+#[derive(Clone, Debug, Default)]
+pub struct PartialOptions {
+    /// Which transforms the plan runs (default both).
+    pub direction: Direction,
+    /// Worker threads (0 = all cores).
+    pub threads: usize,
+    /// FFTW planner rigour.
+    pub rigor: Rigor,
+    /// Instruction set of the kernels (`None`: the best this CPU has).
+    pub isa: Option<Isa>,
+    /// Also prepare the real-signal transforms.
+    pub real: bool,
+    /// The betas the inverse evaluates (default all; a plan with a selection runs the
+    /// inverse only).
+    pub betas: Betas,
+    /// Wigner-d prefixes below this value (relative to the data they multiply) are
+    /// skipped; `None`: `2^-64`, `Some(0.0)`: nothing skipped. Values above `2^-24` count
+    /// as `2^-24`. See `docs/partial-plans.md` for the error it costs.
+    pub tolerance: Option<f64>,
+    /// Cap on the chunk buffer in bytes (`None`: 256 MiB).
+    pub max_workspace_bytes: Option<usize>,
+    /// Run the full shape on the general engine too (normally the full shape runs on
+    /// [`Plan`], which is faster): for tests and benchmarks.
+    #[doc(hidden)]
+    pub general_engine: bool,
+}
+
+/// Several transforms in one call, FFTW `plan_many` style: `count` inputs `in_dist` values
+/// apart and `count` outputs `out_dist` values apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Batch {
+    /// Number of transforms.
+    pub count: usize,
+    /// Values from one input to the next.
+    pub in_dist: usize,
+    /// Values from one output to the next (at least one output's length).
+    pub out_dist: usize,
+}
+
+/// The skip threshold's exponent for a tolerance (`None`: the default; 0: no skipping).
+fn skip_bits(tolerance: Option<f64>) -> Result<u32> {
+    match tolerance {
+        None => Ok(DEFAULT_SKIP_BITS),
+        Some(0.0) => Ok(0),
+        Some(t) if t.is_finite() && t > 0.0 && t < 1.0 => {
+            let bits = (-t.log2()).ceil() as u32;
+            Ok(bits.clamp(*SKIP_BITS_RANGE.start(), *SKIP_BITS_RANGE.end()))
+        }
+        Some(t) => Err(Error::InvalidArgument(format!(
+            "tolerance {t} outside [0, 1)"
+        ))),
+    }
+}
+
+/// A plan of the general engine.
+struct General {
+    layout: CoefLayout,
+    pairs: LanePairs,
+    dwt: DwtStage,
+    fft: FftStage,
+    /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
+    pair_weight: Vec<f64>,
+    /// Per-worker FFT buffers (made on first use).
+    work: Vec<Mutex<Option<Work>>>,
+    /// The chunk buffer (taken by one execution at a time).
+    buf: Mutex<Option<AlignedBuf>>,
+    budget: usize,
+    lanes_w: usize,
+    workers: WorkerPool,
+}
+
+enum Engine {
+    Full(Box<Plan>),
+    General(Box<General>),
+}
+
+/// A transform on SO(3) that computes only what a [`Shape`] holds: band-limited,
+/// order-limited, oversampled or undersampled in alpha and gamma, restricted to some
+/// betas, several at once ([`Batch`]), complex or real.
+///
+/// The full shape ([`Shape::new`]) with all betas runs on [`Plan`]; everything else on
+/// the general engine: the DWT kernels per cluster of order pairs over chunks of beta
+/// pairs, and pruned slice DFTs. Execution takes `&self`; one plan may run on different
+/// arrays from several threads.
+pub struct PartialPlan {
+    shape: Shape,
+    direction: Direction,
+    real: bool,
+    threads: usize,
+    n_slices: usize,
+    engine: Engine,
+}
+
+/// Pointers of one execution (all arrays of a batch).
+#[derive(Clone, Copy)]
+enum Data {
+    Complex(SendPtr<Complex64>),
+    Real(SendPtr<f64>),
+}
+
+impl PartialPlan {
+    /// A plan for `shape` with `options`.
+    pub fn new(shape: &Shape, options: &PartialOptions) -> Result<PartialPlan> {
+        shape.validate()?;
+        let restricted = options.betas != Betas::All;
+        let direction = if restricted {
+            match options.direction {
+                Direction::Forward => {
+                    return Err(Error::InvalidArgument(
+                        "a forward transform needs every beta of the grid".into(),
+                    ))
+                }
+                _ => Direction::Inverse,
+            }
+        } else {
+            options.direction
+        };
+        if direction != Direction::Inverse {
+            shape.check_forward()?;
+        }
+        let threads = match options.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            t if t > 1024 => {
+                return Err(Error::InvalidArgument(format!(
+                    "{t} threads requested (at most 1024)"
+                )))
+            }
+            t => t,
+        };
+        let isa = options.isa.unwrap_or_else(Isa::detect);
+        if !isa.is_supported() {
+            return Err(Error::InvalidArgument(format!(
+                "instruction set {isa:?} not supported by this CPU"
+            )));
+        }
+        let bits = skip_bits(options.tolerance)?;
+        if let Some(0) = options.max_workspace_bytes {
+            return Err(Error::InvalidArgument("max_workspace_bytes is 0".into()));
+        }
+        let pairs = LanePairs::new(shape, &options.betas)?;
+        let n_slices = pairs.n_slices;
+        let engine = if shape.is_full() && !restricted && !options.general_engine {
+            let po = PlanOptions {
+                direction,
+                threads,
+                rigor: options.rigor,
+                max_workspace_bytes: options.max_workspace_bytes,
+                isa: Some(isa),
+                skip_bits: Some(bits),
+                real: options.real,
+                ..PlanOptions::default()
+            };
+            Engine::Full(Box::new(Plan::new(shape.degree_limit, &po)?))
+        } else {
+            Engine::General(Box::new(General::new(
+                shape,
+                pairs,
+                (isa, bits, threads),
+                options,
+            )?))
+        };
+        Ok(PartialPlan {
+            shape: *shape,
+            direction,
+            real: options.real,
+            threads,
+            n_slices,
+            engine,
+        })
+    }
+
+    /// The plan's shape.
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+
+    /// Which transforms the plan runs.
+    pub fn direction(&self) -> Direction {
+        self.direction
+    }
+
+    /// Worker threads.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Whether the plan runs on [`Plan`] (the full shape) rather than the general engine.
+    pub fn uses_full_plan(&self) -> bool {
+        matches!(self.engine, Engine::Full(_))
+    }
+
+    /// Coefficients of one transform ([`Shape::num_coeffs`]).
+    pub fn num_coeffs(&self) -> usize {
+        match &self.engine {
+            Engine::Full(p) => p.num_coeffs(),
+            Engine::General(g) => g.layout.total,
+        }
+    }
+
+    /// Samples of one transform: `n_alpha n_gamma` per beta slice, times the number of
+    /// betas (`2 B_grid`, or the selection's length).
+    pub fn num_samples(&self) -> usize {
+        self.n_slices * self.shape.slice_len()
+    }
+
+    /// Number of beta slices of the samples.
+    pub fn num_slices(&self) -> usize {
+        self.n_slices
+    }
+
+    /// Forward: samples to coefficients.
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
+        self.forward_many(one(samples.len(), coeffs.len()), samples, coeffs)
+            .map(|_| ())
+    }
+
+    /// Inverse: coefficients to samples.
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
+        self.inverse_many(one(coeffs.len(), samples.len()), coeffs, samples)
+            .map(|_| ())
+    }
+
+    /// Forward of a real signal (`num_samples` doubles): every coefficient block written.
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
+        self.forward_real_many(one(samples.len(), coeffs.len()), samples, coeffs)
+            .map(|_| ())
+    }
+
+    /// Inverse to a real signal: reads only the blocks `M' > 0`, or `M' = 0` and `M >= 0`,
+    /// and takes the others as `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
+        self.inverse_real_many(one(coeffs.len(), samples.len()), coeffs, samples)
+            .map(|_| ())
+    }
+
+    /// `batch.count` forwards; the time of each stage.
+    pub fn forward_many(
+        &self,
+        batch: Batch,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, false, batch, samples.len(), coeffs.len())?;
+        match &self.engine {
+            Engine::Full(p) => full_many(batch, self.sizes(true), |i, o| {
+                p.forward_timed(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
+            }),
+            Engine::General(g) => g.forward(
+                batch,
+                SendConstPtr(samples.as_ptr().cast()),
+                SendPtr(coeffs.as_mut_ptr()),
+                false,
+            ),
+        }
+    }
+
+    /// `batch.count` inverses; the time of each stage.
+    pub fn inverse_many(
+        &self,
+        batch: Batch,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(false, false, batch, coeffs.len(), samples.len())?;
+        match &self.engine {
+            Engine::Full(p) => full_many(batch, self.sizes(false), |i, o| {
+                p.inverse_timed(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
+            }),
+            Engine::General(g) => g.inverse(
+                batch,
+                SendConstPtr(coeffs.as_ptr()),
+                Data::Complex(SendPtr(samples.as_mut_ptr())),
+            ),
+        }
+    }
+
+    /// `batch.count` real forwards; the time of each stage.
+    pub fn forward_real_many(
+        &self,
+        batch: Batch,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        self.check(true, true, batch, samples.len(), coeffs.len())?;
+        match &self.engine {
+            Engine::Full(p) => full_many(batch, self.sizes(true), |i, o| {
+                p.forward_real_timed(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
+            }),
+            Engine::General(g) => g.forward(
+                batch,
+                SendConstPtr(samples.as_ptr().cast()),
+                SendPtr(coeffs.as_mut_ptr()),
+                true,
+            ),
+        }
+    }
+
+    /// `batch.count` real inverses; the time of each stage.
+    pub fn inverse_real_many(
+        &self,
+        batch: Batch,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+    ) -> Result<StageTimes> {
+        self.check(false, true, batch, coeffs.len(), samples.len())?;
+        match &self.engine {
+            Engine::Full(p) => full_many(batch, self.sizes(false), |i, o| {
+                p.inverse_real_timed(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
+            }),
+            Engine::General(g) => g.inverse(
+                batch,
+                SendConstPtr(coeffs.as_ptr()),
+                Data::Real(SendPtr(samples.as_mut_ptr())),
+            ),
+        }
+    }
+
+    /// Input and output lengths of one transform.
+    fn sizes(&self, forward: bool) -> (usize, usize) {
+        if forward {
+            (self.num_samples(), self.num_coeffs())
+        } else {
+            (self.num_coeffs(), self.num_samples())
+        }
+    }
+
+    fn check(&self, forward: bool, real: bool, b: Batch, inp: usize, out: usize) -> Result<()> {
+        let in_process = match &self.engine {
+            Engine::Full(_) => true,
+            Engine::General(g) => g.workers.in_own_process(),
+        };
+        if !in_process {
+            return Err(Error::InvalidArgument(
+                "plan made in another process (before fork()); make a new plan here".into(),
+            ));
+        }
+        let ok = if forward {
+            self.direction != Direction::Inverse
+        } else {
+            self.direction != Direction::Forward
+        };
+        if !ok {
+            return Err(Error::WrongDirection);
+        }
+        if real && !self.real {
+            return Err(Error::InvalidArgument(
+                "real-signal transform on a plan made without the real option".into(),
+            ));
+        }
+        let (ilen, olen) = self.sizes(forward);
+        let (iname, oname) = if forward {
+            ("samples", "coefficients")
+        } else {
+            ("coefficients", "samples")
+        };
+        if b.count == 0 {
+            return Err(Error::InvalidArgument("batch of 0 transforms".into()));
+        }
+        if b.count > 1 && b.out_dist < olen {
+            return Err(Error::InvalidArgument(format!(
+                "batch: outputs {} values apart overlap (each has {olen})",
+                b.out_dist
+            )));
+        }
+        let need = |dist: usize, len: usize| {
+            dist.checked_mul(b.count - 1)
+                .and_then(|x| x.checked_add(len))
+                .unwrap_or(usize::MAX)
+        };
+        if inp < need(b.in_dist, ilen) {
+            return Err(Error::LengthMismatch {
+                what: iname,
+                expected: need(b.in_dist, ilen),
+                got: inp,
+            });
+        }
+        if out < need(b.out_dist, olen) {
+            return Err(Error::LengthMismatch {
+                what: oname,
+                expected: need(b.out_dist, olen),
+                got: out,
+            });
+        }
+        if b.count == 1 && (inp != ilen || out != olen) {
+            let (what, expected, got) = if inp != ilen {
+                (iname, ilen, inp)
+            } else {
+                (oname, olen, out)
+            };
+            return Err(Error::LengthMismatch {
+                what,
+                expected,
+                got,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A batch of one for arrays of these lengths.
+fn one(inp: usize, out: usize) -> Batch {
+    Batch {
+        count: 1,
+        in_dist: inp,
+        out_dist: out,
+    }
+}
+
+/// A batch on the full plan: `run(in_offset, (in_len, out_offset, out_len))` per transform.
+fn full_many(
+    b: Batch,
+    (ilen, olen): (usize, usize),
+    mut run: impl FnMut(usize, (usize, usize, usize)) -> Result<StageTimes>,
+) -> Result<StageTimes> {
+    let mut sum = StageTimes::default();
+    for t in 0..b.count {
+        let s = run(t * b.in_dist, (ilen, t * b.out_dist, olen))?;
+        sum.fft += s.fft;
+        sum.dwt += s.dwt;
+        sum.total += s.total;
+    }
+    Ok(sum)
+}
+
+impl General {
+    fn new(
+        shape: &Shape,
+        pairs: LanePairs,
+        (isa, bits, threads): (Isa, u32, usize),
+        options: &PartialOptions,
+    ) -> Result<General> {
+        let layout = CoefLayout::new(shape);
+        let (na, ng) = (shape.n_alpha, shape.n_gamma);
+        let budget = options.max_workspace_bytes.unwrap_or(256 << 20);
+        let w = isa.lanes();
+        let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
+        let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
+        let tables = 64 * 2 * pairs.pairs * (2 * shape.degree_limit + 66);
+        check_headroom(
+            DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
+                .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
+                .saturating_add(tables)
+                .saturating_add(crate::fft::planning_bytes(4 * na * ng, 1)),
+        )?;
+        // No skipping: the scaled starting values still need a threshold (the widest).
+        let skip = if bits == 0 {
+            (*SKIP_BITS_RANGE.end(), false)
+        } else {
+            (bits, true)
+        };
+        let dwt = DwtStage::new(&layout, (na, ng), isa, skip, (threads, max_lanes));
+        let fft = FftStage::new(
+            (na, ng),
+            (shape.order_limit_alpha, shape.order_limit_gamma),
+            options.real,
+            options.rigor,
+        )?;
+        let pair_weight = if options.betas == Betas::All {
+            let wts = crate::grid::weights(shape.grid_bandwidth);
+            let f = 2.0 * PI / (na * ng) as f64;
+            wts[..pairs.pairs].iter().map(|x| x * f).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(General {
+            layout,
+            pairs,
+            dwt,
+            fft,
+            pair_weight,
+            work: (0..threads).map(|_| Mutex::new(None)).collect(),
+            buf: Mutex::new(None),
+            budget,
+            lanes_w: w,
+            workers: WorkerPool::new(threads, "so3fft-partial")?,
+        })
+    }
+
+    /// Bytes of one transform's blocks per lane pair.
+    fn pair_bytes(&self) -> usize {
+        (self.dwt.row_total * 2 * 8).max(1)
+    }
+
+    /// Lane pairs per chunk: what an eighth of the workspace cap holds for one transform
+    /// (at least one), a multiple of the vector width when that is at least one vector.
+    /// It does not depend on the batch, so a batch sums in the order of single executes.
+    fn chunk_pairs(&self) -> usize {
+        let h = (self.budget / 8 / self.pair_bytes()).max(1);
+        let h = if h >= self.lanes_w {
+            h / self.lanes_w * self.lanes_w
+        } else {
+            h
+        };
+        h.min(self.pairs.pairs)
+    }
+
+    /// Transforms of a batch run together (sharing recurrence coefficients and starting
+    /// values): as many as the workspace cap holds at the chunk size (at least one).
+    fn group_size(&self) -> usize {
+        let hp = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        (self.budget / (hp * self.pair_bytes())).max(1)
+    }
+
+    /// Runs `run(first, sub_batch)` on the groups of `batch` (see [`General::group_size`]),
+    /// summing the stage times.
+    fn by_groups(
+        &self,
+        batch: Batch,
+        mut run: impl FnMut(usize, Batch) -> Result<StageTimes>,
+    ) -> Result<StageTimes> {
+        let g = self.group_size();
+        let mut sum = StageTimes::default();
+        let mut t0 = 0;
+        while t0 < batch.count {
+            let count = g.min(batch.count - t0);
+            let s = run(t0, Batch { count, ..batch })?;
+            sum.fft += s.fft;
+            sum.dwt += s.dwt;
+            sum.total += s.total;
+            t0 += count;
+        }
+        Ok(sum)
+    }
+
+    /// Inverse of a batch, group by group.
+    fn inverse(
+        &self,
+        batch: Batch,
+        coef: SendConstPtr<Complex64>,
+        out: Data,
+    ) -> Result<StageTimes> {
+        self.by_groups(batch, |t0, b| {
+            let c = SendConstPtr(coef.get().wrapping_add(t0 * batch.in_dist));
+            let o = match out {
+                Data::Complex(p) => {
+                    Data::Complex(SendPtr(p.get().wrapping_add(t0 * batch.out_dist)))
+                }
+                Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(t0 * batch.out_dist))),
+            };
+            self.inverse_group(b, c, o)
+        })
+    }
+
+    /// Forward of a batch, group by group (`inp` complex values, or reals with `real`).
+    fn forward(
+        &self,
+        batch: Batch,
+        inp: SendConstPtr<f64>,
+        coef: SendPtr<Complex64>,
+        real: bool,
+    ) -> Result<StageTimes> {
+        let per_value = if real { 1 } else { 2 };
+        self.by_groups(batch, |t0, b| {
+            let i = SendConstPtr(inp.get().wrapping_add(t0 * batch.in_dist * per_value));
+            let c = SendPtr(coef.get().wrapping_add(t0 * batch.out_dist));
+            self.forward_group(b, i, c, real)
+        })
+    }
+
+    /// Runs `f` with the chunk buffer of at least `len` doubles (the plan's, else a new one).
+    fn with_buf<R>(&self, len: usize, f: impl FnOnce(*mut f64) -> Result<R>) -> Result<R> {
+        let mut guard = self.buf.try_lock().ok();
+        let mut own = None;
+        let slot: &mut Option<AlignedBuf> = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => &mut own,
+        };
+        let complex = len.div_ceil(2);
+        if slot.as_ref().is_none_or(|b| b.len() < complex) {
+            *slot = None;
+            check_headroom(complex * 16)?;
+            *slot = Some(AlignedBuf::new(complex)?);
+        }
+        let p = slot.as_ref().expect("just made").as_mut_ptr().cast::<f64>();
+        f(p)
+    }
+
+    /// Runs `f` with a worker's FFT buffers.
+    fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> R) -> Result<R> {
+        let mut guard = lock_free(&self.work);
+        let mut own = None;
+        let slot: &mut Option<Work> = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => &mut own,
+        };
+        if slot.is_none() {
+            *slot = Some(self.fft.work()?);
+        }
+        Ok(f(slot.as_mut().expect("just made")))
+    }
+
+    /// The chunks of lane pairs for `count` transforms.
+    fn chunks(&self) -> impl Iterator<Item = ChunkLanes> + '_ {
+        let h = self.chunk_pairs();
+        let w = self.lanes_w;
+        (0..self.pairs.pairs).step_by(h).map(move |j0| {
+            let h = h.min(self.pairs.pairs - j0);
+            ChunkLanes {
+                j0,
+                h,
+                hp: h.next_multiple_of(w),
+            }
+        })
+    }
+
+    /// Inverse of a group of transforms, chunk by chunk.
+    fn inverse_group(
+        &self,
+        batch: Batch,
+        coef: SendConstPtr<Complex64>,
+        out: Data,
+    ) -> Result<StageTimes> {
+        let start = Instant::now();
+        let mut times = StageTimes::default();
+        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let slice_len = self.fft.slice_len();
+        let real = matches!(out, Data::Real(_));
+        self.with_buf(batch.count * per_t_max, |buf| {
+            let buf = SendPtr(buf);
+            self.workers.pool().install(|| {
+                for ch in self.chunks() {
+                    let lanes = ch.lanes();
+                    let per_t = self.dwt.row_total * lanes;
+                    let t0 = Instant::now();
+                    self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
+                        self.dwt.with_scratch(|sc| {
+                            let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                            for t in 0..batch.count {
+                                // SAFETY: coefficient array `t` of the batch (checked
+                                // lengths), read only; this cluster's block of transform
+                                // `t`, `lanes` rows of `cl.p` inside the chunk buffer
+                                // (`count * row_total * lanes` doubles), written by this
+                                // task only.
+                                unsafe {
+                                    self.dwt.inverse(
+                                        sc,
+                                        cl,
+                                        ch,
+                                        n,
+                                        coef.get().add(t * batch.in_dist),
+                                        real,
+                                        buf.get().add(t * per_t + cl.offset * lanes),
+                                    )
+                                }
+                            }
+                        })
+                    });
+                    let t1 = Instant::now();
+                    times.dwt += (t1 - t0).as_secs_f64();
+                    let tasks = self.slice_tasks(ch, batch.count);
+                    tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        self.with_work(|work| {
+                            let blocks = buf.get().wrapping_add(t * per_t);
+                            let (r, rm) = rows_of(ch, jj, upper);
+                            let at = t * batch.out_dist + s * slice_len;
+                            match out {
+                                Data::Complex(o) => {
+                                    // SAFETY: the chunk's blocks were written by the DWT
+                                    // stage above (finished); slice `s` of output `t` is
+                                    // inside the checked output and this task's alone.
+                                    unsafe {
+                                        self.scatter(work, blocks, lanes, (r, rm));
+                                        self.fft.inverse(work, o.get().add(at));
+                                    }
+                                }
+                                Data::Real(o) => {
+                                    // SAFETY: as above, for the real output.
+                                    unsafe {
+                                        self.scatter_real(work, blocks, lanes, (r, rm));
+                                        self.fft.inverse_real(work, o.get().add(at));
+                                    }
+                                }
+                            }
+                        })
+                    })?;
+                    times.fft += t1.elapsed().as_secs_f64();
+                }
+                Ok(())
+            })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// Forward of a group of transforms, chunk by chunk.
+    fn forward_group(
+        &self,
+        batch: Batch,
+        inp: SendConstPtr<f64>,
+        coef: SendPtr<Complex64>,
+        real: bool,
+    ) -> Result<StageTimes> {
+        let start = Instant::now();
+        let mut times = StageTimes::default();
+        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let slice_len = self.fft.slice_len();
+        self.with_buf(batch.count * per_t_max, |buf| {
+            let buf = SendPtr(buf);
+            self.workers.pool().install(|| {
+                for ch in self.chunks() {
+                    let lanes = ch.lanes();
+                    let per_t = self.dwt.row_total * lanes;
+                    let t0 = Instant::now();
+                    let tasks = self.slice_tasks(ch, batch.count);
+                    tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        self.with_work(|work| {
+                            let blocks = buf.get().wrapping_add(t * per_t);
+                            let rows = rows_of(ch, jj, upper);
+                            let w = self.pair_weight[ch.j0 + jj];
+                            // SAFETY: slice `s` of input `t` is inside the checked input
+                            // (complex values, or reals for the real forward); the rows
+                            // written are this slice's slots of the chunk's blocks: no
+                            // other task writes them (its mirror writes the other slots
+                            // of the same rows).
+                            unsafe {
+                                if real {
+                                    let at = t * batch.in_dist + s * slice_len;
+                                    self.fft.forward_real(work, inp.get().add(at));
+                                } else {
+                                    let at = 2 * (t * batch.in_dist + s * slice_len);
+                                    self.fft.forward(work, inp.get().add(at).cast());
+                                }
+                                self.gather(work, blocks, lanes, rows, (w, real));
+                            }
+                        })
+                    })?;
+                    let t1 = Instant::now();
+                    times.fft += (t1 - t0).as_secs_f64();
+                    let first = ch.j0 == 0;
+                    self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
+                        self.dwt.with_scratch(|sc| {
+                            let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                            for t in 0..batch.count {
+                                let block = buf.get().wrapping_add(t * per_t + cl.offset * lanes);
+                                // SAFETY: this cluster's block of transform `t` (its padding
+                                // rows zeroed here, the others written by the FFT stage,
+                                // finished); coefficient array `t` is inside the checked
+                                // output, and this cluster's slots' blocks are this task's.
+                                unsafe {
+                                    zero_padding(block, cl.p, ch);
+                                    self.dwt.forward(
+                                        sc,
+                                        cl,
+                                        ch,
+                                        n,
+                                        block,
+                                        coef.get().add(t * batch.out_dist),
+                                        first,
+                                    )
+                                }
+                            }
+                        })
+                    });
+                    times.dwt += t1.elapsed().as_secs_f64();
+                }
+                Ok(())
+            })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// The FFT stage's tasks of a chunk: `(transform, pair in chunk, upper, slice)` for
+    /// every slice the chunk's pairs write.
+    fn slice_tasks(&self, ch: ChunkLanes, count: usize) -> Vec<(usize, usize, bool, usize)> {
+        let mut v = Vec::new();
+        for t in 0..count {
+            for jj in 0..ch.h {
+                for (u, &s) in self.pairs.outputs[ch.j0 + jj].iter().enumerate() {
+                    if s != usize::MAX {
+                        v.push((t, jj, u == 1, s));
+                    }
+                }
+            }
+        }
+        v
+    }
+
+    /// Complex inverse: the values of a slice from the blocks into the work buffer.
+    ///
+    /// # Safety
+    /// `blocks` holds the chunk's blocks of one transform (`row_total * lanes` doubles).
+    unsafe fn scatter(
+        &self,
+        work: &mut Work,
+        blocks: *const f64,
+        lanes: usize,
+        (r, rm): (usize, usize),
+    ) {
+        let w = work.full.slice_mut(self.fft.slice_len());
+        w.fill(Complex64::default());
+        for cl in &self.dwt.clusters {
+            let base = blocks.wrapping_add(cl.offset * lanes);
+            for (q, s) in cl.slots.iter().enumerate() {
+                let row = if s.member.reversed { rm } else { r };
+                // SAFETY: row `< lanes`, column `2q + 1 < p` of this cluster's block.
+                let v = unsafe {
+                    let x = base.add(row * cl.p + 2 * q);
+                    Complex64::new(*x, *x.add(1))
+                };
+                w[s.work] = v;
+            }
+        }
+    }
+
+    /// Real inverse: `conj` of the slice's values with `M' >= 0` into the half buffer.
+    ///
+    /// # Safety
+    /// As for [`General::scatter`].
+    unsafe fn scatter_real(
+        &self,
+        work: &mut Work,
+        blocks: *const f64,
+        lanes: usize,
+        (r, rm): (usize, usize),
+    ) {
+        let (na, ng) = self.fft.dims();
+        let h = ng / 2 + 1;
+        let w = work
+            .half
+            .as_mut()
+            .expect("real work buffer")
+            .slice_mut(na * h);
+        w.fill(Complex64::default());
+        for cl in &self.dwt.clusters {
+            let base = blocks.wrapping_add(cl.offset * lanes);
+            for (q, s) in cl.slots.iter().enumerate() {
+                let mem = &s.member;
+                if mem.mp < 0 {
+                    continue;
+                }
+                let row = if mem.reversed { rm } else { r };
+                // SAFETY: as in `scatter`.
+                let v = unsafe {
+                    let x = base.add(row * cl.p + 2 * q);
+                    Complex64::new(*x, -*x.add(1))
+                };
+                w[mem.m.rem_euclid(na as isize) as usize * h + mem.mp as usize] = v;
+            }
+        }
+    }
+
+    /// Forward: the slice's values (from the work buffers), times the pair's weight, into
+    /// their rows of the blocks.
+    ///
+    /// # Safety
+    /// As for [`General::scatter`], for writes; no other task writes these slots of rows
+    /// `r` and `rm`.
+    unsafe fn gather(
+        &self,
+        work: &mut Work,
+        blocks: *mut f64,
+        lanes: usize,
+        (r, rm): (usize, usize),
+        (weight, real): (f64, bool),
+    ) {
+        let (na, ng) = self.fft.dims();
+        let h = ng / 2 + 1;
+        let full = work.full.slice_mut(na * ng);
+        let half = work.half.as_mut().map(|b| b.slice_mut(na * h));
+        for cl in &self.dwt.clusters {
+            let base = blocks.wrapping_add(cl.offset * lanes);
+            for (q, s) in cl.slots.iter().enumerate() {
+                let mem = &s.member;
+                let v = match (&half, real) {
+                    (Some(c), true) => {
+                        if mem.mp >= 0 {
+                            c[mem.m.rem_euclid(na as isize) as usize * h + mem.mp as usize].conj()
+                        } else {
+                            c[(-mem.m).rem_euclid(na as isize) as usize * h + (-mem.mp) as usize]
+                        }
+                    }
+                    _ => full[s.work],
+                } * weight;
+                let row = if mem.reversed { rm } else { r };
+                // SAFETY: row `< lanes`, column `2q + 1 < p` of this cluster's block;
+                // these slots of this row are this task's (caller's contract).
+                unsafe {
+                    let x = base.add(row * cl.p + 2 * q);
+                    *x = v.re;
+                    *x.add(1) = v.im;
+                }
+            }
+        }
+    }
+}
+
+/// Block rows of a slice: its own (`r`) and its mirror's (`rm`, where its reversed
+/// members are).
+fn rows_of(ch: ChunkLanes, jj: usize, upper: bool) -> (usize, usize) {
+    if upper {
+        (ch.hp + jj, jj)
+    } else {
+        (jj, ch.hp + jj)
+    }
+}
+
+/// Zero the padding rows (lanes `h..hp` of each half) of a block of `p` doubles a row,
+/// which the forward kernel multiplies by exact zeros.
+///
+/// # Safety
+/// The block's `2 hp` rows are the caller's.
+unsafe fn zero_padding(block: *mut f64, p: usize, ch: ChunkLanes) {
+    for half in 0..2 {
+        let from = half * ch.hp + ch.h;
+        // SAFETY: rows `from..(half + 1) hp` of the block.
+        unsafe { std::ptr::write_bytes(block.add(from * p), 0, (ch.hp - ch.h) * p) };
+    }
+}

@@ -1,0 +1,524 @@
+//! Partial plans (`so3fft::PartialPlan`) against direct summation, the full plan with the
+//! absent coefficients zeroed, and exact properties (round trip, batches, selections,
+//! real signals).
+
+use so3fft::wigner::wigner_d_column;
+use so3fft::{
+    coef_index, num_coeffs, Batch, Betas, Complex64, Direction, PartialOptions, PartialPlan, Plan,
+    PlanOptions, Shape,
+};
+use std::f64::consts::PI;
+
+/// Deterministic pseudo-random values in (-1, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+    fn c(&mut self) -> Complex64 {
+        Complex64::new(self.next(), self.next())
+    }
+}
+
+/// Every `(l, m, mp)` a shape holds.
+fn triples(s: &Shape) -> Vec<(usize, isize, isize)> {
+    let mut v = Vec::new();
+    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
+    for l in s.degree_min..s.degree_limit {
+        for m in -a..=a {
+            for mp in -n..=n {
+                if m.unsigned_abs() <= l && mp.unsigned_abs() <= l {
+                    v.push((l, m, mp));
+                }
+            }
+        }
+    }
+    v
+}
+
+fn random_coeffs(s: &Shape, seed: u64) -> Vec<Complex64> {
+    let mut r = Rng(seed);
+    (0..s.num_coeffs()).map(|_| r.c()).collect()
+}
+
+/// Coefficients of a real signal: `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
+fn hermitian(s: &Shape, c: &mut [Complex64]) {
+    for (l, m, mp) in triples(s) {
+        let i = s.coef_index(l, m, mp).unwrap();
+        let j = s.coef_index(l, -m, -mp).unwrap();
+        if i < j {
+            let sg = if (m - mp).rem_euclid(2) == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            c[j] = c[i].conj() * sg;
+        } else if i == j {
+            c[i] = Complex64::new(c[i].re, 0.0);
+        }
+    }
+}
+
+/// `sum fhat(l,M,M') Dt^l_{M,M'}(alpha, beta, gamma)` by direct summation.
+fn direct(s: &Shape, c: &[Complex64], alpha: f64, beta: f64, gamma: f64) -> Complex64 {
+    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
+    let mut sum = Complex64::default();
+    for m in -a..=a {
+        for mp in -n..=n {
+            let lo = m.unsigned_abs().max(mp.unsigned_abs());
+            if lo >= s.degree_limit {
+                continue;
+            }
+            let d = wigner_d_column(m, mp, s.degree_limit - 1, beta);
+            let phase = Complex64::from_polar(1.0, -(m as f64) * alpha - (mp as f64) * gamma);
+            for l in lo.max(s.degree_min)..s.degree_limit {
+                let norm = ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI);
+                sum += c[s.coef_index(l, m, mp).unwrap()] * phase * (d[l - lo] * norm);
+            }
+        }
+    }
+    sum
+}
+
+fn max_abs(v: &[Complex64]) -> f64 {
+    v.iter().map(|x| x.norm()).fold(0.0, f64::max)
+}
+
+fn max_diff(a: &[Complex64], b: &[Complex64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
+}
+
+fn opts() -> PartialOptions {
+    PartialOptions {
+        threads: 2,
+        ..PartialOptions::default()
+    }
+}
+
+fn zeros(n: usize) -> Vec<Complex64> {
+    vec![Complex64::default(); n]
+}
+
+#[test]
+fn default_shape_is_todays_layout() {
+    let b = 16;
+    let s = Shape::new(b);
+    assert!(s.is_full());
+    assert_eq!(s.num_coeffs(), num_coeffs(b));
+    for (l, m, mp) in triples(&s) {
+        assert_eq!(s.coef_index(l, m, mp), Some(coef_index(b, l, m, mp)));
+    }
+    assert_eq!(s.num_samples(), 8 * b * b * b);
+    assert_eq!(s.coef_index(b, 0, 0), None);
+    assert_eq!(s.coef_index(2, 3, 0), None);
+}
+
+#[test]
+fn limited_layout_is_dense_and_ordered() {
+    let s = Shape::new(10).with_orders(3, 5).with_degree_min(2);
+    let mut seen = vec![false; s.num_coeffs()];
+    let mut last: Option<(usize, isize, isize, usize)> = None;
+    let key = |m: isize, lim: isize| if m >= 0 { m } else { 2 * lim + 1 + m };
+    let mut all = triples(&s);
+    all.sort_by_key(|&(l, m, mp)| (key(m, 3), key(mp, 5), l));
+    for (l, m, mp) in all {
+        let i = s.coef_index(l, m, mp).unwrap();
+        assert!(!seen[i]);
+        seen[i] = true;
+        if let Some((_, _, _, j)) = last {
+            assert_eq!(i, j + 1, "blocks in so3CoefLoc order at ({l},{m},{mp})");
+        }
+        last = Some((l, m, mp, i));
+    }
+    assert!(seen.iter().all(|&x| x));
+    assert_eq!(s.coef_index(5, 4, 0), None);
+    assert_eq!(s.coef_index(1, 0, 0), None);
+}
+
+/// The general engine on the full shape agrees with the full plan.
+#[test]
+fn general_engine_matches_full_plan() {
+    for b in [1, 2, 5, 8, 16] {
+        let s = Shape::new(b);
+        let o = PartialOptions {
+            general_engine: true,
+            ..opts()
+        };
+        let pp = PartialPlan::new(&s, &o).unwrap();
+        assert!(!pp.uses_full_plan());
+        let full = Plan::new(b, &PlanOptions::default()).unwrap();
+        let c = random_coeffs(&s, 7 + b as u64);
+        let (mut x, mut y) = (zeros(s.num_samples()), zeros(s.num_samples()));
+        pp.inverse(&c, &mut x).unwrap();
+        full.inverse(&c, &mut y).unwrap();
+        let e = max_diff(&x, &y) / max_abs(&y);
+        assert!(e < 1e-13, "B={b}: inverse differs by {e:e}");
+        let (mut c1, mut c2) = (zeros(c.len()), zeros(c.len()));
+        pp.forward(&x, &mut c1).unwrap();
+        full.forward(&x, &mut c2).unwrap();
+        let e = max_diff(&c1, &c2);
+        assert!(e < 1e-12, "B={b}: forward differs by {e:e}");
+        assert!(max_diff(&c1, &c) < 1e-12);
+    }
+}
+
+/// Limited shapes on SOFT's grid against the full plan with the absent coefficients zeroed
+/// (inverse), and the full forward restricted to the shape (forward).
+#[test]
+fn limited_shapes_match_full_plan() {
+    let b = 12;
+    let full = Plan::new(b, &PlanOptions::default()).unwrap();
+    let shapes = [
+        Shape::new(b).with_orders(4, 2).with_grid(b, 2 * b, 2 * b),
+        Shape::new(b).with_orders(1, 7).with_grid(b, 2 * b, 2 * b),
+        Shape::new(b).with_degree_min(5),
+        Shape::new(b)
+            .with_orders(0, 0)
+            .with_degree_min(3)
+            .with_grid(b, 2 * b, 2 * b),
+        Shape::new(b)
+            .with_orders(11, 3)
+            .with_degree_min(4)
+            .with_grid(b, 2 * b, 2 * b),
+    ];
+    for s in shapes {
+        let pp = PartialPlan::new(&s, &opts()).unwrap();
+        let c = random_coeffs(&s, 3);
+        let mut padded = zeros(num_coeffs(b));
+        for (l, m, mp) in triples(&s) {
+            padded[coef_index(b, l, m, mp)] = c[s.coef_index(l, m, mp).unwrap()];
+        }
+        let (mut x, mut y) = (zeros(s.num_samples()), zeros(s.num_samples()));
+        pp.inverse(&c, &mut x).unwrap();
+        full.inverse(&padded, &mut y).unwrap();
+        let e = max_diff(&x, &y) / max_abs(&y);
+        assert!(e < 1e-13, "{s:?}: inverse differs by {e:e}");
+        // Forward of a full-band signal: the shape's coefficients of the full forward.
+        let mut r = Rng(11);
+        let all: Vec<Complex64> = (0..num_coeffs(b)).map(|_| r.c()).collect();
+        full.inverse(&all, &mut y).unwrap();
+        let mut got = zeros(s.num_coeffs());
+        pp.forward(&y, &mut got).unwrap();
+        for (l, m, mp) in triples(&s) {
+            let d = (got[s.coef_index(l, m, mp).unwrap()] - all[coef_index(b, l, m, mp)]).norm();
+            assert!(d < 1e-12, "{s:?}: forward ({l},{m},{mp}) off by {d:e}");
+        }
+    }
+}
+
+/// Odd and oversampled grids against direct summation, and the round trip.
+#[test]
+fn other_grids_against_direct_summation() {
+    let shapes = [
+        Shape::new(5).with_orders(3, 2).with_grid(7, 9, 7),
+        Shape::new(6).with_grid(6, 11, 13),
+        Shape::new(4)
+            .with_orders(2, 3)
+            .with_grid(9, 5, 8)
+            .with_degree_min(1),
+        Shape::new(7).with_orders(6, 0).with_grid(8, 13, 1),
+    ];
+    for s in shapes {
+        let pp = PartialPlan::new(&s, &opts()).unwrap();
+        let c = random_coeffs(&s, 5);
+        let mut x = zeros(s.num_samples());
+        pp.inverse(&c, &mut x).unwrap();
+        let mut worst: f64 = 0.0;
+        for k in 0..s.n_beta() {
+            for ja in 0..s.n_alpha {
+                for jg in 0..s.n_gamma {
+                    let want = direct(&s, &c, s.alpha(ja), s.beta(k), s.gamma(jg));
+                    let got = x[s.sample_index(ja, k, jg)];
+                    worst = worst.max((want - got).norm());
+                }
+            }
+        }
+        assert!(worst < 1e-12, "{s:?}: direct summation off by {worst:e}");
+        let mut back = zeros(c.len());
+        pp.forward(&x, &mut back).unwrap();
+        let e = max_diff(&back, &c);
+        assert!(e < 1e-12, "{s:?}: round trip {e:e}");
+    }
+}
+
+/// A batch gives bitwise the results of single executes.
+#[test]
+fn batches_equal_single_executes() {
+    // A small cap: chunks of one pair, groups of one transform; the default: one of each.
+    for cap in [Some(40 << 10), None] {
+        batch_case(cap);
+    }
+}
+
+fn batch_case(cap: Option<usize>) {
+    let s = Shape::new(9).with_orders(5, 3).with_grid(10, 12, 9);
+    let o = PartialOptions {
+        real: true,
+        max_workspace_bytes: cap,
+        ..opts()
+    };
+    let pp = PartialPlan::new(&s, &o).unwrap();
+    let (nc, ns) = (s.num_coeffs(), s.num_samples());
+    let count = 3;
+    let (idist, odist) = (nc + 5, ns + 3);
+    let mut r = Rng(9);
+    let coeffs: Vec<Complex64> = (0..idist * count).map(|_| r.c()).collect();
+    let mut many = zeros(odist * count);
+    let b = Batch {
+        count,
+        in_dist: idist,
+        out_dist: odist,
+    };
+    pp.inverse_many(b, &coeffs, &mut many).unwrap();
+    let mut back_many = zeros(idist * count);
+    let fb = Batch {
+        count,
+        in_dist: odist,
+        out_dist: idist,
+    };
+    pp.forward_many(fb, &many, &mut back_many).unwrap();
+    for t in 0..count {
+        let mut one = zeros(ns);
+        pp.inverse(&coeffs[t * idist..][..nc], &mut one).unwrap();
+        assert!(one == many[t * odist..][..ns], "inverse {t}");
+        let mut back = zeros(nc);
+        pp.forward(&one, &mut back).unwrap();
+        assert!(back == back_many[t * idist..][..nc], "forward {t}");
+        assert!(max_diff(&back, &coeffs[t * idist..][..nc]) < 1e-12);
+    }
+    // Real batches too.
+    let mut hc: Vec<Complex64> = zeros(nc * count);
+    for t in 0..count {
+        let mut c = random_coeffs(&s, 20 + t as u64);
+        hermitian(&s, &mut c);
+        hc[t * nc..][..nc].copy_from_slice(&c);
+    }
+    let mut re_many = vec![0.0; ns * count];
+    let rb = Batch {
+        count,
+        in_dist: nc,
+        out_dist: ns,
+    };
+    pp.inverse_real_many(rb, &hc, &mut re_many).unwrap();
+    for t in 0..count {
+        let mut one = vec![0.0; ns];
+        pp.inverse_real(&hc[t * nc..][..nc], &mut one).unwrap();
+        assert!(one == re_many[t * ns..][..ns], "real inverse {t}");
+    }
+}
+
+/// Inverses at selected betas equal the full inverse's slices (grid indices), and direct
+/// summation (arbitrary values).
+#[test]
+fn selected_betas() {
+    let s = Shape::new(10).with_orders(6, 4).with_grid(12, 14, 10);
+    let c = random_coeffs(&s, 13);
+    let all = PartialPlan::new(&s, &opts()).unwrap();
+    let mut x = zeros(s.num_samples());
+    all.inverse(&c, &mut x).unwrap();
+    let ks = vec![23, 0, 5, 18, 6, 11, 12];
+    let o = PartialOptions {
+        betas: Betas::Indices(ks.clone()),
+        ..opts()
+    };
+    let sel = PartialPlan::new(&s, &o).unwrap();
+    assert_eq!(sel.direction(), Direction::Inverse);
+    assert_eq!(sel.num_slices(), ks.len());
+    let mut y = zeros(sel.num_samples());
+    sel.inverse(&c, &mut y).unwrap();
+    let sl = s.slice_len();
+    for (i, &k) in ks.iter().enumerate() {
+        let e = max_diff(&y[i * sl..][..sl], &x[k * sl..][..sl]);
+        assert!(e < 1e-13, "slice {k}: {e:e}");
+    }
+    let vals = vec![0.0, 0.3, PI / 2.0, 2.9, PI, 1.0];
+    let o = PartialOptions {
+        betas: Betas::Values(vals.clone()),
+        ..opts()
+    };
+    let sel = PartialPlan::new(&s, &o).unwrap();
+    let mut y = zeros(sel.num_samples());
+    sel.inverse(&c, &mut y).unwrap();
+    for (i, &beta) in vals.iter().enumerate() {
+        for ja in 0..s.n_alpha {
+            for jg in 0..s.n_gamma {
+                let want = direct(&s, &c, s.alpha(ja), beta, s.gamma(jg));
+                let got = y[i * sl + ja * s.n_gamma + jg];
+                assert!((want - got).norm() < 1e-12, "beta {beta}");
+            }
+        }
+    }
+}
+
+/// Real plans against complex ones, also on the full plan.
+#[test]
+fn real_against_complex() {
+    let shapes = [
+        Shape::new(8).with_orders(5, 3).with_grid(9, 12, 7),
+        Shape::new(8)
+            .with_orders(2, 6)
+            .with_grid(8, 6, 14)
+            .with_degree_min(2),
+        Shape::new(6),
+    ];
+    for s in shapes {
+        for general in [false, true] {
+            let o = PartialOptions {
+                real: true,
+                general_engine: general,
+                ..opts()
+            };
+            let pp = PartialPlan::new(&s, &o).unwrap();
+            let mut c = random_coeffs(&s, 17);
+            hermitian(&s, &mut c);
+            let mut z = zeros(s.num_samples());
+            pp.inverse(&c, &mut z).unwrap();
+            assert!(z.iter().all(|v| v.im.abs() < 1e-12));
+            // The real inverse reads only the representatives: spoil the others.
+            let mut spoiled = c.clone();
+            for (l, m, mp) in triples(&s) {
+                if mp < 0 || (mp == 0 && m < 0) {
+                    spoiled[s.coef_index(l, m, mp).unwrap()] = Complex64::new(9.0, 9.0);
+                }
+            }
+            let mut re = vec![0.0; s.num_samples()];
+            pp.inverse_real(&spoiled, &mut re).unwrap();
+            let e = re
+                .iter()
+                .zip(&z)
+                .map(|(a, b)| (a - b.re).abs())
+                .fold(0.0, f64::max);
+            assert!(e < 1e-13, "{s:?}: real inverse {e:e}");
+            let mut back = zeros(c.len());
+            pp.forward_real(&re, &mut back).unwrap();
+            let e = max_diff(&back, &c);
+            assert!(e < 1e-12, "{s:?}: real forward {e:e}");
+        }
+    }
+}
+
+#[test]
+fn invalid_shapes_and_calls_are_rejected() {
+    let bad = [
+        (Shape::new(0), "degree limit"),
+        (Shape::new(5000), "degree limit"),
+        (Shape::new(8).with_degree_min(8), "L0"),
+        (Shape::new(8).with_orders(8, 2), "order limits"),
+        (
+            Shape::new(8).with_orders(3, 2).with_grid(8, 6, 16),
+            "n_alpha",
+        ),
+        (
+            Shape::new(8).with_orders(3, 2).with_grid(8, 7, 4),
+            "n_gamma",
+        ),
+        (Shape::new(8).with_grid(0, 16, 16), "B_grid"),
+        (Shape::new(8).with_grid(7, 16, 16), "B_grid >= L"),
+    ];
+    for (s, what) in bad {
+        let err = PartialPlan::new(&s, &opts()).err().expect("rejected");
+        assert!(
+            err.to_string().contains(what),
+            "{s:?}: '{err}' lacks '{what}'"
+        );
+        assert_eq!(s.coef_index(0, 0, 0).is_none(), s.validate().is_err());
+    }
+    // Undersampled beta grid: fine for the inverse.
+    let s = Shape::new(8).with_grid(4, 16, 16);
+    let o = PartialOptions {
+        direction: Direction::Inverse,
+        ..opts()
+    };
+    assert!(PartialPlan::new(&s, &o).is_ok());
+    let s = Shape::new(6).with_orders(2, 2);
+    for (betas, what) in [
+        (Betas::Indices(vec![12]), "outside the grid"),
+        (Betas::Indices(vec![1, 1]), "twice"),
+        (Betas::Values(vec![-0.1]), "outside [0, pi]"),
+        (Betas::Values(vec![f64::NAN]), "outside [0, pi]"),
+        (Betas::Indices(vec![]), "no betas"),
+    ] {
+        let o = PartialOptions { betas, ..opts() };
+        let err = PartialPlan::new(&s, &o).err().expect("rejected");
+        assert!(err.to_string().contains(what), "'{err}' lacks '{what}'");
+    }
+    let o = PartialOptions {
+        betas: Betas::Indices(vec![1]),
+        direction: Direction::Forward,
+        ..opts()
+    };
+    assert!(PartialPlan::new(&s, &o).is_err());
+    for t in [-1.0, 1.0, f64::INFINITY] {
+        let o = PartialOptions {
+            tolerance: Some(t),
+            ..opts()
+        };
+        assert!(PartialPlan::new(&s, &o).is_err());
+    }
+    let pp = PartialPlan::new(&s, &opts()).unwrap();
+    let c = zeros(pp.num_coeffs());
+    let mut x = zeros(pp.num_samples() - 1);
+    assert!(pp.inverse(&c, &mut x).is_err());
+    let mut x = zeros(pp.num_samples());
+    assert!(pp
+        .inverse_real(&c, &mut vec![0.0; pp.num_samples()])
+        .is_err());
+    let b = Batch {
+        count: 2,
+        in_dist: pp.num_coeffs(),
+        out_dist: pp.num_samples() - 1,
+    };
+    assert!(pp.inverse_many(b, &c, &mut x).is_err());
+    let b = Batch {
+        count: 0,
+        in_dist: 0,
+        out_dist: 0,
+    };
+    assert!(pp.inverse_many(b, &c, &mut x).is_err());
+}
+
+/// The tolerance knob: looser tolerances stay within their documented error.
+#[test]
+fn tolerance_bounds_the_error() {
+    let s = Shape::new(48).with_orders(20, 20).with_grid(48, 41, 41);
+    let c = random_coeffs(&s, 21);
+    let exact = PartialPlan::new(
+        &s,
+        &PartialOptions {
+            tolerance: Some(0.0),
+            ..opts()
+        },
+    )
+    .unwrap();
+    let mut x0 = zeros(s.num_samples());
+    exact.inverse(&c, &mut x0).unwrap();
+    let scale = max_abs(&c);
+    for tol in [1e-6, 1e-10] {
+        let pp = PartialPlan::new(
+            &s,
+            &PartialOptions {
+                tolerance: Some(tol),
+                ..opts()
+            },
+        )
+        .unwrap();
+        let mut x = zeros(s.num_samples());
+        pp.inverse(&c, &mut x).unwrap();
+        // Bound: per slice value, L * tol * max|c| per order pair, summed over the
+        // (2Mmax+1)(2N+1) pairs of the 2-D DFT.
+        let bound = s.degree_limit as f64 * tol * scale * (41.0 * 41.0);
+        let e = max_diff(&x, &x0);
+        assert!(e < bound, "tolerance {tol}: error {e:e} above {bound:e}");
+        let mut back = zeros(c.len());
+        pp.forward(&x0, &mut back).unwrap();
+        assert!(max_diff(&back, &c) < 2.0 * tol * max_abs(&x0) * 10.0);
+    }
+}
