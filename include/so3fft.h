@@ -101,6 +101,9 @@
 // Opaque correlation plan (made by `so3fft_plan_correlation`).
 typedef struct so3fft_correlation_s so3fft_correlation_s;
 
+// Opaque partial plan object.
+typedef struct so3fft_partial_s so3fft_partial_s;
+
 // Opaque plan object (made by a planner, released by `so3fft_destroy_plan`).
 typedef struct so3fft_plan_s so3fft_plan_s;
 
@@ -112,6 +115,48 @@ typedef struct so3fft_plan_s *so3fft_plan;
 
 // One complex number `{re, im}`, identical to `fftw_complex` (`double[2]`).
 typedef double so3fft_complex[2];
+
+// What a partial plan computes: degrees `L0 <= l < L`, orders `|m| <= m_max`,
+// `|mp| <= mp_max`, on `2 B_grid` betas x `n_alpha` alphas x `n_gamma` gammas.
+// `so3fft_shape_default(L)` gives the full transform on SOFT's grid.
+typedef struct so3fft_shape {
+    // Degree limit: degrees `l < L`.
+    int L;
+    // Lowest degree.
+    int L0;
+    // Order limit of `m` (paired with alpha).
+    int m_max;
+    // Order limit of `mp` (paired with gamma).
+    int mp_max;
+    // Beta grid: `2 B_grid` points.
+    int B_grid;
+    // Alpha samples (`>= 2 m_max + 1`).
+    int n_alpha;
+    // Gamma samples (`>= 2 mp_max + 1`).
+    int n_gamma;
+} so3fft_shape;
+
+// A partial plan: a pointer to an opaque object.
+typedef struct so3fft_partial_s *so3fft_partial;
+
+// Options of a partial plan; all zero means: both directions, all cores, the default
+// tolerance and workspace, every beta.
+typedef struct so3fft_partial_options {
+    // `SO3FFT_FORWARD`, `SO3FFT_INVERSE`, `SO3FFT_BOTH` (0: both).
+    int direction;
+    // Worker threads (0: all cores).
+    int nthreads;
+    // Wigner-d prefixes below this are skipped (0: 2^-64; negative: none skipped).
+    double tolerance;
+    // Number of betas the inverse evaluates (0: every beta of the grid).
+    int nbetas;
+    // `nbetas` grid indices (or NULL).
+    const int *beta_indices;
+    // `nbetas` beta values in `[0, pi]` (or NULL; exactly one of the two is given).
+    const double *beta_values;
+    // Cap on the chunk buffer in bytes (0: default).
+    size_t max_workspace;
+} so3fft_partial_options;
 
 // An S^2 plan: a pointer to an opaque object.
 typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
@@ -212,6 +257,65 @@ int so3fft_weights(int B, double *w);
 
 // `SO3FFT_MAX_BANDWIDTH` of the library linked.
 int so3fft_max_bandwidth(void);
+
+// The full transform of bandwidth `L` on SOFT's grid (`2L x 2L x 2L`); a shape with
+// `L = 0` (rejected by the planner) for `L` outside `1..=SO3FFT_MAX_BANDWIDTH`.
+struct so3fft_shape so3fft_shape_default(int L);
+
+// `SO3FFT_OK` if a plan of `direction` can be made for `shape` (the forward needs
+// `B_grid >= L`), else `SO3FFT_EINVAL` with the violated condition in the message.
+int so3fft_shape_check(const struct so3fft_shape *shape, int direction);
+
+// Number of coefficients of `shape` (a negative code if invalid).
+ptrdiff_t so3fft_shape_num_coeffs(const struct so3fft_shape *shape);
+
+// Number of samples of `shape` with every beta, `2 B_grid n_alpha n_gamma`.
+ptrdiff_t so3fft_shape_num_samples(const struct so3fft_shape *shape);
+
+// Index of `fhat(l, m, mp)` in the coefficients of `shape`; `SO3FFT_EINVAL` if the
+// shape does not hold it.
+ptrdiff_t so3fft_shape_coef_index(const struct so3fft_shape *shape, int l, int m, int mp);
+
+// Plans the transforms of `shape` with `options` (NULL: defaults); `flags` a planner
+// rigour, `| SO3FFT_REAL` for the real-signal executes too. A beta selection makes an
+// inverse-only plan. NULL on error.
+so3fft_partial so3fft_plan_partial(const struct so3fft_shape *shape, const struct so3fft_partial_options *options, unsigned int flags);
+
+// Destroys a partial plan; NULL is a no-op.
+void so3fft_destroy_partial(so3fft_partial p);
+
+// Coefficients of one transform of the plan.
+ptrdiff_t so3fft_partial_num_coeffs(so3fft_partial p);
+
+// Samples of one transform of the plan (`n_alpha n_gamma` per beta evaluated).
+ptrdiff_t so3fft_partial_num_samples(so3fft_partial p);
+
+// `howmany` forward transforms: samples `idist` values apart (only read) to coefficients
+// `odist` apart. `SO3FFT_OK` or an error code.
+int so3fft_partial_forward_many(so3fft_partial p, int howmany, so3fft_complex *samples, ptrdiff_t idist, so3fft_complex *coeffs, ptrdiff_t odist);
+
+// `howmany` inverse transforms: coefficients `idist` apart to samples `odist` apart.
+int so3fft_partial_inverse_many(so3fft_partial p, int howmany, so3fft_complex *coeffs, ptrdiff_t idist, so3fft_complex *samples, ptrdiff_t odist);
+
+// `howmany` forward transforms of real samples (doubles, `idist` apart); every
+// coefficient written. Needs a plan made with `SO3FFT_REAL`.
+int so3fft_partial_forward_real_many(so3fft_partial p, int howmany, const double *samples, ptrdiff_t idist, so3fft_complex *coeffs, ptrdiff_t odist);
+
+// `howmany` inverse transforms to real samples; reads the blocks `mp > 0`, or `mp = 0`
+// and `m >= 0` (the others follow by symmetry). Needs `SO3FFT_REAL`.
+int so3fft_partial_inverse_real_many(so3fft_partial p, int howmany, so3fft_complex *coeffs, ptrdiff_t idist, double *samples, ptrdiff_t odist);
+
+// One forward transform (`so3fft_partial_forward_many` with `howmany = 1`).
+int so3fft_partial_forward(so3fft_partial p, so3fft_complex *samples, so3fft_complex *coeffs);
+
+// One inverse transform.
+int so3fft_partial_inverse(so3fft_partial p, so3fft_complex *coeffs, so3fft_complex *samples);
+
+// One forward transform of real samples.
+int so3fft_partial_forward_real(so3fft_partial p, const double *samples, so3fft_complex *coeffs);
+
+// One inverse transform to real samples.
+int so3fft_partial_inverse_real(so3fft_partial p, so3fft_complex *coeffs, double *samples);
 
 // Plans the S^2 transforms of bandwidth `B` (both directions, complex and real samples),
 // `flags` a planner rigour (`SO3FFT_ESTIMATE` ...), `nthreads` workers (0 = all cores).

@@ -37,6 +37,8 @@ mod execute;
 mod query;
 // Sizes, indices, angles, weights.
 mod grid;
+// Partial plans (guru interface).
+mod partial;
 // Spherical-harmonic transforms.
 mod s2;
 // Rotational matching.
@@ -58,6 +60,15 @@ pub use matching::{
     so3fft_correlate, so3fft_correlate_real, so3fft_correlation, so3fft_correlation_grid_size,
     so3fft_correlation_refine, so3fft_correlation_s, so3fft_destroy_correlation,
     so3fft_grid_argmax, so3fft_grid_argmax_real, so3fft_plan_correlation, SO3FFT_NORMALIZED,
+};
+pub use partial::{
+    so3fft_destroy_partial, so3fft_partial, so3fft_partial_forward, so3fft_partial_forward_many,
+    so3fft_partial_forward_real, so3fft_partial_forward_real_many, so3fft_partial_inverse,
+    so3fft_partial_inverse_many, so3fft_partial_inverse_real, so3fft_partial_inverse_real_many,
+    so3fft_partial_num_coeffs, so3fft_partial_num_samples, so3fft_partial_options,
+    so3fft_partial_s, so3fft_plan_partial, so3fft_shape, so3fft_shape_check,
+    so3fft_shape_coef_index, so3fft_shape_default, so3fft_shape_num_coeffs,
+    so3fft_shape_num_samples,
 };
 pub use planner::{
     so3fft_destroy_plan, so3fft_plan_both, so3fft_plan_forward, so3fft_plan_general,

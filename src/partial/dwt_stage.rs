@@ -2,11 +2,14 @@
 //! kernels over a chunk of lane pairs, writing (inverse) or reading (forward) each
 //! cluster's block of the chunk buffer.
 //!
-//! A chunk of `h` lane pairs (padded to `hp`, a multiple of the vector width) gives every
-//! cluster a block of `2 hp` rows of `P` doubles: rows `0..hp` the pairs' lower points,
-//! rows `hp..2hp` their mirrors; slot `q` of a row holds the value of the cluster's `q`-th
-//! order pair present in the shape (or, for a reversed member, its value at the row's
-//! mirror). With a batch, the blocks of transform `t` follow those of transform `t - 1`.
+//! A chunk of `h` lane pairs (padded to `hp`, a multiple of the vector width) has `2 hp`
+//! lane rows: rows `0..hp` the pairs' lower points, rows `hp..2hp` their mirrors. The
+//! chunk buffer is lane-major: a lane row holds every cluster's `P` doubles (16 for
+//! clusters of more than four order pairs in the shape, else 8) one after another, so the
+//! FFT stage reads or writes a slice's values in one sequential pass. Slot `q` of a
+//! cluster's row holds the value of its `q`-th order pair present in the shape (or, for a
+//! reversed member, its value at the row's mirror). With a batch, the lane rows of
+//! transform `t` follow those of transform `t - 1`.
 
 use super::betas::LanePairs;
 use super::shape::CoefLayout;
@@ -23,7 +26,8 @@ use std::sync::Mutex;
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Slot {
     pub member: Member,
-    /// Index of `(M, M')` in a transformed slice of `n_alpha x n_gamma` values.
+    /// Index of `(M, M')` in a work buffer of `n_alpha` rows of `n_gamma` values, rows
+    /// `row_stride` apart.
     pub work: usize,
     /// Start of the pair's coefficient block and its lowest stored degree.
     pub block: usize,
@@ -44,7 +48,7 @@ pub(super) struct ClusterPlan {
     /// Doubles per block row: 16 for more than four slots, else 8.
     pub p: usize,
     pub slots: Vec<Slot>,
-    /// Doubles per lane of the blocks before this one.
+    /// Doubles before this cluster's in a lane row.
     pub offset: usize,
 }
 
@@ -92,7 +96,7 @@ pub(super) struct DwtStage {
     /// Degree limit `L`.
     l: usize,
     pub clusters: Vec<ClusterPlan>,
-    /// Doubles per lane of all blocks (one transform).
+    /// Doubles of a lane row (all clusters).
     pub row_total: usize,
     recurrence: RecTables,
     skip_bits: u32,
@@ -102,11 +106,12 @@ pub(super) struct DwtStage {
 }
 
 impl DwtStage {
-    /// The clusters of `layout` (a shape with `n_alpha x n_gamma` slices), scratch for
+    /// The clusters of `layout` (slices of `n_alpha x n_gamma` values, work buffers with
+    /// rows `row_stride` apart), scratch for
     /// `workers` workers and chunks of up to `max_lanes` lanes.
     pub fn new(
         layout: &CoefLayout,
-        (n_alpha, n_gamma): (usize, usize),
+        (n_alpha, n_gamma, row_stride): (usize, usize, usize),
         isa: Isa,
         (skip_bits, skip): (u32, bool),
         (workers, max_lanes): (usize, usize),
@@ -123,7 +128,7 @@ impl DwtStage {
                     .filter(|mem| layout.holds(mem.m, mem.mp))
                     .map(|mem| Slot {
                         member: *mem,
-                        work: mem.m.rem_euclid(n_alpha as isize) as usize * n_gamma
+                        work: mem.m.rem_euclid(n_alpha as isize) as usize * row_stride
                             + mem.mp.rem_euclid(n_gamma as isize) as usize,
                         block: layout.block_start(mem.m, mem.mp),
                         first: layout.first_degree(mem.m, mem.mp),
@@ -213,7 +218,9 @@ impl DwtStage {
         n
     }
 
-    fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes) -> Lanes<'a> {
+    /// The kernels' lanes for a chunk in the lane-major buffer: lower row `j` at
+    /// `j row_total`, its mirror `hp row_total` further.
+    fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes, stream: bool) -> Lanes<'a> {
         let nl = ch.lanes();
         Lanes {
             tau: &sc.tau[..nl],
@@ -222,22 +229,24 @@ impl DwtStage {
             upper_from: ch.hp,
             big: big(self.skip_bits),
             skip: self.skip,
-            interleaved: false,
+            interleaved: true,
             prefetch: Prefetch::none(),
-            stream: false,
-            pair_stride: 0,
-            row_gap: 0,
+            stream,
+            pair_stride: self.row_total,
+            row_gap: ch.hp * self.row_total,
         }
     }
 
     /// Inverse kernel of `cl` (set up by [`DwtStage::setup`], `n` degrees) from the
-    /// coefficients at `coef` into `block` (`2 hp` rows of `cl.p`). With `real`, the
+    /// coefficients at `coef` into the cluster's slots of the chunk's lane rows at `block`
+    /// (lane row `r` at `block + r row_total`, `cl.p` doubles). With `real`, the
     /// non-representative order pairs are read from their representatives
-    /// (`fhat(l,M,M') = (-1)^(M-M') conj(fhat(l,-M,-M'))`).
+    /// (`fhat(l,M,M') = (-1)^(M-M') conj(fhat(l,-M,-M'))`). With `stream`, written by
+    /// non-temporal stores.
     ///
     /// # Safety
-    /// `coef` holds the shape's coefficients (read only meanwhile); `block` is valid for
-    /// writes of `2 hp cl.p` doubles and nobody else's meanwhile.
+    /// `coef` holds the shape's coefficients (read only meanwhile); the `2 hp` rows of
+    /// `cl.p` doubles at `block` are valid for writes and nobody else's meanwhile.
     #[allow(clippy::too_many_arguments)]
     pub unsafe fn inverse(
         &self,
@@ -246,7 +255,7 @@ impl DwtStage {
         ch: ChunkLanes,
         n: usize,
         coef: *const Complex64,
-        real: bool,
+        (real, stream): (bool, bool),
         block: *mut f64,
     ) {
         let p = cl.p;
@@ -286,9 +295,9 @@ impl DwtStage {
             }
         };
         let rec = Rec::new(&sc.rec, n);
-        let lanes = self.lanes(sc, ch);
-        // SAFETY: `block` holds the chunk's `2 hp` rows of `p` doubles (caller's contract),
-        // consecutive as the non-interleaved lanes address them.
+        let lanes = self.lanes(sc, ch, stream);
+        // SAFETY: the chunk's `2 hp` rows of `p` doubles at `block`, addressed as the lanes
+        // say, are the caller's (caller's contract).
         unsafe {
             dwt::inverse_raw(
                 self.isa,
@@ -303,12 +312,13 @@ impl DwtStage {
         sc.data = data;
     }
 
-    /// Forward kernel of `cl` over `block` (`2 hp` rows of `cl.p`, padding rows zero),
-    /// accumulated into the coefficients at `coef` (`first`: assign instead).
+    /// Forward kernel of `cl` over its slots of the chunk's lane rows at `block` (as for
+    /// [`DwtStage::inverse`]; padding rows zero), accumulated into the coefficients at
+    /// `coef` (`first`: assign instead).
     ///
     /// # Safety
-    /// `block` is valid for reads; `coef` holds the shape's coefficients, whose blocks of
-    /// this cluster's slots nobody else touches meanwhile.
+    /// The rows at `block` are valid for reads; `coef` holds the shape's coefficients,
+    /// whose blocks of this cluster's slots nobody else touches meanwhile.
     #[allow(clippy::too_many_arguments)]
     pub unsafe fn forward(
         &self,
@@ -326,8 +336,8 @@ impl DwtStage {
             data = vec![0.0; (self.l + 8) * 16];
         }
         let rec = Rec::new(&sc.rec, n);
-        let lanes = self.lanes(sc, ch);
-        // SAFETY: `block` holds `2 hp` rows of `p` doubles, read only (caller's contract).
+        let lanes = self.lanes(sc, ch, false);
+        // SAFETY: the `2 hp` rows of `p` doubles at `block`, read only (caller's contract).
         let lo = unsafe { dwt::forward_raw(self.isa, p, &rec, &lanes, block, &mut data) }.min(n);
         for (q, s) in cl.slots.iter().enumerate() {
             let mem = &s.member;

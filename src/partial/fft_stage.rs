@@ -1,12 +1,14 @@
 //! The FFT stage of a partial plan: pruned 2-D DFTs of one beta slice over
 //! `(alpha, gamma)`, as 1-D transforms of only the rows and columns that can be non-zero.
 //!
-//! Inverse: the `2 Mmax + 1` rows `M` of a slice's values (zero outside `|M'| <= N`) are
-//! transformed over gamma in the worker's work buffer (`n_alpha x n_gamma`, other rows
-//! zero), then every column over alpha into the caller's slice. Forward: every row of the
-//! caller's slice over gamma into the work buffer, then only the `2N + 1` columns `M'`
-//! over alpha. The real transforms use `r2c` rows of `n_gamma / 2 + 1` values and
-//! transform only the columns `0 ..= N`.
+//! Inverse: the values of a slice sit in the columns `|M'| <= N` of the worker's work
+//! buffer (`n_alpha` rows, the other columns zero); those columns are transformed over
+//! alpha in place, then every row over gamma into the caller's slice (rows written
+//! whole). Forward: every row of the caller's slice over gamma into the work buffer, then
+//! only the `2N + 1` columns `M'` over alpha. The real transforms use rows of
+//! `n_gamma / 2 + 1` values (`r2c`, `c2r`) and transform only the columns `0 ..= N`.
+//! The work buffers' rows are padded by a cache line so that a walk down a column does
+//! not stay in one cache set.
 //!
 //! Plans on the caller's arrays exist twice: for arrays aligned as FFTW's SIMD code wants
 //! and (`FFTW_UNALIGNED`) for the others; plans inside the page-aligned work buffers once.
@@ -17,17 +19,21 @@ use fftw_sys as fftw;
 use num_complex::Complex64;
 use std::ffi::c_int;
 
+/// Complex values of padding after each row of a work buffer.
+pub(super) const ROW_PAD: usize = 4;
+
 /// A batch of 1-D DFTs: `howmany` transforms of `n` points, `stride` apart within one,
-/// `dist` from one to the next (the same on both sides).
+/// `dist` from one to the next, on the input and the output side.
 #[derive(Clone, Copy)]
 struct DftBatch {
     n: usize,
     howmany: usize,
     stride: usize,
-    dist: usize,
+    idist: usize,
+    odist: usize,
 }
 
-/// Which kind of DFT a [`DftBatch`] is planned as.
+/// Which kind of DFT a [`DftBatch`] is planned as (the real kinds have stride 1).
 #[derive(Clone, Copy)]
 enum Kind {
     Complex(i32),
@@ -38,21 +44,20 @@ enum Kind {
 /// Plans a batch from `inp` to `out` (the same pointer: in place).
 ///
 /// # Safety
-/// `inp` and `out` cover the batch's extent (complex values, or reals for the real side of
-/// `R2c` / `C2r`, whose complex side has rows of `n/2 + 1` values `dist_c` apart).
+/// `inp` and `out` cover the batch's extent (complex values, or reals on the real side of
+/// `R2c` / `C2r`).
 unsafe fn plan_batch(
     b: DftBatch,
     kind: Kind,
     (inp, out): (*mut Complex64, *mut Complex64),
-    dist_c: usize,
     flags: u32,
 ) -> Result<RawPlan> {
     let dims = [b.n as c_int];
-    let (h, s, d, dc) = (
+    let (h, s, id, od) = (
         b.howmany as c_int,
         b.stride as c_int,
-        b.dist as c_int,
-        dist_c as c_int,
+        b.idist as c_int,
+        b.odist as c_int,
     );
     plan_guarded(b.n * b.howmany, 1, || {
         // SAFETY: under the planner lock (plan_guarded); the arrays cover the batch
@@ -66,11 +71,11 @@ unsafe fn plan_batch(
                     inp,
                     std::ptr::null(),
                     s,
-                    d,
+                    id,
                     out,
                     std::ptr::null(),
                     s,
-                    d,
+                    od,
                     sign,
                     flags,
                 ),
@@ -81,11 +86,11 @@ unsafe fn plan_batch(
                     inp.cast::<f64>(),
                     std::ptr::null(),
                     1,
-                    d,
+                    id,
                     out,
                     std::ptr::null(),
                     1,
-                    dc,
+                    od,
                     flags | fftw::FFTW_PRESERVE_INPUT,
                 ),
                 Kind::C2r => fftw::fftw_plan_many_dft_c2r(
@@ -95,11 +100,11 @@ unsafe fn plan_batch(
                     inp,
                     std::ptr::null(),
                     1,
-                    dc,
+                    id,
                     out.cast::<f64>(),
                     std::ptr::null(),
                     1,
-                    d,
+                    od,
                     flags,
                 ),
             }
@@ -120,20 +125,13 @@ impl TwoWay {
         b: DftBatch,
         kind: Kind,
         arrays: (*mut Complex64, *mut Complex64),
-        dist_c: usize,
         rigor: Rigor,
     ) -> Result<TwoWay> {
         // SAFETY: the caller's contract.
         unsafe {
             Ok(TwoWay {
-                aligned: plan_batch(b, kind, arrays, dist_c, rigor.flags())?,
-                unaligned: plan_batch(
-                    b,
-                    kind,
-                    arrays,
-                    dist_c,
-                    fftw::FFTW_ESTIMATE | fftw::FFTW_UNALIGNED,
-                )?,
+                aligned: plan_batch(b, kind, arrays, rigor.flags())?,
+                unaligned: plan_batch(b, kind, arrays, fftw::FFTW_ESTIMATE | fftw::FFTW_UNALIGNED)?,
             })
         }
     }
@@ -153,9 +151,12 @@ impl TwoWay {
     }
 }
 
-/// A worker's buffers: a complex slice and (real plans) a half-spectrum slice.
+/// A worker's buffers, each made on first use: the inverse's (whose columns outside
+/// `|M'| <= N` stay zero), the forward's, and the real transforms' half spectra.
+#[derive(Default)]
 pub(super) struct Work {
-    pub full: AlignedBuf,
+    pub inv: Option<AlignedBuf>,
+    pub fwd: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
 }
 
@@ -163,12 +164,15 @@ pub(super) struct Work {
 pub(super) struct FftStage {
     na: usize,
     ng: usize,
-    mmax: usize,
     n: usize,
-    inv_rows: [Option<RawPlan>; 2],
-    inv_cols: TwoWay,
-    fwd_rows: TwoWay,
+    /// Row strides of the complex and the half-spectrum work buffers.
+    rs: usize,
+    hs: usize,
+    /// Columns `0..=N` and `-N..-1` over alpha, in place: sign -1 (inverse), +1 (forward).
+    inv_cols: [Option<RawPlan>; 2],
     fwd_cols: [Option<RawPlan>; 2],
+    inv_rows: TwoWay,
+    fwd_rows: TwoWay,
     real: Option<RealFfts>,
 }
 
@@ -181,76 +185,63 @@ struct RealFfts {
 }
 
 impl FftStage {
-    /// Plans for slices of `na x ng` values with orders `|M| <= mmax`, `|M'| <= n`.
-    pub fn new(
-        (na, ng): (usize, usize),
-        (mmax, n): (usize, usize),
-        real: bool,
-        rigor: Rigor,
-    ) -> Result<FftStage> {
-        let len = na * ng;
-        let a = AlignedBuf::new(len)?;
-        let b = AlignedBuf::new(len)?;
+    /// Plans for slices of `na x ng` values with orders `|M'| <= n`.
+    pub fn new((na, ng): (usize, usize), n: usize, real: bool, rigor: Rigor) -> Result<FftStage> {
+        let (rs, hs) = (ng + ROW_PAD, ng / 2 + 1 + ROW_PAD);
+        let a = AlignedBuf::new(na * rs)?;
+        let b = AlignedBuf::new(na * rs)?;
         let (pa, pb) = (a.as_mut_ptr(), b.as_mut_ptr());
         let flags = rigor.flags();
-        let rows = |howmany: usize| DftBatch {
-            n: ng,
-            howmany,
-            stride: 1,
-            dist: ng,
-        };
-        let cols = |howmany: usize| DftBatch {
+        let cols = |howmany: usize, stride: usize| DftBatch {
             n: na,
             howmany,
-            stride: ng,
-            dist: 1,
+            stride,
+            idist: 1,
+            odist: 1,
         };
-        // SAFETY (all plans below): `a` and `b` hold `na ng` values; each batch stays
-        // inside them (rows `r..r+howmany` of `ng` values, or columns `c..c+howmany` of
-        // `na` values `ng` apart), as does the real side (`na` rows of `ng` reals).
-        let opt = |howmany: usize,
-                   at: usize,
-                   batch: &dyn Fn(usize) -> DftBatch,
-                   sign: i32|
-         -> Result<Option<RawPlan>> {
-            if howmany == 0 {
-                return Ok(None);
-            }
-            let p = pa.wrapping_add(at);
-            // SAFETY: see above: the batch lies inside `a` from offset `at`.
-            unsafe { plan_batch(batch(howmany), Kind::Complex(sign), (p, p), 0, flags) }.map(Some)
+        let rows = |idist: usize, odist: usize| DftBatch {
+            n: ng,
+            howmany: na,
+            stride: 1,
+            idist,
+            odist,
         };
-        let inv_rows = [
-            opt(mmax + 1, 0, &rows, SIGN_MINUS)?,
-            opt(mmax, (na - mmax) * ng, &rows, SIGN_MINUS)?,
+        // SAFETY (all plans below): `a` and `b` hold `na` rows of `rs >= ng` values (or,
+        // as reals, `na` rows of `ng`); each batch stays inside them: columns `c..c+howmany`
+        // (`c + howmany <= ng`, or `<= hs` of the half spectrum) of `na` values, or the
+        // `na` rows.
+        let col_plan =
+            |howmany: usize, at: usize, stride: usize, sign: i32| -> Result<Option<RawPlan>> {
+                if howmany == 0 {
+                    return Ok(None);
+                }
+                let p = pa.wrapping_add(at);
+                // SAFETY: see above.
+                unsafe { plan_batch(cols(howmany, stride), Kind::Complex(sign), (p, p), flags) }
+                    .map(Some)
+            };
+        let inv_cols = [
+            col_plan(n + 1, 0, rs, SIGN_MINUS)?,
+            col_plan(n, ng - n, rs, SIGN_MINUS)?,
         ];
         let fwd_cols = [
-            opt(n + 1, 0, &cols, SIGN_PLUS)?,
-            opt(n, ng - n, &cols, SIGN_PLUS)?,
+            col_plan(n + 1, 0, rs, SIGN_PLUS)?,
+            col_plan(n, ng - n, rs, SIGN_PLUS)?,
         ];
         // SAFETY: as above.
-        let inv_cols =
-            unsafe { TwoWay::new(cols(ng), Kind::Complex(SIGN_MINUS), (pa, pb), 0, rigor)? };
+        let inv_rows =
+            unsafe { TwoWay::new(rows(rs, ng), Kind::Complex(SIGN_MINUS), (pa, pb), rigor)? };
         // SAFETY: as above.
         let fwd_rows =
-            unsafe { TwoWay::new(rows(na), Kind::Complex(SIGN_PLUS), (pb, pa), 0, rigor)? };
+            unsafe { TwoWay::new(rows(ng, rs), Kind::Complex(SIGN_PLUS), (pb, pa), rigor)? };
         let real = if real {
-            let h = ng / 2 + 1;
-            let half_cols = |sign| {
-                let batch = DftBatch {
-                    n: na,
-                    howmany: n + 1,
-                    stride: h,
-                    dist: 1,
-                };
-                // SAFETY: columns 0..=N of `na` rows of `h <= ng` values, inside `a`.
-                unsafe { plan_batch(batch, Kind::Complex(sign), (pa, pa), 0, flags) }
-            };
+            let half_cols =
+                |sign| col_plan(n + 1, 0, hs, sign).map(|p| p.expect("N + 1 > 0 columns"));
             Some(RealFfts {
-                // SAFETY: `na` rows of `ng` reals in `b`, `h` complex values each in `a`.
-                r2c: unsafe { TwoWay::new(rows(na), Kind::R2c, (pb, pa), h, rigor)? },
+                // SAFETY: `na` rows of `ng` reals in `b`, rows of `hs` values in `a`.
+                r2c: unsafe { TwoWay::new(rows(ng, hs), Kind::R2c, (pb, pa), rigor)? },
                 // SAFETY: as for r2c, the other way.
-                c2r: unsafe { TwoWay::new(rows(na), Kind::C2r, (pa, pb), h, rigor)? },
+                c2r: unsafe { TwoWay::new(rows(hs, ng), Kind::C2r, (pa, pb), rigor)? },
                 cols_minus: half_cols(SIGN_MINUS)?,
                 cols_plus: half_cols(SIGN_PLUS)?,
             })
@@ -260,12 +251,13 @@ impl FftStage {
         Ok(FftStage {
             na,
             ng,
-            mmax,
             n,
-            inv_rows,
+            rs,
+            hs,
             inv_cols,
-            fwd_rows,
             fwd_cols,
+            inv_rows,
+            fwd_rows,
             real,
         })
     }
@@ -280,26 +272,48 @@ impl FftStage {
         self.na * self.ng
     }
 
-    /// A worker's buffers for these plans.
-    pub fn work(&self) -> Result<Work> {
-        Ok(Work {
-            full: AlignedBuf::new(self.na * self.ng)?,
-            half: match self.real {
-                Some(_) => Some(AlignedBuf::new(self.na * (self.ng / 2 + 1))?),
-                None => None,
-            },
-        })
+    /// Row strides of the complex and the half-spectrum work buffers.
+    pub fn strides(&self) -> (usize, usize) {
+        (self.rs, self.hs)
     }
 
-    /// Inverse of a slice: the order rows of `work.full` (values at `(M mod na) ng + M' mod ng`,
-    /// everything else zero) over gamma in place, then all columns over alpha into `out`.
+    /// The inverse's work buffer, zero where no value is ever placed.
+    pub fn inv_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
+        let len = self.na * self.rs;
+        if work.inv.is_none() {
+            work.inv = Some(AlignedBuf::new(len)?);
+        }
+        Ok(work.inv.as_mut().expect("just made").slice_mut(len))
+    }
+
+    /// The forward's work buffer.
+    pub fn fwd_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
+        let len = self.na * self.rs;
+        if work.fwd.is_none() {
+            work.fwd = Some(AlignedBuf::new(len)?);
+        }
+        Ok(work.fwd.as_mut().expect("just made").slice_mut(len))
+    }
+
+    /// The real transforms' half-spectrum buffer.
+    pub fn half_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
+        let len = self.na * self.hs;
+        if work.half.is_none() {
+            work.half = Some(AlignedBuf::new(len)?);
+        }
+        Ok(work.half.as_mut().expect("just made").slice_mut(len))
+    }
+
+    /// Inverse of a slice: `w` (the inverse's work buffer) holds the values at
+    /// `(M mod na) rs + (M' mod ng)`, zero elsewhere; its columns `|M'| <= N` over alpha in
+    /// place, then its rows over gamma into `out`.
     ///
     /// # Safety
-    /// `out` is valid for writes of `na ng` values, nobody else's meanwhile.
-    pub unsafe fn inverse(&self, work: &mut Work, out: *mut Complex64) {
-        let w = work.full.as_mut_ptr();
-        let (na, ng, mmax) = (self.na, self.ng, self.mmax);
-        for (plan, at) in self.inv_rows.iter().zip([0, (na - mmax) * ng]) {
+    /// `w` is [`FftStage::inv_buf`]'s; `out` is valid for writes of `na ng` values, nobody
+    /// else's meanwhile.
+    pub unsafe fn inverse(&self, w: &mut [Complex64], out: *mut Complex64) {
+        let w = w.as_mut_ptr();
+        for (plan, at) in self.inv_cols.iter().zip([0, self.ng - self.n]) {
             if let Some(p) = plan {
                 // SAFETY: the plan was made at this offset of a page-aligned buffer of
                 // the same size (same alignment); the work buffer is this worker's.
@@ -307,17 +321,17 @@ impl FftStage {
             }
         }
         // SAFETY: `out` holds the slice (caller's contract); the variant matches the
-        // arrays' alignment.
-        unsafe { fftw::fftw_execute_dft(self.inv_cols.pick(w, out), w, out) };
+        // arrays' alignment; the input rows are only read (out of place).
+        unsafe { fftw::fftw_execute_dft(self.inv_rows.pick(w, out), w, out) };
     }
 
-    /// Forward of the slice at `inp`: its rows over gamma into `work.full`, then the
-    /// columns `|M'| <= N` over alpha, in place.
+    /// Forward of the slice at `inp`: its rows over gamma into `w` (the forward's work
+    /// buffer), then the columns `|M'| <= N` over alpha, in place.
     ///
     /// # Safety
-    /// `inp` is valid for reads of `na ng` values.
-    pub unsafe fn forward(&self, work: &mut Work, inp: *const Complex64) {
-        let w = work.full.as_mut_ptr();
+    /// `inp` is valid for reads of `na ng` values; `w` is [`FftStage::fwd_buf`]'s.
+    pub unsafe fn forward(&self, w: &mut [Complex64], inp: *const Complex64) {
+        let w = w.as_mut_ptr();
         let inp = inp.cast_mut();
         // SAFETY: `inp` holds the slice and is only read (FFTW preserves the input of an
         // out-of-place complex DFT); the variant matches the arrays' alignment.
@@ -330,15 +344,16 @@ impl FftStage {
         }
     }
 
-    /// Real inverse: `work.half` holds `conj(G[M][M'])` at `(M mod na) h + M'` for
-    /// `0 <= M' <= N` (everything else zero); its columns over alpha (sign +1), then the
-    /// rows `c2r` into `out` (`na ng` reals). The half buffer is destroyed.
+    /// Real inverse: `w` (the half buffer) holds `conj(G[M][M'])` at `(M mod na) hs + M'`
+    /// for `0 <= M' <= N`, zero elsewhere; its columns over alpha (sign +1), then the rows
+    /// `c2r` into `out` (`na ng` reals). `w` is destroyed.
     ///
     /// # Safety
-    /// `out` valid for writes of `na ng` doubles, nobody else's; the plan is real.
-    pub unsafe fn inverse_real(&self, work: &mut Work, out: *mut f64) {
+    /// `out` valid for writes of `na ng` doubles, nobody else's; the plan is real; `w` is
+    /// [`FftStage::half_buf`]'s.
+    pub unsafe fn inverse_real(&self, w: &mut [Complex64], out: *mut f64) {
         let r = self.real.as_ref().expect("real plans");
-        let w = work.half.as_mut().expect("real work buffer").as_mut_ptr();
+        let w = w.as_mut_ptr();
         // SAFETY: plan made on a same-size page-aligned buffer; the buffer is this worker's.
         unsafe { fftw::fftw_execute_dft(r.cols_plus.0, w, w) };
         let o = out.cast::<Complex64>();
@@ -346,14 +361,15 @@ impl FftStage {
         unsafe { fftw::fftw_execute_dft_c2r(r.c2r.pick(w, o), w, out) };
     }
 
-    /// Real forward of the `na ng` reals at `inp`: rows `r2c` into `work.half`, then its
-    /// columns `0..=N` over alpha with sign -1 (`C` of the module documentation).
+    /// Real forward of the `na ng` reals at `inp`: rows `r2c` into `w` (the half buffer),
+    /// then its columns `0..=N` over alpha with sign -1.
     ///
     /// # Safety
-    /// `inp` valid for reads of `na ng` doubles; the plan is real.
-    pub unsafe fn forward_real(&self, work: &mut Work, inp: *const f64) {
+    /// `inp` valid for reads of `na ng` doubles; the plan is real; `w` is
+    /// [`FftStage::half_buf`]'s.
+    pub unsafe fn forward_real(&self, w: &mut [Complex64], inp: *const f64) {
         let r = self.real.as_ref().expect("real plans");
-        let w = work.half.as_mut().expect("real work buffer").as_mut_ptr();
+        let w = w.as_mut_ptr();
         let i = inp.cast_mut();
         // SAFETY: `inp` holds the slice and is only read (FFTW_PRESERVE_INPUT); variant
         // by alignment.

@@ -83,11 +83,13 @@ struct General {
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
     pair_weight: Vec<f64>,
     /// Per-worker FFT buffers (made on first use).
-    work: Vec<Mutex<Option<Work>>>,
+    work: Vec<Mutex<Work>>,
     /// The chunk buffer (taken by one execution at a time).
     buf: Mutex<Option<AlignedBuf>>,
     budget: usize,
     lanes_w: usize,
+    /// The order limit `N` of `M'`.
+    layout_n: usize,
     workers: WorkerPool,
 }
 
@@ -453,7 +455,10 @@ impl General {
     ) -> Result<General> {
         let layout = CoefLayout::new(shape);
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
-        let budget = options.max_workspace_bytes.unwrap_or(256 << 20);
+        let arrays = 16 * (shape.num_samples() + shape.num_coeffs());
+        let budget = options
+            .max_workspace_bytes
+            .unwrap_or_else(|| (512usize << 20).max(arrays / 20));
         let w = isa.lanes();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
         let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
@@ -470,13 +475,19 @@ impl General {
         } else {
             (bits, true)
         };
-        let dwt = DwtStage::new(&layout, (na, ng), isa, skip, (threads, max_lanes));
         let fft = FftStage::new(
             (na, ng),
-            (shape.order_limit_alpha, shape.order_limit_gamma),
+            shape.order_limit_gamma,
             options.real,
             options.rigor,
         )?;
+        let dwt = DwtStage::new(
+            &layout,
+            (na, ng, fft.strides().0),
+            isa,
+            skip,
+            (threads, max_lanes),
+        );
         let pair_weight = if options.betas == Betas::All {
             let wts = crate::grid::weights(shape.grid_bandwidth);
             let f = 2.0 * PI / (na * ng) as f64;
@@ -490,10 +501,11 @@ impl General {
             dwt,
             fft,
             pair_weight,
-            work: (0..threads).map(|_| Mutex::new(None)).collect(),
+            work: (0..threads).map(|_| Mutex::new(Work::default())).collect(),
             buf: Mutex::new(None),
             budget,
             lanes_w: w,
+            layout_n: shape.order_limit_gamma,
             workers: WorkerPool::new(threads, "so3fft-partial")?,
         })
     }
@@ -503,17 +515,20 @@ impl General {
         (self.dwt.row_total * 2 * 8).max(1)
     }
 
-    /// Lane pairs per chunk: what an eighth of the workspace cap holds for one transform
-    /// (at least one), a multiple of the vector width when that is at least one vector.
-    /// It does not depend on the batch, so a batch sums in the order of single executes.
+    /// Lane pairs per chunk: what the workspace cap holds for one transform (at least
+    /// one), the pairs spread evenly over the fewest chunks, a multiple of the vector
+    /// width when that is at least one vector. It does not depend on the batch, so a batch
+    /// sums in the order of single executes.
     fn chunk_pairs(&self) -> usize {
-        let h = (self.budget / 8 / self.pair_bytes()).max(1);
-        let h = if h >= self.lanes_w {
-            h / self.lanes_w * self.lanes_w
+        let pairs = self.pairs.pairs;
+        let most = (self.budget / self.pair_bytes()).clamp(1, pairs);
+        let h = pairs.div_ceil(pairs.div_ceil(most));
+        let w = self.lanes_w;
+        if h >= w && h.next_multiple_of(w) <= most {
+            h.next_multiple_of(w)
         } else {
             h
-        };
-        h.min(self.pairs.pairs)
+        }
     }
 
     /// Transforms of a batch run together (sharing recurrence coefficients and starting
@@ -597,18 +612,12 @@ impl General {
         f(p)
     }
 
-    /// Runs `f` with a worker's FFT buffers.
-    fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> R) -> Result<R> {
-        let mut guard = lock_free(&self.work);
-        let mut own = None;
-        let slot: &mut Option<Work> = match guard.as_deref_mut() {
-            Some(s) => s,
-            None => &mut own,
-        };
-        if slot.is_none() {
-            *slot = Some(self.fft.work()?);
+    /// Runs `f` with a worker's FFT buffers (a private set when all are busy).
+    fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> Result<R>) -> Result<R> {
+        match lock_free(&self.work) {
+            Some(mut g) => f(&mut g),
+            None => f(&mut Work::default()),
         }
-        Ok(f(slot.as_mut().expect("just made")))
     }
 
     /// The chunks of lane pairs for `count` transforms.
@@ -638,6 +647,8 @@ impl General {
         let per_t_max = self.dwt.row_total * 2 * hp_max;
         let slice_len = self.fft.slice_len();
         let real = matches!(out, Data::Real(_));
+        // Rows far larger than the caches go out with non-temporal stores.
+        let stream = batch.count * per_t_max * 8 > 8 << 20;
         self.with_buf(batch.count * per_t_max, |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
@@ -650,10 +661,10 @@ impl General {
                             let n = self.dwt.setup(sc, cl, &self.pairs, ch);
                             for t in 0..batch.count {
                                 // SAFETY: coefficient array `t` of the batch (checked
-                                // lengths), read only; this cluster's block of transform
-                                // `t`, `lanes` rows of `cl.p` inside the chunk buffer
-                                // (`count * row_total * lanes` doubles), written by this
-                                // task only.
+                                // lengths), read only; this cluster's `cl.p` doubles of
+                                // the `lanes` lane rows of transform `t`, inside the chunk
+                                // buffer (`count * row_total * lanes` doubles), written by
+                                // this task only.
                                 unsafe {
                                     self.dwt.inverse(
                                         sc,
@@ -661,8 +672,8 @@ impl General {
                                         ch,
                                         n,
                                         coef.get().add(t * batch.in_dist),
-                                        real,
-                                        buf.get().add(t * per_t + cl.offset * lanes),
+                                        (real, stream),
+                                        buf.get().add(t * per_t + cl.offset),
                                     )
                                 }
                             }
@@ -673,27 +684,29 @@ impl General {
                     let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
                         self.with_work(|work| {
-                            let blocks = buf.get().wrapping_add(t * per_t);
-                            let (r, rm) = rows_of(ch, jj, upper);
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
                             let at = t * batch.out_dist + s * slice_len;
                             match out {
                                 Data::Complex(o) => {
-                                    // SAFETY: the chunk's blocks were written by the DWT
-                                    // stage above (finished); slice `s` of output `t` is
-                                    // inside the checked output and this task's alone.
+                                    let w = self.fft.inv_buf(work)?;
+                                    // SAFETY: the lane rows were written by the DWT stage
+                                    // above (finished); slice `s` of output `t` is inside
+                                    // the checked output and this task's alone.
                                     unsafe {
-                                        self.scatter(work, blocks, lanes, (r, rm));
-                                        self.fft.inverse(work, o.get().add(at));
+                                        self.scatter(w, rows);
+                                        self.fft.inverse(w, o.get().add(at));
                                     }
                                 }
                                 Data::Real(o) => {
+                                    let w = self.fft.half_buf(work)?;
                                     // SAFETY: as above, for the real output.
                                     unsafe {
-                                        self.scatter_real(work, blocks, lanes, (r, rm));
-                                        self.fft.inverse_real(work, o.get().add(at));
+                                        self.scatter_real(w, rows);
+                                        self.fft.inverse_real(w, o.get().add(at));
                                     }
                                 }
                             }
+                            Ok(())
                         })
                     })?;
                     times.fft += t1.elapsed().as_secs_f64();
@@ -728,40 +741,47 @@ impl General {
                     let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
                         self.with_work(|work| {
-                            let blocks = buf.get().wrapping_add(t * per_t);
-                            let rows = rows_of(ch, jj, upper);
-                            let w = self.pair_weight[ch.j0 + jj];
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                            let weight = self.pair_weight[ch.j0 + jj];
                             // SAFETY: slice `s` of input `t` is inside the checked input
-                            // (complex values, or reals for the real forward); the rows
-                            // written are this slice's slots of the chunk's blocks: no
-                            // other task writes them (its mirror writes the other slots
-                            // of the same rows).
+                            // (complex values, or reals for the real forward); the values
+                            // written are this slice's slots of two lane rows: no other
+                            // task writes them (its mirror writes the other slots of the
+                            // same rows).
                             unsafe {
                                 if real {
+                                    let w = self.fft.half_buf(work)?;
                                     let at = t * batch.in_dist + s * slice_len;
-                                    self.fft.forward_real(work, inp.get().add(at));
+                                    self.fft.forward_real(w, inp.get().add(at));
+                                    self.gather_real(w, rows, weight);
                                 } else {
+                                    let w = self.fft.fwd_buf(work)?;
                                     let at = 2 * (t * batch.in_dist + s * slice_len);
-                                    self.fft.forward(work, inp.get().add(at).cast());
+                                    self.fft.forward(w, inp.get().add(at).cast());
+                                    self.gather(w, rows, weight);
                                 }
-                                self.gather(work, blocks, lanes, rows, (w, real));
                             }
+                            Ok(())
                         })
                     })?;
                     let t1 = Instant::now();
                     times.fft += (t1 - t0).as_secs_f64();
                     let first = ch.j0 == 0;
+                    for t in 0..batch.count {
+                        // SAFETY: the padding lane rows of transform `t` in the chunk
+                        // buffer, written by nobody (the FFT stage is finished).
+                        unsafe { self.zero_padding(buf.get().add(t * per_t), ch) };
+                    }
                     self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
                         self.dwt.with_scratch(|sc| {
                             let n = self.dwt.setup(sc, cl, &self.pairs, ch);
                             for t in 0..batch.count {
-                                let block = buf.get().wrapping_add(t * per_t + cl.offset * lanes);
-                                // SAFETY: this cluster's block of transform `t` (its padding
-                                // rows zeroed here, the others written by the FFT stage,
-                                // finished); coefficient array `t` is inside the checked
-                                // output, and this cluster's slots' blocks are this task's.
+                                let block = buf.get().wrapping_add(t * per_t + cl.offset);
+                                // SAFETY: this cluster's slots of the lane rows of transform
+                                // `t` (written by the FFT stage or zeroed above, finished);
+                                // coefficient array `t` is inside the checked output, and
+                                // this cluster's slots' blocks are this task's.
                                 unsafe {
-                                    zero_padding(block, cl.p, ch);
                                     self.dwt.forward(
                                         sc,
                                         cl,
@@ -800,26 +820,50 @@ impl General {
         v
     }
 
-    /// Complex inverse: the values of a slice from the blocks into the work buffer.
+    /// The lane rows of a slice (its own, and its mirror's, where its reversed members
+    /// are) in the chunk buffer at `buf`, transform offset `at`.
+    fn lane_rows(
+        &self,
+        buf: *mut f64,
+        at: usize,
+        ch: ChunkLanes,
+        (jj, upper): (usize, bool),
+    ) -> LaneRows {
+        let rt = self.dwt.row_total;
+        let (r, rm) = if upper {
+            (ch.hp + jj, jj)
+        } else {
+            (jj, ch.hp + jj)
+        };
+        LaneRows {
+            own: buf.wrapping_add(at + r * rt),
+            mirror: buf.wrapping_add(at + rm * rt),
+        }
+    }
+
+    /// Complex inverse: a slice's values from its lane rows into the inverse's work buffer
+    /// (whose columns `|M'| <= N` are cleared first; the others stay zero).
     ///
     /// # Safety
-    /// `blocks` holds the chunk's blocks of one transform (`row_total * lanes` doubles).
-    unsafe fn scatter(
-        &self,
-        work: &mut Work,
-        blocks: *const f64,
-        lanes: usize,
-        (r, rm): (usize, usize),
-    ) {
-        let w = work.full.slice_mut(self.fft.slice_len());
-        w.fill(Complex64::default());
+    /// The lane rows hold `row_total` doubles each, written by the DWT stage.
+    unsafe fn scatter(&self, w: &mut [Complex64], rows: LaneRows) {
+        let (na, ng) = self.fft.dims();
+        let (rs, _) = self.fft.strides();
+        let n = self.layout_n;
+        for row in w.chunks_exact_mut(rs).take(na) {
+            row[..=n].fill(Complex64::default());
+            row[ng - n..ng].fill(Complex64::default());
+        }
         for cl in &self.dwt.clusters {
-            let base = blocks.wrapping_add(cl.offset * lanes);
             for (q, s) in cl.slots.iter().enumerate() {
-                let row = if s.member.reversed { rm } else { r };
-                // SAFETY: row `< lanes`, column `2q + 1 < p` of this cluster's block.
+                let row = if s.member.reversed {
+                    rows.mirror
+                } else {
+                    rows.own
+                };
+                // SAFETY: `offset + 2q + 1 < row_total` doubles of a lane row.
                 let v = unsafe {
-                    let x = base.add(row * cl.p + 2 * q);
+                    let x = row.add(cl.offset + 2 * q);
                     Complex64::new(*x, *x.add(1))
                 };
                 w[s.work] = v;
@@ -827,107 +871,101 @@ impl General {
         }
     }
 
-    /// Real inverse: `conj` of the slice's values with `M' >= 0` into the half buffer.
+    /// Real inverse: `conj` of a slice's values with `M' >= 0` into the half buffer.
     ///
     /// # Safety
     /// As for [`General::scatter`].
-    unsafe fn scatter_real(
-        &self,
-        work: &mut Work,
-        blocks: *const f64,
-        lanes: usize,
-        (r, rm): (usize, usize),
-    ) {
-        let (na, ng) = self.fft.dims();
-        let h = ng / 2 + 1;
-        let w = work
-            .half
-            .as_mut()
-            .expect("real work buffer")
-            .slice_mut(na * h);
+    unsafe fn scatter_real(&self, w: &mut [Complex64], rows: LaneRows) {
+        let (na, _) = self.fft.dims();
+        let (_, hs) = self.fft.strides();
         w.fill(Complex64::default());
         for cl in &self.dwt.clusters {
-            let base = blocks.wrapping_add(cl.offset * lanes);
             for (q, s) in cl.slots.iter().enumerate() {
                 let mem = &s.member;
                 if mem.mp < 0 {
                     continue;
                 }
-                let row = if mem.reversed { rm } else { r };
+                let row = if mem.reversed { rows.mirror } else { rows.own };
                 // SAFETY: as in `scatter`.
                 let v = unsafe {
-                    let x = base.add(row * cl.p + 2 * q);
+                    let x = row.add(cl.offset + 2 * q);
                     Complex64::new(*x, -*x.add(1))
                 };
-                w[mem.m.rem_euclid(na as isize) as usize * h + mem.mp as usize] = v;
+                w[mem.m.rem_euclid(na as isize) as usize * hs + mem.mp as usize] = v;
             }
         }
     }
 
-    /// Forward: the slice's values (from the work buffers), times the pair's weight, into
-    /// their rows of the blocks.
+    /// Forward: a slice's values (the forward's work buffer), times its weight, into
+    /// its slots of the lane rows.
     ///
     /// # Safety
-    /// As for [`General::scatter`], for writes; no other task writes these slots of rows
-    /// `r` and `rm`.
-    unsafe fn gather(
-        &self,
-        work: &mut Work,
-        blocks: *mut f64,
-        lanes: usize,
-        (r, rm): (usize, usize),
-        (weight, real): (f64, bool),
-    ) {
-        let (na, ng) = self.fft.dims();
-        let h = ng / 2 + 1;
-        let full = work.full.slice_mut(na * ng);
-        let half = work.half.as_mut().map(|b| b.slice_mut(na * h));
+    /// As for [`General::scatter`], for writes; no other task writes these slots.
+    unsafe fn gather(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
         for cl in &self.dwt.clusters {
-            let base = blocks.wrapping_add(cl.offset * lanes);
             for (q, s) in cl.slots.iter().enumerate() {
-                let mem = &s.member;
-                let v = match (&half, real) {
-                    (Some(c), true) => {
-                        if mem.mp >= 0 {
-                            c[mem.m.rem_euclid(na as isize) as usize * h + mem.mp as usize].conj()
-                        } else {
-                            c[(-mem.m).rem_euclid(na as isize) as usize * h + (-mem.mp) as usize]
-                        }
-                    }
-                    _ => full[s.work],
-                } * weight;
-                let row = if mem.reversed { rm } else { r };
-                // SAFETY: row `< lanes`, column `2q + 1 < p` of this cluster's block;
-                // these slots of this row are this task's (caller's contract).
+                let v = w[s.work] * weight;
+                let row = if s.member.reversed {
+                    rows.mirror
+                } else {
+                    rows.own
+                };
+                // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
                 unsafe {
-                    let x = base.add(row * cl.p + 2 * q);
+                    let x = row.add(cl.offset + 2 * q);
                     *x = v.re;
                     *x.add(1) = v.im;
                 }
             }
         }
     }
-}
 
-/// Block rows of a slice: its own (`r`) and its mirror's (`rm`, where its reversed
-/// members are).
-fn rows_of(ch: ChunkLanes, jj: usize, upper: bool) -> (usize, usize) {
-    if upper {
-        (ch.hp + jj, jj)
-    } else {
-        (jj, ch.hp + jj)
+    /// Real forward: as [`General::gather`], from the half spectrum `C` (see the FFT
+    /// stage): `F(M, M') = conj(C[M][M'])` for `M' >= 0`, `C[-M][-M']` below.
+    ///
+    /// # Safety
+    /// As for [`General::gather`].
+    unsafe fn gather_real(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
+        let (na, _) = self.fft.dims();
+        let (_, hs) = self.fft.strides();
+        let at = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
+        for cl in &self.dwt.clusters {
+            for (q, s) in cl.slots.iter().enumerate() {
+                let mem = &s.member;
+                let v = if mem.mp >= 0 {
+                    w[at(mem.m, mem.mp)].conj()
+                } else {
+                    w[at(-mem.m, -mem.mp)]
+                } * weight;
+                let row = if mem.reversed { rows.mirror } else { rows.own };
+                // SAFETY: as in `gather`.
+                unsafe {
+                    let x = row.add(cl.offset + 2 * q);
+                    *x = v.re;
+                    *x.add(1) = v.im;
+                }
+            }
+        }
+    }
+
+    /// Zero the padding lane rows (`h..hp` of each half) of one transform's chunk rows at
+    /// `rows`, which the forward kernel multiplies by exact zeros.
+    ///
+    /// # Safety
+    /// The chunk's `2 hp` lane rows at `rows` are the caller's.
+    unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
+        let rt = self.dwt.row_total;
+        for half in 0..2 {
+            let from = half * ch.hp + ch.h;
+            // SAFETY: lane rows `from..(half + 1) hp`, inside the chunk's rows.
+            unsafe { std::ptr::write_bytes(rows.add(from * rt), 0, (ch.hp - ch.h) * rt) };
+        }
     }
 }
 
-/// Zero the padding rows (lanes `h..hp` of each half) of a block of `p` doubles a row,
-/// which the forward kernel multiplies by exact zeros.
-///
-/// # Safety
-/// The block's `2 hp` rows are the caller's.
-unsafe fn zero_padding(block: *mut f64, p: usize, ch: ChunkLanes) {
-    for half in 0..2 {
-        let from = half * ch.hp + ch.h;
-        // SAFETY: rows `from..(half + 1) hp` of the block.
-        unsafe { std::ptr::write_bytes(block.add(from * p), 0, (ch.hp - ch.h) * p) };
-    }
+/// A slice's lane rows: its own and its mirror's.
+#[derive(Clone, Copy)]
+struct LaneRows {
+    own: *mut f64,
+    mirror: *mut f64,
 }

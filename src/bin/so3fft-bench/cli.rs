@@ -38,6 +38,9 @@ TOOL (default: the full benchmark described below):
                       GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
   match (or --match)  rotational matching: a rotated random function recovered; pipeline
                       medians (complex, real), ten refinements, grid and refined angle errors
+  partial (or --partial)  partial plans against the transforms they replace: degree-limited
+                      on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
+                      1/16 of the betas, tolerance 1e-6 and 1e-10 (ratios in one run)
 options:
   --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
                       (default 16,32,64,128,256)
@@ -85,6 +88,8 @@ pub enum Tool {
     S2,
     /// Rotational matching (`matching.rs`).
     Match,
+    /// Partial plans (`partial.rs`).
+    Partial,
 }
 
 /// Transforms the `stages` tool repeats.
@@ -211,6 +216,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("real") => Tool::Real,
         Some("s2" | "--s2") => Tool::S2,
         Some("match" | "--match") => Tool::Match,
+        Some("partial" | "--partial") => Tool::Partial,
         _ => Tool::Full,
     };
     if opts.tool != Tool::Full {
@@ -312,6 +318,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
         Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
+        Tool::Partial => (vec![256], vec![2], None),
     };
     if !bandwidths_given {
         opts.bandwidths = bandwidths;

@@ -24,6 +24,7 @@ mod cli;
 mod matching;
 mod memory;
 mod naive;
+mod partial;
 mod peak;
 mod plot;
 mod regular;
@@ -54,6 +55,7 @@ fn main() -> ExitCode {
             Tool::Real => report_failure("real", run_real(&opts)),
             Tool::S2 => report_failure("s2", s2::run(&opts)),
             Tool::Match => report_failure("match", matching::run(&opts)),
+            Tool::Partial => report_failure("partial", partial::run(&opts)),
         },
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
