@@ -15,6 +15,7 @@ use super::betas::LanePairs;
 use super::shape::CoefLayout;
 use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
+use crate::plan::coeffs::{self, DegreeFactors};
 use crate::simd::Isa;
 use crate::symmetry::{Cluster, Member};
 use crate::wigner::{big, start_norm, RecCoeffs, RecTables};
@@ -265,32 +266,48 @@ impl DwtStage {
         }
         let scales = &sc.rec.s;
         let scale = 1.0 / (2.0 * PI);
+        // Rows with no value in some column (unused slots, degrees below `L0`) start as 0.
+        let partly = 2 * cl.slots.len() < p || cl.slots.iter().any(|s| s.first > cl.m);
         let mut fill = |fin: &mut [f64], from: usize, to: usize| {
             let rows = &mut fin[from * p..to * p];
-            rows.fill(0.0);
+            if partly {
+                rows.fill(0.0);
+            }
             for (q, s) in cl.slots.iter().enumerate() {
+                let lo = from.max(s.first - cl.m);
+                if lo >= to {
+                    continue;
+                }
                 let mem = &s.member;
-                for i in from.max(s.first - cl.m)..to {
-                    let l = cl.m + i;
-                    let f = mem.sign_at(l) * scales[i] * scale;
-                    // SAFETY: degree `l` in `s.first..L` of the pair's block (or of its
-                    // partner's, which has the same degrees), inside the coefficient array
-                    // (caller's contract).
-                    let v = unsafe {
-                        if real && !s.representative {
-                            let c = *coef.add(s.partner_block + l - s.first);
-                            let sg = if (mem.m - mem.mp).rem_euclid(2) == 0 {
-                                1.0
-                            } else {
-                                -1.0
-                            };
-                            c.conj() * sg
-                        } else {
-                            *coef.add(s.block + l - s.first)
-                        }
-                    } * f;
-                    rows[(i - from) * p + 2 * q] = v.re;
-                    rows[(i - from) * p + 2 * q + 1] = v.im;
+                // The real inverse reads a non-representative from its partner:
+                // `(-1)^(M-M') conj(fhat(l,-M,-M'))`.
+                let conj = real && !s.representative;
+                let (block, sign) = if conj {
+                    let ps = if (mem.m - mem.mp).rem_euclid(2) == 0 { 1.0 } else { -1.0 };
+                    (s.partner_block, ps * scale)
+                } else {
+                    (s.block, scale)
+                };
+                let factors = DegreeFactors {
+                    signs: [
+                        mem.sign_at(cl.m + lo) * sign,
+                        mem.sign_at(cl.m + lo + 1) * sign,
+                    ],
+                    scales: &scales[lo..to],
+                };
+                let dst = &mut rows[(lo - from) * p + 2 * q..];
+                // SAFETY: degrees `cl.m + lo .. cl.m + to` of the block (or of its partner,
+                // which stores the same degrees) are inside the coefficient array (caller's
+                // contract); `dst` holds rows `lo - from .. to - from` of `p >= 2q + 2`
+                // doubles.
+                unsafe {
+                    let src = coef.add(block + cl.m + lo - s.first);
+                    coeffs::gather(dst.as_mut_ptr(), src, p, factors);
+                }
+                if conj {
+                    for row in dst.chunks_mut(p).take(to - lo) {
+                        row[1] = -row[1];
+                    }
                 }
             }
         };
@@ -341,23 +358,27 @@ impl DwtStage {
         let lo = unsafe { dwt::forward_raw(self.isa, p, &rec, &lanes, block, &mut data) }.min(n);
         for (q, s) in cl.slots.iter().enumerate() {
             let mem = &s.member;
-            for l in s.first..self.l {
-                let i = l - cl.m;
-                let v = if i < lo {
-                    Complex64::default()
-                } else {
-                    Complex64::new(data[i * p + 2 * q], data[i * p + 2 * q + 1])
-                        * (mem.sign_at(l) * sc.rec.s[i])
-                };
-                // SAFETY: degree `l` of the pair's block, this cluster's (caller's contract).
-                unsafe {
-                    let d = coef.add(s.block + l - s.first);
-                    if first {
-                        *d = v;
-                    } else {
-                        *d += v;
-                    }
-                }
+            let i0 = s.first - cl.m;
+            // Degrees below the kernel's `lo` are zero: assigned on the first chunk, else
+            // nothing to add.
+            let from = i0.max(lo);
+            if first && lo > i0 {
+                // SAFETY: degrees `s.first .. cl.m + lo` of the pair's block, this
+                // cluster's (caller's contract).
+                unsafe { std::ptr::write_bytes(coef.add(s.block), 0, lo - i0) };
+            }
+            if from >= n {
+                continue;
+            }
+            let factors = DegreeFactors {
+                signs: [mem.sign_at(cl.m + from), mem.sign_at(cl.m + from + 1)],
+                scales: &sc.rec.s[from..n],
+            };
+            // SAFETY: degrees `cl.m + from .. L` of the pair's block (this cluster's, caller's
+            // contract); `data` holds the kernel's `n` rows of `p >= 2q + 2` sums.
+            unsafe {
+                let dst = coef.add(s.block + cl.m + from - s.first);
+                coeffs::scatter(dst, data.as_ptr().add(from * p + 2 * q), p, factors, !first, None);
             }
         }
         sc.data = data;

@@ -11,7 +11,7 @@ use num_complex::Complex64;
 /// the order pair's sign for even and odd offsets times the kernels' value scale (see
 /// `RecTables::coeffs`).
 #[derive(Clone, Copy)]
-pub(super) struct DegreeFactors<'a> {
+pub(crate) struct DegreeFactors<'a> {
     pub signs: [f64; 2],
     pub scales: &'a [f64],
 }
@@ -21,7 +21,7 @@ pub(super) struct DegreeFactors<'a> {
 ///
 /// # Safety
 /// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
-pub(super) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
+pub(crate) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
     let (sg, s) = (f.signs, f.scales);
     // SAFETY: the caller's contract (see `# Safety`): reads of `src` below `n`, writes at
     // `i * p` and `i * p + 1` of `dst` for `i < n`.
@@ -55,7 +55,7 @@ pub(super) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: D
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
 /// `i * p` and `i * p + 1`, `i < n`; no overlap.
-pub(super) unsafe fn scatter(
+pub(crate) unsafe fn scatter(
     dst: *mut Complex64,
     src: *const f64,
     p: usize,

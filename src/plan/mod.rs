@@ -25,7 +25,7 @@
 mod block_copies;
 mod blocks;
 mod build;
-mod coeffs;
+pub(crate) mod coeffs;
 mod dwt_stage;
 mod exec;
 mod fft_stage;
