@@ -566,3 +566,67 @@ fn correlation_grid_matches_direct_integration() {
         );
     }
 }
+
+/// Correlations on a finer grid (`b_out > b_in`) or with a degree limit run on a partial
+/// plan: their grids equal the full plan's inverse of the correlation's coefficients.
+#[test]
+fn padded_and_degree_limited_grids_match_the_full_inverse() {
+    use so3fft::{Plan, PlanOptions};
+    for (b_in, b_out, deg_lim, real) in [
+        (8, 16, None, false),
+        (8, 16, Some(4), true),
+        (8, 8, Some(3), false),
+        (6, 12, Some(2), true),
+    ] {
+        let opts = CorrelationOptions {
+            b_out: Some(b_out),
+            deg_lim,
+            real,
+            threads: 2,
+            ..Default::default()
+        };
+        let plan = Correlation::new(b_in, &opts).unwrap();
+        let n = 4 * b_in * b_in;
+        let mut state = 17u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let full = Plan::new(
+            b_out,
+            &PlanOptions {
+                real,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(b_out)];
+        let mut want = vec![Complex64::default(); plan.num_grid()];
+        if real {
+            let sig: Vec<f64> = (0..n).map(|_| rnd()).collect();
+            let pat: Vec<f64> = (0..n).map(|_| rnd()).collect();
+            plan.coefficients_real(&sig, &pat, &mut coeffs).unwrap();
+            let mut got = vec![0.0; plan.num_grid()];
+            plan.correlate_real(&sig, &pat, &mut got).unwrap();
+            full.inverse(&coeffs, &mut want).unwrap();
+            let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    (g - w.re).abs() < 1e-13 * scale,
+                    "{b_in} {b_out} {deg_lim:?}"
+                );
+            }
+        } else {
+            let sig: Vec<Complex64> = (0..n).map(|_| Complex64::new(rnd(), rnd())).collect();
+            let pat: Vec<Complex64> = (0..n).map(|_| Complex64::new(rnd(), rnd())).collect();
+            plan.coefficients(&sig, &pat, &mut coeffs).unwrap();
+            let mut got = vec![Complex64::default(); plan.num_grid()];
+            plan.correlate(&sig, &pat, &mut got).unwrap();
+            full.inverse(&coeffs, &mut want).unwrap();
+            let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).norm() < 1e-13 * scale, "{b_in} {b_out} {deg_lim:?}");
+            }
+        }
+    }
+}

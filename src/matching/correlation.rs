@@ -4,9 +4,10 @@
 
 use super::combine::add_combined;
 use crate::error::{Error, Result};
-use crate::grid::num_coeffs;
+use crate::grid::{coef_index, num_coeffs};
+use crate::partial::{PartialOptions, PartialPlan, Shape};
 use crate::s2::{S2Options, S2Plan};
-use crate::{Direction, Plan, PlanOptions, Rigor};
+use crate::{Direction, Rigor};
 use num_complex::Complex64;
 use std::sync::Mutex;
 
@@ -50,7 +51,8 @@ pub struct Correlation {
     real: bool,
     normalized: bool,
     s2: S2Plan,
-    so3: Plan,
+    /// The inverse onto the grid: degrees `l <= deg_lim` (bandwidth `deg_lim + 1`).
+    so3: PartialPlan,
     buffers: Mutex<Option<Buffers>>,
 }
 
@@ -75,14 +77,16 @@ impl Correlation {
                 ..S2Options::default()
             },
         )?;
-        let so3 = Plan::new(
-            b_out,
-            &PlanOptions {
+        // Degrees up to `deg_lim` on the grid of `b_out`: a partial plan when that is less
+        // than the grid's bandwidth (the full plan otherwise).
+        let so3 = PartialPlan::new(
+            &Shape::new(deg_lim + 1).with_grid(b_out, 2 * b_out, 2 * b_out),
+            &PartialOptions {
                 direction: Direction::Inverse,
                 threads: options.threads,
                 rigor: options.rigor,
                 real: options.real,
-                ..PlanOptions::default()
+                ..PartialOptions::default()
             },
         )?;
         Ok(Correlation {
@@ -269,6 +273,48 @@ impl Correlation {
         self.deg_lim
     }
 
+    /// Coefficients of bandwidth `b_out` (zero above `deg_lim`) in the layout of
+    /// bandwidth `deg_lim + 1`, the inverse plan's input; `None` when the two are the same.
+    fn restrict(&self, c: &[Complex64]) -> Result<Option<Vec<Complex64>>> {
+        let l = self.deg_lim + 1;
+        if l == self.b_out {
+            return Ok(None);
+        }
+        let mut small = Vec::new();
+        small
+            .try_reserve_exact(num_coeffs(l))
+            .map_err(|_| Error::OutOfMemory {
+                bytes: 16 * num_coeffs(l),
+            })?;
+        small.resize(num_coeffs(l), Complex64::default());
+        let lim = self.deg_lim as isize;
+        for m in -lim..=lim {
+            for mp in -lim..=lim {
+                let lo = m.unsigned_abs().max(mp.unsigned_abs());
+                let from = coef_index(self.b_out, lo, m, mp);
+                let to = coef_index(l, lo, m, mp);
+                small[to..to + l - lo].copy_from_slice(&c[from..from + l - lo]);
+            }
+        }
+        Ok(Some(small))
+    }
+
+    /// The inverse of coefficients of bandwidth `b_out` onto the grid.
+    fn inverse_grid(&self, c: &[Complex64], grid: &mut [Complex64]) -> Result<()> {
+        match self.restrict(c)? {
+            Some(small) => self.so3.inverse(&small, grid),
+            None => self.so3.inverse(c, grid),
+        }
+    }
+
+    /// [`Correlation::inverse_grid`] to a real grid.
+    fn inverse_grid_real(&self, c: &[Complex64], grid: &mut [f64]) -> Result<()> {
+        match self.restrict(c)? {
+            Some(small) => self.so3.inverse_real(&small, grid),
+            None => self.so3.inverse_real(c, grid),
+        }
+    }
+
     fn need(&self, real: bool) -> Result<()> {
         if real != self.real {
             return Err(Error::InvalidArgument(format!(
@@ -308,7 +354,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
             self.combine_shells(shells, fwd, buf)?;
-            self.so3.inverse(&buf.so3, out)
+            self.inverse_grid(&buf.so3, out)
         })
     }
 
@@ -322,7 +368,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
             self.combine_shells(shells, fwd, buf)?;
-            self.so3.inverse_real(&buf.so3, out)
+            self.inverse_grid_real(&buf.so3, out)
         })
     }
 
@@ -337,7 +383,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(false)?;
         let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
+        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.inverse_grid(c, g);
         self.many((signal, patterns, out), forward, inverse)
     }
 
@@ -350,7 +396,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(true)?;
         let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
+        let inverse = |c: &[Complex64], g: &mut [f64]| self.inverse_grid_real(c, g);
         self.many((signal, patterns, out), forward, inverse)
     }
 

@@ -283,7 +283,11 @@ impl DwtStage {
                 // `(-1)^(M-M') conj(fhat(l,-M,-M'))`.
                 let conj = real && !s.representative;
                 let (block, sign) = if conj {
-                    let ps = if (mem.m - mem.mp).rem_euclid(2) == 0 { 1.0 } else { -1.0 };
+                    let ps = if (mem.m - mem.mp).rem_euclid(2) == 0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
                     (s.partner_block, ps * scale)
                 } else {
                     (s.block, scale)
@@ -378,7 +382,14 @@ impl DwtStage {
             // contract); `data` holds the kernel's `n` rows of `p >= 2q + 2` sums.
             unsafe {
                 let dst = coef.add(s.block + cl.m + from - s.first);
-                coeffs::scatter(dst, data.as_ptr().add(from * p + 2 * q), p, factors, !first, None);
+                coeffs::scatter(
+                    dst,
+                    data.as_ptr().add(from * p + 2 * q),
+                    p,
+                    factors,
+                    !first,
+                    None,
+                );
             }
         }
         sc.data = data;
