@@ -5,6 +5,25 @@
 use crate::error::{Error, Result};
 use std::sync::{Arc, Condvar, Mutex};
 
+/// Largest worker count a plan accepts.
+pub(crate) const MAX_THREADS: usize = 1024;
+
+/// The worker count of a `threads` option: 0 means all cores; more than
+/// [`MAX_THREADS`] is an error.
+pub(crate) fn thread_count(threads: usize) -> Result<usize> {
+    let n = if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        threads
+    };
+    if n > MAX_THREADS {
+        return Err(Error::InvalidArgument(format!(
+            "{n} threads requested (at most {MAX_THREADS})"
+        )));
+    }
+    Ok(n)
+}
+
 /// Stack of each worker thread (the kernels keep their state in per-worker scratch).
 pub(crate) const WORKER_STACK_BYTES: usize = 2 << 20;
 

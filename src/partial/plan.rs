@@ -142,21 +142,8 @@ impl PartialPlan {
         if direction != Direction::Inverse {
             shape.check_forward()?;
         }
-        let threads = match options.threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            t if t > 1024 => {
-                return Err(Error::InvalidArgument(format!(
-                    "{t} threads requested (at most 1024)"
-                )))
-            }
-            t => t,
-        };
-        let isa = options.isa.unwrap_or_else(Isa::detect);
-        if !isa.is_supported() {
-            return Err(Error::InvalidArgument(format!(
-                "instruction set {isa:?} not supported by this CPU"
-            )));
-        }
+        let threads = crate::workers::thread_count(options.threads)?;
+        let isa = Isa::resolve(options.isa)?;
         let bits = skip_bits(options.tolerance)?;
         if let Some(0) = options.max_workspace_bytes {
             return Err(Error::InvalidArgument("max_workspace_bytes is 0".into()));

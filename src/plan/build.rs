@@ -133,18 +133,7 @@ impl Plan {
                 max: MAX_BANDWIDTH,
             });
         }
-        let threads = if options.threads == 0 {
-            std::thread::available_parallelism()
-                .map(|n| n.get())
-                .unwrap_or(1)
-        } else {
-            options.threads
-        };
-        if threads > 1024 {
-            return Err(Error::InvalidArgument(format!(
-                "{threads} threads requested (at most 1024)"
-            )));
-        }
+        let threads = crate::workers::thread_count(options.threads)?;
         let skip_bits = match options.skip_bits {
             None => DEFAULT_SKIP_BITS,
             Some(0) => *SKIP_BITS_RANGE.end(),
@@ -155,12 +144,7 @@ impl Plan {
                 "skip_bits {skip_bits} outside {SKIP_BITS_RANGE:?}"
             )));
         }
-        let isa = options.isa.unwrap_or_else(Isa::detect);
-        if !isa.is_supported() {
-            return Err(Error::InvalidArgument(format!(
-                "instruction set {isa:?} not supported by this CPU"
-            )));
-        }
+        let isa = Isa::resolve(options.isa)?;
         Ok(Checked {
             threads,
             skip_bits,

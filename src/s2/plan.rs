@@ -70,21 +70,8 @@ impl S2Plan {
                 max: S2_MAX_BANDWIDTH,
             });
         }
-        let threads = match options.threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            t if t > 1024 => {
-                return Err(Error::InvalidArgument(format!(
-                    "{t} threads requested (at most 1024)"
-                )))
-            }
-            t => t,
-        };
-        let isa = options.isa.unwrap_or_else(Isa::detect);
-        if !isa.is_supported() {
-            return Err(Error::InvalidArgument(format!(
-                "instruction set {isa:?} not supported by this CPU"
-            )));
-        }
+        let threads = crate::workers::thread_count(options.threads)?;
+        let isa = Isa::resolve(options.isa)?;
         let n = 2 * b;
         let bytes = S2Plan::memory_needed(b, threads);
         check_headroom(

@@ -27,6 +27,18 @@ pub enum Isa {
 }
 
 impl Isa {
+    /// The instruction set of an `isa` option (`None`: the best this CPU has); an error
+    /// when the CPU does not support it.
+    pub(crate) fn resolve(isa: Option<Isa>) -> crate::Result<Isa> {
+        let isa = isa.unwrap_or_else(Isa::detect);
+        if !isa.is_supported() {
+            return Err(crate::Error::InvalidArgument(format!(
+                "instruction set {isa:?} not supported by this CPU"
+            )));
+        }
+        Ok(isa)
+    }
+
     /// The best instruction set this CPU supports.
     pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
