@@ -140,14 +140,12 @@ typedef struct so3fft_shape {
 typedef struct so3fft_partial_s *so3fft_partial;
 
 // Options of a partial plan; all zero means: both directions, all cores, the default
-// tolerance and workspace, every beta.
+// workspace, every beta.
 typedef struct so3fft_partial_options {
     // `SO3FFT_FORWARD`, `SO3FFT_INVERSE`, `SO3FFT_BOTH` (0: both).
     int direction;
     // Worker threads (0: all cores).
     int nthreads;
-    // Wigner-d prefixes below this are skipped (0: 2^-64; negative: none skipped).
-    double tolerance;
     // Number of betas the inverse evaluates (0: every beta of the grid).
     int nbetas;
     // `nbetas` grid indices (or NULL).

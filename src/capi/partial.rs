@@ -32,7 +32,7 @@ pub struct so3fft_shape {
 }
 
 /// Options of a partial plan; all zero means: both directions, all cores, the default
-/// tolerance and workspace, every beta.
+/// workspace, every beta.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct so3fft_partial_options {
@@ -40,8 +40,6 @@ pub struct so3fft_partial_options {
     pub direction: c_int,
     /// Worker threads (0: all cores).
     pub nthreads: c_int,
-    /// Wigner-d prefixes below this are skipped (0: 2^-64; negative: none skipped).
-    pub tolerance: f64,
     /// Number of betas the inverse evaluates (0: every beta of the grid).
     pub nbetas: c_int,
     /// `nbetas` grid indices (or NULL).
@@ -205,13 +203,6 @@ unsafe fn options_of(
         direction_of(o.direction)?
     };
     opts.threads = threads_of(o.nthreads)?;
-    opts.tolerance = if o.tolerance == 0.0 {
-        None
-    } else if o.tolerance < 0.0 {
-        Some(0.0)
-    } else {
-        Some(o.tolerance)
-    };
     if o.max_workspace > 0 {
         opts.max_workspace_bytes = Some(o.max_workspace);
     }

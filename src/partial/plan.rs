@@ -35,10 +35,10 @@ pub struct PartialOptions {
     /// The betas the inverse evaluates (default all; a plan with a selection runs the
     /// inverse only).
     pub betas: Betas,
-    /// Wigner-d prefixes below this value (relative to the data they multiply) are
-    /// skipped; `None`: `2^-64`, `Some(0.0)`: nothing skipped. Values above `2^-24` count
-    /// as `2^-24`. See `docs/partial-plans.md` for the error it costs.
-    pub tolerance: Option<f64>,
+    /// Skip threshold `2^-skip_bits` of negligible Wigner-d prefixes, as
+    /// [`PlanOptions::skip_bits`] (`None`: 64; `Some(0)`: nothing skipped; else 24..=560).
+    /// Thresholds above the default save nothing measurable (`docs/partial-plans.md`).
+    pub skip_bits: Option<u32>,
     /// Cap on the chunk buffer in bytes (`None`: 256 MiB).
     pub max_workspace_bytes: Option<usize>,
     /// Run the full shape on the general engine too (normally the full shape runs on
@@ -59,17 +59,14 @@ pub struct Batch {
     pub out_dist: usize,
 }
 
-/// The skip threshold's exponent for a tolerance (`None`: the default; 0: no skipping).
-fn skip_bits(tolerance: Option<f64>) -> Result<u32> {
-    match tolerance {
+/// The skip threshold's exponent of a `skip_bits` option (0: no skipping).
+fn skip_bits(option: Option<u32>) -> Result<u32> {
+    match option {
         None => Ok(DEFAULT_SKIP_BITS),
-        Some(0.0) => Ok(0),
-        Some(t) if t.is_finite() && t > 0.0 && t < 1.0 => {
-            let bits = (-t.log2()).ceil() as u32;
-            Ok(bits.clamp(*SKIP_BITS_RANGE.start(), *SKIP_BITS_RANGE.end()))
-        }
-        Some(t) => Err(Error::InvalidArgument(format!(
-            "tolerance {t} outside [0, 1)"
+        Some(0) => Ok(0),
+        Some(b) if SKIP_BITS_RANGE.contains(&b) => Ok(b),
+        Some(b) => Err(Error::InvalidArgument(format!(
+            "skip_bits {b} outside {SKIP_BITS_RANGE:?}"
         ))),
     }
 }
@@ -144,7 +141,7 @@ impl PartialPlan {
         }
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
-        let bits = skip_bits(options.tolerance)?;
+        let bits = skip_bits(options.skip_bits)?;
         if let Some(0) = options.max_workspace_bytes {
             return Err(Error::InvalidArgument("max_workspace_bytes is 0".into()));
         }

@@ -40,7 +40,7 @@ TOOL (default: the full benchmark described below):
                       medians (complex, real), ten refinements, grid and refined angle errors
   partial (or --partial)  partial plans against the transforms they replace: degree-limited
                       on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
-                      1/16 of the betas, tolerance 1e-6 and 1e-10 (ratios in one run)
+                      1/16 of the betas, skip thresholds 2^-24 and 2^-34 (ratios in one run)
 options:
   --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
                       (default 16,32,64,128,256)

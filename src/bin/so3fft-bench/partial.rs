@@ -1,7 +1,7 @@
 //! `so3fft-bench partial` (or `--partial`): what each kind of partial plan costs against
 //! the transform it replaces, as ratios measured in the same run (medians of alternating
 //! runs): degree-limited on an oversampled grid, order-limited (pruned FFTs, and large B),
-//! batched, selected betas, and the tolerance knob. Columns: notes/bench.md.
+//! batched, selected betas, and looser skip thresholds. Columns: docs/benchmark.md.
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
@@ -93,7 +93,7 @@ pub fn run(o: &Options) -> so3fft::Result<()> {
     order_limited_large(o, threads)?;
     batched(o, runs, peak1)?;
     selected_betas(o, threads, runs)?;
-    tolerance(o, threads, runs)?;
+    skip_thresholds(o, threads, runs)?;
     Ok(())
 }
 
@@ -342,19 +342,20 @@ fn selected_betas(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()
     Ok(())
 }
 
-/// 6: tolerance 1e-6 and 1e-10 against the default, B = 64..256.
-fn tolerance(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()> {
-    println!("6. Tolerance: round trip (inverse + forward) time against the default 2^-64");
+/// 6: skip thresholds `2^-24` (6e-8) and `2^-34` (6e-11) against the default `2^-64`,
+/// B = 64..256.
+fn skip_thresholds(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()> {
+    println!("6. Skip thresholds: round trip (inverse + forward) time against the default 2^-64");
     println!(
         "   {:>5} {:>9} {:>9} {:>7} {:>10} {:>10}",
-        "B", "tol", "ms", "/def", "err", "err def"
+        "B", "threshold", "ms", "/def", "err", "err def"
     );
     for b in [64, 128, 256] {
-        let mk = |tol: Option<f64>| {
+        let mk = |bits: Option<u32>| {
             PartialPlan::new(
                 &Shape::new(b),
                 &PartialOptions {
-                    tolerance: tol,
+                    skip_bits: bits,
                     ..opts(threads, o)
                 },
             )
@@ -362,8 +363,8 @@ fn tolerance(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()> {
         let def = mk(None)?;
         let c = random_coeffs(def.num_coeffs(), 11);
         let (nc, ns) = (def.num_coeffs(), def.num_samples());
-        for tol in [1e-6, 1e-10] {
-            let tp = mk(Some(tol))?;
+        for bits in [24, 34] {
+            let tp = mk(Some(bits))?;
             let (mut x0, mut x1) = (zeros(ns), zeros(ns));
             let (mut b0, mut b1) = (zeros(nc), zeros(nc));
             let rt = |p: &PartialPlan, x: &mut Vec<Complex64>, bk: &mut Vec<Complex64>| {
@@ -381,7 +382,8 @@ fn tolerance(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()> {
                 }],
             )?;
             println!(
-                "   {b:>5} {tol:>9.0e} {:>9.1} {:>7.3} {:>10.2e} {:>10.2e}",
+                "   {b:>5} {:>9.1e} {:>9.1} {:>7.3} {:>10.2e} {:>10.2e}",
+                2f64.powi(-(bits as i32)),
                 t1.total * 1e3,
                 t1.total / t0.total,
                 rel_err(&b1, &c),
