@@ -29,6 +29,42 @@ fn main() {
     }
 
     generate_header();
+    if env::var_os("CARGO_FEATURE_MPI").is_some() {
+        build_mpi_shim();
+    }
+}
+
+/// Compiles `src/partial/mpi_shim.c` with the include and link flags `mpicc` reports.
+fn build_mpi_shim() {
+    let shim = "src/partial/mpi_shim.c";
+    println!("cargo:rerun-if-changed={shim}");
+    let showme = |what: &str| -> Vec<String> {
+        let out = std::process::Command::new("mpicc")
+            .arg(format!("--showme:{what}"))
+            .output()
+            .unwrap_or_else(|e| panic!("feature mpi: running `mpicc --showme:{what}`: {e}"));
+        String::from_utf8_lossy(&out.stdout)
+            .split_whitespace()
+            .map(str::to_string)
+            .collect()
+    };
+    let mut build = cc::Build::new();
+    build.file(shim).warnings(true);
+    for flag in showme("compile") {
+        if let Some(dir) = flag.strip_prefix("-I") {
+            build.include(dir);
+        } else {
+            build.flag(&flag);
+        }
+    }
+    build.compile("so3fft_mpi_shim");
+    for flag in showme("link") {
+        if let Some(dir) = flag.strip_prefix("-L") {
+            println!("cargo:rustc-link-search=native={dir}");
+        } else if let Some(lib) = flag.strip_prefix("-l") {
+            println!("cargo:rustc-link-lib={lib}");
+        }
+    }
 }
 
 fn generate_header() {

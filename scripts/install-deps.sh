@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Install what so3fft needs on Debian/Ubuntu beyond the Rust toolchain:
-# FFTW 3 (with its threads library), CMake, pkg-config and valgrind (for the C test suite).
+# FFTW 3 (with its threads library), CMake, pkg-config and valgrind (for the C test suite),
+# Open MPI (for the distributed plans' checks under mpirun).
 set -euo pipefail
-pkgs=(libfftw3-dev cmake pkg-config valgrind gcc g++ make)
+pkgs=(libfftw3-dev cmake pkg-config valgrind gcc g++ make libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

@@ -50,6 +50,8 @@ pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
 pub use num_complex::Complex64;
-pub use partial::{Batch, Betas, PartialOptions, PartialPlan, Shape};
+pub use partial::{
+    Batch, Betas, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
+};
 pub use plan::{Direction, FftThreading, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
 pub use simd::Isa;

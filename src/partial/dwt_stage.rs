@@ -61,6 +61,9 @@ pub(super) struct ChunkLanes {
     pub h: usize,
     /// `h` rounded up to the vector width.
     pub hp: usize,
+    /// Doubles of a lane row in the buffer the kernels run on (the DWT stage's
+    /// `row_total`, or a distributed plan's segment of it).
+    pub row_len: usize,
 }
 
 impl ChunkLanes {
@@ -219,8 +222,8 @@ impl DwtStage {
         n
     }
 
-    /// The kernels' lanes for a chunk in the lane-major buffer: lower row `j` at
-    /// `j row_total`, its mirror `hp row_total` further.
+    /// The kernels' lanes for a chunk in a lane-major buffer: lower row `j` at
+    /// `j row_len`, its mirror `hp row_len` further.
     fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes, stream: bool) -> Lanes<'a> {
         let nl = ch.lanes();
         Lanes {
@@ -233,8 +236,8 @@ impl DwtStage {
             interleaved: true,
             prefetch: Prefetch::none(),
             stream,
-            pair_stride: self.row_total,
-            row_gap: ch.hp * self.row_total,
+            pair_stride: ch.row_len,
+            row_gap: ch.hp * ch.row_len,
         }
     }
 

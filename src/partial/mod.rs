@@ -6,16 +6,23 @@
 //! - `betas`: [`Betas`] and the kernels' lane pairs of a beta and its mirror;
 //! - `dwt_stage`: the clusters of a shape and their kernel calls;
 //! - `fft_stage`: pruned slice DFTs;
-//! - `plan`: [`PartialPlan`], construction and the chunk loop.
+//! - `plan`: [`PartialPlan`], construction and the chunk loop;
+//! - `distributed`: [`DistributedPlan`], the transforms spread over ranks ([`Exchange`]).
 
 mod betas;
+mod distributed;
 mod dwt_stage;
 mod fft_stage;
+#[cfg(feature = "mpi")]
+mod mpi;
 mod plan;
 mod shape;
 #[cfg(test)]
 mod tests;
 
 pub use betas::Betas;
+pub use distributed::{DistributedPlan, Exchange, ThreadExchange};
+#[cfg(feature = "mpi")]
+pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
 pub use plan::{Batch, PartialOptions, PartialPlan};
 pub use shape::{Shape, MAX_GRID_SIDE};

@@ -72,22 +72,22 @@ fn skip_bits(option: Option<u32>) -> Result<u32> {
 }
 
 /// A plan of the general engine.
-struct General {
-    layout: CoefLayout,
-    pairs: LanePairs,
-    dwt: DwtStage,
-    fft: FftStage,
+pub(super) struct General {
+    pub(super) layout: CoefLayout,
+    pub(super) pairs: LanePairs,
+    pub(super) dwt: DwtStage,
+    pub(super) fft: FftStage,
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
-    pair_weight: Vec<f64>,
+    pub(super) pair_weight: Vec<f64>,
     /// Per-worker FFT buffers (made on first use).
     work: Vec<Mutex<Work>>,
     /// The chunk buffer (taken by one execution at a time).
     buf: Mutex<Option<AlignedBuf>>,
     budget: usize,
-    lanes_w: usize,
+    pub(super) lanes_w: usize,
     /// The order limit `N` of `M'`.
     layout_n: usize,
-    workers: WorkerPool,
+    pub(super) workers: WorkerPool,
 }
 
 enum Engine {
@@ -431,7 +431,7 @@ fn full_many(
 }
 
 impl General {
-    fn new(
+    pub(super) fn new(
         shape: &Shape,
         pairs: LanePairs,
         (isa, bits, threads): (Isa, u32, usize),
@@ -597,7 +597,7 @@ impl General {
     }
 
     /// Runs `f` with a worker's FFT buffers (a private set when all are busy).
-    fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> Result<R>) -> Result<R> {
+    pub(super) fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> Result<R>) -> Result<R> {
         match lock_free(&self.work) {
             Some(mut g) => f(&mut g),
             None => f(&mut Work::default()),
@@ -614,6 +614,7 @@ impl General {
                 j0,
                 h,
                 hp: h.next_multiple_of(w),
+                row_len: self.dwt.row_total,
             }
         })
     }
@@ -806,7 +807,7 @@ impl General {
 
     /// The lane rows of a slice (its own, and its mirror's, where its reversed members
     /// are) in the chunk buffer at `buf`, transform offset `at`.
-    fn lane_rows(
+    pub(super) fn lane_rows(
         &self,
         buf: *mut f64,
         at: usize,
@@ -830,7 +831,7 @@ impl General {
     ///
     /// # Safety
     /// The lane rows hold `row_total` doubles each, written by the DWT stage.
-    unsafe fn scatter(&self, w: &mut [Complex64], rows: LaneRows) {
+    pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: LaneRows) {
         let (na, ng) = self.fft.dims();
         let (rs, _) = self.fft.strides();
         let n = self.layout_n;
@@ -859,7 +860,7 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`].
-    unsafe fn scatter_real(&self, w: &mut [Complex64], rows: LaneRows) {
+    pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: LaneRows) {
         let (na, _) = self.fft.dims();
         let (_, hs) = self.fft.strides();
         w.fill(Complex64::default());
@@ -885,7 +886,7 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`], for writes; no other task writes these slots.
-    unsafe fn gather(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
+    pub(super) unsafe fn gather(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
         for cl in &self.dwt.clusters {
             for (q, s) in cl.slots.iter().enumerate() {
                 let v = w[s.work] * weight;
@@ -909,7 +910,7 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::gather`].
-    unsafe fn gather_real(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
+    pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
         let (na, _) = self.fft.dims();
         let (_, hs) = self.fft.strides();
         let at = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
@@ -937,7 +938,7 @@ impl General {
     ///
     /// # Safety
     /// The chunk's `2 hp` lane rows at `rows` are the caller's.
-    unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
+    pub(super) unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
         let rt = self.dwt.row_total;
         for half in 0..2 {
             let from = half * ch.hp + ch.h;
@@ -949,7 +950,7 @@ impl General {
 
 /// A slice's lane rows: its own and its mirror's.
 #[derive(Clone, Copy)]
-struct LaneRows {
+pub(super) struct LaneRows {
     own: *mut f64,
     mirror: *mut f64,
 }

@@ -1,0 +1,201 @@
+//! Distributed plans over 1..4 ranks (threads of this process, `ThreadExchange`) against the
+//! single-process partial plan: bitwise equal results (each lane is the same kernel lane,
+//! each cluster's sum runs over all betas in one call in both), complex and real, forward and
+//! inverse, and collective errors.
+
+use so3fft::{
+    Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
+};
+
+fn rnd(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
+
+fn opts(real: bool) -> PartialOptions {
+    PartialOptions {
+        threads: 1,
+        real,
+        general_engine: true,
+        ..PartialOptions::default()
+    }
+}
+
+/// Coefficients of a real signal (Hermitian in `(M, M')`).
+fn hermitian(s: &Shape, c: &mut [Complex64]) {
+    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
+    for l in s.degree_min..s.degree_limit {
+        for m in -a..=a {
+            for mp in -n..=n {
+                let (Some(i), Some(j)) = (s.coef_index(l, m, mp), s.coef_index(l, -m, -mp)) else {
+                    continue;
+                };
+                if i < j {
+                    let sg = if (m - mp).rem_euclid(2) == 0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    c[j] = c[i].conj() * sg;
+                } else if i == j {
+                    c[i].im = 0.0;
+                }
+            }
+        }
+    }
+}
+
+/// Every `(l, m, mp)` the shape holds, with its global index.
+fn entries(s: &Shape) -> Vec<(usize, isize, isize, usize)> {
+    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
+    let mut v = Vec::new();
+    for l in 0..s.degree_limit {
+        for m in -a..=a {
+            for mp in -n..=n {
+                if let Some(i) = s.coef_index(l, m, mp) {
+                    v.push((l, m, mp, i));
+                }
+            }
+        }
+    }
+    v
+}
+
+/// The global slices a rank holds, in its local order.
+fn local_slices(s: &Shape, (j0, j1): (usize, usize)) -> Vec<usize> {
+    let nb = s.n_beta();
+    (j0..j1).chain(nb - j1..nb - j0).collect()
+}
+
+fn check_shape(s: Shape, ranks: usize, real: bool) {
+    let single = PartialPlan::new(&s, &opts(real)).unwrap();
+    let (nc, ns, sl) = (s.num_coeffs(), s.num_samples(), s.slice_len());
+    let mut st = 5u64;
+    let mut c: Vec<Complex64> = (0..nc)
+        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+        .collect();
+    let samples: Vec<Complex64> = (0..ns)
+        .map(|_| Complex64::new(rnd(&mut st), if real { 0.0 } else { rnd(&mut st) }))
+        .collect();
+    if real {
+        hermitian(&s, &mut c);
+    }
+    // Single-process results.
+    let mut want_x = vec![Complex64::default(); ns];
+    let mut want_xr = vec![0.0; ns];
+    let mut want_c = vec![Complex64::default(); nc];
+    if real {
+        single.inverse_real(&c, &mut want_xr).unwrap();
+        let re: Vec<f64> = samples.iter().map(|z| z.re).collect();
+        single.forward_real(&re, &mut want_c).unwrap();
+    } else {
+        single.inverse(&c, &mut want_x).unwrap();
+        single.forward(&samples, &mut want_c).unwrap();
+    }
+    let group = ThreadExchange::group(ranks);
+    std::thread::scope(|scope| {
+        for comm in &group {
+            let (c, samples) = (&c, &samples);
+            let (want_x, want_xr, want_c) = (&want_x, &want_xr, &want_c);
+            scope.spawn(move || {
+                let plan = DistributedPlan::new(comm, &s, &opts(real)).unwrap();
+                let mine = local_slices(&s, plan.local_pairs());
+                assert_eq!(plan.local_num_samples(), mine.len() * sl);
+                // Local coefficients from the global ones.
+                let mut lc = vec![Complex64::default(); plan.local_num_coeffs()];
+                let mut held = 0;
+                for (l, m, mp, i) in entries(&s) {
+                    let (owner, at) = plan.coef_owner(l, m, mp).unwrap();
+                    if owner == comm.rank() {
+                        assert_eq!(plan.local_coef_index(l, m, mp), Some(at));
+                        lc[at] = c[i];
+                        held += 1;
+                    }
+                }
+                assert_eq!(held, lc.len());
+                let local_samples: Vec<Complex64> = mine
+                    .iter()
+                    .flat_map(|&k| samples[k * sl..][..sl].to_vec())
+                    .collect();
+                let mut back = vec![Complex64::default(); lc.len()];
+                if real {
+                    let mut x = vec![0.0; plan.local_num_samples()];
+                    plan.inverse_real(&lc, &mut x).unwrap();
+                    for (t, &k) in mine.iter().enumerate() {
+                        assert!(
+                            x[t * sl..][..sl] == want_xr[k * sl..][..sl],
+                            "real inverse slice {k}"
+                        );
+                    }
+                    let re: Vec<f64> = local_samples.iter().map(|z| z.re).collect();
+                    plan.forward_real(&re, &mut back).unwrap();
+                } else {
+                    let mut x = vec![Complex64::default(); plan.local_num_samples()];
+                    plan.inverse(&lc, &mut x).unwrap();
+                    for (t, &k) in mine.iter().enumerate() {
+                        assert!(
+                            x[t * sl..][..sl] == want_x[k * sl..][..sl],
+                            "inverse slice {k}"
+                        );
+                    }
+                    plan.forward(&local_samples, &mut back).unwrap();
+                }
+                for (l, m, mp, i) in entries(&s) {
+                    if let Some(at) = plan.local_coef_index(l, m, mp) {
+                        assert!(
+                            back[at] == want_c[i],
+                            "forward ({l},{m},{mp}) on {} ranks",
+                            ranks
+                        );
+                    }
+                }
+            });
+        }
+    });
+}
+
+#[test]
+fn equals_single_process_plan() {
+    for ranks in 1..=4 {
+        for real in [false, true] {
+            check_shape(Shape::new(6), ranks, real);
+            check_shape(
+                Shape::new(9).with_orders(4, 2).with_grid(10, 11, 7),
+                ranks,
+                real,
+            );
+        }
+    }
+    check_shape(Shape::new(5).with_degree_min(2), 3, false);
+}
+
+#[test]
+fn collective_errors() {
+    // Ranks given different shapes: every rank gets the error, nobody waits forever.
+    let group = ThreadExchange::group(3);
+    std::thread::scope(|scope| {
+        for comm in &group {
+            scope.spawn(move || {
+                let b = if comm.rank() == 1 { 7 } else { 6 };
+                let r = DistributedPlan::new(comm, &Shape::new(b), &opts(false));
+                assert!(r.is_err());
+            });
+        }
+    });
+    // One rank passes a wrong array length: all ranks fail the execute.
+    let group = ThreadExchange::group(2);
+    std::thread::scope(|scope| {
+        for comm in &group {
+            scope.spawn(move || {
+                let s = Shape::new(4);
+                let plan = DistributedPlan::new(comm, &s, &opts(false)).unwrap();
+                let c = vec![Complex64::default(); plan.local_num_coeffs()];
+                let short = usize::from(comm.rank() == 0);
+                let mut x = vec![Complex64::default(); plan.local_num_samples() - short];
+                assert!(plan.inverse(&c, &mut x).is_err());
+            });
+        }
+    });
+}
