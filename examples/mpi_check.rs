@@ -5,6 +5,10 @@
 //! Exits non-zero on every rank if any check fails on any rank.
 //!
 //! `mpirun -np 3 target/release/examples/mpi_check`
+//!
+//! With `--bench B THREADS RUNS`: times inverse + forward of the full shape at bandwidth `B`
+//! on the ranks (THREADS workers each): medians, the exchange's share, each rank's workspace
+//! and peak resident memory.
 
 use so3fft::partial::{mpi_finalize, mpi_init, MpiExchange};
 use so3fft::{Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape};
@@ -159,9 +163,76 @@ fn run(comm: &MpiExchange) -> so3fft::Result<usize> {
     Ok(bad)
 }
 
+/// Peak resident memory of this process (`VmHWM`), bytes.
+fn peak_rss() -> usize {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<usize>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn bench(comm: &MpiExchange, b: usize, threads: usize, runs: usize) -> so3fft::Result<()> {
+    let s = Shape::new(b);
+    let o = PartialOptions {
+        threads,
+        rigor: so3fft::Rigor::Measure,
+        ..PartialOptions::default()
+    };
+    let plan = DistributedPlan::new(comm, &s, &o)?;
+    let mut st = 7u64 + comm.rank() as u64;
+    let c: Vec<Complex64> = (0..plan.local_num_coeffs())
+        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+        .collect();
+    let mut x = vec![Complex64::default(); plan.local_num_samples()];
+    let mut back = vec![Complex64::default(); c.len()];
+    let (mut inv, mut fwd, mut ex) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..runs {
+        plan.inverse(&c, &mut x)?;
+        let ti = plan.last_times();
+        plan.forward(&x, &mut back)?;
+        let tf = plan.last_times();
+        inv.push(ti.total);
+        fwd.push(tf.total);
+        ex.push((ti.exchange + tf.exchange) / (ti.total + tf.total));
+    }
+    let (i, f, e) = (median(inv), median(fwd), median(ex));
+    let mine = format!(
+        "rank {} of {}: B = {b}, {threads} threads: inverse {:.1} ms, forward {:.1} ms, exchange {:.0}%, \
+         workspace {:.0} MB, arrays {:.0} MB, peak RSS {:.0} MB",
+        comm.rank(),
+        comm.size(),
+        i * 1e3,
+        f * 1e3,
+        e * 100.0,
+        plan.local_workspace_bytes() as f64 / 1e6,
+        16.0 * (x.len() + c.len()) as f64 / 1e6,
+        peak_rss() as f64 / 1e6
+    );
+    println!("{mine}");
+    Ok(())
+}
+
 fn main() {
     mpi_init().expect("MPI_Init");
     let comm = MpiExchange::world().expect("MPI_COMM_WORLD");
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("--bench") {
+        let num = |i: usize, d: usize| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
+        if let Err(e) = bench(&comm, num(2, 128), num(3, 1), num(4, 5)) {
+            eprintln!("rank {}: {e}", comm.rank());
+        }
+        mpi_finalize().ok();
+        return;
+    }
     let bad = run(&comm).unwrap_or_else(|e| {
         eprintln!("rank {}: {e}", comm.rank());
         1

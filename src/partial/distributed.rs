@@ -35,11 +35,25 @@ pub trait Exchange: Sync {
     fn rank(&self) -> usize;
     /// Number of ranks.
     fn size(&self) -> usize;
-    /// Sends `send[q]` to every rank `q` and receives into `recv[q]` what rank `q` sent here
-    /// (the lengths agree pairwise: the callers compute them from the same plan).
-    fn all_to_all(&self, send: &[&[f64]], recv: &mut [&mut [f64]]) -> Result<()>;
+    /// Sends `send` to rank `dest` and receives into `recv` what rank `src` sends here (every
+    /// rank calls it at once, each with its own pair; lengths agree pairwise: the callers
+    /// compute them from the same plan).
+    fn sendrecv(&self, send: &[f64], dest: usize, recv: &mut [f64], src: usize) -> Result<()>;
     /// The largest of the ranks' `value`s, on every rank.
     fn max(&self, value: u64) -> Result<u64>;
+}
+
+/// Wall times of a distributed transform's parts on this rank, in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DistributedTimes {
+    /// The slice DFTs and the moves between slices and lane rows.
+    pub fft: f64,
+    /// The all-to-all exchange (with the packing around it).
+    pub exchange: f64,
+    /// The DWT stage.
+    pub dwt: f64,
+    /// The whole call.
+    pub total: f64,
 }
 
 /// A rank's share of the betas and the clusters.
@@ -64,6 +78,10 @@ pub struct DistributedPlan<'a, X: Exchange> {
     /// offsets within the local segment of a lane row.
     local: Vec<ClusterPlan>,
     local_coeffs: usize,
+    /// Times of the last transform on this rank.
+    last: std::sync::Mutex<DistributedTimes>,
+    /// The lane rows of the FFT stage and of the DWT stage, kept between transforms.
+    rows: std::sync::Mutex<(Vec<f64>, Vec<f64>)>,
 }
 
 /// An error on every rank if it is one on any (agreed through `comm`).
@@ -208,6 +226,8 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             shares,
             local,
             local_coeffs: at,
+            last: std::sync::Mutex::new(DistributedTimes::default()),
+            rows: std::sync::Mutex::new((Vec::new(), Vec::new())),
         })
     }
 
@@ -338,6 +358,44 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr()), true)
     }
 
+    /// Times of this rank's part of the last transform.
+    pub fn last_times(&self) -> DistributedTimes {
+        *self.last.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Bytes this rank holds during a transform besides its arrays: the lane rows of its
+    /// slices (all clusters) and of its clusters (all betas); the exchange adds one packed
+    /// block for one other rank at a time, and the plan's tables and per-worker FFT buffers
+    /// come on top (`O(L^2)` and a few slices).
+    pub fn local_workspace_bytes(&self) -> usize {
+        let (loc, all) = (self.local_lanes(), self.all_lanes());
+        let rows = 2 * loc.h * loc.row_len + all.lanes() * all.row_len;
+        8 * rows
+    }
+
+    /// The two row buffers, taken from the plan (or new when another call has them), at
+    /// their sizes: `a` for this rank's slices, `b` for this rank's clusters.
+    fn take_rows(&self) -> (Vec<f64>, Vec<f64>) {
+        let (loc, all) = (self.local_lanes(), self.all_lanes());
+        let (mut a, mut b) = match self.rows.try_lock() {
+            Ok(mut g) => std::mem::take(&mut *g),
+            Err(_) => (Vec::new(), Vec::new()),
+        };
+        a.resize(2 * loc.h * loc.row_len, 0.0);
+        b.resize(all.lanes() * all.row_len, 0.0);
+        (a, b)
+    }
+
+    fn put_rows(&self, rows: (Vec<f64>, Vec<f64>)) {
+        if let Ok(mut g) = self.rows.try_lock() {
+            *g = rows;
+        }
+    }
+
+    fn record(&self, t: DistributedTimes) {
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = t;
+    }
+
     /// Lanes of the DWT stage: every pair, padded to the vector width.
     fn all_lanes(&self) -> ChunkLanes {
         let me = &self.shares[self.comm.rank()];
@@ -372,23 +430,16 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
 
     /// The exchange between the FFT stage's rows (`a`: this rank's pairs, every cluster) and
     /// the DWT stage's rows (`b`: every pair, this rank's clusters). `to_dwt`: `a` to `b`.
+    /// Rank `r` sends to `r + k` and receives from `r - k` in step `k` (one packed block at a
+    /// time); its own part is copied directly.
     fn exchange(&self, a: &mut [f64], b: &mut [f64], to_dwt: bool) -> Result<()> {
-        let me = self.comm.rank();
+        let (me, p) = (self.comm.rank(), self.comm.size());
         let rt = self.general.dwt.row_total;
         let all = self.all_lanes();
         let mine = &self.shares[me];
         let my_len = mine.segment.1 - mine.segment.0;
         let ha = mine.pairs.1 - mine.pairs.0;
-        // Packed blocks: to/from rank q, `2 h_q` rows of the other side's segment.
-        let mut packed_a: Vec<Vec<f64>> = Vec::with_capacity(self.shares.len());
-        let mut packed_b: Vec<Vec<f64>> = Vec::with_capacity(self.shares.len());
-        for share in &self.shares {
-            let len = share.segment.1 - share.segment.0;
-            let hq = share.pairs.1 - share.pairs.0;
-            packed_a.push(vec![0.0; 2 * ha * len]);
-            packed_b.push(vec![0.0; 2 * hq * my_len]);
-        }
-        // Row `i < 2 h` of a pair range in `b`: lower rows at the pair, upper at hp + pair.
+        // Row `i < 2 h_q` of rank q's pairs in `b`: lower rows at the pair, upper at hp + pair.
         let b_row = |share: &Share, i: usize| {
             let hq = share.pairs.1 - share.pairs.0;
             if i < hq {
@@ -397,44 +448,52 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                 all.hp + share.pairs.0 + i - hq
             }
         };
-        if to_dwt {
-            for (share, out) in self.shares.iter().zip(&mut packed_a) {
-                let len = share.segment.1 - share.segment.0;
-                for (i, row) in out.chunks_exact_mut(len.max(1)).enumerate().take(2 * ha) {
-                    row.copy_from_slice(&a[i * rt + share.segment.0..][..len]);
+        // `a`'s part for rank q: rows `0..2 ha`, columns of q's segment.
+        let a_block = |share: &Share| (share.segment.0, share.segment.1 - share.segment.0);
+        let mut send = Vec::new();
+        let mut recv = Vec::new();
+        for step in 0..p {
+            let (dest, src) = ((me + step) % p, (me + p - step) % p);
+            let (sd, ss) = (&self.shares[dest], &self.shares[src]);
+            if to_dwt {
+                let (col, len) = a_block(sd);
+                let h_src = ss.pairs.1 - ss.pairs.0;
+                if step == 0 {
+                    for i in 0..2 * ha {
+                        let r = b_row(mine, i);
+                        b[r * my_len..][..my_len].copy_from_slice(&a[i * rt + col..][..len]);
+                    }
+                    continue;
                 }
-            }
-            {
-                let send: Vec<&[f64]> = packed_a.iter().map(|v| v.as_slice()).collect();
-                let mut recv: Vec<&mut [f64]> =
-                    packed_b.iter_mut().map(|v| v.as_mut_slice()).collect();
-                self.comm.all_to_all(&send, &mut recv)?;
-            }
-            for (share, inp) in self.shares.iter().zip(&packed_b) {
-                let hq = share.pairs.1 - share.pairs.0;
-                for i in 0..2 * hq {
-                    let r = b_row(share, i);
-                    b[r * my_len..][..my_len].copy_from_slice(&inp[i * my_len..][..my_len]);
-                }
-            }
-        } else {
-            for (share, out) in self.shares.iter().zip(&mut packed_b) {
-                let hq = share.pairs.1 - share.pairs.0;
-                for i in 0..2 * hq {
-                    let r = b_row(share, i);
-                    out[i * my_len..][..my_len].copy_from_slice(&b[r * my_len..][..my_len]);
-                }
-            }
-            {
-                let send: Vec<&[f64]> = packed_b.iter().map(|v| v.as_slice()).collect();
-                let mut recv: Vec<&mut [f64]> =
-                    packed_a.iter_mut().map(|v| v.as_mut_slice()).collect();
-                self.comm.all_to_all(&send, &mut recv)?;
-            }
-            for (share, inp) in self.shares.iter().zip(&packed_a) {
-                let len = share.segment.1 - share.segment.0;
+                send.clear();
                 for i in 0..2 * ha {
-                    a[i * rt + share.segment.0..][..len].copy_from_slice(&inp[i * len..][..len]);
+                    send.extend_from_slice(&a[i * rt + col..][..len]);
+                }
+                recv.resize(2 * h_src * my_len, 0.0);
+                self.comm.sendrecv(&send, dest, &mut recv, src)?;
+                for i in 0..2 * h_src {
+                    let r = b_row(ss, i);
+                    b[r * my_len..][..my_len].copy_from_slice(&recv[i * my_len..][..my_len]);
+                }
+            } else {
+                let (col, len) = a_block(ss);
+                let h_dest = sd.pairs.1 - sd.pairs.0;
+                if step == 0 {
+                    for i in 0..2 * ha {
+                        let r = b_row(mine, i);
+                        a[i * rt + col..][..len].copy_from_slice(&b[r * my_len..][..my_len]);
+                    }
+                    continue;
+                }
+                send.clear();
+                for i in 0..2 * h_dest {
+                    let r = b_row(sd, i);
+                    send.extend_from_slice(&b[r * my_len..][..my_len]);
+                }
+                recv.resize(2 * ha * len, 0.0);
+                self.comm.sendrecv(&send, dest, &mut recv, src)?;
+                for i in 0..2 * ha {
+                    a[i * rt + col..][..len].copy_from_slice(&recv[i * len..][..len]);
                 }
             }
         }
@@ -450,13 +509,12 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         let g = &self.general;
         let loc = self.local_lanes();
         let all = self.all_lanes();
-        let rt = g.dwt.row_total;
         let slice_len = self.shape.slice_len();
-        let mut a = vec![0.0; 2 * loc.h * rt];
-        let mut b = vec![0.0; all.lanes() * all.row_len];
+        let (mut a, mut b) = self.take_rows();
         let a_ptr = SendPtr(a.as_mut_ptr());
         let per_value = if real { 1 } else { 2 };
         let slices = self.local_slices();
+        let start = std::time::Instant::now();
         let done: Result<()> = g.workers.pool().install(|| {
             slices
                 .par_iter()
@@ -485,8 +543,15 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                 })
         });
         collective(self.comm, done)?;
+        let t1 = std::time::Instant::now();
         self.exchange(&mut a, &mut b, true)?;
-        drop(a);
+        // Padding lanes: the kernel multiplies them by exact zeros, which must not meet a
+        // non-finite value an inverse left there.
+        for half in 0..2 {
+            let from = half * all.hp + all.h;
+            b[from * all.row_len..(half * all.hp + all.hp) * all.row_len].fill(0.0);
+        }
+        let t2 = std::time::Instant::now();
         let b_ptr = SendPtr(b.as_mut_ptr());
         let coef = SendPtr(coeffs.as_mut_ptr());
         g.workers.pool().install(|| {
@@ -503,6 +568,14 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                 })
             })
         });
+        let t3 = std::time::Instant::now();
+        self.record(DistributedTimes {
+            fft: (t1 - start).as_secs_f64(),
+            exchange: (t2 - t1).as_secs_f64(),
+            dwt: (t3 - t2).as_secs_f64(),
+            total: (t3 - start).as_secs_f64(),
+        });
+        self.put_rows((a, b));
         Ok(())
     }
 
@@ -510,9 +583,9 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         let g = &self.general;
         let loc = self.local_lanes();
         let all = self.all_lanes();
-        let rt = g.dwt.row_total;
         let slice_len = self.shape.slice_len();
-        let mut b = vec![0.0; all.lanes() * all.row_len];
+        let start = std::time::Instant::now();
+        let (mut a, mut b) = self.take_rows();
         let b_ptr = SendPtr(b.as_mut_ptr());
         let coef = SendConstPtr(coeffs.as_ptr());
         g.workers.pool().install(|| {
@@ -535,9 +608,9 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                 })
             })
         });
-        let mut a = vec![0.0; 2 * loc.h * rt];
+        let t1 = std::time::Instant::now();
         self.exchange(&mut a, &mut b, false)?;
-        drop(b);
+        let t2 = std::time::Instant::now();
         let a_ptr = SendPtr(a.as_mut_ptr());
         let slices = self.local_slices();
         let done: Result<()> = g.workers.pool().install(|| {
@@ -565,6 +638,14 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                     })
                 })
         });
+        let t3 = std::time::Instant::now();
+        self.record(DistributedTimes {
+            dwt: (t1 - start).as_secs_f64(),
+            exchange: (t2 - t1).as_secs_f64(),
+            fft: (t3 - t2).as_secs_f64(),
+            total: (t3 - start).as_secs_f64(),
+        });
+        self.put_rows((a, b));
         collective(self.comm, done)
     }
 }
@@ -610,7 +691,7 @@ impl Exchange for ThreadExchange {
         self.shared.size
     }
 
-    fn all_to_all(&self, send: &[&[f64]], recv: &mut [&mut [f64]]) -> Result<()> {
+    fn sendrecv(&self, send: &[f64], dest: usize, recv: &mut [f64], src: usize) -> Result<()> {
         let (p, me) = (self.shared.size, self.rank);
         {
             let mut mail = self
@@ -618,35 +699,25 @@ impl Exchange for ThreadExchange {
                 .mailbox
                 .lock()
                 .unwrap_or_else(|e| e.into_inner());
-            for (q, data) in send.iter().enumerate() {
-                mail[me * p + q] = data.to_vec();
-            }
+            mail[me * p + dest] = send.to_vec();
         }
         self.shared.barrier.wait();
-        let mut ok = true;
-        {
+        let data = {
             let mut mail = self
                 .shared
                 .mailbox
                 .lock()
                 .unwrap_or_else(|e| e.into_inner());
-            for (q, out) in recv.iter_mut().enumerate() {
-                let data = std::mem::take(&mut mail[q * p + me]);
-                if data.len() == out.len() {
-                    out.copy_from_slice(&data);
-                } else {
-                    ok = false;
-                }
-            }
-        }
+            std::mem::take(&mut mail[src * p + me])
+        };
         self.shared.barrier.wait();
-        if ok {
-            Ok(())
-        } else {
-            Err(Error::InvalidArgument(
+        if data.len() != recv.len() {
+            return Err(Error::InvalidArgument(
                 "exchange: message lengths differ".into(),
-            ))
+            ));
         }
+        recv.copy_from_slice(&data);
+        Ok(())
     }
 
     fn max(&self, value: u64) -> Result<u64> {

@@ -21,7 +21,7 @@ mod shape;
 mod tests;
 
 pub use betas::Betas;
-pub use distributed::{DistributedPlan, Exchange, ThreadExchange};
+pub use distributed::{DistributedPlan, DistributedTimes, Exchange, ThreadExchange};
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
 pub use plan::{Batch, PartialOptions, PartialPlan};

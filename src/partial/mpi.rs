@@ -113,32 +113,22 @@ impl Exchange for MpiExchange {
         self.size
     }
 
-    fn all_to_all(&self, send: &[&[f64]], recv: &mut [&mut [f64]]) -> Result<()> {
-        let p = self.size;
-        for step in 0..p {
-            let dest = (self.rank + step) % p;
-            let src = (self.rank + p - step) % p;
-            if step == 0 {
-                recv[src].copy_from_slice(send[dest]);
-                continue;
-            }
-            let (s, r) = (send[dest], &mut recv[src]);
-            // SAFETY: `s` and `r` are valid for their lengths; MPI copies them during the
-            // call only.
-            let e = unsafe {
-                so3fft_mpi_sendrecv(
-                    self.comm,
-                    s.as_ptr(),
-                    s.len(),
-                    dest as c_int,
-                    r.as_mut_ptr(),
-                    r.len(),
-                    src as c_int,
-                )
-            };
-            if e != 0 {
-                return Err(mpi_error("MPI_Sendrecv", e));
-            }
+    fn sendrecv(&self, send: &[f64], dest: usize, recv: &mut [f64], src: usize) -> Result<()> {
+        // SAFETY: `send` and `recv` are valid for their lengths; MPI uses them during the
+        // call only.
+        let e = unsafe {
+            so3fft_mpi_sendrecv(
+                self.comm,
+                send.as_ptr(),
+                send.len(),
+                dest as c_int,
+                recv.as_mut_ptr(),
+                recv.len(),
+                src as c_int,
+            )
+        };
+        if e != 0 {
+            return Err(mpi_error("MPI_Sendrecv", e));
         }
         Ok(())
     }
