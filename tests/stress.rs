@@ -98,19 +98,26 @@ fn round_trips_meet_the_target() {
     }
 }
 
-/// Single coefficients at the top degree and orders: the inverse matches the closed form,
-/// the round trip returns the coefficient.
+/// Single coefficients at the top degree and orders (SO(3) and S^2): the inverse matches
+/// the closed form, the round trip returns the coefficient.
 #[test]
 fn top_orders_are_accurate() {
     let mut report = Report::default();
     for b in [16, 64] {
         adversarial::top_order(b, 2, &mut report).unwrap();
     }
-    for r in rows(&report, "top-order-inverse") {
-        assert!(r.rel_l2 <= 1e-14, "{r:?}");
+    for b in [64, 256] {
+        adversarial::s2_top_order(b, 2, &mut report).unwrap();
     }
-    for r in rows(&report, "top-order-roundtrip") {
-        assert!(r.rel_l2 <= 1e-15, "{r:?}");
+    for test in ["top-order-inverse", "s2-top-order-inverse"] {
+        for r in rows(&report, test) {
+            assert!(r.rel_l2 <= 1e-14, "{r:?}");
+        }
+    }
+    for test in ["top-order-roundtrip", "s2-top-order-roundtrip"] {
+        for r in rows(&report, test) {
+            assert!(r.rel_l2 <= 1e-15, "{r:?}");
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 use crate::record::{bit_differences, errors, Case, Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::ORDER_LIMIT;
-use so3fft::s2::{s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
 use so3fft::{
     coef_index, num_coeffs, num_samples, sample_index, Complex64, PartialOptions, PartialPlan,
     Plan, PlanOptions, Shape,
@@ -34,6 +34,14 @@ fn phase(t: isize, b: usize) -> Complex64 {
     Complex64::new(angle.cos(), angle.sin())
 }
 
+/// `cos^(2l)(x)` for `x = pi t / q` in `[0, pi/2]`, as `exp(l ln1p(-sin^2 x))`: accurate to
+/// a few ulps wherever the value is not negligible (a plain power would carry `2l` times
+/// the rounding of `cos x`).
+fn cos_power(l: usize, t: f64, q: f64) -> f64 {
+    let s = (PI * t / q).sin();
+    (l as f64 * (-s * s).ln_1p()).exp()
+}
+
 /// The inverse of the single coefficient `fhat(l, m, mp) = c` with `l = |m| = |mp|`, from
 /// `d^l_{l,l} = cos^{2l}(beta/2)` and `d^l_{l,-l} = d^l_{-l,l} = sin^{2l}(beta/2)`.
 fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex64> {
@@ -41,9 +49,13 @@ fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex
     let n = 2 * b;
     let mut out = vec![ZERO; num_samples(b)];
     for k in 0..n {
-        let half = PI * (2 * k + 1) as f64 / (8 * b) as f64;
-        let base = if m == mp { half.cos() } else { half.sin() };
-        let d = base.powi(2 * l as i32);
+        // beta / 2 = pi (2k+1) / (8B); sin(beta/2) = cos(pi (4B-2k-1) / (8B)).
+        let q = (8 * b) as f64;
+        let d = if m == mp {
+            cos_power(l, (2 * k + 1) as f64, q)
+        } else {
+            cos_power(l, (4 * b - 2 * k - 1) as f64, q)
+        };
         let dt = ((2 * l + 1) as f64 / 2.0).sqrt() * d / (2.0 * PI);
         for j1 in 0..n {
             for j2 in 0..n {
@@ -53,6 +65,74 @@ fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex
         }
     }
     out
+}
+
+/// The S^2 synthesis of `fhat(l, m) = c`, `l = |m|`: `Y_l^l = (-1)^l sqrt((2l+1)/2)
+/// sqrt(prod_{i<=l} (2i-1)/(2i)) sin^l(theta) e^{i l phi} / sqrt(2 pi)` and
+/// `Y_l^{-l} = (-1)^l conj(Y_l^l)`.
+fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
+    let l = m.unsigned_abs();
+    let n = 2 * b;
+    let log_ratio: f64 = (1..=l).map(|i| (-1.0 / (2 * i) as f64).ln_1p()).sum();
+    let sign = if l % 2 == 0 { 1.0 } else { -1.0 };
+    let norm = sign * ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI).sqrt();
+    let mut out = vec![ZERO; s2_num_samples(b)];
+    for j in 0..n {
+        // sin^l(theta) = cos^l(pi/2 - theta), pi/2 - theta_j = pi (2B-2j-1) / (4B); the
+        // power is taken as exp(l/2 ln1p(-sin^2)) with the half in the log of the ratio.
+        let x = PI * (2 * b as isize - 2 * j as isize - 1).unsigned_abs() as f64 / (4 * b) as f64;
+        let s = x.sin();
+        let p = (0.5 * log_ratio + 0.5 * l as f64 * (-s * s).ln_1p()).exp();
+        for k in 0..n {
+            // e^{i m phi_k}, phi_k = pi k / B: phase() gives e^{-i pi t / B}.
+            let y = norm * p * phase(-m * k as isize, b);
+            let y = if m < 0 { y * sign } else { y };
+            out[j * n + k] = c * y;
+        }
+    }
+    out
+}
+
+/// S^2 single coefficients at `l = |m| = B-1`: the synthesis against the closed form
+/// (`s2-top-order-inverse`) and the round trip (`s2-top-order-roundtrip`).
+pub fn s2_top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    let plan = S2Plan::new(
+        b,
+        &S2Options {
+            threads,
+            ..Default::default()
+        },
+    )?;
+    let c = Complex64::new(0.75, -0.5);
+    let top = b as isize - 1;
+    for (m, variant) in [(top, "m=B-1"), (-top, "m=-(B-1)")] {
+        let mut coeffs = vec![ZERO; s2_num_coeffs(b)];
+        coeffs[s2_coef_index(b, b - 1, m)] = c;
+        let mut samples = vec![ZERO; s2_num_samples(b)];
+        let start = Instant::now();
+        plan.inverse(&coeffs, &mut samples)?;
+        let t_inv = start.elapsed().as_secs_f64();
+        let want = s2_top_order_samples(b, m, c);
+        let case = |test| Case { test, b, variant };
+        let note = "vs closed form sin^l(theta)";
+        report.push_errors(
+            case("s2-top-order-inverse"),
+            errors(&samples, &want),
+            t_inv,
+            note,
+        );
+        let mut back = vec![ZERO; s2_num_coeffs(b)];
+        let start = Instant::now();
+        plan.forward(&samples, &mut back)?;
+        let t_fwd = start.elapsed().as_secs_f64();
+        report.push_errors(
+            case("s2-top-order-roundtrip"),
+            errors(&back, &coeffs),
+            t_fwd,
+            "",
+        );
+    }
+    Ok(())
 }
 
 /// Single coefficients at `l = B-1`, `|M| = |M'| = B-1`: the inverse against the closed
@@ -74,7 +154,7 @@ pub fn top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Resul
         let t_inv = start.elapsed().as_secs_f64();
         let want = top_order_samples(b, m, mp, c);
         let case = |test| Case { test, b, variant };
-        let note = "vs closed form sin/cos^(2l)(beta/2)";
+        let note = "vs closed form cos/sin^(2l)(beta/2)";
         report.push_errors(
             case("top-order-inverse"),
             errors(&samples, &want),
@@ -493,21 +573,29 @@ pub fn special_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Re
     Ok(())
 }
 
-/// Every adversarial test at the bandwidths given.
-pub fn run(
-    top_bandwidths: &[usize],
-    b_small: usize,
-    threads: usize,
-    report: &mut Report,
-) -> so3fft::Result<()> {
-    for &b in top_bandwidths {
+/// The bandwidths of the adversarial tests.
+pub struct Bandwidths<'a> {
+    /// SO(3) top-order single coefficients.
+    pub top: &'a [usize],
+    /// S^2 top-order single coefficients.
+    pub s2_top: &'a [usize],
+    /// Power laws, scaling, subnormal and special values.
+    pub small: usize,
+}
+
+/// Every adversarial test.
+pub fn run(bw: &Bandwidths<'_>, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    for &b in bw.top {
         top_order(b, threads, report)?;
     }
-    for p in [2.0, 4.0, -2.0] {
-        power_law(b_small, p, threads, report)?;
+    for &b in bw.s2_top {
+        s2_top_order(b, threads, report)?;
     }
-    scaling_rows(b_small, threads, report)?;
-    subnormal_rows(b_small, threads, report)?;
-    special_rows(b_small, threads, report)?;
+    for p in [2.0, 4.0, -2.0] {
+        power_law(bw.small, p, threads, report)?;
+    }
+    scaling_rows(bw.small, threads, report)?;
+    subnormal_rows(bw.small, threads, report)?;
+    special_rows(bw.small, threads, report)?;
     Ok(())
 }

@@ -137,12 +137,20 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
         }
     }
     if o.wants("adversarial") {
-        let (tops, small): (&[usize], usize) = if o.quick {
-            (&[16, 64], 16)
+        let bw = if o.quick {
+            adversarial::Bandwidths {
+                top: &[16, 64],
+                s2_top: &[64, 256],
+                small: 16,
+            }
         } else {
-            (&[16, 64, 256], 64)
+            adversarial::Bandwidths {
+                top: &[16, 64, 256],
+                s2_top: &[64, 256, 1024, 2048],
+                small: 64,
+            }
         };
-        adversarial::run(tops, small, t, report)?;
+        adversarial::run(&bw, t, report)?;
     }
     if o.wants("determinism") {
         determinism::run(if o.quick { 32 } else { 64 }, report)?;
