@@ -74,7 +74,7 @@ fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
     let l = m.unsigned_abs();
     let n = 2 * b;
     let log_ratio: f64 = (1..=l).map(|i| (-1.0 / (2 * i) as f64).ln_1p()).sum();
-    let sign = if l % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = if l.is_multiple_of(2) { 1.0 } else { -1.0 };
     let norm = sign * ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI).sqrt();
     let mut out = vec![ZERO; s2_num_samples(b)];
     for j in 0..n {
