@@ -13,7 +13,7 @@ const TOP: f64 = 50.0;
 const BOTTOM: f64 = 55.0;
 /// Colour-blind safe colours (Okabe-Ito) and two greys.
 const PALETTE: [&str; 10] = [
-    "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442",
+    "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#882255",
     "#777777", "#AA4499",
 ];
 
@@ -39,6 +39,8 @@ struct Chart {
     vlines: Vec<(f64, String)>,
     /// Horizontal marker lines: (y, label).
     hlines: Vec<(f64, String)>,
+    /// x ticks at powers of two (bandwidths) instead of decades.
+    x_powers_of_two: bool,
 }
 
 fn decade_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -60,7 +62,12 @@ impl Chart {
             .series
             .iter()
             .flat_map(|s| s.points.iter().map(|p| p.0));
-        let (x0, x1) = decade_range(xs.chain(self.vlines.iter().map(|v| v.0)));
+        let xs = xs.chain(self.vlines.iter().map(|v| v.0));
+        let (x0, x1) = if self.x_powers_of_two {
+            octave_range(xs)
+        } else {
+            decade_range(xs)
+        };
         let ys = self
             .series
             .iter()
@@ -82,12 +89,22 @@ impl Chart {
             LEFT + plot_w / 2.0,
             escape(&self.title)
         );
-        // Grid and ticks, one per decade.
-        for d in x0 as i32..=x1 as i32 {
-            let x = px(10f64.powi(d));
+        // Grid and ticks, one per decade (or per power of two).
+        let x_ticks: Vec<(f64, String)> = if self.x_powers_of_two {
+            let (a, b) = (10f64.powf(x0).log2().round(), 10f64.powf(x1).log2().round());
+            (a as i32..=b as i32)
+                .map(|k| (2f64.powi(k), format!("{}", 1u64 << k.max(0))))
+                .collect()
+        } else {
+            (x0 as i32..=x1 as i32)
+                .map(|d| (10f64.powi(d), format!("1e{d}")))
+                .collect()
+        };
+        for (value, label) in x_ticks {
+            let x = px(value);
             let _ = writeln!(
                 out,
-                "<line x1=\"{x:.1}\" y1=\"{TOP}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#ddd\"/>\n<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">1e{d}</text>",
+                "<line x1=\"{x:.1}\" y1=\"{TOP}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#ddd\"/>\n<text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{label}</text>",
                 TOP + PLOT_H,
                 TOP + PLOT_H + 18.0
             );
@@ -232,6 +249,23 @@ impl Chart {
     }
 }
 
+/// `log10` of the powers of two around the positive values (the x range of a bandwidth axis).
+fn octave_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let (a, b) = (
+        lo.log2().floor(),
+        hi.log2().ceil().max(lo.log2().floor() + 1.0),
+    );
+    (2f64.powf(a).log10(), 2f64.powf(b).log10())
+}
+
 fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -303,6 +337,7 @@ pub fn error_svg(rows: &[Row], growths: &[Growth]) -> String {
             (1e-14, "target SO(3) 1e-14".into()),
             (1e-12, "target S^2 B=2048: 1e-12".into()),
         ],
+        x_powers_of_two: true,
     }
     .svg()
 }
@@ -377,6 +412,7 @@ pub fn time_svg(rows: &[Row]) -> String {
         series,
         vlines: Vec::new(),
         hlines: Vec::new(),
+        x_powers_of_two: false,
     }
     .svg()
 }
