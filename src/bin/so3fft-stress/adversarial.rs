@@ -4,7 +4,7 @@
 
 use crate::record::{bit_differences, errors, Case, Report, Row};
 use crate::rng::SplitMix64;
-use crate::roundtrip::ORDER_LIMIT;
+use crate::roundtrip::{compensated_sum, ORDER_LIMIT};
 use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
 use so3fft::{
     coef_index, num_coeffs, num_samples, sample_index, Complex64, PartialOptions, PartialPlan,
@@ -73,7 +73,8 @@ fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex
 fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
     let l = m.unsigned_abs();
     let n = 2 * b;
-    let log_ratio: f64 = (1..=l).map(|i| (-1.0 / (2 * i) as f64).ln_1p()).sum();
+    // Compensated: a plain sum of 2047 terms would carry about 5e-15 of rounding.
+    let log_ratio = compensated_sum((1..=l).map(|i| (-1.0 / (2 * i) as f64).ln_1p()));
     let sign = if l.is_multiple_of(2) { 1.0 } else { -1.0 };
     let norm = sign * ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI).sqrt();
     let mut out = vec![ZERO; s2_num_samples(b)];
@@ -235,6 +236,10 @@ pub struct Transform {
     pub run: TransformFn,
     /// Input length.
     pub input_len: usize,
+    /// The input whose contributions are skipped most: the top-order coefficient
+    /// `(B-1, -(B-1), B-1)` of an inverse (`(B-1, -8, 8)` partial, `(B-1, B-1)` on S^2), the
+    /// sample at `beta_0`, `alpha = gamma = 0` of a forward.
+    pub top: usize,
 }
 
 fn real_parts(x: &[Complex64]) -> Vec<f64> {
@@ -245,8 +250,9 @@ fn as_complex(x: &[f64]) -> Vec<Complex64> {
     x.iter().map(|&r| Complex64::new(r, 0.0)).collect()
 }
 
-/// The eight transforms of the scaling test: full plan complex and real, partial
-/// order-limited, S^2 complex; inverse and forward of each. Real inverses read the
+/// The ten transforms of the scaling and special-value tests: full plan with skipping
+/// off, full plan complex and real, partial order-limited, S^2 complex; inverse and forward
+/// of each. Real inverses read the
 /// representatives only; real forwards read the real parts.
 pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     let full = std::sync::Arc::new(plan(b, threads, true)?);
@@ -268,11 +274,45 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     let (nc, ns) = (num_coeffs(b), num_samples(b));
     let (pc, ps) = (part.num_coeffs(), part.num_samples());
     let (sc, ss) = (s2_num_coeffs(b), s2_num_samples(b));
+    let top = b as isize - 1;
+    let m = ORDER_LIMIT.min(b - 1) as isize;
+    let top_so3 = coef_index(b, b - 1, -top, top);
+    let top_partial = shape.coef_index(b - 1, -m, m).unwrap_or(0);
+    let top_s2 = s2_coef_index(b, b - 1, top);
+    let noskip = std::sync::Arc::new(Plan::new(
+        b,
+        &PlanOptions {
+            threads,
+            skip_bits: Some(0),
+            ..Default::default()
+        },
+    )?);
     let mut out: Vec<Transform> = Vec::new();
+    let p = noskip.clone();
+    out.push(Transform {
+        name: "so3-inverse-noskip",
+        input_len: nc,
+        top: top_so3,
+        run: Box::new(move |c| {
+            let mut f = vec![ZERO; ns];
+            p.inverse(c, &mut f).map(|_| f)
+        }),
+    });
+    let p = noskip;
+    out.push(Transform {
+        name: "so3-forward-noskip",
+        input_len: ns,
+        top: 0,
+        run: Box::new(move |f| {
+            let mut c = vec![ZERO; nc];
+            p.forward(f, &mut c).map(|_| c)
+        }),
+    });
     let p = full.clone();
     out.push(Transform {
         name: "so3-inverse",
         input_len: nc,
+        top: top_so3,
         run: Box::new(move |c| {
             let mut f = vec![ZERO; ns];
             p.inverse(c, &mut f).map(|_| f)
@@ -282,6 +322,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "so3-forward",
         input_len: ns,
+        top: 0,
         run: Box::new(move |f| {
             let mut c = vec![ZERO; nc];
             p.forward(f, &mut c).map(|_| c)
@@ -291,6 +332,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "so3-real-inverse",
         input_len: nc,
+        top: top_so3,
         run: Box::new(move |c| {
             let mut f = vec![0.0; ns];
             p.inverse_real(c, &mut f).map(|_| as_complex(&f))
@@ -300,6 +342,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "so3-real-forward",
         input_len: ns,
+        top: 0,
         run: Box::new(move |f| {
             let mut c = vec![ZERO; nc];
             p.forward_real(&real_parts(f), &mut c).map(|_| c)
@@ -309,6 +352,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "partial-m8-inverse",
         input_len: pc,
+        top: top_partial,
         run: Box::new(move |c| {
             let mut f = vec![ZERO; ps];
             p.inverse(c, &mut f).map(|_| f)
@@ -318,6 +362,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "partial-m8-forward",
         input_len: ps,
+        top: 0,
         run: Box::new(move |f| {
             let mut c = vec![ZERO; pc];
             p.forward(f, &mut c).map(|_| c)
@@ -327,6 +372,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "s2-inverse",
         input_len: sc,
+        top: top_s2,
         run: Box::new(move |c| {
             let mut f = vec![ZERO; ss];
             p.inverse(c, &mut f).map(|_| f)
@@ -336,6 +382,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     out.push(Transform {
         name: "s2-forward",
         input_len: ss,
+        top: 0,
         run: Box::new(move |f| {
             let mut c = vec![ZERO; sc];
             p.forward(f, &mut c).map(|_| c)
@@ -484,10 +531,17 @@ pub enum PoisonSite {
     Low,
     /// The last input (the top order pair's last degree / a sample on the last slice).
     Last,
+    /// [`Transform::top`].
+    Top,
 }
 
 /// The poisons of the NaN / Inf test.
-pub const POISONS: [Poison; 4] = [
+pub const POISONS: [Poison; 5] = [
+    Poison {
+        name: "NaN@top",
+        value: Complex64::new(f64::NAN, 0.0),
+        at: PoisonSite::Top,
+    },
     Poison {
         name: "NaN@low",
         value: Complex64::new(f64::NAN, 0.0),
@@ -527,6 +581,7 @@ pub fn poisoned(
             let i = match poison.at {
                 PoisonSite::Low => 1,
                 PoisonSite::Last => t.input_len - 1,
+                PoisonSite::Top => t.top,
             };
             x[i] = poison.value;
             let start = Instant::now();
