@@ -33,7 +33,7 @@ usage: so3fft-stress [--quick] [--big] [--threads N] [--only LIST] [--data DIR]
                      [--csv FILE] [--svg FILE] [--time-svg FILE] [--docs DIR]
 
   --quick      small bandwidths only (SO(3) round trips to 64, partial to 128, S^2 to 256;
-               about 10 s); default: the full run (SO(3) to 256, partial and S^2 to 2048;
+               about 5 s); default: the full run (SO(3) to 256, partial and S^2 to 2048;
                a few minutes, under 6 GB)
   --big        also B = 512 full-grid SO(3) round trips (needs about 24 GB)
   --threads N  worker threads of the transforms (default 0 = all cores)

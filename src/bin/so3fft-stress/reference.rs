@@ -201,7 +201,7 @@ pub fn run(dir: &Path, threads: usize, report: &mut Report) -> so3fft::Result<()
                 b,
                 variant,
             };
-            report.push_errors(case, e, t, "vs 40-digit direct sum, 64 grid points");
+            report.push_errors(case, e, t, "vs 40-digit direct sum, 7-8 betas x 8 points");
         }
         for b in FORWARD_BANDWIDTHS {
             let (e, t) = check_forward(dir, b, ForwardKind::Everywhere, isa, threads)?;

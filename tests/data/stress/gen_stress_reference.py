@@ -6,7 +6,7 @@ independently of so3fft, then rounded once to double. Inputs (coefficients or sa
 stored: both sides draw them from the same tiny PRNG (splitmix64, below; the Rust side is
 src/bin/so3fft-stress/rng.rs), so the files hold only outputs and stay small.
 
-Usage: python3 gen_stress_reference.py [outdir]     (deterministic; about a minute)
+Usage: python3 gen_stress_reference.py [outdir]     (deterministic; about 4 minutes on one core)
 
 Files (one per bandwidth B and kind; lines after the '#' header):
   inverse_B{B}.txt  f at a subset of grid points (k j1 j2 re im) of the inverse transform of
