@@ -10,7 +10,8 @@
 //!   `2^k`, subnormal inputs, NaN and infinite inputs;
 //! - (d) `determinism`: bits across 1, 2, 4 threads and repeated executions.
 //!
-//! Prints a table, the fitted exponents and the targets; `--csv`, `--svg`,
+//! Prints a table (a row per case as it is measured), the fitted exponents and the issue's
+//! targets; `--csv`, `--svg`,
 //! `--time-svg` write the results, `--docs DIR` all of them plus the tables in
 //! `DIR/stability.md`. See `docs/stability.md`.
 
@@ -222,11 +223,12 @@ fn main() -> ExitCode {
         ..Default::default()
     };
     let start = Instant::now();
+    println!("{}", Report::header());
     if let Err(e) = run_tests(&o, &mut report) {
         eprintln!("so3fft-stress: {e}");
         return ExitCode::from(2);
     }
-    println!("\n{}", report.table());
+    println!();
     let growths = record::growths(&report.rows, &roundtrip::GROWTH_TESTS);
     println!(
         "growth of the error with B (least squares on log-log):\n{}",
