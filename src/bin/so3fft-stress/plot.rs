@@ -14,7 +14,7 @@ const BOTTOM: f64 = 55.0;
 /// Colour-blind safe colours (Okabe-Ito) and two greys.
 const PALETTE: [&str; 10] = [
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#882255",
-    "#777777", "#AA4499",
+    "#777777", "#44AA99",
 ];
 
 /// One line of points.
@@ -286,7 +286,12 @@ const VARIANTS: [&str; 10] = [
     "reference",
 ];
 
+/// ` (~B^p)` for a variant whose error follows a power law (not the tolerance variants,
+/// whose error saturates at their threshold).
 fn growth_label(growths: &[Growth], variant: &str) -> String {
+    if variant.contains("tol") {
+        return String::new();
+    }
     growths
         .iter()
         .find(|g| g.test == "roundtrip" && g.variant == variant)
