@@ -1,0 +1,310 @@
+//! The targets of issue 23, checked against the rows of a run, and the Markdown tables of
+//! `docs/stability.md`.
+
+use crate::record::{Growth, Report, Row};
+use std::fmt::Write as _;
+
+/// Whether a target was met.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// Every row it covers meets it.
+    Met,
+    /// Some row misses it.
+    Missed,
+    /// The run has no row for it.
+    NotRun,
+}
+
+/// One target and its outcome.
+#[derive(Clone, Debug)]
+pub struct Target {
+    /// What is required.
+    pub name: String,
+    /// The outcome.
+    pub status: Status,
+    /// The measured figure(s).
+    pub detail: String,
+}
+
+/// Every target of a run.
+pub struct Summary {
+    /// In the issue's order.
+    pub targets: Vec<Target>,
+}
+
+impl Summary {
+    /// No target missed (those not run do not count).
+    pub fn all_met(&self) -> bool {
+        self.targets.iter().all(|t| t.status != Status::Missed)
+    }
+
+    /// One line per target.
+    pub fn text(&self) -> String {
+        let mut out = String::new();
+        for t in &self.targets {
+            let _ = writeln!(
+                out,
+                "  [{}] {}: {}",
+                status_word(t.status),
+                t.name,
+                t.detail
+            );
+        }
+        out
+    }
+}
+
+fn status_word(s: Status) -> &'static str {
+    match s {
+        Status::Met => "met",
+        Status::Missed => "MISSED",
+        Status::NotRun => "not run",
+    }
+}
+
+/// Worst value of `field` over `rows`, with the row it came from.
+fn worst<'a>(rows: &[&'a Row], field: fn(&Row) -> f64) -> Option<(f64, &'a Row)> {
+    rows.iter().fold(None, |acc: Option<(f64, &Row)>, r| {
+        let v = field(r);
+        match acc {
+            Some((w, _)) if !(v > w || v.is_nan()) => acc,
+            _ => Some((v, r)),
+        }
+    })
+}
+
+/// A bound on the worst `field` of the rows `select` picks.
+fn bound(
+    rows: &[Row],
+    name: &str,
+    select: impl Fn(&Row) -> bool,
+    field: fn(&Row) -> f64,
+    limit: f64,
+) -> Target {
+    let picked: Vec<&Row> = rows.iter().filter(|r| select(r)).collect();
+    let (status, detail) = match worst(&picked, field) {
+        None => (Status::NotRun, "no rows".to_string()),
+        Some((v, r)) => {
+            let bs: Vec<usize> = picked.iter().map(|r| r.b).collect();
+            let range = format!(
+                "B = {}..{}",
+                bs.iter().min().unwrap(),
+                bs.iter().max().unwrap()
+            );
+            let status = if v <= limit {
+                Status::Met
+            } else {
+                Status::Missed
+            };
+            (
+                status,
+                format!(
+                    "worst {v:.2e} ({} B = {}; {} rows, {range})",
+                    r.variant,
+                    r.b,
+                    picked.len()
+                ),
+            )
+        }
+    };
+    Target {
+        name: name.into(),
+        status,
+        detail,
+    }
+}
+
+/// A condition on the notes of the rows `select` picks.
+fn every_note(
+    rows: &[Row],
+    name: &str,
+    select: impl Fn(&Row) -> bool,
+    ok: impl Fn(&str) -> bool,
+) -> Target {
+    let picked: Vec<&Row> = rows.iter().filter(|r| select(r)).collect();
+    let bad: Vec<String> = picked
+        .iter()
+        .filter(|r| !ok(&r.note))
+        .map(|r| format!("{} {} B={}: {}", r.test, r.variant, r.b, r.note))
+        .collect();
+    let (status, detail) = if picked.is_empty() {
+        (Status::NotRun, "no rows".to_string())
+    } else if bad.is_empty() {
+        (Status::Met, format!("all {} rows", picked.len()))
+    } else {
+        (Status::Missed, bad.join("; "))
+    };
+    Target {
+        name: name.into(),
+        status,
+        detail,
+    }
+}
+
+fn rel(r: &Row) -> f64 {
+    r.rel_l2
+}
+
+fn max_abs(r: &Row) -> f64 {
+    r.max_abs
+}
+
+/// Scaling exponents that keep every value of these tests in the normal range (see
+/// docs/stability.md): the target covers them; `2^+-1000` rows are reported only.
+fn scale_in_range(test: &str) -> bool {
+    [
+        "scale-2^1",
+        "scale-2^-1",
+        "scale-2^100",
+        "scale-2^-100",
+        "scale-2^900",
+    ]
+    .contains(&test)
+}
+
+/// Checks the targets against the rows (`big`: the run included B = 512).
+pub fn evaluate(rows: &[Row], big: bool) -> Summary {
+    let so3 = |r: &Row| r.test == "roundtrip" && (r.variant == "complex" || r.variant == "real");
+    let partial = |b: usize| {
+        move |r: &Row| r.test == "roundtrip" && r.variant.starts_with("partial-m8") && r.b == b
+    };
+    let s2 = |r: &Row| r.test == "roundtrip" && r.variant.starts_with("s2-") && r.b == 2048;
+    let mut targets = vec![
+        bound(
+            rows,
+            "SO(3) round trip rel L2 <= 1e-14 (complex, real)",
+            so3,
+            rel,
+            1e-14,
+        ),
+        bound(
+            rows,
+            "SO(3) round trip max abs <= 3e-13 at B = 512",
+            |r: &Row| so3(r) && r.b == 512,
+            max_abs,
+            3e-13,
+        ),
+        bound(
+            rows,
+            "order-limited B = 1024 rel L2 <= 5e-14",
+            partial(1024),
+            rel,
+            5e-14,
+        ),
+        bound(
+            rows,
+            "order-limited B = 2048 rel L2 <= 1e-13",
+            partial(2048),
+            rel,
+            1e-13,
+        ),
+        bound(rows, "S^2 B = 2048 rel L2 <= 1e-12", s2, rel, 1e-12),
+        every_note(
+            rows,
+            "scaling by 2^k bit-exact (k = +-1, +-100, 900)",
+            |r: &Row| scale_in_range(&r.test),
+            |n| n == "bit-exact",
+        ),
+        every_note(
+            rows,
+            "NaN / Inf inputs: a result, no hang, no error",
+            |r: &Row| r.test == "nan-inf",
+            |n| !n.starts_with("HANG") && !n.starts_with("error"),
+        ),
+        every_note(
+            rows,
+            "subnormal inputs: finite results",
+            |r: &Row| r.test == "subnormal",
+            |n| n.ends_with("; finite"),
+        ),
+        every_note(
+            rows,
+            "determinism: bit-identical on 1, 2, 4 threads and repeats",
+            |r: &Row| r.test == "determinism",
+            |n| n.starts_with("bit-identical"),
+        ),
+    ];
+    if !big {
+        targets[1].detail = "needs --big (B = 512 full grid, about 24 GB)".into();
+    }
+    Summary { targets }
+}
+
+fn fmt_value(v: f64) -> String {
+    if v.is_nan() {
+        "-".into()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// The Markdown of the targets, the growth exponents and every row.
+pub fn markdown(report: &Report, growths: &[Growth], summary: &Summary) -> String {
+    let mut out =
+        String::from("### Targets of issue 23\n\n| target | status | measured |\n|---|---|---|\n");
+    for t in &summary.targets {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} |",
+            t.name,
+            status_word(t.status),
+            t.detail
+        );
+    }
+    out.push_str("\n### Growth of the error with the bandwidth\n\n");
+    out.push_str("Least-squares slope of log(error) against log(B): error ~ C B^p.\n\n");
+    out.push_str(
+        "| test | variant | p (rel L2) | p (max abs) | bandwidths |\n|---|---|---|---|---|\n",
+    );
+    let show = |e: Option<f64>| e.map_or("-".to_string(), |v| format!("{v:.2}"));
+    for g in growths {
+        let bs: Vec<String> = g.bandwidths.iter().map(|b| b.to_string()).collect();
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} |",
+            g.test,
+            g.variant,
+            show(g.rel_exponent),
+            show(g.max_exponent),
+            bs.join(", ")
+        );
+    }
+    out.push_str("\n### Every row\n\n<details><summary>The whole table (also in stability.csv)</summary>\n\n");
+    out.push_str("| test | B | variant | rel L2 | max abs | time s | note |\n|---|---|---|---|---|---|---|\n");
+    for r in &report.rows {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            r.test,
+            r.b,
+            r.variant,
+            fmt_value(r.rel_l2),
+            fmt_value(r.max_abs),
+            fmt_value(r.time_s),
+            r.note.replace('|', "/")
+        );
+    }
+    out.push_str("\n</details>\n");
+    out
+}
+
+/// Marker lines of the generated part of docs/stability.md.
+pub const BEGIN: &str = "<!-- stress-tables:begin (generated by so3fft-stress --docs docs) -->";
+/// End marker.
+pub const END: &str = "<!-- stress-tables:end -->";
+
+/// `old` with the text between the markers replaced by `tables`.
+pub fn splice(old: &str, tables: &str) -> Result<String, String> {
+    let start = old
+        .find(BEGIN)
+        .ok_or("stability.md: begin marker missing")?;
+    let end = old.find(END).ok_or("stability.md: end marker missing")?;
+    if end < start {
+        return Err("stability.md: markers out of order".into());
+    }
+    Ok(format!(
+        "{}{BEGIN}\n\n{tables}\n{}",
+        &old[..start],
+        &old[end..]
+    ))
+}
