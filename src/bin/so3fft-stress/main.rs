@@ -8,7 +8,8 @@
 //!   partial plans, S^2; growth exponents fitted by least squares;
 //! - (c) `adversarial`: top-order single coefficients, power-law spectra, exact scaling by
 //!   `2^k`, subnormal inputs, NaN and infinite inputs;
-//! - (d) `determinism`: bits across 1, 2, 4 threads and repeated executions.
+//! - (d) `determinism`: bits across 1, 2, 4 threads and repeated executions;
+//! - `matching`: rotational matching's angle error and time (points of the time chart).
 //!
 //! Prints a table (a row per case as it is measured), the fitted exponents and the issue's
 //! targets; `--csv`, `--svg`,
@@ -17,6 +18,7 @@
 
 mod adversarial;
 mod determinism;
+mod matching;
 mod plot;
 mod record;
 mod reference;
@@ -38,7 +40,8 @@ usage: so3fft-stress [--quick] [--big] [--threads N] [--only LIST] [--data DIR]
                a few minutes, under 6 GB)
   --big        also B = 512 full-grid SO(3) round trips (needs about 24 GB)
   --threads N  worker threads of the transforms (default 0 = all cores)
-  --only LIST  comma-separated tests among reference,roundtrip,adversarial,determinism,isa
+  --only LIST  comma-separated tests among reference,roundtrip,adversarial,determinism,isa,
+               matching
   --data DIR   reference data (default tests/data/stress of the source tree)
   --csv FILE   write every row as CSV
   --svg FILE   write the error-against-bandwidth plot
@@ -155,6 +158,14 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
     }
     if o.wants("determinism") {
         determinism::run(if o.quick { 32 } else { 64 }, report)?;
+    }
+    if o.wants("matching") {
+        let ls: &[usize] = if o.quick {
+            &[16, 32]
+        } else {
+            &[16, 32, 64, 128]
+        };
+        matching::run(ls, t, report)?;
     }
     if o.wants("isa") {
         let bw = if o.quick {

@@ -409,6 +409,24 @@ pub fn time_svg(rows: &[Row]) -> String {
             point_labels: picked.iter().map(|r| r.b.to_string()).collect(),
         });
     }
+    // Matching: the angle to the true rotation (rad) against the pipeline's time.
+    for (k, v) in ["match-grid", "match-grid-2x", "match-refined"]
+        .iter()
+        .enumerate()
+    {
+        let picked: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.test == "matching" && r.variant == *v && r.time_s > 0.0)
+            .collect();
+        series.push(Series {
+            label: format!("{v} (angle error, rad; labels = L)"),
+            color: PALETTE[(VARIANTS.len() + k) % PALETTE.len()],
+            dashed: true,
+            scatter: false,
+            points: picked.iter().map(|r| (r.time_s, r.max_abs)).collect(),
+            point_labels: picked.iter().map(|r| r.b.to_string()).collect(),
+        });
+    }
     series.extend(peer_series());
     Chart {
         title: "Run time against error: inverse + forward, labels = B".into(),
