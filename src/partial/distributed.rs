@@ -22,6 +22,7 @@ use super::dwt_stage::{ChunkLanes, ClusterPlan};
 use super::plan::{General, PartialOptions};
 use super::shape::Shape;
 use crate::error::{Error, Result};
+use crate::fft::AlignedBuf;
 use crate::plan::Direction;
 use crate::simd::Isa;
 use crate::workers::{SendConstPtr, SendPtr};
@@ -41,6 +42,38 @@ pub trait Exchange: Sync {
     fn sendrecv(&self, send: &[f64], dest: usize, recv: &mut [f64], src: usize) -> Result<()>;
     /// The largest of the ranks' `value`s, on every rank.
     fn max(&self, value: u64) -> Result<u64>;
+}
+
+/// Page-aligned doubles, zero-filled (huge pages where the system gives them): the lane
+/// rows are written and read far apart, which 4 KiB pages would turn into TLB misses.
+struct Rows {
+    buf: AlignedBuf,
+    len: usize,
+}
+
+impl Rows {
+    fn new(len: usize) -> Result<Rows> {
+        Ok(Rows {
+            buf: AlignedBuf::new(len.div_ceil(2).max(1))?,
+            len,
+        })
+    }
+}
+
+impl std::ops::Deref for Rows {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        // SAFETY: the buffer holds at least `len` doubles (`len / 2` complex values rounded
+        // up), initialised (zero-filled at creation), owned by `self`.
+        unsafe { std::slice::from_raw_parts(self.buf.as_mut_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+impl std::ops::DerefMut for Rows {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        // SAFETY: as for `deref`; `&mut self` makes the borrow exclusive.
+        unsafe { std::slice::from_raw_parts_mut(self.buf.as_mut_ptr().cast::<f64>(), self.len) }
+    }
 }
 
 /// Wall times of a distributed transform's parts on this rank, in seconds.
@@ -81,7 +114,7 @@ pub struct DistributedPlan<'a, X: Exchange> {
     /// Times of the last transform on this rank.
     last: std::sync::Mutex<DistributedTimes>,
     /// The lane rows of the FFT stage and of the DWT stage, kept between transforms.
-    rows: std::sync::Mutex<(Vec<f64>, Vec<f64>)>,
+    rows: std::sync::Mutex<Option<(Rows, Rows)>>,
 }
 
 /// An error on every rank if it is one on any (agreed through `comm`).
@@ -227,7 +260,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             local,
             local_coeffs: at,
             last: std::sync::Mutex::new(DistributedTimes::default()),
-            rows: std::sync::Mutex::new((Vec::new(), Vec::new())),
+            rows: std::sync::Mutex::new(None),
         })
     }
 
@@ -375,20 +408,22 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
 
     /// The two row buffers, taken from the plan (or new when another call has them), at
     /// their sizes: `a` for this rank's slices, `b` for this rank's clusters.
-    fn take_rows(&self) -> (Vec<f64>, Vec<f64>) {
+    fn take_rows(&self) -> Result<(Rows, Rows)> {
         let (loc, all) = (self.local_lanes(), self.all_lanes());
-        let (mut a, mut b) = match self.rows.try_lock() {
-            Ok(mut g) => std::mem::take(&mut *g),
-            Err(_) => (Vec::new(), Vec::new()),
+        let (na, nb) = (2 * loc.h * loc.row_len, all.lanes() * all.row_len);
+        let kept = match self.rows.try_lock() {
+            Ok(mut g) => g.take(),
+            Err(_) => None,
         };
-        a.resize(2 * loc.h * loc.row_len, 0.0);
-        b.resize(all.lanes() * all.row_len, 0.0);
-        (a, b)
+        match kept {
+            Some((a, b)) if a.len == na && b.len == nb => Ok((a, b)),
+            _ => Ok((Rows::new(na)?, Rows::new(nb)?)),
+        }
     }
 
-    fn put_rows(&self, rows: (Vec<f64>, Vec<f64>)) {
+    fn put_rows(&self, rows: (Rows, Rows)) {
         if let Ok(mut g) = self.rows.try_lock() {
-            *g = rows;
+            *g = Some(rows);
         }
     }
 
@@ -510,7 +545,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         let loc = self.local_lanes();
         let all = self.all_lanes();
         let slice_len = self.shape.slice_len();
-        let (mut a, mut b) = self.take_rows();
+        let (mut a, mut b) = self.take_rows()?;
         let a_ptr = SendPtr(a.as_mut_ptr());
         let per_value = if real { 1 } else { 2 };
         let slices = self.local_slices();
@@ -544,7 +579,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         });
         collective(self.comm, done)?;
         let t1 = std::time::Instant::now();
-        self.exchange(&mut a, &mut b, true)?;
+        self.exchange(&mut a[..], &mut b[..], true)?;
         // Padding lanes: the kernel multiplies them by exact zeros, which must not meet a
         // non-finite value an inverse left there.
         for half in 0..2 {
@@ -585,7 +620,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
         let all = self.all_lanes();
         let slice_len = self.shape.slice_len();
         let start = std::time::Instant::now();
-        let (mut a, mut b) = self.take_rows();
+        let (mut a, mut b) = self.take_rows()?;
         let b_ptr = SendPtr(b.as_mut_ptr());
         let coef = SendConstPtr(coeffs.as_ptr());
         g.workers.pool().install(|| {
@@ -609,7 +644,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             })
         });
         let t1 = std::time::Instant::now();
-        self.exchange(&mut a, &mut b, false)?;
+        self.exchange(&mut a[..], &mut b[..], false)?;
         let t2 = std::time::Instant::now();
         let a_ptr = SendPtr(a.as_mut_ptr());
         let slices = self.local_slices();
