@@ -38,6 +38,8 @@ TOOL (default: the full benchmark described below):
                       GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
   match (or --match)  rotational matching: a rotated random function recovered; pipeline
                       medians (complex, real), ten refinements, grid and refined angle errors
+  mpi-model (or --mpi-model)  distributed plans at B = 1024, 2048 on 8..256 nodes: memory
+                      per rank, bytes exchanged, expected time, from one-core rates measured here
   partial (or --partial)  partial plans against the transforms they replace: degree-limited
                       on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
                       1/16 of the betas, skip thresholds 2^-24 and 2^-34 (ratios in one run)
@@ -90,6 +92,8 @@ pub enum Tool {
     Match,
     /// Partial plans (`partial.rs`).
     Partial,
+    /// The distributed plans' model for large B (`mpi_model.rs`).
+    MpiModel,
 }
 
 /// Transforms the `stages` tool repeats.
@@ -217,6 +221,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("s2" | "--s2") => Tool::S2,
         Some("match" | "--match") => Tool::Match,
         Some("partial" | "--partial") => Tool::Partial,
+        Some("mpi-model" | "--mpi-model") => Tool::MpiModel,
         _ => Tool::Full,
     };
     if opts.tool != Tool::Full {
@@ -319,6 +324,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
         Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
         Tool::Partial => (vec![256], vec![2], None),
+        Tool::MpiModel => (vec![128], vec![1], None),
     };
     if !bandwidths_given {
         opts.bandwidths = bandwidths;

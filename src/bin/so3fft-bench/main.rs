@@ -23,6 +23,7 @@ mod big;
 mod cli;
 mod matching;
 mod memory;
+mod mpi_model;
 mod naive;
 mod partial;
 mod peak;
@@ -56,6 +57,7 @@ fn main() -> ExitCode {
             Tool::S2 => report_failure("s2", s2::run(&opts)),
             Tool::Match => report_failure("match", matching::run(&opts)),
             Tool::Partial => report_failure("partial", partial::run(&opts)),
+            Tool::MpiModel => report_failure("mpi-model", mpi_model::run(&opts)),
         },
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
