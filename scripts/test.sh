@@ -12,11 +12,19 @@ if [ -f CMakeLists.txt ]; then
   ctest --test-dir build/ci --output-on-failure
 fi
 if command -v mpirun >/dev/null && command -v mpicc >/dev/null; then
-  cargo build --release --features mpi --example mpi_check
+  cargo build --release --features mpi --lib --example mpi_check
+  # The C API of include/so3fft_mpi.h against the library built with the feature.
+  mpilib=target/mpi-lib
+  mkdir -p "$mpilib"
+  cp target/release/libso3fft.so "$mpilib/"
+  ln -sf libso3fft.so "$mpilib/libso3fft.so.0"
+  mpicc -std=c11 -Wall -Wextra -Werror -Iinclude -o "$mpilib/test_mpi" c_tests/mpi/test_mpi.c \
+    -L"$mpilib" -lso3fft -Wl,-rpath,"$PWD/$mpilib" -lm
   for np in 1 2 3 4; do
     # A deadlock fails the run instead of hanging it.
     timeout 600 mpirun --allow-run-as-root --oversubscribe -np "$np" \
       target/release/examples/mpi_check
+    timeout 300 mpirun --allow-run-as-root --oversubscribe -np "$np" "$mpilib/test_mpi"
   done
 else
   echo "mpirun or mpicc not found: distributed plans not tested" >&2

@@ -184,6 +184,19 @@ fn collective_errors() {
             });
         }
     });
+    // One rank refuses (bad arguments of its own): the others fail too.
+    let group = ThreadExchange::group(3);
+    std::thread::scope(|scope| {
+        for comm in &group {
+            scope.spawn(move || {
+                if comm.rank() == 0 {
+                    DistributedPlan::refuse_collectively(&comm).unwrap();
+                } else {
+                    assert!(DistributedPlan::new(comm, &Shape::new(5), &opts(false)).is_err());
+                }
+            });
+        }
+    });
     // One rank passes a wrong array length: all ranks fail the execute.
     let group = ThreadExchange::group(2);
     std::thread::scope(|scope| {

@@ -39,6 +39,9 @@ mod query;
 mod grid;
 // Partial plans (guru interface).
 mod partial;
+// Distributed plans over MPI (feature `mpi`; declared in include/so3fft_mpi.h).
+#[cfg(feature = "mpi")]
+mod mpi;
 // Spherical-harmonic transforms.
 mod s2;
 // Rotational matching.

@@ -79,7 +79,7 @@ fn shape_of(s: &so3fft_shape) -> Result<Shape, CallError> {
 ///
 /// # Safety
 /// `s` is NULL or points to a shape.
-unsafe fn checked_shape(s: *const so3fft_shape) -> Result<Shape, CallError> {
+pub(super) unsafe fn checked_shape(s: *const so3fft_shape) -> Result<Shape, CallError> {
     // SAFETY: a non-NULL `s` points to a shape (the API's contract), only read.
     let s = unsafe { s.as_ref() }
         .ok_or_else(|| CallError::new(ErrorKind::Null, "the shape is NULL"))?;
@@ -179,7 +179,7 @@ pub unsafe extern "C" fn so3fft_shape_coef_index(
 ///
 /// # Safety
 /// `o` is NULL or points to options whose non-NULL beta array holds `nbetas` values.
-unsafe fn options_of(
+pub(super) unsafe fn options_of(
     o: *const so3fft_partial_options,
     flags: c_uint,
 ) -> Result<PartialOptions, CallError> {

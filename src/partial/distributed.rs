@@ -100,8 +100,8 @@ struct Share {
 }
 
 /// The transforms of a [`Shape`] over the ranks of an [`Exchange`].
-pub struct DistributedPlan<'a, X: Exchange> {
-    comm: &'a X,
+pub struct DistributedPlan<X: Exchange> {
+    comm: X,
     shape: Shape,
     real: bool,
     direction: Direction,
@@ -129,10 +129,36 @@ fn collective<X: Exchange, T>(comm: &X, r: Result<T>) -> Result<T> {
     }
 }
 
-impl<'a, X: Exchange> DistributedPlan<'a, X> {
+/// What a rank builds of a plan (everything but the exchange).
+struct Parts {
+    shape: Shape,
+    real: bool,
+    direction: Direction,
+    general: General,
+    shares: Vec<Share>,
+    local: Vec<ClusterPlan>,
+    local_coeffs: usize,
+}
+
+impl<T: Exchange + ?Sized> Exchange for &T {
+    fn rank(&self) -> usize {
+        (**self).rank()
+    }
+    fn size(&self) -> usize {
+        (**self).size()
+    }
+    fn sendrecv(&self, send: &[f64], dest: usize, recv: &mut [f64], src: usize) -> Result<()> {
+        (**self).sendrecv(send, dest, recv, src)
+    }
+    fn max(&self, value: u64) -> Result<u64> {
+        (**self).max(value)
+    }
+}
+
+impl<X: Exchange> DistributedPlan<X> {
     /// A plan for `shape` over the ranks of `comm` (collective; every rank passes the same
     /// shape and options). `options.betas` must be [`Betas::All`]; batches are not offered.
-    pub fn new(comm: &'a X, shape: &Shape, options: &PartialOptions) -> Result<Self> {
+    pub fn new(comm: X, shape: &Shape, options: &PartialOptions) -> Result<Self> {
         // The ranks first agree on the shape and options (a rank with others would exchange
         // other lengths), then each builds its part; a failure anywhere fails every rank.
         let key = [
@@ -158,10 +184,32 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                 "the ranks of a distributed plan were given different shapes or options".into(),
             ));
         }
-        collective(comm, Self::build(comm, shape, options))
+        let parts = collective(&comm, Self::build(&comm, shape, options))?;
+        Ok(DistributedPlan {
+            comm,
+            shape: parts.shape,
+            real: parts.real,
+            direction: parts.direction,
+            general: parts.general,
+            shares: parts.shares,
+            local: parts.local,
+            local_coeffs: parts.local_coeffs,
+            last: std::sync::Mutex::new(DistributedTimes::default()),
+            rows: std::sync::Mutex::new(None),
+        })
     }
 
-    fn build(comm: &'a X, shape: &Shape, options: &PartialOptions) -> Result<Self> {
+    /// What a rank whose arguments were bad calls instead of [`DistributedPlan::new`]: it
+    /// takes part in the agreement with a key no rank can match, so every rank returns an
+    /// error and none waits.
+    pub fn refuse_collectively(comm: &X) -> Result<()> {
+        // The others' largest key becomes u64::MAX and their smallest 0: they differ.
+        comm.max(u64::MAX)?;
+        comm.max(u64::MAX)?;
+        Ok(())
+    }
+
+    fn build(comm: &X, shape: &Shape, options: &PartialOptions) -> Result<Parts> {
         shape.validate()?;
         if options.betas != Betas::All {
             return Err(Error::InvalidArgument(
@@ -250,8 +298,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             }
             local.push(c);
         }
-        Ok(DistributedPlan {
-            comm,
+        Ok(Parts {
             shape: *shape,
             real: options.real,
             direction: options.direction,
@@ -259,8 +306,6 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             shares,
             local,
             local_coeffs: at,
-            last: std::sync::Mutex::new(DistributedTimes::default()),
-            rows: std::sync::Mutex::new(None),
         })
     }
 
@@ -357,7 +402,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
     /// Forward (collective): this rank's samples to this rank's coefficients.
     pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
         collective(
-            self.comm,
+            &self.comm,
             self.check(true, false, samples.len(), coeffs.len()),
         )?;
         self.forward_impl(SendConstPtr(samples.as_ptr().cast()), coeffs, false)
@@ -366,7 +411,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
     /// Forward of real samples (collective; plan made with `real`).
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
         collective(
-            self.comm,
+            &self.comm,
             self.check(true, true, samples.len(), coeffs.len()),
         )?;
         self.forward_impl(SendConstPtr(samples.as_ptr()), coeffs, true)
@@ -375,7 +420,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
     /// Inverse (collective): this rank's coefficients to this rank's samples.
     pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
         collective(
-            self.comm,
+            &self.comm,
             self.check(false, false, samples.len(), coeffs.len()),
         )?;
         self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr().cast()), false)
@@ -385,7 +430,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
     /// [`PartialPlan::inverse_real`](super::PartialPlan::inverse_real)).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
         collective(
-            self.comm,
+            &self.comm,
             self.check(false, true, samples.len(), coeffs.len()),
         )?;
         self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr()), true)
@@ -577,7 +622,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
                     })
                 })
         });
-        collective(self.comm, done)?;
+        collective(&self.comm, done)?;
         let t1 = std::time::Instant::now();
         self.exchange(&mut a[..], &mut b[..], true)?;
         // Padding lanes: the kernel multiplies them by exact zeros, which must not meet a
@@ -681,7 +726,7 @@ impl<'a, X: Exchange> DistributedPlan<'a, X> {
             total: (t3 - start).as_secs_f64(),
         });
         self.put_rows((a, b));
-        collective(self.comm, done)
+        collective(&self.comm, done)
     }
 }
 

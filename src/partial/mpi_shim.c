@@ -44,3 +44,4 @@ int so3fft_mpi_sendrecv(MPI_Fint comm, const double *send, size_t ns, int dest, 
     }
     return MPI_SUCCESS;
 }
+
