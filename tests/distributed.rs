@@ -3,6 +3,8 @@
 //! each cluster's sum runs over all betas in one call in both), complex and real, forward and
 //! inverse, and collective errors.
 
+mod common;
+
 use so3fft::{
     Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
 };
@@ -20,30 +22,6 @@ fn opts(real: bool) -> PartialOptions {
         real,
         general_engine: true,
         ..PartialOptions::default()
-    }
-}
-
-/// Coefficients of a real signal (Hermitian in `(M, M')`).
-fn hermitian(s: &Shape, c: &mut [Complex64]) {
-    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
-    for l in s.degree_min..s.degree_limit {
-        for m in -a..=a {
-            for mp in -n..=n {
-                let (Some(i), Some(j)) = (s.coef_index(l, m, mp), s.coef_index(l, -m, -mp)) else {
-                    continue;
-                };
-                if i < j {
-                    let sg = if (m - mp).rem_euclid(2) == 0 {
-                        1.0
-                    } else {
-                        -1.0
-                    };
-                    c[j] = c[i].conj() * sg;
-                } else if i == j {
-                    c[i].im = 0.0;
-                }
-            }
-        }
     }
 }
 
@@ -80,7 +58,7 @@ fn check_shape(s: Shape, ranks: usize, real: bool) {
         .map(|_| Complex64::new(rnd(&mut st), if real { 0.0 } else { rnd(&mut st) }))
         .collect();
     if real {
-        hermitian(&s, &mut c);
+        common::make_hermitian(&s, &mut c);
     }
     // Single-process results.
     let mut want_x = vec![Complex64::default(); ns];

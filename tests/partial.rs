@@ -2,6 +2,8 @@
 //! absent coefficients zeroed, and exact properties (round trip, batches, selections,
 //! real signals).
 
+mod common;
+
 use so3fft::wigner::wigner_d_column;
 use so3fft::{
     coef_index, num_coeffs, Batch, Betas, Complex64, Direction, PartialOptions, PartialPlan, Plan,
@@ -43,24 +45,6 @@ fn triples(s: &Shape) -> Vec<(usize, isize, isize)> {
 fn random_coeffs(s: &Shape, seed: u64) -> Vec<Complex64> {
     let mut r = Rng(seed);
     (0..s.num_coeffs()).map(|_| r.c()).collect()
-}
-
-/// Coefficients of a real signal: `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
-fn hermitian(s: &Shape, c: &mut [Complex64]) {
-    for (l, m, mp) in triples(s) {
-        let i = s.coef_index(l, m, mp).unwrap();
-        let j = s.coef_index(l, -m, -mp).unwrap();
-        if i < j {
-            let sg = if (m - mp).rem_euclid(2) == 0 {
-                1.0
-            } else {
-                -1.0
-            };
-            c[j] = c[i].conj() * sg;
-        } else if i == j {
-            c[i] = Complex64::new(c[i].re, 0.0);
-        }
-    }
 }
 
 /// `sum fhat(l,M,M') Dt^l_{M,M'}(alpha, beta, gamma)` by direct summation.
@@ -298,7 +282,7 @@ fn batch_case(cap: Option<usize>) {
     let mut hc: Vec<Complex64> = zeros(nc * count);
     for t in 0..count {
         let mut c = random_coeffs(&s, 20 + t as u64);
-        hermitian(&s, &mut c);
+        common::make_hermitian(&s, &mut c);
         hc[t * nc..][..nc].copy_from_slice(&c);
     }
     let mut re_many = vec![0.0; ns * count];
@@ -378,7 +362,7 @@ fn real_against_complex() {
             };
             let pp = PartialPlan::new(&s, &o).unwrap();
             let mut c = random_coeffs(&s, 17);
-            hermitian(&s, &mut c);
+            common::make_hermitian(&s, &mut c);
             let mut z = zeros(s.num_samples());
             pp.inverse(&c, &mut z).unwrap();
             assert!(z.iter().all(|v| v.im.abs() < 1e-12));

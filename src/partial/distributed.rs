@@ -369,14 +369,7 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     fn check(&self, forward: bool, real: bool, samples: usize, coeffs: usize) -> Result<()> {
-        let ok = if forward {
-            self.direction != Direction::Inverse
-        } else {
-            self.direction != Direction::Forward
-        };
-        if !ok {
-            return Err(Error::WrongDirection);
-        }
+        self.direction.check_runs(forward)?;
         if real && !self.real {
             return Err(Error::InvalidArgument(
                 "real-signal transform on a plan made without the real option".into(),

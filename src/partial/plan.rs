@@ -342,14 +342,7 @@ impl PartialPlan {
                 "plan made in another process (before fork()); make a new plan here".into(),
             ));
         }
-        let ok = if forward {
-            self.direction != Direction::Inverse
-        } else {
-            self.direction != Direction::Forward
-        };
-        if !ok {
-            return Err(Error::WrongDirection);
-        }
+        self.direction.check_runs(forward)?;
         if real && !self.real {
             return Err(Error::InvalidArgument(
                 "real-signal transform on a plan made without the real option".into(),

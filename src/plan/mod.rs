@@ -194,14 +194,7 @@ impl Plan {
                     .into(),
             ));
         }
-        let ok = if fwd {
-            self.direction != Direction::Inverse
-        } else {
-            self.direction != Direction::Forward
-        };
-        if !ok {
-            return Err(Error::WrongDirection);
-        }
+        self.direction.check_runs(fwd)?;
         if samples != self.num_samples() {
             return Err(Error::LengthMismatch {
                 what: "samples",

@@ -18,6 +18,22 @@ pub enum Direction {
     Both,
 }
 
+impl Direction {
+    /// `Ok` if a plan made for this direction runs a forward (`forward`) or an inverse
+    /// transform, else [`Error::WrongDirection`](crate::Error::WrongDirection).
+    pub(crate) fn check_runs(self, forward: bool) -> crate::Result<()> {
+        let excluded = if forward {
+            Direction::Inverse
+        } else {
+            Direction::Forward
+        };
+        if self == excluded {
+            return Err(crate::Error::WrongDirection);
+        }
+        Ok(())
+    }
+}
+
 /// Options for [`Plan::new`](crate::Plan::new).
 #[derive(Clone, Debug, Default)]
 pub struct PlanOptions {

@@ -526,3 +526,36 @@ pub fn read_s2_reference(name: &str) -> S2Reference {
     }
     out
 }
+
+// ---------------------------------------------------------------------------------------------
+// Partial-plan shapes.
+// ---------------------------------------------------------------------------------------------
+
+/// Makes the coefficients of `shape` those of a real signal:
+/// `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`, and `fhat(l,0,0)` real.
+pub fn make_hermitian(shape: &so3fft::Shape, c: &mut [Complex64]) {
+    let (a, n) = (
+        shape.order_limit_alpha as isize,
+        shape.order_limit_gamma as isize,
+    );
+    for l in 0..shape.degree_limit {
+        for m in -a..=a {
+            for mp in -n..=n {
+                let (Some(i), Some(j)) = (shape.coef_index(l, m, mp), shape.coef_index(l, -m, -mp))
+                else {
+                    continue;
+                };
+                if i < j {
+                    let sg = if (m - mp).rem_euclid(2) == 0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    c[j] = c[i].conj() * sg;
+                } else if i == j {
+                    c[i].im = 0.0;
+                }
+            }
+        }
+    }
+}
