@@ -175,6 +175,17 @@ pub unsafe extern "C" fn so3fft_shape_coef_index(
     })
 }
 
+/// An empty vector with room for `n` values, or an out-of-memory error (never an abort).
+fn vec_for<T>(n: usize) -> Result<Vec<T>, CallError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        CallError::from(crate::Error::OutOfMemory {
+            bytes: n.saturating_mul(std::mem::size_of::<T>()),
+        })
+    })?;
+    Ok(v)
+}
+
 /// The Rust options of C options (`NULL`: defaults).
 ///
 /// # Safety
@@ -209,31 +220,33 @@ pub(super) unsafe fn options_of(
     let n = usize::try_from(o.nbetas)
         .map_err(|_| CallError::invalid(format!("nbetas = {} is negative", o.nbetas)))?;
     if n > 0 {
-        opts.betas = match (o.beta_indices.is_null(), o.beta_values.is_null()) {
-            (false, true) => {
-                Array::new(o.beta_indices, n, "beta_indices").check()?;
-                // SAFETY: non-NULL, aligned, `nbetas` values (the API's contract).
-                let ks = unsafe { std::slice::from_raw_parts(o.beta_indices, n) };
-                let ks = ks
-                    .iter()
-                    .map(|&k| {
-                        usize::try_from(k)
-                            .map_err(|_| CallError::invalid(format!("beta index {k} is negative")))
-                    })
-                    .collect::<Result<Vec<_>, _>>()?;
-                Betas::Indices(ks)
-            }
-            (true, false) => {
-                Array::new(o.beta_values, n, "beta_values").check()?;
-                // SAFETY: as above.
-                Betas::Values(unsafe { std::slice::from_raw_parts(o.beta_values, n) }.to_vec())
-            }
-            _ => {
-                return Err(CallError::invalid(
-                    "nbetas > 0 needs exactly one of beta_indices and beta_values".to_string(),
-                ))
-            }
-        };
+        opts.betas =
+            match (o.beta_indices.is_null(), o.beta_values.is_null()) {
+                (false, true) => {
+                    Array::new(o.beta_indices, n, "beta_indices").check()?;
+                    // SAFETY: non-NULL, aligned, `nbetas` values (the API's contract).
+                    let ks = unsafe { std::slice::from_raw_parts(o.beta_indices, n) };
+                    let mut v = vec_for(n)?;
+                    for &k in ks {
+                        v.push(usize::try_from(k).map_err(|_| {
+                            CallError::invalid(format!("beta index {k} is negative"))
+                        })?);
+                    }
+                    Betas::Indices(v)
+                }
+                (true, false) => {
+                    Array::new(o.beta_values, n, "beta_values").check()?;
+                    let mut v = vec_for(n)?;
+                    // SAFETY: as above.
+                    v.extend_from_slice(unsafe { std::slice::from_raw_parts(o.beta_values, n) });
+                    Betas::Values(v)
+                }
+                _ => {
+                    return Err(CallError::invalid(
+                        "nbetas > 0 needs exactly one of beta_indices and beta_values".to_string(),
+                    ))
+                }
+            };
     }
     Ok(opts)
 }

@@ -44,6 +44,16 @@ impl LanePairs {
     pub fn new(shape: &Shape, betas: &Betas) -> Result<LanePairs> {
         let bg = shape.grid_bandwidth;
         let nb = 2 * bg;
+        // What the tables take per pair (two points, each with its powers of the half-angle
+        // cosine and sine up to 2L, about 64 (66 + L/32) bytes, and the bookkeeping here),
+        // checked before anything is made.
+        let count = match betas {
+            Betas::All => bg,
+            Betas::Indices(v) => v.len(),
+            Betas::Values(v) => v.len(),
+        };
+        let per_pair = 2 * (64 * (66 + shape.degree_limit / 32) + 64) + 96;
+        crate::system::check_headroom(count.saturating_mul(per_pair))?;
         // Half angles of the lower points, and which slices each pair writes.
         let mut half: Vec<Dd> = Vec::new();
         let mut outputs: Vec<[usize; 2]> = Vec::new();
@@ -109,6 +119,7 @@ impl LanePairs {
             return Err(Error::InvalidArgument("no betas selected".into()));
         }
         let pairs = half.len();
+        let maxpow = 2 * shape.degree_limit;
         // Lower points, then their mirrors: the mirror's half angle is pi/2 - x, whose
         // cosine and sine are the sine and cosine of x.
         let mut points: Vec<(Dd, Dd)> = half.iter().map(|&x| half_angle_point(x)).collect();
@@ -116,7 +127,6 @@ impl LanePairs {
             let (c, s) = points[j];
             points.push((s, c));
         }
-        let maxpow = 2 * shape.degree_limit;
         Ok(LanePairs {
             tables: BetaTables::new(&points, maxpow),
             pairs,
