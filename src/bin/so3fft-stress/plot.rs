@@ -347,7 +347,7 @@ pub fn error_svg(rows: &[Row], growths: &[Growth]) -> String {
     .svg()
 }
 
-/// Reference figures measured on this machine (../shared/NOTES.md): (label, colour,
+/// Reference figures measured on this machine (docs/reference-figures.md): (label, colour,
 /// points (seconds for inverse + forward, error), point labels).
 fn peer_series() -> Vec<Series> {
     let peer = |label: &str, color, points: Vec<(f64, f64)>, bs: &[usize]| Series {
