@@ -69,3 +69,15 @@ impl std::error::Error for Error {}
 
 /// Result type of this crate.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// [`Error::LengthMismatch`] unless an array named `what` has the `expected` length.
+pub(crate) fn check_length(what: &'static str, expected: usize, got: usize) -> Result<()> {
+    if got != expected {
+        return Err(Error::LengthMismatch {
+            what,
+            expected,
+            got,
+        });
+    }
+    Ok(())
+}

@@ -3,7 +3,7 @@
 //! inverse SO(3) transform.
 
 use super::combine::add_combined;
-use crate::error::{Error, Result};
+use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::partial::{PartialOptions, PartialPlan, Shape};
 use crate::s2::{S2Options, S2Plan};
@@ -36,6 +36,8 @@ pub struct CorrelationOptions {
 struct Buffers {
     sig: Vec<Complex64>,
     pat: Vec<Complex64>,
+    /// The combined coefficients in the layout of bandwidth `deg_lim + 1`: the inverse
+    /// plan's input (all higher degrees are zero).
     so3: Vec<Complex64>,
 }
 
@@ -130,7 +132,7 @@ impl Correlation {
             Ok(Buffers {
                 sig: vec(n)?,
                 pat: vec(n)?,
-                so3: vec(num_coeffs(self.b_out))?,
+                so3: vec(num_coeffs(self.deg_lim + 1))?,
             })
         };
         match self.buffers.try_lock() {
@@ -182,7 +184,7 @@ impl Correlation {
                 (&buf.sig, &buf.pat),
                 self.b_in,
                 (from, self.deg_lim),
-                self.b_out,
+                self.deg_lim + 1,
                 (weight, &mut buf.so3),
             );
         }
@@ -228,9 +230,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
             self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
-            check_len("SO(3) coefficients", buf.so3.len(), out.len())?;
-            out.copy_from_slice(&buf.so3);
-            Ok(())
+            self.widen(&buf.so3, out)
         })
     }
 
@@ -244,9 +244,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
             self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
-            check_len("SO(3) coefficients", buf.so3.len(), out.len())?;
-            out.copy_from_slice(&buf.so3);
-            Ok(())
+            self.widen(&buf.so3, out)
         })
     }
 
@@ -258,7 +256,7 @@ impl Correlation {
         coeffs: &[Complex64],
         start: &super::Rotation,
     ) -> Result<(super::Rotation, f64)> {
-        check_len("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
+        check_length("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
         let series = super::So3Series::new(self.b_out, self.deg_lim, coeffs);
         Ok(self.s2.install(|| series.maximise(start)))
     }
@@ -273,46 +271,26 @@ impl Correlation {
         self.deg_lim
     }
 
-    /// Coefficients of bandwidth `b_out` (zero above `deg_lim`) in the layout of
-    /// bandwidth `deg_lim + 1`, the inverse plan's input; `None` when the two are the same.
-    fn restrict(&self, c: &[Complex64]) -> Result<Option<Vec<Complex64>>> {
+    /// `small` (the layout of bandwidth `deg_lim + 1`) into `out` in the layout of
+    /// bandwidth `b_out`, zero above `deg_lim`.
+    fn widen(&self, small: &[Complex64], out: &mut [Complex64]) -> Result<()> {
+        check_length("SO(3) coefficients", num_coeffs(self.b_out), out.len())?;
         let l = self.deg_lim + 1;
         if l == self.b_out {
-            return Ok(None);
+            out.copy_from_slice(small);
+            return Ok(());
         }
-        let mut small = Vec::new();
-        small
-            .try_reserve_exact(num_coeffs(l))
-            .map_err(|_| Error::OutOfMemory {
-                bytes: 16 * num_coeffs(l),
-            })?;
-        small.resize(num_coeffs(l), Complex64::default());
+        out.fill(Complex64::default());
         let lim = self.deg_lim as isize;
         for m in -lim..=lim {
             for mp in -lim..=lim {
                 let lo = m.unsigned_abs().max(mp.unsigned_abs());
-                let from = coef_index(self.b_out, lo, m, mp);
-                let to = coef_index(l, lo, m, mp);
-                small[to..to + l - lo].copy_from_slice(&c[from..from + l - lo]);
+                let from = coef_index(l, lo, m, mp);
+                let to = coef_index(self.b_out, lo, m, mp);
+                out[to..to + l - lo].copy_from_slice(&small[from..from + l - lo]);
             }
         }
-        Ok(Some(small))
-    }
-
-    /// The inverse of coefficients of bandwidth `b_out` onto the grid.
-    fn inverse_grid(&self, c: &[Complex64], grid: &mut [Complex64]) -> Result<()> {
-        match self.restrict(c)? {
-            Some(small) => self.so3.inverse(&small, grid),
-            None => self.so3.inverse(c, grid),
-        }
-    }
-
-    /// [`Correlation::inverse_grid`] to a real grid.
-    fn inverse_grid_real(&self, c: &[Complex64], grid: &mut [f64]) -> Result<()> {
-        match self.restrict(c)? {
-            Some(small) => self.so3.inverse_real(&small, grid),
-            None => self.so3.inverse_real(c, grid),
-        }
+        Ok(())
     }
 
     fn need(&self, real: bool) -> Result<()> {
@@ -354,7 +332,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
             self.combine_shells(shells, fwd, buf)?;
-            self.inverse_grid(&buf.so3, out)
+            self.so3.inverse(&buf.so3, out)
         })
     }
 
@@ -368,7 +346,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
             self.combine_shells(shells, fwd, buf)?;
-            self.inverse_grid_real(&buf.so3, out)
+            self.so3.inverse_real(&buf.so3, out)
         })
     }
 
@@ -383,7 +361,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(false)?;
         let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.inverse_grid(c, g);
+        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
         self.many((signal, patterns, out), forward, inverse)
     }
 
@@ -396,7 +374,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(true)?;
         let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-        let inverse = |c: &[Complex64], g: &mut [f64]| self.inverse_grid_real(c, g);
+        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
         self.many((signal, patterns, out), forward, inverse)
     }
 
@@ -431,18 +409,6 @@ impl Correlation {
     }
 }
 
-/// An error unless `got == expected`.
-fn check_len(what: &'static str, expected: usize, got: usize) -> Result<()> {
-    if got != expected {
-        return Err(Error::LengthMismatch {
-            what,
-            expected,
-            got,
-        });
-    }
-    Ok(())
-}
-
 /// An error unless `patterns` holds a positive number of fields of `ns` and `out` as many
 /// of `ng`.
 fn check_many(patterns: usize, ns: usize, out: usize, ng: usize) -> Result<()> {
@@ -451,5 +417,5 @@ fn check_many(patterns: usize, ns: usize, out: usize, ng: usize) -> Result<()> {
             "{patterns} pattern samples are not a positive multiple of {ns}"
         )));
     }
-    check_len("correlation grids", patterns / ns * ng, out)
+    check_length("correlation grids", patterns / ns * ng, out)
 }

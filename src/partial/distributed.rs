@@ -21,7 +21,7 @@ use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
 use super::plan::{General, PartialOptions};
 use super::shape::Shape;
-use crate::error::{Error, Result};
+use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::plan::Direction;
 use crate::simd::Isa;
@@ -115,6 +115,8 @@ pub struct DistributedPlan<X: Exchange> {
     last: std::sync::Mutex<DistributedTimes>,
     /// The lane rows of the FFT stage and of the DWT stage, kept between transforms.
     rows: std::sync::Mutex<Option<(Rows, Rows)>>,
+    /// The exchange's packed blocks (sent and received), kept between transforms.
+    packed: std::sync::Mutex<(Vec<f64>, Vec<f64>)>,
 }
 
 /// An error on every rank if it is one on any (agreed through `comm`).
@@ -196,6 +198,7 @@ impl<X: Exchange> DistributedPlan<X> {
             local_coeffs: parts.local_coeffs,
             last: std::sync::Mutex::new(DistributedTimes::default()),
             rows: std::sync::Mutex::new(None),
+            packed: std::sync::Mutex::new((Vec::new(), Vec::new())),
         })
     }
 
@@ -375,21 +378,8 @@ impl<X: Exchange> DistributedPlan<X> {
                 "real-signal transform on a plan made without the real option".into(),
             ));
         }
-        if samples != self.local_num_samples() {
-            return Err(Error::LengthMismatch {
-                what: "local samples",
-                expected: self.local_num_samples(),
-                got: samples,
-            });
-        }
-        if coeffs != self.local_coeffs {
-            return Err(Error::LengthMismatch {
-                what: "local coefficients",
-                expected: self.local_coeffs,
-                got: coeffs,
-            });
-        }
-        Ok(())
+        check_length("local samples", self.local_num_samples(), samples)?;
+        check_length("local coefficients", self.local_coeffs, coeffs)
     }
 
     /// Forward (collective): this rank's samples to this rank's coefficients.
@@ -523,8 +513,10 @@ impl<X: Exchange> DistributedPlan<X> {
         };
         // `a`'s part for rank q: rows `0..2 ha`, columns of q's segment.
         let a_block = |share: &Share| (share.segment.0, share.segment.1 - share.segment.0);
-        let mut send = Vec::new();
-        let mut recv = Vec::new();
+        let (mut send, mut recv) = match self.packed.try_lock() {
+            Ok(mut g) => std::mem::take(&mut *g),
+            Err(_) => (Vec::new(), Vec::new()),
+        };
         for step in 0..p {
             let (dest, src) = ((me + step) % p, (me + p - step) % p);
             let (sd, ss) = (&self.shares[dest], &self.shares[src]);
@@ -569,6 +561,9 @@ impl<X: Exchange> DistributedPlan<X> {
                     a[i * rt + col..][..len].copy_from_slice(&recv[i * len..][..len]);
                 }
             }
+        }
+        if let Ok(mut g) = self.packed.try_lock() {
+            *g = (send, recv);
         }
         Ok(())
     }

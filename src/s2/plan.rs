@@ -3,7 +3,7 @@
 use super::layout::{order_start, s2_num_coeffs, s2_num_samples};
 use super::legendre::{CoeffRows, Group, LegendreStage, Spectra};
 use super::rings::RingFft;
-use crate::error::{Error, Result};
+use crate::error::{check_length, Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
 use crate::simd::Isa;
 use crate::system::check_headroom;
@@ -149,14 +149,7 @@ impl S2Plan {
             ("samples", self.num_samples(), samples),
             ("coefficients", self.num_coeffs(), coeffs),
         ] {
-            let expected = each.saturating_mul(howmany);
-            if got != expected {
-                return Err(Error::LengthMismatch {
-                    what,
-                    expected,
-                    got,
-                });
-            }
+            check_length(what, each.saturating_mul(howmany), got)?;
         }
         Ok(())
     }
