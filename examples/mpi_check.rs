@@ -188,33 +188,52 @@ fn bench(comm: &MpiExchange, b: usize, threads: usize, runs: usize) -> so3fft::R
         ..PartialOptions::default()
     };
     let plan = DistributedPlan::new(comm, &s, &o)?;
-    let mut st = 7u64 + comm.rank() as u64;
-    let c: Vec<Complex64> = (0..plan.local_num_coeffs())
-        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+    // What the planner says this rank will hold, before anything large is allocated.
+    let arrays = 16 * (plan.local_num_samples() + plan.local_num_coeffs());
+    let planned = arrays + plan.local_workspace_bytes();
+    let seed = 7u64 + comm.rank() as u64;
+    let coeffs = |st: &mut u64| Complex64::new(rnd(st), rnd(st));
+    let mut st = seed;
+    let mut c: Vec<Complex64> = (0..plan.local_num_coeffs())
+        .map(|_| coeffs(&mut st))
         .collect();
     let mut x = vec![Complex64::default(); plan.local_num_samples()];
-    let mut back = vec![Complex64::default(); c.len()];
     let (mut inv, mut fwd, mut ex) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut dwt, mut fft) = (Vec::new(), Vec::new());
     for _ in 0..runs {
+        // Round trips in place: the coefficients come back to rounding each time.
         plan.inverse(&c, &mut x)?;
         let ti = plan.last_times();
-        plan.forward(&x, &mut back)?;
+        plan.forward(&x, &mut c)?;
         let tf = plan.last_times();
         inv.push(ti.total);
         fwd.push(tf.total);
         ex.push((ti.exchange + tf.exchange) / (ti.total + tf.total));
+        dwt.push(ti.dwt + tf.dwt);
+        fft.push(ti.fft + tf.fft);
     }
+    let mut st = seed;
+    let err = c
+        .iter()
+        .map(|v| (v - coeffs(&mut st)).norm())
+        .fold(0.0, f64::max);
+    let worst = f64::from_bits(comm.max(err.to_bits())?);
     let (i, f, e) = (median(inv), median(fwd), median(ex));
     let mine = format!(
-        "rank {} of {}: B = {b}, {threads} threads: inverse {:.1} ms, forward {:.1} ms, exchange {:.0}%, \
-         workspace {:.0} MB, arrays {:.0} MB, peak RSS {:.0} MB",
+        "rank {} of {}: B = {b}, {threads} threads, {} groups: inverse {:.1} ms, forward {:.1} ms, \
+         exchange {:.0}% (DWT {:.0} ms, FFT {:.0} ms), planned {:.0} MB (arrays {:.0} MB + workspace {:.0} MB), peak RSS {:.0} MB, \
+         error after {runs} round trips {worst:.1e}",
         comm.rank(),
         comm.size(),
+        plan.groups(),
         i * 1e3,
         f * 1e3,
         e * 100.0,
+        median(dwt) * 1e3,
+        median(fft) * 1e3,
+        planned as f64 / 1e6,
+        arrays as f64 / 1e6,
         plan.local_workspace_bytes() as f64 / 1e6,
-        16.0 * (x.len() + c.len()) as f64 / 1e6,
         peak_rss() as f64 / 1e6
     );
     println!("{mine}");

@@ -54,6 +54,14 @@ ptrdiff_t so3fft_mpi_local_num_samples(so3fft_mpi_plan p);
 /* Coefficients this rank holds. */
 ptrdiff_t so3fft_mpi_local_num_coeffs(so3fft_mpi_plan p);
 
+/* Bytes this rank's transforms hold besides its arrays (known before the first transform
+ * allocates them): lane-row buffers and exchange blocks. */
+ptrdiff_t so3fft_mpi_local_workspace(so3fft_mpi_plan p);
+
+/* Groups of pairs a transform runs in, chosen to fit options->max_workspace on every rank
+ * (1: results bitwise those of a single-process plan of the same shape). */
+int so3fft_mpi_groups(so3fft_mpi_plan p);
+
 /* Index of fhat(l, m, mp) in the coefficients of rank *rank (written if rank != NULL);
  * SO3FFT_EINVAL if the shape does not hold it. */
 ptrdiff_t so3fft_mpi_coef_owner(so3fft_mpi_plan p, int l, int m, int mp, int *rank);

@@ -1,7 +1,8 @@
 /* Distributed plans through the C API (include/so3fft_mpi.h), run under mpirun -np 1..4 by
  * scripts/test.sh: every rank's part of an order-limited shape against a single-process
- * partial plan (bitwise: the same kernel lanes and sums), real transforms, and collective
- * errors (a NULL array on one rank, different shapes). */
+ * partial plan (bitwise: the same kernel lanes and sums), a plan run in groups of pairs
+ * (to rounding), real transforms, and collective errors (a NULL array on one rank,
+ * different shapes). */
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -86,6 +87,36 @@ int main(int argc, char **argv) {
         }
         MPI_Allreduce(&e, &all, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         CHECK(all < 1e-12);
+    }
+    CHECK(so3fft_mpi_groups(p) == 1 && so3fft_mpi_local_workspace(p) >= 0);
+    /* A small workspace cap: the pairs run in groups; the same round trip. */
+    {
+        so3fft_partial_options small = o;
+        so3fft_mpi_plan pg;
+        double e = 0.0, all = 0.0;
+        small.max_workspace = 1;
+        pg = so3fft_mpi_plan_partial(&s, &small, SO3FFT_ESTIMATE, MPI_COMM_WORLD);
+        CHECK(pg != NULL);
+        if (pg) {
+            CHECK(so3fft_mpi_groups(pg) > 1);
+            CHECK(so3fft_mpi_inverse(pg, lc, lx) == SO3FFT_OK);
+            for (t = 0; t < 2 * (j1 - j0); t++) {
+                int k = t < j1 - j0 ? j0 + t : 2 * 11 - j1 + (t - (j1 - j0));
+                for (i = 0; i < sl; i++) {
+                    double d = fabs(lx[t * sl + i][0] - x[k * sl + i][0]) +
+                               fabs(lx[t * sl + i][1] - x[k * sl + i][1]);
+                    if (d > e) e = d;
+                }
+            }
+            CHECK(so3fft_mpi_forward(pg, lx, back) == SO3FFT_OK);
+            for (i = 0; i < lnc; i++) {
+                double d = fabs(back[i][0] - lc[i][0]) + fabs(back[i][1] - lc[i][1]);
+                if (d > e) e = d;
+            }
+            MPI_Allreduce(&e, &all, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+            CHECK(all < 1e-12);
+            so3fft_mpi_destroy_plan(pg);
+        }
     }
     /* A NULL array on one rank: every rank gets the error. */
     CHECK(so3fft_mpi_inverse(p, lc, rank == size - 1 ? NULL : lx) != SO3FFT_OK);

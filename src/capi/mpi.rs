@@ -112,6 +112,21 @@ pub unsafe extern "C" fn so3fft_mpi_local_num_coeffs(p: so3fft_mpi_plan) -> isiz
     guarded_count(|| Ok(unsafe { plan_ref(p) }?.local_num_coeffs() as isize))
 }
 
+/// Bytes this rank's transforms hold besides its arrays (the lane-row buffers, allocated
+/// at the first transform and kept until destroy).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_mpi_local_workspace(p: so3fft_mpi_plan) -> isize {
+    // SAFETY: the API's contract.
+    guarded_count(|| Ok(unsafe { plan_ref(p) }?.local_workspace_bytes() as isize))
+}
+
+/// Groups of pairs a transform runs in (1: results bitwise those of one process).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_mpi_groups(p: so3fft_mpi_plan) -> c_int {
+    // SAFETY: the API's contract.
+    guarded_count(|| Ok(unsafe { plan_ref(p) }?.groups() as isize)) as c_int
+}
+
 /// Where `fhat(l, m, mp)` is: its index in the coefficients of rank `*rank` (written when
 /// `rank` is not NULL); `SO3FFT_EINVAL` if the shape does not hold it.
 #[no_mangle]

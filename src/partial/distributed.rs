@@ -10,16 +10,21 @@
 //!   cluster and order pair after order pair, the degrees `max(|M|, |M'|, L0) .. L - 1` of each
 //!   order pair of its clusters ([`DistributedPlan::local_coef_index`]).
 //! - Forward: the FFT stage on the local slices gives their lane rows (every cluster's values,
-//!   see `dwt_stage.rs`); one all-to-all exchange sends each rank the segment of every lane
-//!   row that holds its clusters; the DWT stage then runs each local cluster over all betas.
-//!   The inverse runs the same steps backwards. Each lane is one kernel lane in both, and a
-//!   cluster's kernel call covers all betas, so the results are bitwise those of a
-//!   single-process [`PartialPlan`](super::PartialPlan) of the same shape whose chunk holds
-//!   every beta (its default up to large bandwidths).
+//!   see `dwt_stage.rs`); an all-to-all exchange sends each rank the segment of every lane
+//!   row that holds its clusters; the DWT stage then runs each local cluster over the betas.
+//!   The inverse runs the same steps backwards.
+//! - Groups: to bound the memory, the pairs run in groups (every rank's first pairs, then
+//!   its next ones, ...): FFT stage, exchange and DWT stage per group, the forward summing
+//!   each cluster over the groups. The lane tables list the pairs group after group, so a
+//!   group's lanes are one contiguous run.
+//! - In one group (the default whenever the rows fit in the workspace cap) each lane is one
+//!   kernel lane and a cluster's kernel call covers all betas, as in a single-process
+//!   [`PartialPlan`](super::PartialPlan) whose chunk holds every beta: the results are
+//!   bitwise equal. With several groups the forward adds the same terms in another order.
 
 use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
-use super::plan::{General, PartialOptions};
+use super::plan::{General, LaneRows, PartialOptions};
 use super::shape::Shape;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
@@ -111,12 +116,13 @@ pub struct DistributedPlan<X: Exchange> {
     /// offsets within the local segment of a lane row.
     local: Vec<ClusterPlan>,
     local_coeffs: usize,
+    /// Groups of pairs the transforms run in (see [`DistributedPlan::groups`]).
+    groups: usize,
     /// Times of the last transform on this rank.
     last: std::sync::Mutex<DistributedTimes>,
-    /// The lane rows of the FFT stage and of the DWT stage, kept between transforms.
+    /// The FFT stage's lane rows of other ranks' clusters (`a`) and the DWT stage's lane
+    /// rows (`b`), kept between transforms.
     rows: std::sync::Mutex<Option<(Rows, Rows)>>,
-    /// The exchange's packed blocks (sent and received), kept between transforms.
-    packed: std::sync::Mutex<(Vec<f64>, Vec<f64>)>,
 }
 
 /// An error on every rank if it is one on any (agreed through `comm`).
@@ -131,6 +137,36 @@ fn collective<X: Exchange, T>(comm: &X, r: Result<T>) -> Result<T> {
     }
 }
 
+/// Pairs of a rank's range `(j0, j1)` in group `k` of `groups`.
+fn group_range((j0, j1): (usize, usize), k: usize, groups: usize) -> (usize, usize) {
+    let h = j1 - j0;
+    (j0 + k * h / groups, j0 + (k + 1) * h / groups)
+}
+
+/// Doubles of rank `rank`'s two buffers when the transforms run in `groups` groups, for
+/// lane rows of `row_total` doubles and vectors of `w` lanes: `a`, the lane rows of its
+/// slices in one group for the other ranks' clusters, and `b`, the group's lane rows of its
+/// own clusters (every rank's pairs, padded to vectors).
+fn row_sizes(
+    shares: &[Share],
+    rank: usize,
+    groups: usize,
+    (row_total, w): (usize, usize),
+) -> (usize, usize) {
+    let count = |r: usize, k: usize| {
+        let (g0, g1) = group_range(shares[r].pairs, k, groups);
+        g1 - g0
+    };
+    let n_me = (0..groups).map(|k| count(rank, k)).max().unwrap_or(0);
+    let hp = (0..groups)
+        .map(|k| (0..shares.len()).map(|r| count(r, k)).sum::<usize>())
+        .max()
+        .unwrap_or(0)
+        .next_multiple_of(w);
+    let mine = shares[rank].segment.1 - shares[rank].segment.0;
+    (2 * n_me * (row_total - mine), 2 * hp * mine)
+}
+
 /// What a rank builds of a plan (everything but the exchange).
 struct Parts {
     shape: Shape,
@@ -140,6 +176,7 @@ struct Parts {
     shares: Vec<Share>,
     local: Vec<ClusterPlan>,
     local_coeffs: usize,
+    groups: usize,
 }
 
 impl<T: Exchange + ?Sized> Exchange for &T {
@@ -174,6 +211,7 @@ impl<X: Exchange> DistributedPlan<X> {
             options.real as usize,
             options.direction as usize,
             options.skip_bits.map_or(usize::MAX, |b| b as usize),
+            options.max_workspace_bytes.unwrap_or(0),
         ]
         .iter()
         .fold(0xcbf29ce484222325u64, |h, &v| {
@@ -196,9 +234,9 @@ impl<X: Exchange> DistributedPlan<X> {
             shares: parts.shares,
             local: parts.local,
             local_coeffs: parts.local_coeffs,
+            groups: parts.groups,
             last: std::sync::Mutex::new(DistributedTimes::default()),
             rows: std::sync::Mutex::new(None),
-            packed: std::sync::Mutex::new((Vec::new(), Vec::new())),
         })
     }
 
@@ -235,7 +273,7 @@ impl<X: Exchange> DistributedPlan<X> {
             max_workspace_bytes: Some(usize::MAX / 4),
             ..options.clone()
         };
-        let general = General::new(shape, pairs, (isa, bits, threads), &opts)?;
+        let mut general = General::new(shape, pairs, (isa, bits, threads), &opts)?;
         let p = comm.size();
         let clusters = &general.dwt.clusters;
         let cost: Vec<usize> = clusters
@@ -301,6 +339,51 @@ impl<X: Exchange> DistributedPlan<X> {
             }
             local.push(c);
         }
+        // Every rank computes the same group count: from every rank's sizes and budget.
+        let geometry = (general.dwt.row_total, general.lanes_w);
+        let sample_bytes = if options.real { 8 } else { 16 };
+        let coeffs_of = |share: &Share| -> usize {
+            clusters[share.clusters.0..share.clusters.1]
+                .iter()
+                .flat_map(|c| c.slots.iter())
+                .map(|sl| shape.degree_limit - sl.first)
+                .sum()
+        };
+        let budget = |share: &Share| {
+            options.max_workspace_bytes.unwrap_or_else(|| {
+                let h = share.pairs.1 - share.pairs.0;
+                let arrays = sample_bytes * 2 * h * shape.slice_len() + 16 * coeffs_of(share);
+                (512usize << 20).max(arrays / 20)
+            })
+        };
+        let most = shares
+            .iter()
+            .map(|sh| sh.pairs.1 - sh.pairs.0)
+            .filter(|&h| h > 0)
+            .min()
+            .unwrap_or(1);
+        let groups = (1..=most)
+            .find(|&k| {
+                (0..p).all(|r| {
+                    let (a, b) = row_sizes(&shares, r, k, geometry);
+                    8 * (a + b) <= budget(&shares[r])
+                })
+            })
+            .unwrap_or(most);
+        if groups > 1 {
+            // Lanes in group order: group 0 of every rank, then group 1, ..., so that each
+            // group's lanes are a contiguous run of the kernels' lane tables.
+            let order: Vec<usize> = (0..groups)
+                .flat_map(|k| {
+                    let shares = &shares;
+                    (0..p).flat_map(move |r| {
+                        let (g0, g1) = group_range(shares[r].pairs, k, groups);
+                        g0..g1
+                    })
+                })
+                .collect();
+            general.pairs = LanePairs::new(shape, &Betas::Indices(order))?;
+        }
         Ok(Parts {
             shape: *shape,
             real: options.real,
@@ -309,6 +392,7 @@ impl<X: Exchange> DistributedPlan<X> {
             shares,
             local,
             local_coeffs: at,
+            groups,
         })
     }
 
@@ -424,21 +508,34 @@ impl<X: Exchange> DistributedPlan<X> {
         *self.last.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Bytes this rank holds during a transform besides its arrays: the lane rows of its
-    /// slices (all clusters) and of its clusters (all betas); the exchange adds one packed
-    /// block for one other rank at a time, and the plan's tables and per-worker FFT buffers
-    /// come on top (`O(L^2)` and a few slices).
+    /// Bytes this rank holds during a transform besides its arrays (known at plan time, taken
+    /// at the first transform and kept): the lane rows of its slices in one group of pairs
+    /// for the other ranks' clusters, and the group's lane rows of its own clusters (every
+    /// rank's pairs of the group). The plan's tables and per-worker FFT buffers come on top
+    /// (`O(B L)` and a few slices).
     pub fn local_workspace_bytes(&self) -> usize {
-        let (loc, all) = (self.local_lanes(), self.all_lanes());
-        let rows = 2 * loc.h * loc.row_len + all.lanes() * all.row_len;
-        8 * rows
+        let (a, b) = self.row_sizes();
+        8 * (a + b)
+    }
+
+    /// Number of groups of pairs a transform runs in: the fewest whose buffers fit every
+    /// rank's workspace cap (`PartialOptions::max_workspace_bytes`, by default the larger of
+    /// 512 MiB and a twentieth of the rank's arrays). With one group the results are bitwise
+    /// those of a single-process plan; with more, the forward sums each cluster over the
+    /// groups in turn (a different order of the same sum, equal to rounding).
+    pub fn groups(&self) -> usize {
+        self.groups
+    }
+
+    fn row_sizes(&self) -> (usize, usize) {
+        let geometry = (self.general.dwt.row_total, self.general.lanes_w);
+        row_sizes(&self.shares, self.comm.rank(), self.groups, geometry)
     }
 
     /// The two row buffers, taken from the plan (or new when another call has them), at
     /// their sizes: `a` for this rank's slices, `b` for this rank's clusters.
     fn take_rows(&self) -> Result<(Rows, Rows)> {
-        let (loc, all) = (self.local_lanes(), self.all_lanes());
-        let (na, nb) = (2 * loc.h * loc.row_len, all.lanes() * all.row_len);
+        let (na, nb) = self.row_sizes();
         let kept = match self.rows.try_lock() {
             Ok(mut g) => g.take(),
             Err(_) => None,
@@ -459,111 +556,115 @@ impl<X: Exchange> DistributedPlan<X> {
         *self.last.lock().unwrap_or_else(|e| e.into_inner()) = t;
     }
 
-    /// Lanes of the DWT stage: every pair, padded to the vector width.
-    fn all_lanes(&self) -> ChunkLanes {
+    /// Rank `q`'s pairs in group `k`: `(offset among the group's lanes, count)`.
+    fn part(&self, q: usize, k: usize) -> (usize, usize) {
+        let count = |r: usize| {
+            let (g0, g1) = group_range(self.shares[r].pairs, k, self.groups);
+            g1 - g0
+        };
+        ((0..q).map(count).sum(), count(q))
+    }
+
+    /// Lanes of group `k` in the DWT stage: every rank's pairs of the group (a contiguous run
+    /// of the lane tables), padded to the vector width, rows of this rank's segment.
+    fn group_lanes(&self, k: usize) -> ChunkLanes {
         let me = &self.shares[self.comm.rank()];
-        let np = self.general.pairs.pairs;
+        let first: usize = self
+            .shares
+            .iter()
+            .map(|s| group_range(s.pairs, k, self.groups).0 - s.pairs.0)
+            .sum();
+        let h = (0..self.shares.len()).map(|q| self.part(q, k).1).sum();
         ChunkLanes {
-            j0: 0,
-            h: np,
-            hp: np.next_multiple_of(self.general.lanes_w),
+            j0: first,
+            h,
+            hp: h.next_multiple_of(self.general.lanes_w),
             row_len: me.segment.1 - me.segment.0,
         }
     }
 
-    /// This rank's lane rows in the FFT stage's layout: `2 h` rows of `row_total`.
-    fn local_lanes(&self) -> ChunkLanes {
-        let (j0, j1) = self.local_pairs();
-        ChunkLanes {
-            j0,
-            h: j1 - j0,
-            hp: j1 - j0,
-            row_len: self.general.dwt.row_total,
-        }
+    /// Where rank `q`'s columns of this rank's group-`k` slices are in `a` (`q` not this
+    /// rank): `(first double, row length)`; rows `0 .. n` lower, `n .. 2 n` mirrors.
+    fn a_block(&self, q: usize, k: usize) -> (usize, usize) {
+        let me = self.comm.rank();
+        let n_me = self.part(me, k).1;
+        let width = |s: &Share| s.segment.1 - s.segment.0;
+        let start = (0..q)
+            .filter(|&r| r != me)
+            .map(|r| 2 * n_me * width(&self.shares[r]))
+            .sum();
+        (start, width(&self.shares[q]))
     }
 
-    /// Slice `s` of this rank's samples: `(pair within the rank, upper)`.
-    fn local_slices(&self) -> Vec<(usize, bool)> {
-        let h = self.local_lanes().h;
-        (0..h)
-            .map(|jj| (jj, false))
-            .chain((0..h).rev().map(|jj| (jj, true)))
+    /// A slice's lane rows in group `k` (`jj`: its pair within this rank's pairs of the
+    /// group), one part per rank's clusters: this rank's in `b` (where the DWT stage runs
+    /// on them), the others' in their blocks of `a` (sent and received whole).
+    fn slice_parts(
+        &self,
+        (a, b): (*mut f64, *mut f64),
+        k: usize,
+        (jj, upper): (usize, bool),
+    ) -> Vec<LaneRows> {
+        let me = self.comm.rank();
+        let ch = self.group_lanes(k);
+        let (off, n_me) = self.part(me, k);
+        (0..self.shares.len())
+            .map(|q| {
+                let sh = &self.shares[q];
+                // Rows of the part: base, rows per half, this pair's row, row length.
+                let (base, half, lane, len) = if q == me {
+                    (b, ch.hp, off + jj, ch.row_len)
+                } else {
+                    let (at, len) = self.a_block(q, k);
+                    (a.wrapping_add(at), n_me, jj, len)
+                };
+                let (r, rm) = if upper {
+                    (half + lane, lane)
+                } else {
+                    (lane, half + lane)
+                };
+                let rows = (base.wrapping_add(r * len), base.wrapping_add(rm * len));
+                LaneRows::part(rows, sh.clusters, sh.segment.0)
+            })
             .collect()
     }
 
-    /// The exchange between the FFT stage's rows (`a`: this rank's pairs, every cluster) and
-    /// the DWT stage's rows (`b`: every pair, this rank's clusters). `to_dwt`: `a` to `b`.
-    /// Rank `r` sends to `r + k` and receives from `r - k` in step `k` (one packed block at a
-    /// time); its own part is copied directly.
-    fn exchange(&self, a: &mut [f64], b: &mut [f64], to_dwt: bool) -> Result<()> {
+    /// This rank's slices of group `k`: `(index in the local samples, pair within the
+    /// group, upper)`.
+    fn group_slices(&self, k: usize) -> Vec<(usize, usize, bool)> {
+        let (j0, j1) = self.local_pairs();
+        let h = j1 - j0;
+        let (g0, g1) = group_range((j0, j1), k, self.groups);
+        (g0..g1)
+            .map(|j| (j - j0, j - g0, false))
+            .chain((g0..g1).map(|j| (2 * h - 1 - (j - j0), j - g0, true)))
+            .collect()
+    }
+
+    /// The exchange of group `k` between `a` (this rank's slices, other ranks' clusters)
+    /// and `b` (every rank's slices of the group, this rank's clusters). `to_dwt`: `a` to
+    /// `b`. Rank `r` sends to `r + s` and receives from `r - s` in step `s`, lower rows then
+    /// mirror rows; every block moves whole, from and into its place (nothing is packed).
+    fn exchange(&self, (a, b): (&mut [f64], &mut [f64]), to_dwt: bool, k: usize) -> Result<()> {
         let (me, p) = (self.comm.rank(), self.comm.size());
-        let rt = self.general.dwt.row_total;
-        let all = self.all_lanes();
-        let mine = &self.shares[me];
-        let my_len = mine.segment.1 - mine.segment.0;
-        let ha = mine.pairs.1 - mine.pairs.0;
-        // Row `i < 2 h_q` of rank q's pairs in `b`: lower rows at the pair, upper at hp + pair.
-        let b_row = |share: &Share, i: usize| {
-            let hq = share.pairs.1 - share.pairs.0;
-            if i < hq {
-                share.pairs.0 + i
-            } else {
-                all.hp + share.pairs.0 + i - hq
-            }
-        };
-        // `a`'s part for rank q: rows `0..2 ha`, columns of q's segment.
-        let a_block = |share: &Share| (share.segment.0, share.segment.1 - share.segment.0);
-        let (mut send, mut recv) = match self.packed.try_lock() {
-            Ok(mut g) => std::mem::take(&mut *g),
-            Err(_) => (Vec::new(), Vec::new()),
-        };
-        for step in 0..p {
+        let ch = self.group_lanes(k);
+        let my_len = ch.row_len;
+        let n_me = self.part(me, k).1;
+        for step in 1..p {
             let (dest, src) = ((me + step) % p, (me + p - step) % p);
-            let (sd, ss) = (&self.shares[dest], &self.shares[src]);
-            if to_dwt {
-                let (col, len) = a_block(sd);
-                let h_src = ss.pairs.1 - ss.pairs.0;
-                if step == 0 {
-                    for i in 0..2 * ha {
-                        let r = b_row(mine, i);
-                        b[r * my_len..][..my_len].copy_from_slice(&a[i * rt + col..][..len]);
-                    }
-                    continue;
-                }
-                send.clear();
-                for i in 0..2 * ha {
-                    send.extend_from_slice(&a[i * rt + col..][..len]);
-                }
-                recv.resize(2 * h_src * my_len, 0.0);
-                self.comm.sendrecv(&send, dest, &mut recv, src)?;
-                for i in 0..2 * h_src {
-                    let r = b_row(ss, i);
-                    b[r * my_len..][..my_len].copy_from_slice(&recv[i * my_len..][..my_len]);
-                }
-            } else {
-                let (col, len) = a_block(ss);
-                let h_dest = sd.pairs.1 - sd.pairs.0;
-                if step == 0 {
-                    for i in 0..2 * ha {
-                        let r = b_row(mine, i);
-                        a[i * rt + col..][..len].copy_from_slice(&b[r * my_len..][..my_len]);
-                    }
-                    continue;
-                }
-                send.clear();
-                for i in 0..2 * h_dest {
-                    let r = b_row(sd, i);
-                    send.extend_from_slice(&b[r * my_len..][..my_len]);
-                }
-                recv.resize(2 * ha * len, 0.0);
-                self.comm.sendrecv(&send, dest, &mut recv, src)?;
-                for i in 0..2 * ha {
-                    a[i * rt + col..][..len].copy_from_slice(&recv[i * len..][..len]);
+            // The rank whose rows of `b` move and the rank whose columns of `a` move.
+            let (other, q) = if to_dwt { (src, dest) } else { (dest, src) };
+            let (off, n) = self.part(other, k);
+            let (at, len) = self.a_block(q, k);
+            for half in 0..2 {
+                let run = (half * ch.hp + off) * my_len..(half * ch.hp + off + n) * my_len;
+                let block = at + half * n_me * len..at + (half + 1) * n_me * len;
+                if to_dwt {
+                    self.comm.sendrecv(&a[block], dest, &mut b[run], src)?;
+                } else {
+                    self.comm.sendrecv(&b[run], dest, &mut a[block], src)?;
                 }
             }
-        }
-        if let Ok(mut g) = self.packed.try_lock() {
-            *g = (send, recv);
         }
         Ok(())
     }
@@ -575,144 +676,153 @@ impl<X: Exchange> DistributedPlan<X> {
         real: bool,
     ) -> Result<()> {
         let g = &self.general;
-        let loc = self.local_lanes();
-        let all = self.all_lanes();
         let slice_len = self.shape.slice_len();
         let (mut a, mut b) = self.take_rows()?;
-        let a_ptr = SendPtr(a.as_mut_ptr());
         let per_value = if real { 1 } else { 2 };
-        let slices = self.local_slices();
+        let mut times = DistributedTimes::default();
         let start = std::time::Instant::now();
-        let done: Result<()> = g.workers.pool().install(|| {
-            slices
-                .par_iter()
-                .enumerate()
-                .try_for_each(|(s, &(jj, upper))| {
+        for k in 0..self.groups {
+            let t0 = std::time::Instant::now();
+            let ch = self.group_lanes(k);
+            let g0 = group_range(self.local_pairs(), k, self.groups).0;
+            let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
+            let slices = self.group_slices(k);
+            let done: Result<()> = g.workers.pool().install(|| {
+                slices.par_iter().try_for_each(|&(s, jj, upper)| {
                     g.with_work(|work| {
-                        let rows = g.lane_rows(a_ptr.get(), 0, loc, (jj, upper));
-                        let weight = g.pair_weight[loc.j0 + jj];
-                        // SAFETY: local slice `s` is inside the checked local samples; the slots
-                        // written are this slice's, of its two rows of `a` (`2 h` rows of
-                        // `row_total`); its mirror writes the other slots of the same rows.
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), k, (jj, upper));
+                        let weight = g.pair_weight[g0 + jj];
+                        // SAFETY: local slice `s` is inside the checked local samples; the
+                        // slots written are this slice's, of its two rows in each part (in
+                        // `a` and `b`, sized for the group); its mirror writes the other
+                        // slots of those rows.
                         unsafe {
                             let at = s * slice_len * per_value;
                             if real {
                                 let w = g.fft.half_buf(work)?;
                                 g.fft.forward_real(w, inp.get().add(at));
-                                g.gather_real(w, rows, weight);
+                                g.gather_real(w, &rows, weight);
                             } else {
                                 let w = g.fft.fwd_buf(work)?;
                                 g.fft.forward(w, inp.get().add(at).cast());
-                                g.gather(w, rows, weight);
+                                g.gather(w, &rows, weight);
                             }
                         }
                         Ok(())
                     })
                 })
-        });
-        collective(&self.comm, done)?;
-        let t1 = std::time::Instant::now();
-        self.exchange(&mut a[..], &mut b[..], true)?;
-        // Padding lanes: the kernel multiplies them by exact zeros, which must not meet a
-        // non-finite value an inverse left there.
-        for half in 0..2 {
-            let from = half * all.hp + all.h;
-            b[from * all.row_len..(half * all.hp + all.hp) * all.row_len].fill(0.0);
-        }
-        let t2 = std::time::Instant::now();
-        let b_ptr = SendPtr(b.as_mut_ptr());
-        let coef = SendPtr(coeffs.as_mut_ptr());
-        g.workers.pool().install(|| {
-            self.local.par_iter().for_each(|cl| {
-                g.dwt.with_scratch(|sc| {
-                    let n = g.dwt.setup(sc, cl, &g.pairs, all);
-                    // SAFETY: this cluster's slots of `b`'s lane rows (padding rows zero, the
-                    // others filled by the exchange); its coefficient blocks are inside the
-                    // local coefficients (checked length) and this task's.
-                    unsafe {
-                        g.dwt
-                            .forward(sc, cl, all, n, b_ptr.get().add(cl.offset), coef.get(), true)
-                    }
+            });
+            collective(&self.comm, done)?;
+            let t1 = std::time::Instant::now();
+            self.exchange((&mut a[..], &mut b[..]), true, k)?;
+            // Padding lanes: the kernel multiplies them by exact zeros, which must not meet
+            // a non-finite value an inverse left there.
+            for half in 0..2 {
+                let from = half * ch.hp + ch.h;
+                b[from * ch.row_len..(half + 1) * ch.hp * ch.row_len].fill(0.0);
+            }
+            let t2 = std::time::Instant::now();
+            let b_ptr = SendPtr(b.as_mut_ptr());
+            let coef = SendPtr(coeffs.as_mut_ptr());
+            g.workers.pool().install(|| {
+                self.local.par_iter().for_each(|cl| {
+                    g.dwt.with_scratch(|sc| {
+                        let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                        // SAFETY: this cluster's slots of `b`'s lane rows of the group
+                        // (padding rows zero, the others filled by the exchange); its
+                        // coefficient blocks are inside the local coefficients (checked
+                        // length) and this task's.
+                        unsafe {
+                            let rows = b_ptr.get().add(cl.offset);
+                            g.dwt.forward(sc, cl, ch, n, rows, coef.get(), k == 0)
+                        }
+                    })
                 })
-            })
-        });
-        let t3 = std::time::Instant::now();
-        self.record(DistributedTimes {
-            fft: (t1 - start).as_secs_f64(),
-            exchange: (t2 - t1).as_secs_f64(),
-            dwt: (t3 - t2).as_secs_f64(),
-            total: (t3 - start).as_secs_f64(),
-        });
+            });
+            let t3 = std::time::Instant::now();
+            times.fft += (t1 - t0).as_secs_f64();
+            times.exchange += (t2 - t1).as_secs_f64();
+            times.dwt += (t3 - t2).as_secs_f64();
+        }
+        times.total = start.elapsed().as_secs_f64();
+        self.record(times);
         self.put_rows((a, b));
         Ok(())
     }
 
     fn inverse_impl(&self, coeffs: &[Complex64], out: SendPtr<f64>, real: bool) -> Result<()> {
         let g = &self.general;
-        let loc = self.local_lanes();
-        let all = self.all_lanes();
         let slice_len = self.shape.slice_len();
         let start = std::time::Instant::now();
         let (mut a, mut b) = self.take_rows()?;
-        let b_ptr = SendPtr(b.as_mut_ptr());
-        let coef = SendConstPtr(coeffs.as_ptr());
-        g.workers.pool().install(|| {
-            self.local.par_iter().for_each(|cl| {
-                g.dwt.with_scratch(|sc| {
-                    let n = g.dwt.setup(sc, cl, &g.pairs, all);
-                    // SAFETY: the local coefficients (checked length), read only; this
-                    // cluster's slots of `b`'s lane rows, written by this task only.
-                    unsafe {
-                        g.dwt.inverse(
-                            sc,
-                            cl,
-                            all,
-                            n,
-                            coef.get(),
-                            (real, false),
-                            b_ptr.get().add(cl.offset),
-                        )
-                    }
+        let mut times = DistributedTimes::default();
+        let mut done: Result<()> = Ok(());
+        for k in 0..self.groups {
+            let t0 = std::time::Instant::now();
+            let ch = self.group_lanes(k);
+            let b_ptr = SendPtr(b.as_mut_ptr());
+            let coef = SendConstPtr(coeffs.as_ptr());
+            g.workers.pool().install(|| {
+                self.local.par_iter().for_each(|cl| {
+                    g.dwt.with_scratch(|sc| {
+                        let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                        // SAFETY: the local coefficients (checked length), read only; this
+                        // cluster's slots of `b`'s lane rows of the group, written by this
+                        // task only.
+                        unsafe {
+                            g.dwt.inverse(
+                                sc,
+                                cl,
+                                ch,
+                                n,
+                                coef.get(),
+                                (real, false),
+                                b_ptr.get().add(cl.offset),
+                            )
+                        }
+                    })
                 })
-            })
-        });
-        let t1 = std::time::Instant::now();
-        self.exchange(&mut a[..], &mut b[..], false)?;
-        let t2 = std::time::Instant::now();
-        let a_ptr = SendPtr(a.as_mut_ptr());
-        let slices = self.local_slices();
-        let done: Result<()> = g.workers.pool().install(|| {
-            slices
-                .par_iter()
-                .enumerate()
-                .try_for_each(|(s, &(jj, upper))| {
+            });
+            let t1 = std::time::Instant::now();
+            self.exchange((&mut a[..], &mut b[..]), false, k)?;
+            let t2 = std::time::Instant::now();
+            let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
+            let slices = self.group_slices(k);
+            let group_done: Result<()> = g.workers.pool().install(|| {
+                slices.par_iter().try_for_each(|&(s, jj, upper)| {
                     g.with_work(|work| {
-                        let rows = g.lane_rows(a_ptr.get(), 0, loc, (jj, upper));
-                        // SAFETY: the rows of `a` were filled by the exchange (finished); local
-                        // slice `s` is inside the checked local samples and this task's.
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), k, (jj, upper));
+                        // SAFETY: the parts' rows were written by the DWT stage (`b`) and
+                        // the exchange (`a`), both finished; local slice `s` is inside the
+                        // checked local samples and this task's.
                         unsafe {
                             if real {
                                 let w = g.fft.half_buf(work)?;
-                                g.scatter_real(w, rows);
+                                g.scatter_real(w, &rows);
                                 g.fft.inverse_real(w, out.get().add(s * slice_len));
                             } else {
                                 let w = g.fft.inv_buf(work)?;
-                                g.scatter(w, rows);
-                                g.fft
-                                    .inverse(w, out.get().cast::<Complex64>().add(s * slice_len));
+                                g.scatter(w, &rows);
+                                let at = out.get().cast::<Complex64>().add(s * slice_len);
+                                g.fft.inverse(w, at);
                             }
                         }
                         Ok(())
                     })
                 })
-        });
-        let t3 = std::time::Instant::now();
-        self.record(DistributedTimes {
-            dwt: (t1 - start).as_secs_f64(),
-            exchange: (t2 - t1).as_secs_f64(),
-            fft: (t3 - t2).as_secs_f64(),
-            total: (t3 - start).as_secs_f64(),
-        });
+            });
+            // A failed slice fails the call (after every group, so that no rank leaves the
+            // exchanges early).
+            if done.is_ok() {
+                done = group_done;
+            }
+            let t3 = std::time::Instant::now();
+            times.dwt += (t1 - t0).as_secs_f64();
+            times.exchange += (t2 - t1).as_secs_f64();
+            times.fft += (t3 - t2).as_secs_f64();
+        }
+        times.total = start.elapsed().as_secs_f64();
+        self.record(times);
         self.put_rows((a, b));
         collective(&self.comm, done)
     }

@@ -3,7 +3,7 @@
 //! chunk's slices).
 
 use super::betas::{Betas, LanePairs};
-use super::dwt_stage::{ChunkLanes, DwtStage};
+use super::dwt_stage::{ChunkLanes, ClusterPlan, DwtStage};
 use super::fft_stage::{FftStage, Work};
 use super::shape::{CoefLayout, Shape};
 use crate::error::{Error, Result};
@@ -671,7 +671,7 @@ impl General {
                                     // above (finished); slice `s` of output `t` is inside
                                     // the checked output and this task's alone.
                                     unsafe {
-                                        self.scatter(w, rows);
+                                        self.scatter(w, &[rows]);
                                         self.fft.inverse(w, o.get().add(at));
                                     }
                                 }
@@ -679,7 +679,7 @@ impl General {
                                     let w = self.fft.half_buf(work)?;
                                     // SAFETY: as above, for the real output.
                                     unsafe {
-                                        self.scatter_real(w, rows);
+                                        self.scatter_real(w, &[rows]);
                                         self.fft.inverse_real(w, o.get().add(at));
                                     }
                                 }
@@ -731,12 +731,12 @@ impl General {
                                     let w = self.fft.half_buf(work)?;
                                     let at = t * batch.in_dist + s * slice_len;
                                     self.fft.forward_real(w, inp.get().add(at));
-                                    self.gather_real(w, rows, weight);
+                                    self.gather_real(w, &[rows], weight);
                                 } else {
                                     let w = self.fft.fwd_buf(work)?;
                                     let at = 2 * (t * batch.in_dist + s * slice_len);
                                     self.fft.forward(w, inp.get().add(at).cast());
-                                    self.gather(w, rows, weight);
+                                    self.gather(w, &[rows], weight);
                                 }
                             }
                             Ok(())
@@ -816,6 +816,7 @@ impl General {
         LaneRows {
             own: buf.wrapping_add(at + r * rt),
             mirror: buf.wrapping_add(at + rm * rt),
+            clusters: (0, self.dwt.clusters.len()),
         }
     }
 
@@ -823,8 +824,8 @@ impl General {
     /// (whose columns `|M'| <= N` are cleared first; the others stay zero).
     ///
     /// # Safety
-    /// The lane rows hold `row_total` doubles each, written by the DWT stage.
-    pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: LaneRows) {
+    /// Each part's lane rows hold its clusters' slots, written by the DWT stage.
+    pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: &[LaneRows]) {
         let (na, ng) = self.fft.dims();
         let (rs, _) = self.fft.strides();
         let n = self.layout_n;
@@ -832,19 +833,13 @@ impl General {
             row[..=n].fill(Complex64::default());
             row[ng - n..ng].fill(Complex64::default());
         }
-        for cl in &self.dwt.clusters {
-            for (q, s) in cl.slots.iter().enumerate() {
-                let row = if s.member.reversed {
-                    rows.mirror
-                } else {
-                    rows.own
-                };
-                // SAFETY: `offset + 2q + 1 < row_total` doubles of a lane row.
-                let v = unsafe {
-                    let x = row.add(cl.offset + 2 * q);
-                    Complex64::new(*x, *x.add(1))
-                };
-                w[s.work] = v;
+        for part in rows {
+            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
+                for (q, s) in cl.slots.iter().enumerate() {
+                    let x = part.slot(cl, q, s.member.reversed);
+                    // SAFETY: the slot's two doubles are inside the part's lane row.
+                    w[s.work] = unsafe { Complex64::new(*x, *x.add(1)) };
+                }
             }
         }
     }
@@ -853,23 +848,22 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`].
-    pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: LaneRows) {
+    pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: &[LaneRows]) {
         let (na, _) = self.fft.dims();
         let (_, hs) = self.fft.strides();
         w.fill(Complex64::default());
-        for cl in &self.dwt.clusters {
-            for (q, s) in cl.slots.iter().enumerate() {
-                let mem = &s.member;
-                if mem.mp < 0 {
-                    continue;
+        for part in rows {
+            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
+                for (q, s) in cl.slots.iter().enumerate() {
+                    let mem = &s.member;
+                    if mem.mp < 0 {
+                        continue;
+                    }
+                    let x = part.slot(cl, q, mem.reversed);
+                    // SAFETY: as in `scatter`.
+                    let v = unsafe { Complex64::new(*x, -*x.add(1)) };
+                    w[mem.m.rem_euclid(na as isize) as usize * hs + mem.mp as usize] = v;
                 }
-                let row = if mem.reversed { rows.mirror } else { rows.own };
-                // SAFETY: as in `scatter`.
-                let v = unsafe {
-                    let x = row.add(cl.offset + 2 * q);
-                    Complex64::new(*x, -*x.add(1))
-                };
-                w[mem.m.rem_euclid(na as isize) as usize * hs + mem.mp as usize] = v;
             }
         }
     }
@@ -879,20 +873,18 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`], for writes; no other task writes these slots.
-    pub(super) unsafe fn gather(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
-        for cl in &self.dwt.clusters {
-            for (q, s) in cl.slots.iter().enumerate() {
-                let v = w[s.work] * weight;
-                let row = if s.member.reversed {
-                    rows.mirror
-                } else {
-                    rows.own
-                };
-                // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
-                unsafe {
-                    let x = row.add(cl.offset + 2 * q);
-                    *x = v.re;
-                    *x.add(1) = v.im;
+    pub(super) unsafe fn gather(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
+        for part in rows {
+            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
+                for (q, s) in cl.slots.iter().enumerate() {
+                    let v = w[s.work] * weight;
+                    let x = part.slot(cl, q, s.member.reversed);
+                    // SAFETY: as in `scatter`; these slots are this task's (caller's
+                    // contract).
+                    unsafe {
+                        *x = v.re;
+                        *x.add(1) = v.im;
+                    }
                 }
             }
         }
@@ -903,24 +895,25 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::gather`].
-    pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: LaneRows, weight: f64) {
+    pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
         let (na, _) = self.fft.dims();
         let (_, hs) = self.fft.strides();
         let at = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
-        for cl in &self.dwt.clusters {
-            for (q, s) in cl.slots.iter().enumerate() {
-                let mem = &s.member;
-                let v = if mem.mp >= 0 {
-                    w[at(mem.m, mem.mp)].conj()
-                } else {
-                    w[at(-mem.m, -mem.mp)]
-                } * weight;
-                let row = if mem.reversed { rows.mirror } else { rows.own };
-                // SAFETY: as in `gather`.
-                unsafe {
-                    let x = row.add(cl.offset + 2 * q);
-                    *x = v.re;
-                    *x.add(1) = v.im;
+        for part in rows {
+            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
+                for (q, s) in cl.slots.iter().enumerate() {
+                    let mem = &s.member;
+                    let v = if mem.mp >= 0 {
+                        w[at(mem.m, mem.mp)].conj()
+                    } else {
+                        w[at(-mem.m, -mem.mp)]
+                    } * weight;
+                    let x = part.slot(cl, q, mem.reversed);
+                    // SAFETY: as in `gather`.
+                    unsafe {
+                        *x = v.re;
+                        *x.add(1) = v.im;
+                    }
                 }
             }
         }
@@ -941,9 +934,34 @@ impl General {
     }
 }
 
-/// A slice's lane rows: its own and its mirror's.
+/// A slice's lane rows: its own and its mirror's, for the clusters `clusters.0 ..
+/// clusters.1`; cluster `c`'s slots start `offset(c)` doubles after the pointers (which may
+/// point before the rows when they hold only a later part of the clusters).
 #[derive(Clone, Copy)]
 pub(super) struct LaneRows {
     own: *mut f64,
     mirror: *mut f64,
+    clusters: (usize, usize),
+}
+
+impl LaneRows {
+    /// Rows that hold the clusters `clusters` only, the first of which at offset `first`
+    /// of the full lane row: their slots at `own` and `mirror` onwards.
+    pub(super) fn part(
+        (own, mirror): (*mut f64, *mut f64),
+        clusters: (usize, usize),
+        first: usize,
+    ) -> LaneRows {
+        LaneRows {
+            own: own.wrapping_sub(first),
+            mirror: mirror.wrapping_sub(first),
+            clusters,
+        }
+    }
+
+    /// Where the `q`-th slot of cluster `cl` is (in the mirror's row if `reversed`).
+    fn slot(&self, cl: &ClusterPlan, q: usize, reversed: bool) -> *mut f64 {
+        let row = if reversed { self.mirror } else { self.own };
+        row.wrapping_add(cl.offset + 2 * q)
+    }
 }

@@ -55,7 +55,10 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         NODE_BYTES / 1e9,
         NODE_NET / 1e9
     );
-    println!("  one rank per node; memory per rank = (samples + 2 lane-row buffers) / P + coefficients / P;");
+    println!("  one rank per node; memory per rank = (samples + coefficients) / P + workspace, the larger of");
+    println!(
+        "  512 MiB and a twentieth of the arrays (the pairs run in as many groups as that needs);"
+    );
     println!("  exchange per rank and transform = lane rows / P x (P - 1) / P each way, at the network's speed");
     println!("  (no overlap of computation and exchange); time = inverse + forward.");
     println!(
@@ -70,7 +73,8 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         let rows = (n - 1.0) * (n - 1.0) * n * 16.0;
         let compute = per_term * terms(b) + per_sample_log * n * n * n * (n * n).log2();
         for p in [8f64, 16.0, 32.0, 64.0, 128.0, 256.0] {
-            let mem = (samples + 2.0 * rows + coeffs) / p;
+            let arrays = (samples + coeffs) / p;
+            let mem = arrays + (arrays / 20.0).max(512.0 * 1024.0 * 1024.0);
             let exchange = rows / p * (p - 1.0) / p;
             let t_compute = compute / (p * NODE_CORES);
             let t_net = 2.0 * exchange / NODE_NET;
