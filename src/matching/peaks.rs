@@ -42,19 +42,39 @@ impl Peak {
 /// and replaced only by a strictly larger value: ties go to the lowest index, an all-zero
 /// grid gives index 0 (SOFT's `softFFTWCor2` rule). NaN values are never taken.
 pub fn grid_argmax(b: usize, values: &[Complex64]) -> Peak {
-    argmax_by(b, values.iter().map(|z| z.norm_sqr()))
+    argmax_by(b, values, |z| z.norm_sqr())
 }
 
 /// [`grid_argmax`] of a real grid (`|C|^2 = C^2`).
 pub fn grid_argmax_real(b: usize, values: &[f64]) -> Peak {
-    argmax_by(b, values.iter().map(|x| x * x))
+    argmax_by(b, values, |x| x * x)
 }
 
-fn argmax_by(b: usize, values: impl Iterator<Item = f64>) -> Peak {
+/// The scan of [`grid_argmax`] in blocks: a block's maximum first (eight independent running
+/// maxima, which vectorise), then, only when it beats the best so far, the first index in
+/// the block that reaches it. The same index as a one-by-one scan.
+fn argmax_by<T: Copy>(b: usize, values: &[T], f: impl Fn(T) -> f64) -> Peak {
+    const BLOCK: usize = 1024;
     let (mut best, mut at) = (0.0, 0);
-    for (i, v) in values.enumerate() {
-        if v > best {
-            (best, at) = (v, i);
+    for (k, block) in values.chunks(BLOCK).enumerate() {
+        let mut lanes = [0.0f64; 8];
+        let mut groups = block.chunks_exact(8);
+        for g in &mut groups {
+            for (m, &v) in lanes.iter_mut().zip(g) {
+                let x = f(v);
+                // NaN compares false and is never taken.
+                *m = if x > *m { x } else { *m };
+            }
+        }
+        let top = groups
+            .remainder()
+            .iter()
+            .map(|&v| f(v))
+            .chain(lanes)
+            .fold(0.0, |m, x| if x > m { x } else { m });
+        if top > best {
+            let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
+            (best, at) = (top, k * BLOCK + i);
         }
     }
     Peak::at(b, at, best)
@@ -113,4 +133,47 @@ pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Ve
         }
     }
     taken
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule itself: a one-by-one scan taking only strictly larger values.
+    fn plain(values: &[f64]) -> (usize, f64) {
+        let (mut best, mut at) = (0.0, 0);
+        for (i, &v) in values.iter().enumerate() {
+            if v * v > best {
+                (best, at) = (v * v, i);
+            }
+        }
+        (at, best)
+    }
+
+    #[test]
+    fn block_scan_takes_the_first_largest_value() {
+        let b = 9;
+        let n = 8 * b * b * b;
+        let mut state = 1u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (state >> 40) % 50
+        };
+        // Few distinct values (many ties), a NaN and negative values; then special grids.
+        let mut v: Vec<f64> = (0..n).map(|_| next() as f64 - 25.0).collect();
+        v[3] = f64::NAN;
+        let mut grids = vec![v.clone(), vec![0.0; n], vec![f64::NAN; n]];
+        v[n - 1] = 1e3;
+        grids.push(v.clone());
+        v[2000] = -1e3;
+        grids.push(v);
+        for g in &grids {
+            let p = grid_argmax_real(b, g);
+            let (at, best) = plain(g);
+            assert_eq!((p.index, p.value), (at, best));
+            let z: Vec<Complex64> = g.iter().map(|&x| Complex64::new(0.0, x)).collect();
+            let q = grid_argmax(b, &z);
+            assert_eq!((q.index, q.value), (at, best));
+        }
+    }
 }
