@@ -18,6 +18,11 @@ if [ -f CMakeLists.txt ]; then
   cmake -S . -B build/ci -DCMAKE_BUILD_TYPE=Release -DSO3FFT_MPI=ON >/dev/null
   cmake --build build/ci -j2
   ctest --test-dir build/ci --output-on-failure
+  # The default build (no MPI) too, on cargo test's library: C API and installed package.
+  cmake -S . -B build/ci-nompi -DCMAKE_BUILD_TYPE=Release -DSO3FFT_VALGRIND_TESTS=OFF \
+        -DSO3FFT_ATTACK_TESTS=OFF >/dev/null
+  cmake --build build/ci-nompi -j2
+  ctest --test-dir build/ci-nompi -L '^(c|downstream)$' --output-on-failure
 fi
 # In the CMake build's target directory: reuses its MPI-enabled library.
 CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi
