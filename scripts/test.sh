@@ -1,32 +1,28 @@
 #!/usr/bin/env bash
 # Every test: the Rust suite (unit, integration, doc tests), the C/C++ suite under CTest
-# (C API, SOFT compatibility layer, installed-package tests, valgrind runs), and the
-# distributed plans under mpirun on 1..4 ranks (feature `mpi`).
+# (C API, SOFT compatibility layer, installed-package tests, valgrind runs, and the
+# distributed plans under mpirun on 1..4 ranks: label `mpi`), and the Rust MPI test
+# (tests/mpi.rs, feature `mpi`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-cargo test --release
-if [ -f CMakeLists.txt ]; then
-  cmake -S . -B build/ci -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build build/ci -j2
-  ctest --test-dir build/ci --output-on-failure
-fi
-if command -v mpirun >/dev/null && command -v mpicc >/dev/null; then
-  cargo build --release --features mpi --lib --example mpi_check
-  # The C API of include/so3fft_mpi.h against the library built with the feature.
-  mpilib=target/mpi-lib
-  mkdir -p "$mpilib"
-  cp target/release/libso3fft.so "$mpilib/"
-  ln -sf libso3fft.so "$mpilib/libso3fft.so.0"
-  mpicc -std=c11 -Wall -Wextra -Werror -Iinclude -o "$mpilib/test_mpi" c_tests/mpi/test_mpi.c \
-    -L"$mpilib" -lso3fft -Wl,-rpath,"$PWD/$mpilib" -lm
-  for np in 1 2 3 4; do
-    # A deadlock fails the run instead of hanging it.
-    timeout 600 mpirun --allow-run-as-root --oversubscribe -np "$np" \
-      target/release/examples/mpi_check
-    timeout 300 mpirun --allow-run-as-root --oversubscribe -np "$np" "$mpilib/test_mpi"
-  done
-else
-  echo "mpirun or mpicc not found: distributed plans not tested" >&2
+if ! command -v mpirun >/dev/null || ! command -v mpicc >/dev/null; then
+  echo "mpirun or mpicc not found: distributed plans cannot be tested" \
+       "(scripts/install-deps.sh installs Open MPI)" >&2
   exit 1
 fi
+cargo test --release
+if [ -f CMakeLists.txt ]; then
+  # SO3FFT_MPI=ON: libso3fft is built with the feature `mpi` (into target/mpi, apart from
+  # cargo test's target/release), every C test runs on that library, plus the mpi tests.
+  cmake -S . -B build/ci -DCMAKE_BUILD_TYPE=Release -DSO3FFT_MPI=ON >/dev/null
+  cmake --build build/ci -j2
+  ctest --test-dir build/ci --output-on-failure
+  # The default build (no MPI) too, on cargo test's library: C API and installed package.
+  cmake -S . -B build/ci-nompi -DCMAKE_BUILD_TYPE=Release -DSO3FFT_VALGRIND_TESTS=OFF \
+        -DSO3FFT_ATTACK_TESTS=OFF >/dev/null
+  cmake --build build/ci-nompi -j2
+  ctest --test-dir build/ci-nompi -L '^(c|downstream)$' --output-on-failure
+fi
+# In the CMake build's target directory: reuses its MPI-enabled library.
+CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi

@@ -7,8 +7,12 @@
 #   KIND=soft20     a SOFT 2.0 client project: find_package(soft20), headers included bare, as
 #                   soft/... and as soft20/...
 #   KIND=pkgconfig  `pkg-config --cflags --libs so3fft` (shared) and
-#                   `pkg-config --static --cflags --libs so3fft` with -static (fully static).
-# Inputs: KIND, BUILD_DIR, WORK_DIR, SOURCE_DIR, C_COMPILER, GENERATOR.
+#                   `pkg-config --static --cflags --libs so3fft` with -static (fully static;
+#                   with MPI only libso3fft.a is static: Debian ships no static libmpi).
+#   KIND=mpi        an MPI program (mpi/main.c) built by a CMake project linking so3fft::mpi
+#                   and with `pkg-config --cflags --libs so3fft-mpi`, each run on 2 ranks.
+# Inputs: KIND, BUILD_DIR, WORK_DIR, SOURCE_DIR, C_COMPILER, GENERATOR; for a build with
+# SO3FFT_MPI: MPI=ON, MPIEXEC, MPIEXEC_NUMPROC_FLAG, MPIEXEC_FLAGS (comma-separated).
 cmake_minimum_required(VERSION 3.21)
 
 function(run)
@@ -95,11 +99,42 @@ elseif(KIND STREQUAL "pkgconfig")
   capture(sflags "${PKG_CONFIG}" --static --cflags --libs so3fft)
   message(STATUS "pkg-config --static --cflags --libs so3fft: ${sflags}")
   separate_arguments(sflags UNIX_COMMAND "${sflags}")
-  run("${C_COMPILER}" -Wall -Wextra -Werror -static "${SOURCE_DIR}/main.c"
+  set(static -static)
+  if(MPI)
+    # libso3fft.a by name, the rest (libmpi through Requires.private) shared.
+    list(TRANSFORM sflags REPLACE "^-lso3fft$" "-l:libso3fft.a")
+    set(static)
+  endif()
+  run("${C_COMPILER}" -Wall -Wextra -Werror ${static} "${SOURCE_DIR}/main.c"
       -o "${WORK_DIR}/use_pc_static" ${sflags} -lm)
   file(RENAME "${prefix}" "${WORK_DIR}/gone")
   run("${WORK_DIR}/use_pc_static")
   message(STATUS "pkg-config: OK")
+elseif(KIND STREQUAL "mpi")
+  file(GLOB_RECURSE mpi_pcfile "${prefix}/*/so3fft-mpi.pc")
+  if(NOT mpi_pcfile OR NOT EXISTS "${prefix}/include/so3fft_mpi.h")
+    message(FATAL_ERROR "so3fft-mpi.pc or so3fft_mpi.h not installed under ${prefix}")
+  endif()
+  string(REPLACE "," ";" flags "${MPIEXEC_FLAGS}")
+  set(mpiexec "${MPIEXEC}" ${flags} ${MPIEXEC_NUMPROC_FLAG} 2)
+
+  run("${CMAKE_COMMAND}" -S "${SOURCE_DIR}/mpi" -B "${WORK_DIR}/build" -G "${GENERATOR}"
+      "-DCMAKE_C_COMPILER=${C_COMPILER}" "-DCMAKE_PREFIX_PATH=${prefix}"
+      -DCMAKE_BUILD_TYPE=Release)
+  run("${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
+  run(${mpiexec} "${WORK_DIR}/build/use_mpi")
+
+  find_program(PKG_CONFIG pkg-config REQUIRED)
+  get_filename_component(pcdir "${mpi_pcfile}" DIRECTORY)
+  set(ENV{PKG_CONFIG_PATH} "${pcdir}")
+  capture(pc_libdir "${PKG_CONFIG}" --variable=libdir so3fft-mpi)
+  capture(flags "${PKG_CONFIG}" --cflags --libs so3fft-mpi)
+  message(STATUS "pkg-config --cflags --libs so3fft-mpi: ${flags}")
+  separate_arguments(flags UNIX_COMMAND "${flags}")
+  run("${C_COMPILER}" -Wall -Wextra -Werror "${SOURCE_DIR}/mpi/main.c"
+      -o "${WORK_DIR}/use_pc_mpi" ${flags} -lm "-Wl,-rpath,${pc_libdir}")
+  run(${mpiexec} "${WORK_DIR}/use_pc_mpi")
+  message(STATUS "downstream MPI program (so3fft::mpi, so3fft-mpi.pc): OK")
 else()
   message(FATAL_ERROR "unknown KIND '${KIND}'")
 endif()
