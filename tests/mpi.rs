@@ -4,8 +4,8 @@
 //! after 600 s, so a deadlock fails instead of hanging) and fails if any run fails. Run under
 //! `mpirun` (`OMPI_COMM_WORLD_SIZE` or `PMI_SIZE` set), every rank checks its part against a
 //! single-process plan of the same shape (bitwise: complex and real, forward and inverse), a
-//! distributed round trip with `|M|, |M'| <= 8` at B = 1024, and a collective error (ranks
-//! given different shapes), and exits non-zero on every rank if any check fails on any rank.
+//! distributed round trip with `|M|, |M'| <= 8` at B = 1024, and collective errors (ranks
+//! given different shapes; one rank out of memory: the same error class on every rank), and exits non-zero on every rank if any check fails on any rank.
 //! Also plans run in groups of pairs (a small workspace cap), against the single-process
 //! plan to rounding.
 
@@ -186,11 +186,64 @@ fn run(comm: &MpiExchange) -> so3fft::Result<usize> {
         );
     }
     bad += usize::from(worst > 1e-11);
+    // A rank that cannot allocate its buffers (its address space capped just above what it
+    // uses): every rank's execute fails, none waits in the exchange.
+    let s = Shape::new(64);
+    let plan = DistributedPlan::new(comm, &s, &opts(false))?;
+    let c = vec![Complex64::default(); plan.local_num_coeffs()];
+    let mut x = vec![Complex64::default(); plan.local_num_samples()];
+    let capped = comm.rank() == 0;
+    let old = if capped {
+        cap_address_space(4 << 20)
+    } else {
+        None
+    };
+    let r = plan.inverse(&c, &mut x);
+    if let Some(old) = old {
+        // SAFETY: `old` is the limit read by getrlimit; raising the soft limit back is allowed.
+        unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+    }
+    // The same error class on every rank (C: SO3FFT_ENOMEM everywhere).
+    if !matches!(r, Err(so3fft::Error::OutOfMemory { .. })) {
+        eprintln!(
+            "rank {}: expected an out-of-memory error, got {r:?}",
+            comm.rank()
+        );
+        bad += 1;
+    }
+    bad += usize::from(plan.inverse(&c, &mut x).is_err());
     // Ranks given different shapes: every rank gets the error.
     let other = Shape::new(8 + usize::from(comm.rank() == comm.size() - 1 && comm.size() > 1));
     let r = DistributedPlan::new(comm, &other, &opts(false));
     bad += usize::from(r.is_err() != (comm.size() > 1));
     Ok(bad)
+}
+
+/// Caps this process's address space at its current size plus `extra` bytes; the old limit.
+fn cap_address_space(extra: u64) -> Option<libc::rlimit> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb: u64 = status
+        .lines()
+        .find(|l| l.starts_with("VmSize:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    let mut old = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: `old` is a valid out-pointer; the new limit is a plain value.
+    unsafe {
+        if libc::getrlimit(libc::RLIMIT_AS, &mut old) != 0 {
+            return None;
+        }
+        let cap = libc::rlimit {
+            rlim_cur: kb * 1024 + extra,
+            rlim_max: old.rlim_max,
+        };
+        (libc::setrlimit(libc::RLIMIT_AS, &cap) == 0).then_some(old)
+    }
 }
 
 /// On a rank under `mpirun`: the checks; the exit code is the same on every rank.

@@ -125,15 +125,54 @@ pub struct DistributedPlan<X: Exchange> {
     rows: std::sync::Mutex<Option<(Rows, Rows)>>,
 }
 
-/// An error on every rank if it is one on any (agreed through `comm`).
+/// The classes of errors the ranks agree on (those of the C error codes), by priority.
+const INVALID: u64 = 1;
+const BANDWIDTH: u64 = 2;
+const DIRECTION: u64 = 3;
+const FFTW: u64 = 4;
+const NO_MEMORY: u64 = 5;
+
+fn error_class(e: &Error) -> u64 {
+    match e {
+        Error::InvalidArgument(_) | Error::LengthMismatch { .. } => INVALID,
+        Error::InvalidBandwidth { .. } => BANDWIDTH,
+        Error::WrongDirection => DIRECTION,
+        Error::Fftw(_) => FFTW,
+        Error::OutOfMemory { .. } | Error::Resources(_) => NO_MEMORY,
+    }
+}
+
+/// An error on every rank if it is one on any, of the same class everywhere (agreed through
+/// `comm`: the highest class of the ranks' errors): a rank whose own error is of that class
+/// returns it, the others an error of that class saying that another rank failed.
 fn collective<X: Exchange, T>(comm: &X, r: Result<T>) -> Result<T> {
-    let failed = comm.max(u64::from(r.is_err()))?;
-    match (r, failed) {
-        (Ok(v), 0) => Ok(v),
-        (Err(e), _) => Err(e),
-        (Ok(_), _) => Err(Error::InvalidArgument(
-            "another rank of the distributed plan failed (see its error)".into(),
-        )),
+    let class = comm.max(r.as_ref().err().map_or(0, error_class))?;
+    if class == 0 {
+        return r;
+    }
+    // Every rank knows that one failed; for memory, they also agree on the largest request.
+    let bytes = match &r {
+        Err(Error::OutOfMemory { bytes }) => *bytes as u64,
+        _ => 0,
+    };
+    let bytes = if class == NO_MEMORY {
+        comm.max(bytes)? as usize
+    } else {
+        0
+    };
+    let other = "another rank of the distributed plan failed (see its error)";
+    match r {
+        Err(e) if error_class(&e) == class => Err(e),
+        _ => Err(match class {
+            NO_MEMORY => Error::OutOfMemory { bytes },
+            FFTW => Error::Fftw(other.into()),
+            DIRECTION => Error::WrongDirection,
+            BANDWIDTH => Error::InvalidBandwidth {
+                bandwidth: 0,
+                max: crate::MAX_BANDWIDTH,
+            },
+            _ => Error::InvalidArgument(other.into()),
+        }),
     }
 }
 
@@ -677,7 +716,8 @@ impl<X: Exchange> DistributedPlan<X> {
     ) -> Result<()> {
         let g = &self.general;
         let slice_len = self.shape.slice_len();
-        let (mut a, mut b) = self.take_rows()?;
+        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
+        let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
         let per_value = if real { 1 } else { 2 };
         let mut times = DistributedTimes::default();
         let start = std::time::Instant::now();
@@ -754,7 +794,8 @@ impl<X: Exchange> DistributedPlan<X> {
         let g = &self.general;
         let slice_len = self.shape.slice_len();
         let start = std::time::Instant::now();
-        let (mut a, mut b) = self.take_rows()?;
+        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
+        let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
         let mut times = DistributedTimes::default();
         let mut done: Result<()> = Ok(());
         for k in 0..self.groups {
