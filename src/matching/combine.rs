@@ -3,7 +3,9 @@
 use crate::error::{Error, Result};
 use crate::grid::{block_start, num_coeffs};
 use crate::s2::order_start;
+use crate::workers::SendPtr;
 use num_complex::Complex64;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// The SO(3) coefficients (bandwidth `b_out`, `so3CoefLoc` order) of the correlation
@@ -70,7 +72,9 @@ pub(super) fn add_combined(
         .map(|l| scale * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt())
         .collect();
     let top = to as isize;
-    for m1 in -top..=top {
+    let len = out.len();
+    let dst = SendPtr(out.as_mut_ptr());
+    let row = |m1: isize| {
         // fhat(l, -m1) for l = |m1|.. is consecutive from order_start(-m1).
         let f_row = &sig[order_start(b_in, -m1)..];
         for m2 in -top..=top {
@@ -86,9 +90,21 @@ pub(super) fn add_combined(
                 -1.0
             };
             let base = block_start(b_out, m1, m2) - a1.max(a2);
+            assert!(base + to < len);
             for l in l0..=to {
-                out[base + l] += f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+                // SAFETY: inside `out` (asserted above); the block of `(m1, m2)` is this
+                // row's alone, no other task touches it.
+                unsafe {
+                    *dst.get().add(base + l) +=
+                        f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+                }
             }
         }
+    };
+    // On a worker pool (the correlation plan's), the orders are spread over its threads.
+    if rayon::current_thread_index().is_some() {
+        (-top..=top).into_par_iter().for_each(row);
+    } else {
+        (-top..=top).for_each(row);
     }
 }

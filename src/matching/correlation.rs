@@ -180,13 +180,17 @@ impl Correlation {
             }
         }
         if from <= self.deg_lim {
-            add_combined(
-                (&buf.sig, &buf.pat),
-                self.b_in,
-                (from, self.deg_lim),
-                self.deg_lim + 1,
-                (weight, &mut buf.so3),
-            );
+            let (sig, pat, so3) = (&buf.sig, &buf.pat, &mut buf.so3);
+            // On the plan's workers (the orders spread over them).
+            self.s2.install(|| {
+                add_combined(
+                    (sig, pat),
+                    self.b_in,
+                    (from, self.deg_lim),
+                    self.deg_lim + 1,
+                    (weight, so3),
+                )
+            });
         }
         Ok(())
     }

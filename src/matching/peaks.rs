@@ -2,6 +2,7 @@
 
 use crate::grid::{alpha, beta, gamma};
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// A grid point of a correlation: its flat index, Euler angles (z-y-z) and value.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,34 +51,53 @@ pub fn grid_argmax_real(b: usize, values: &[f64]) -> Peak {
     argmax_by(b, values, |x| x * x)
 }
 
-/// The scan of [`grid_argmax`] in blocks: a block's maximum first (eight independent running
-/// maxima, which vectorise), then, only when it beats the best so far, the first index in
-/// the block that reaches it. The same index as a one-by-one scan.
-fn argmax_by<T: Copy>(b: usize, values: &[T], f: impl Fn(T) -> f64) -> Peak {
+/// The scan of [`grid_argmax`], in parts spread over rayon's current pool (each part's first
+/// largest value; the parts' results combined by value, then by the lower index) and, within
+/// a part, in blocks: a block's maximum first (eight independent running maxima, which
+/// vectorise), then, only when it beats the best so far, the first index in the block that
+/// reaches it. The same index as a one-by-one scan.
+fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync) -> Peak {
+    const PART: usize = 1 << 16;
     const BLOCK: usize = 1024;
-    let (mut best, mut at) = (0.0, 0);
-    for (k, block) in values.chunks(BLOCK).enumerate() {
-        let mut lanes = [0.0f64; 8];
-        let mut groups = block.chunks_exact(8);
-        for g in &mut groups {
-            for (m, &v) in lanes.iter_mut().zip(g) {
-                let x = f(v);
-                // NaN compares false and is never taken.
-                *m = if x > *m { x } else { *m };
+    let part_best = |(p, part): (usize, &[T])| -> (f64, usize) {
+        let (mut best, mut at) = (0.0, usize::MAX);
+        for (k, block) in part.chunks(BLOCK).enumerate() {
+            let mut lanes = [0.0f64; 8];
+            let mut groups = block.chunks_exact(8);
+            for g in &mut groups {
+                for (m, &v) in lanes.iter_mut().zip(g) {
+                    let x = f(v);
+                    // NaN compares false and is never taken.
+                    *m = if x > *m { x } else { *m };
+                }
+            }
+            let top = groups
+                .remainder()
+                .iter()
+                .map(|&v| f(v))
+                .chain(lanes)
+                .fold(0.0, |m, x| if x > m { x } else { m });
+            if top > best {
+                let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
+                (best, at) = (top, p * PART + k * BLOCK + i);
             }
         }
-        let top = groups
-            .remainder()
-            .iter()
-            .map(|&v| f(v))
-            .chain(lanes)
-            .fold(0.0, |m, x| if x > m { x } else { m });
-        if top > best {
-            let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
-            (best, at) = (top, k * BLOCK + i);
+        (best, at)
+    };
+    let first_largest = |x: (f64, usize), y: (f64, usize)| {
+        if y.0 > x.0 || (y.0 == x.0 && y.1 < x.1) {
+            y
+        } else {
+            x
         }
-    }
-    Peak::at(b, at, best)
+    };
+    let (best, at) = values
+        .par_chunks(PART)
+        .enumerate()
+        .map(part_best)
+        .reduce(|| (0.0, usize::MAX), first_largest);
+    // No positive value: index 0.
+    Peak::at(b, if at == usize::MAX { 0 } else { at }, best)
 }
 
 /// Up to `k` peaks of `|C|^2` on the grid `values` (bandwidth `b`), largest first: grid
@@ -152,7 +172,8 @@ mod tests {
 
     #[test]
     fn block_scan_takes_the_first_largest_value() {
-        let b = 9;
+        // Several parts of the parallel scan (2^16 values each), each of several blocks.
+        let b = 33;
         let n = 8 * b * b * b;
         let mut state = 1u64;
         let mut next = || {
@@ -165,7 +186,10 @@ mod tests {
         let mut grids = vec![v.clone(), vec![0.0; n], vec![f64::NAN; n]];
         v[n - 1] = 1e3;
         grids.push(v.clone());
-        v[2000] = -1e3;
+        v[200_000] = -1e3;
+        grids.push(v.clone());
+        // A tie between two parts: the earlier part's index.
+        v[70_000] = 1e3;
         grids.push(v);
         for g in &grids {
             let p = grid_argmax_real(b, g);
