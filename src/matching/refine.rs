@@ -198,13 +198,13 @@ impl<'a> So3Series<'a> {
                     mu = (2.0 * mu).max(1e-8 * scale.max(1e-300));
                     continue;
                 };
+                let step = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let next = Rotation::new(g.alpha + s[0], g.beta + s[1], g.gamma + s[2]);
                 let (nf, nmid) = self.objective(&next);
                 if nf >= f {
-                    let step = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                     (g, f) = (next, nf);
-                    // Quadratic convergence: a step this small leaves an error far below
-                    // the next one's.
+                    // Near the maximum the steps shrink fast: a step this small leaves an
+                    // error far below the next one's.
                     if step < 1e-10 {
                         return (g, f);
                     }
@@ -212,6 +212,11 @@ impl<'a> So3Series<'a> {
                     mu /= 4.0;
                     moved = true;
                     break;
+                }
+                // A step this small that does not raise `|C|^2` is at what rounding lets
+                // it tell apart: done (damped retries would only be rejected again).
+                if step < 1e-9 {
+                    return (g, f);
                 }
                 mu = (4.0 * mu).max(1e-6 * scale.max(1e-300));
             }
