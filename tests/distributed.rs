@@ -9,13 +9,6 @@ use so3fft::{
     Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
 };
 
-fn rnd(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-}
-
 fn opts(real: bool) -> PartialOptions {
     PartialOptions {
         threads: 1,
@@ -68,10 +61,15 @@ fn check_grouped(s: Shape, ranks: usize, real: bool, cap: Option<usize>) {
     let (nc, ns, sl) = (s.num_coeffs(), s.num_samples(), s.slice_len());
     let mut st = 5u64;
     let mut c: Vec<Complex64> = (0..nc)
-        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+        .map(|_| Complex64::new(common::rnd(&mut st), common::rnd(&mut st)))
         .collect();
     let samples: Vec<Complex64> = (0..ns)
-        .map(|_| Complex64::new(rnd(&mut st), if real { 0.0 } else { rnd(&mut st) }))
+        .map(|_| {
+            Complex64::new(
+                common::rnd(&mut st),
+                if real { 0.0 } else { common::rnd(&mut st) },
+            )
+        })
         .collect();
     if real {
         common::make_hermitian(&s, &mut c);

@@ -9,6 +9,8 @@
 //! Also plans run in groups of pairs (a small workspace cap), against the single-process
 //! plan to rounding.
 
+mod common;
+
 use so3fft::partial::{mpi_finalize, mpi_init, MpiExchange};
 use so3fft::{Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape};
 use std::process::{Command, ExitCode, Stdio};
@@ -17,42 +19,12 @@ use std::time::{Duration, Instant};
 /// Longest a run on N ranks may take.
 const TIMEOUT: Duration = Duration::from_secs(600);
 
-fn rnd(state: &mut u64) -> f64 {
-    *state = state
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-}
-
 fn opts(real: bool) -> PartialOptions {
     PartialOptions {
         threads: 1,
         real,
         general_engine: true,
         ..PartialOptions::default()
-    }
-}
-
-/// A real signal's coefficients: `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
-fn hermitian(s: &Shape, c: &mut [Complex64]) {
-    let (a, n) = (s.order_limit_alpha as isize, s.order_limit_gamma as isize);
-    for l in 0..s.degree_limit {
-        for m in -a..=a {
-            for mp in -n..=n {
-                if let (Some(i), Some(j)) = (s.coef_index(l, m, mp), s.coef_index(l, -m, -mp)) {
-                    if i < j {
-                        let sg = if (m - mp).rem_euclid(2) == 0 {
-                            1.0
-                        } else {
-                            -1.0
-                        };
-                        c[j] = c[i].conj() * sg;
-                    } else if i == j {
-                        c[i].im = 0.0;
-                    }
-                }
-            }
-        }
     }
 }
 
@@ -114,10 +86,10 @@ fn agreement(
     let (ns, sl) = (s.num_samples(), s.slice_len());
     let mut st = 3u64;
     let mut c: Vec<Complex64> = (0..s.num_coeffs())
-        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+        .map(|_| Complex64::new(common::rnd(&mut st), common::rnd(&mut st)))
         .collect();
     if real {
-        hermitian(&s, &mut c);
+        common::make_hermitian(&s, &mut c);
     }
     let lc = local_coeffs(&plan, &s, &c);
     let mine = slices(&s, plan.local_pairs());
@@ -165,7 +137,7 @@ fn run(comm: &MpiExchange) -> so3fft::Result<usize> {
     let plan = DistributedPlan::new(comm, &s, &PartialOptions::default())?;
     let mut st = 11u64 + comm.rank() as u64;
     let c: Vec<Complex64> = (0..plan.local_num_coeffs())
-        .map(|_| Complex64::new(rnd(&mut st), rnd(&mut st)))
+        .map(|_| Complex64::new(common::rnd(&mut st), common::rnd(&mut st)))
         .collect();
     let mut x = vec![Complex64::default(); plan.local_num_samples()];
     let t = std::time::Instant::now();

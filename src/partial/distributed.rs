@@ -104,20 +104,23 @@ struct Share {
     segment: (usize, usize),
 }
 
+/// Where one group's rows are on a rank.
+struct GroupRows {
+    /// The DWT stage's lanes of the group (every rank's pairs), rows of the rank's segment.
+    ch: ChunkLanes,
+    /// Per rank: its pairs' offset among the group's lanes, and their number.
+    parts: Vec<(usize, usize)>,
+    /// Per rank (not this one): its block in `a`, `(first double, row length)`; rows
+    /// `0 .. n_me` lower, `n_me .. 2 n_me` mirrors.
+    blocks: Vec<(usize, usize)>,
+    /// This rank's pairs in the group.
+    n_me: usize,
+}
+
 /// The transforms of a [`Shape`] over the ranks of an [`Exchange`].
 pub struct DistributedPlan<X: Exchange> {
     comm: X,
-    shape: Shape,
-    real: bool,
-    direction: Direction,
-    general: General,
-    shares: Vec<Share>,
-    /// The local clusters, their blocks at local coefficient offsets and their slots at
-    /// offsets within the local segment of a lane row.
-    local: Vec<ClusterPlan>,
-    local_coeffs: usize,
-    /// Groups of pairs the transforms run in (see [`DistributedPlan::groups`]).
-    groups: usize,
+    parts: Parts,
     /// Times of the last transform on this rank.
     last: std::sync::Mutex<DistributedTimes>,
     /// The FFT stage's lane rows of other ranks' clusters (`a`) and the DWT stage's lane
@@ -206,15 +209,18 @@ fn row_sizes(
     (2 * n_me * (row_total - mine), 2 * hp * mine)
 }
 
-/// What a rank builds of a plan (everything but the exchange).
+/// What a rank builds of a plan (everything but the exchange and the buffers).
 struct Parts {
     shape: Shape,
     real: bool,
     direction: Direction,
     general: General,
     shares: Vec<Share>,
+    /// The local clusters, their blocks at local coefficient offsets and their slots at
+    /// offsets within the local segment of a lane row.
     local: Vec<ClusterPlan>,
     local_coeffs: usize,
+    /// Groups of pairs the transforms run in (see [`DistributedPlan::groups`]).
     groups: usize,
 }
 
@@ -266,14 +272,7 @@ impl<X: Exchange> DistributedPlan<X> {
         let parts = collective(&comm, Self::build(&comm, shape, options))?;
         Ok(DistributedPlan {
             comm,
-            shape: parts.shape,
-            real: parts.real,
-            direction: parts.direction,
-            general: parts.general,
-            shares: parts.shares,
-            local: parts.local,
-            local_coeffs: parts.local_coeffs,
-            groups: parts.groups,
+            parts,
             last: std::sync::Mutex::new(DistributedTimes::default()),
             rows: std::sync::Mutex::new(None),
         })
@@ -438,50 +437,52 @@ impl<X: Exchange> DistributedPlan<X> {
     /// Lane pairs `j0 .. j1` of this rank: it holds the slices `j0 .. j1`, then the slices
     /// `2 B_grid - j1 .. 2 B_grid - j0`.
     pub fn local_pairs(&self) -> (usize, usize) {
-        self.shares[self.comm.rank()].pairs
+        self.parts.shares[self.comm.rank()].pairs
     }
 
     /// Samples of this rank.
     pub fn local_num_samples(&self) -> usize {
         let (j0, j1) = self.local_pairs();
-        2 * (j1 - j0) * self.shape.slice_len()
+        2 * (j1 - j0) * self.parts.shape.slice_len()
     }
 
     /// Coefficients of this rank.
     pub fn local_num_coeffs(&self) -> usize {
-        self.local_coeffs
+        self.parts.local_coeffs
     }
 
     /// Where `fhat(l, m, mp)` is held: `(rank, index in that rank's coefficients)`, `None`
     /// when the shape does not hold it.
     pub fn coef_owner(&self, l: usize, m: isize, mp: isize) -> Option<(usize, usize)> {
-        self.shape.coef_index(l, m, mp)?;
+        self.parts.shape.coef_index(l, m, mp)?;
         let (a, b) = (m.unsigned_abs(), mp.unsigned_abs());
         let (bm, bmp) = (a.max(b), a.min(b));
         let c = self
+            .parts
             .general
             .dwt
             .clusters
             .iter()
             .position(|c| (c.m, c.mp) == (bm, bmp))?;
         let rank = self
+            .parts
             .shares
             .iter()
             .position(|s| (s.clusters.0..s.clusters.1).contains(&c))?;
         // Offsets within the owner's coefficients: count the blocks before this one.
         let mut at = 0;
-        for cl in &self.general.dwt.clusters[self.shares[rank].clusters.0..c] {
+        for cl in &self.parts.general.dwt.clusters[self.parts.shares[rank].clusters.0..c] {
             at += cl
                 .slots
                 .iter()
-                .map(|s| self.shape.degree_limit - s.first)
+                .map(|s| self.parts.shape.degree_limit - s.first)
                 .sum::<usize>();
         }
-        for s in &self.general.dwt.clusters[c].slots {
+        for s in &self.parts.general.dwt.clusters[c].slots {
             if (s.member.m, s.member.mp) == (m, mp) {
                 return Some((rank, at + l - s.first));
             }
-            at += self.shape.degree_limit - s.first;
+            at += self.parts.shape.degree_limit - s.first;
         }
         None
     }
@@ -495,14 +496,14 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     fn check(&self, forward: bool, real: bool, samples: usize, coeffs: usize) -> Result<()> {
-        self.direction.check_runs(forward)?;
-        if real && !self.real {
+        self.parts.direction.check_runs(forward)?;
+        if real && !self.parts.real {
             return Err(Error::InvalidArgument(
                 "real-signal transform on a plan made without the real option".into(),
             ));
         }
         check_length("local samples", self.local_num_samples(), samples)?;
-        check_length("local coefficients", self.local_coeffs, coeffs)
+        check_length("local coefficients", self.parts.local_coeffs, coeffs)
     }
 
     /// Forward (collective): this rank's samples to this rank's coefficients.
@@ -563,12 +564,17 @@ impl<X: Exchange> DistributedPlan<X> {
     /// those of a single-process plan; with more, the forward sums each cluster over the
     /// groups in turn (a different order of the same sum, equal to rounding).
     pub fn groups(&self) -> usize {
-        self.groups
+        self.parts.groups
     }
 
     fn row_sizes(&self) -> (usize, usize) {
-        let geometry = (self.general.dwt.row_total, self.general.lanes_w);
-        row_sizes(&self.shares, self.comm.rank(), self.groups, geometry)
+        let geometry = (self.parts.general.dwt.row_total, self.parts.general.lanes_w);
+        row_sizes(
+            &self.parts.shares,
+            self.comm.rank(),
+            self.parts.groups,
+            geometry,
+        )
     }
 
     /// The two row buffers, taken from the plan (or new when another call has them), at
@@ -595,67 +601,76 @@ impl<X: Exchange> DistributedPlan<X> {
         *self.last.lock().unwrap_or_else(|e| e.into_inner()) = t;
     }
 
-    /// Rank `q`'s pairs in group `k`: `(offset among the group's lanes, count)`.
-    fn part(&self, q: usize, k: usize) -> (usize, usize) {
-        let count = |r: usize| {
-            let (g0, g1) = group_range(self.shares[r].pairs, k, self.groups);
-            g1 - g0
-        };
-        ((0..q).map(count).sum(), count(q))
-    }
-
-    /// Lanes of group `k` in the DWT stage: every rank's pairs of the group (a contiguous run
-    /// of the lane tables), padded to the vector width, rows of this rank's segment.
-    fn group_lanes(&self, k: usize) -> ChunkLanes {
-        let me = &self.shares[self.comm.rank()];
-        let first: usize = self
-            .shares
+    /// Where the rows of group `k` are on this rank (made once per group of a transform).
+    fn group_rows(&self, k: usize) -> GroupRows {
+        let (me, shares) = (self.comm.rank(), &self.parts.shares);
+        let counts: Vec<usize> = shares
             .iter()
-            .map(|s| group_range(s.pairs, k, self.groups).0 - s.pairs.0)
+            .map(|s| {
+                let (g0, g1) = group_range(s.pairs, k, self.parts.groups);
+                g1 - g0
+            })
+            .collect();
+        let offsets: Vec<usize> = counts
+            .iter()
+            .scan(0, |at, &n| {
+                *at += n;
+                Some(*at - n)
+            })
+            .collect();
+        let first: usize = shares
+            .iter()
+            .map(|s| group_range(s.pairs, k, self.parts.groups).0 - s.pairs.0)
             .sum();
-        let h = (0..self.shares.len()).map(|q| self.part(q, k).1).sum();
-        ChunkLanes {
-            j0: first,
-            h,
-            hp: h.next_multiple_of(self.general.lanes_w),
-            row_len: me.segment.1 - me.segment.0,
+        let h: usize = counts.iter().sum();
+        let n_me = counts[me];
+        let width = |s: &Share| s.segment.1 - s.segment.0;
+        let mut at = 0;
+        let blocks = shares
+            .iter()
+            .enumerate()
+            .map(|(q, s)| {
+                let block = (at, width(s));
+                if q != me {
+                    at += 2 * n_me * width(s);
+                }
+                block
+            })
+            .collect();
+        GroupRows {
+            ch: ChunkLanes {
+                j0: first,
+                h,
+                hp: h.next_multiple_of(self.parts.general.lanes_w),
+                row_len: width(&shares[me]),
+            },
+            parts: offsets.into_iter().zip(counts).collect(),
+            blocks,
+            n_me,
         }
     }
 
-    /// Where rank `q`'s columns of this rank's group-`k` slices are in `a` (`q` not this
-    /// rank): `(first double, row length)`; rows `0 .. n` lower, `n .. 2 n` mirrors.
-    fn a_block(&self, q: usize, k: usize) -> (usize, usize) {
-        let me = self.comm.rank();
-        let n_me = self.part(me, k).1;
-        let width = |s: &Share| s.segment.1 - s.segment.0;
-        let start = (0..q)
-            .filter(|&r| r != me)
-            .map(|r| 2 * n_me * width(&self.shares[r]))
-            .sum();
-        (start, width(&self.shares[q]))
-    }
-
-    /// A slice's lane rows in group `k` (`jj`: its pair within this rank's pairs of the
+    /// A slice's lane rows in group `gr` (`jj`: its pair within this rank's pairs of the
     /// group), one part per rank's clusters: this rank's in `b` (where the DWT stage runs
     /// on them), the others' in their blocks of `a` (sent and received whole).
     fn slice_parts(
         &self,
         (a, b): (*mut f64, *mut f64),
-        k: usize,
+        gr: &GroupRows,
         (jj, upper): (usize, bool),
     ) -> Vec<LaneRows> {
         let me = self.comm.rank();
-        let ch = self.group_lanes(k);
-        let (off, n_me) = self.part(me, k);
-        (0..self.shares.len())
-            .map(|q| {
-                let sh = &self.shares[q];
+        self.parts
+            .shares
+            .iter()
+            .enumerate()
+            .map(|(q, sh)| {
                 // Rows of the part: base, rows per half, this pair's row, row length.
                 let (base, half, lane, len) = if q == me {
-                    (b, ch.hp, off + jj, ch.row_len)
+                    (b, gr.ch.hp, gr.parts[me].0 + jj, gr.ch.row_len)
                 } else {
-                    let (at, len) = self.a_block(q, k);
-                    (a.wrapping_add(at), n_me, jj, len)
+                    let (at, len) = gr.blocks[q];
+                    (a.wrapping_add(at), gr.n_me, jj, len)
                 };
                 let (r, rm) = if upper {
                     (half + lane, lane)
@@ -673,28 +688,32 @@ impl<X: Exchange> DistributedPlan<X> {
     fn group_slices(&self, k: usize) -> Vec<(usize, usize, bool)> {
         let (j0, j1) = self.local_pairs();
         let h = j1 - j0;
-        let (g0, g1) = group_range((j0, j1), k, self.groups);
+        let (g0, g1) = group_range((j0, j1), k, self.parts.groups);
         (g0..g1)
             .map(|j| (j - j0, j - g0, false))
             .chain((g0..g1).map(|j| (2 * h - 1 - (j - j0), j - g0, true)))
             .collect()
     }
 
-    /// The exchange of group `k` between `a` (this rank's slices, other ranks' clusters)
+    /// The exchange of group `gr` between `a` (this rank's slices, other ranks' clusters)
     /// and `b` (every rank's slices of the group, this rank's clusters). `to_dwt`: `a` to
     /// `b`. Rank `r` sends to `r + s` and receives from `r - s` in step `s`, lower rows then
     /// mirror rows; every block moves whole, from and into its place (nothing is packed).
-    fn exchange(&self, (a, b): (&mut [f64], &mut [f64]), to_dwt: bool, k: usize) -> Result<()> {
+    fn exchange(
+        &self,
+        (a, b): (&mut [f64], &mut [f64]),
+        to_dwt: bool,
+        gr: &GroupRows,
+    ) -> Result<()> {
         let (me, p) = (self.comm.rank(), self.comm.size());
-        let ch = self.group_lanes(k);
+        let (ch, n_me) = (gr.ch, gr.n_me);
         let my_len = ch.row_len;
-        let n_me = self.part(me, k).1;
         for step in 1..p {
             let (dest, src) = ((me + step) % p, (me + p - step) % p);
             // The rank whose rows of `b` move and the rank whose columns of `a` move.
             let (other, q) = if to_dwt { (src, dest) } else { (dest, src) };
-            let (off, n) = self.part(other, k);
-            let (at, len) = self.a_block(q, k);
+            let (off, n) = gr.parts[other];
+            let (at, len) = gr.blocks[q];
             for half in 0..2 {
                 let run = (half * ch.hp + off) * my_len..(half * ch.hp + off + n) * my_len;
                 let block = at + half * n_me * len..at + (half + 1) * n_me * len;
@@ -714,23 +733,24 @@ impl<X: Exchange> DistributedPlan<X> {
         coeffs: &mut [Complex64],
         real: bool,
     ) -> Result<()> {
-        let g = &self.general;
-        let slice_len = self.shape.slice_len();
+        let g = &self.parts.general;
+        let slice_len = self.parts.shape.slice_len();
         // A rank that cannot have its buffers fails every rank (none waits in an exchange).
         let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
         let per_value = if real { 1 } else { 2 };
         let mut times = DistributedTimes::default();
         let start = std::time::Instant::now();
-        for k in 0..self.groups {
+        for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
-            let ch = self.group_lanes(k);
-            let g0 = group_range(self.local_pairs(), k, self.groups).0;
+            let gr = self.group_rows(k);
+            let ch = gr.ch;
+            let g0 = group_range(self.local_pairs(), k, self.parts.groups).0;
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
             let slices = self.group_slices(k);
             let done: Result<()> = g.workers.pool().install(|| {
                 slices.par_iter().try_for_each(|&(s, jj, upper)| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), k, (jj, upper));
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, upper));
                         let weight = g.pair_weight[g0 + jj];
                         // SAFETY: local slice `s` is inside the checked local samples; the
                         // slots written are this slice's, of its two rows in each part (in
@@ -754,7 +774,7 @@ impl<X: Exchange> DistributedPlan<X> {
             });
             collective(&self.comm, done)?;
             let t1 = std::time::Instant::now();
-            self.exchange((&mut a[..], &mut b[..]), true, k)?;
+            self.exchange((&mut a[..], &mut b[..]), true, &gr)?;
             // Padding lanes: the kernel multiplies them by exact zeros, which must not meet
             // a non-finite value an inverse left there.
             for half in 0..2 {
@@ -765,7 +785,7 @@ impl<X: Exchange> DistributedPlan<X> {
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendPtr(coeffs.as_mut_ptr());
             g.workers.pool().install(|| {
-                self.local.par_iter().for_each(|cl| {
+                self.parts.local.par_iter().for_each(|cl| {
                     g.dwt.with_scratch(|sc| {
                         let n = g.dwt.setup(sc, cl, &g.pairs, ch);
                         // SAFETY: this cluster's slots of `b`'s lane rows of the group
@@ -791,20 +811,21 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     fn inverse_impl(&self, coeffs: &[Complex64], out: SendPtr<f64>, real: bool) -> Result<()> {
-        let g = &self.general;
-        let slice_len = self.shape.slice_len();
+        let g = &self.parts.general;
+        let slice_len = self.parts.shape.slice_len();
         let start = std::time::Instant::now();
         // A rank that cannot have its buffers fails every rank (none waits in an exchange).
         let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
         let mut times = DistributedTimes::default();
         let mut done: Result<()> = Ok(());
-        for k in 0..self.groups {
+        for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
-            let ch = self.group_lanes(k);
+            let gr = self.group_rows(k);
+            let ch = gr.ch;
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendConstPtr(coeffs.as_ptr());
             g.workers.pool().install(|| {
-                self.local.par_iter().for_each(|cl| {
+                self.parts.local.par_iter().for_each(|cl| {
                     g.dwt.with_scratch(|sc| {
                         let n = g.dwt.setup(sc, cl, &g.pairs, ch);
                         // SAFETY: the local coefficients (checked length), read only; this
@@ -825,14 +846,14 @@ impl<X: Exchange> DistributedPlan<X> {
                 })
             });
             let t1 = std::time::Instant::now();
-            self.exchange((&mut a[..], &mut b[..]), false, k)?;
+            self.exchange((&mut a[..], &mut b[..]), false, &gr)?;
             let t2 = std::time::Instant::now();
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
             let slices = self.group_slices(k);
             let group_done: Result<()> = g.workers.pool().install(|| {
                 slices.par_iter().try_for_each(|&(s, jj, upper)| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), k, (jj, upper));
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, upper));
                         // SAFETY: the parts' rows were written by the DWT stage (`b`) and
                         // the exchange (`a`), both finished; local slice `s` is inside the
                         // checked local samples and this task's.

@@ -559,3 +559,11 @@ pub fn make_hermitian(shape: &so3fft::Shape, c: &mut [Complex64]) {
         }
     }
 }
+
+/// A uniform value in `[-0.5, 0.5)` from a 64-bit linear congruential state.
+pub fn rnd(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+}
