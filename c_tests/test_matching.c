@@ -46,6 +46,23 @@ int main(int argc, char **argv) {
         CHECK(fabs(angles[0] - c.alpha) < 1e-9 && fabs(angles[1] - c.beta) < 1e-9 &&
               fabs(angles[2] - c.gamma) < 1e-9);
         CHECK(value > 0.0);
+        /* several peaks at once: the grid peak and a start beside it both reach it */
+        {
+            double many[6] = {c.alpha, c.beta, c.gamma, c.alpha + 0.02, c.beta - 0.01, c.gamma + 0.015};
+            double values[2] = {0.0, 0.0};
+            CHECK(so3fft_correlation_refine_many(p, sig, pat, 2, many, values) == SO3FFT_OK);
+            for (int k = 0; k < 2; k++) {
+                CHECK(fabs(many[3 * k] - c.alpha) < 1e-9 && fabs(many[3 * k + 1] - c.beta) < 1e-9 &&
+                      fabs(many[3 * k + 2] - c.gamma) < 1e-9);
+                CHECK(fabs(values[k] - value) <= 1e-12 * value);
+            }
+            CHECK(so3fft_correlation_refine_many(p, sig, pat, 0, many, NULL) == SO3FFT_OK);
+            CHECK(so3fft_correlation_refine_many(p, sig, pat, (size_t)-1, many, NULL) == SO3FFT_EINVAL);
+            CHECK_ERR(SO3FFT_EINVAL);
+            many[1] = NAN;
+            CHECK(so3fft_correlation_refine_many(p, sig, pat, 2, many, values) == SO3FFT_EINVAL);
+            CHECK_ERR(SO3FFT_EINVAL);
+        }
         /* bad arguments */
         CHECK(so3fft_correlation_refine(p, sig, pat, NULL, &value) == SO3FFT_ENULL);
         CHECK_ERR(SO3FFT_ENULL);

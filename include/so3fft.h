@@ -405,6 +405,12 @@ ptrdiff_t so3fft_grid_argmax_real(int B, const double *grid, double *angles);
 // back to `angles`; `|C|^2` there into `value` (or NULL). `SO3FFT_OK` or an error code.
 int so3fft_correlation_refine(so3fft_correlation p, const double *signal, const double *pattern, double *angles, double *value);
 
+// `so3fft_correlation_refine` for `npeaks` peaks at once (one correlation, one pass over
+// its coefficients per step for all peaks): `angles` holds `3 npeaks` doubles (alpha,
+// beta, gamma per peak), each triple replaced by its refined peak; `values` (NULL or
+// `npeaks` doubles) receives `|C|^2` there. `SO3FFT_OK` or an error code.
+int so3fft_correlation_refine_many(so3fft_correlation p, const double *signal, const double *pattern, size_t npeaks, double *angles, double *values);
+
 // Writes FFTW's wisdom to the file `filename` (replaced atomically). `SO3FFT_OK` or an
 // error code.
 int so3fft_export_wisdom_to_filename(const char *filename);

@@ -630,3 +630,61 @@ fn padded_and_degree_limited_grids_match_the_full_inverse() {
         }
     }
 }
+
+/// Several peaks refined together reach the maxima each reaches alone: the ten largest
+/// grid peaks of a random correlation (most of them side maxima, some starting where
+/// `|C|^2` is not concave), refined in lock step and one by one.
+#[test]
+fn peaks_refined_together_reach_the_same_maxima() {
+    use so3fft::matching::top_peaks;
+    let l = 12;
+    let mut rng = common::Rng::new(5);
+    let p = s2_plan(l);
+    let n = 4 * l * l;
+    let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+    p.inverse(&rng.complex_vec(l * l), &mut sig).unwrap();
+    p.inverse(&rng.complex_vec(l * l), &mut pat).unwrap();
+    let plan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut grid = vec![Complex64::default(); plan.num_grid()];
+    plan.correlate(&sig, &pat, &mut grid).unwrap();
+    let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
+    plan.coefficients(&sig, &pat, &mut coeffs).unwrap();
+    let starts: Vec<Rotation> = top_peaks(l, &grid, 10, 0.3)
+        .iter()
+        .map(|p| p.rotation())
+        .collect();
+    assert!(starts.len() >= 5);
+    let together = plan.refine_many(&coeffs, &starts).unwrap();
+    let series = So3Series::new(l, l - 1, &coeffs);
+    for (start, (g, value)) in starts.iter().zip(&together) {
+        let (alone, alone_value) = plan.refine(&coeffs, start).unwrap();
+        assert!(
+            g.angle_to(&alone) < 1e-9,
+            "from {start:?}: {g:?} together, {alone:?} alone"
+        );
+        assert!((value - alone_value).abs() <= 1e-12 * value);
+        // A maximum: the value there is |C|^2 of the series, and no larger nearby.
+        assert!((series.value(g).norm_sqr() - value).abs() <= 1e-12 * value);
+        let around: Vec<Rotation> = (0..6)
+            .map(|k| {
+                let d = if k % 2 == 0 { 1e-4 } else { -1e-4 };
+                let mut a = [g.alpha, g.beta, g.gamma];
+                a[k / 2] += d;
+                Rotation::new(a[0], a[1], a[2])
+            })
+            .collect();
+        for v in series.values(&around) {
+            assert!(v.norm_sqr() <= *value, "not a maximum at {g:?}");
+        }
+    }
+    assert!(plan.refine_many(&coeffs, &[]).unwrap().is_empty());
+    let nan = Rotation::new(0.0, f64::NAN, 0.0);
+    assert!(plan.refine_many(&coeffs, &[nan]).is_err());
+}

@@ -184,7 +184,12 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
         plan.coefficients(&to_c(&sig), &to_c(&pat), &mut coeffs)
             .map_err(fail)?;
     }
-    let (refined, value) = plan.refine(&coeffs, &best.rotation()).map_err(fail)?;
+    // The best grid peak and the top peaks, refined together.
+    let starts: Vec<_> = std::iter::once(best.rotation())
+        .chain(peaks.iter().map(|p| p.rotation()))
+        .collect();
+    let refined_all = plan.refine_many(&coeffs, &starts).map_err(fail)?;
+    let (refined, value) = refined_all[0];
     let t_refine = t.elapsed().as_secs_f64();
     println!(
         "input: B = {b}, {} samples; SO(3) grid of bandwidth {bo} (step {:.3e} rad)",
@@ -199,8 +204,7 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
         refined.gamma,
         refined.angle_to(&best.rotation())
     );
-    for (i, p) in peaks.iter().enumerate() {
-        let (g, v) = plan.refine(&coeffs, &p.rotation()).map_err(fail)?;
+    for (i, (p, &(g, v))) in peaks.iter().zip(&refined_all[1..]).enumerate() {
         println!(
             "peak {}: grid {}  refined alpha {:.10} beta {:.10} gamma {:.10}  |C|^2 = {v:.6e}",
             i + 1,

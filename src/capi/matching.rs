@@ -244,11 +244,39 @@ pub unsafe extern "C" fn so3fft_correlation_refine(
     angles: *mut c_double,
     value: *mut c_double,
 ) -> c_int {
+    // SAFETY: the caller's contract is `so3fft_correlation_refine_many`'s with one peak.
+    unsafe { so3fft_correlation_refine_many(p, signal, pattern, 1, angles, value) }
+}
+
+/// `so3fft_correlation_refine` for `npeaks` peaks at once (one correlation, one pass over
+/// its coefficients per step for all peaks): `angles` holds `3 npeaks` doubles (alpha,
+/// beta, gamma per peak), each triple replaced by its refined peak; `values` (NULL or
+/// `npeaks` doubles) receives `|C|^2` there. `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_refine_many(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    npeaks: usize,
+    angles: *mut c_double,
+    values: *mut c_double,
+) -> c_int {
     guarded_code(|| {
         if angles.is_null() {
             return Err(CallError::new(ErrorKind::Null, "angles is NULL"));
         }
-        // SAFETY: as in `so3fft_correlate`; `angles` holds 3 doubles, `value` NULL or one.
+        let count = npeaks
+            .checked_mul(3)
+            .filter(|&n| n <= isize::MAX as usize / 8)
+            .ok_or_else(|| {
+                CallError::new(ErrorKind::Invalid, format!("npeaks {npeaks} too large"))
+            })?;
+        Array::new(angles.cast_const(), count, "angles").check()?;
+        if !values.is_null() {
+            Array::new(values.cast_const(), npeaks, "values").check()?;
+        }
+        // SAFETY: as in `so3fft_correlate`; `angles` holds `3 npeaks` doubles (checked for
+        // NULL, alignment and range above), `values` NULL or `npeaks`.
         unsafe {
             let plan = plan_ref(p)?;
             let b_out = plan.b_out();
@@ -261,13 +289,17 @@ pub unsafe extern "C" fn so3fft_correlation_refine(
                 let (s, h) = inputs(signal.cast::<Complex64>(), pattern.cast(), ns, None)?;
                 plan.coefficients(s, h, &mut coeffs)?;
             }
-            let start = Rotation::new(*angles, *angles.add(1), *angles.add(2));
-            let (g, v) = plan.refine(&coeffs, &start)?;
-            *angles = g.alpha;
-            *angles.add(1) = g.beta;
-            *angles.add(2) = g.gamma;
-            if !value.is_null() {
-                *value = v;
+            let angles = std::slice::from_raw_parts_mut(angles, count);
+            let starts: Vec<Rotation> = angles
+                .chunks_exact(3)
+                .map(|a| Rotation::new(a[0], a[1], a[2]))
+                .collect();
+            let refined = plan.refine_many(&coeffs, &starts)?;
+            for (k, (g, v)) in refined.into_iter().enumerate() {
+                angles[3 * k..3 * k + 3].copy_from_slice(&[g.alpha, g.beta, g.gamma]);
+                if !values.is_null() {
+                    *values.add(k) = v;
+                }
             }
             Ok(())
         }

@@ -3,13 +3,14 @@
 //! inverse SO(3) transform.
 
 use super::combine::add_combined;
+use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::partial::{PartialOptions, PartialPlan, Shape};
 use crate::s2::{S2Options, S2Plan};
 use crate::{Direction, Rigor};
 use num_complex::Complex64;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Options of a [`Correlation`].
 #[derive(Clone, Debug, Default)]
@@ -56,6 +57,8 @@ pub struct Correlation {
     /// The inverse onto the grid: degrees `l <= deg_lim` (bandwidth `deg_lim + 1`).
     so3: PartialPlan,
     buffers: Mutex<Option<Buffers>>,
+    /// Tables of [`So3Series`](super::So3Series) for refinement, built on first use.
+    series: OnceLock<Arc<SeriesTables>>,
 }
 
 impl Correlation {
@@ -100,6 +103,7 @@ impl Correlation {
             s2,
             so3,
             buffers: Mutex::new(None),
+            series: OnceLock::new(),
         })
     }
 
@@ -260,9 +264,33 @@ impl Correlation {
         coeffs: &[Complex64],
         start: &super::Rotation,
     ) -> Result<(super::Rotation, f64)> {
+        Ok(self.refine_many(coeffs, std::slice::from_ref(start))?[0])
+    }
+
+    /// [`Correlation::refine`] from every rotation of `starts`, in lock step
+    /// ([`So3Series::maximise_many`](super::So3Series::maximise_many): one pass over the
+    /// coefficients per step serves all peaks).
+    pub fn refine_many(
+        &self,
+        coeffs: &[Complex64],
+        starts: &[super::Rotation],
+    ) -> Result<Vec<(super::Rotation, f64)>> {
         check_length("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
-        let series = super::So3Series::new(self.b_out, self.deg_lim, coeffs);
-        Ok(self.s2.install(|| series.maximise(start)))
+        if let Some(g) = starts
+            .iter()
+            .find(|g| ![g.alpha, g.beta, g.gamma].iter().all(|v| v.is_finite()))
+        {
+            return Err(Error::InvalidArgument(format!(
+                "start rotation {g:?} is not finite"
+            )));
+        }
+        let tables = self
+            .series
+            .get_or_init(|| Arc::new(SeriesTables::new(self.b_out, self.deg_lim)))
+            .clone();
+        Ok(self
+            .s2
+            .install(|| super::So3Series::with_tables(tables, coeffs).maximise_many(starts)))
     }
 
     /// Whether the plan takes real inputs.

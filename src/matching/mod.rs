@@ -13,6 +13,7 @@ mod correlation;
 mod peaks;
 mod refine;
 mod rotation;
+mod series;
 
 pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};

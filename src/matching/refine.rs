@@ -1,230 +1,270 @@
 //! Peaks refined off the grid: the band-limited correlation evaluated at any rotation from
-//! its SO(3) coefficients, and maximised by damped Newton steps.
+//! its SO(3) coefficients, and maximised by damped Newton steps, several peaks in lock step
+//! (one pass over the coefficients per step serves all of them).
 
 use super::rotation::Rotation;
-use crate::grid::block_start;
-use crate::numeric::{sin_cos_dd, Dd, Ext};
+use super::series::{Local, SeriesTables};
 use crate::simd::Isa;
-use crate::symmetry::Cluster;
-use crate::wigner::column::column_with;
-use crate::wigner::{start_norms, BetaTables, RecCoeffs, RecTables};
 use num_complex::Complex64;
-use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// A band-limited function on SO(3) given by its coefficients (bandwidth `b`, degrees up to
 /// `lmax`), in the normalisation of the inverse transform (`docs/conventions.md`):
 /// `C(g) = sum fhat(l,M,M') (1/2pi) sqrt((2l+1)/2) D^l_{M,M'}(g)`.
-pub struct So3Series<'a> {
-    b: usize,
-    lmax: usize,
-    coeffs: &'a [Complex64],
-    recurrence: RecTables,
-    /// Norms of the starting values per base pair `(m, m')`, index `m(m+1)/2 + m'`.
-    norms: Vec<Ext>,
+pub struct So3Series {
+    /// The coefficients in the evaluation's order ([`SeriesTables::pack`]).
+    packed: Vec<Complex64>,
+    tables: Arc<SeriesTables>,
     isa: Isa,
 }
 
-/// Value and derivatives in `alpha` and `gamma` at one rotation.
-#[derive(Clone, Copy, Default)]
-struct Local {
-    c: Complex64,
-    a: Complex64,
-    g: Complex64,
-    aa: Complex64,
-    ag: Complex64,
-    gg: Complex64,
+/// `|C|^2`, its gradient and its Hessian in `(alpha, beta, gamma)`.
+type Objective = (f64, [f64; 3], [[f64; 3]; 3]);
+
+fn objective(l: &Local) -> Objective {
+    let grad = l.d.map(|di| 2.0 * (l.c.conj() * di).re);
+    let hess = std::array::from_fn(|i| {
+        std::array::from_fn(|j| 2.0 * (l.d[i].conj() * l.d[j] + l.c.conj() * l.dd[i][j]).re)
+    });
+    (l.c.norm_sqr(), grad, hess)
 }
 
-impl<'a> So3Series<'a> {
+/// One peak's damped Newton (Levenberg-Marquardt) search for the largest `|C|^2`.
+struct Search {
+    g: Rotation,
+    f: f64,
+    grad: [f64; 3],
+    hess: [[f64; 3]; 3],
+    /// Damping of the next trial.
+    mu: f64,
+    /// Accepted steps, and rounds without one since the last.
+    steps: usize,
+    failures: usize,
+    /// The trial rotations under evaluation: rotation, step size, damping.
+    trials: Vec<(Rotation, f64, f64)>,
+    /// Largest step (max-norm) of a trial.
+    radius: f64,
+    done: bool,
+}
+
+/// A Newton step of this size (max-norm, radians) from a point where `|C|^2` is concave
+/// is below what rounding resolves: the search ends there without evaluating it.
+const NEGLIGIBLE_STEP: f64 = 1e-11;
+
+impl Search {
+    fn new(g: Rotation, (f, grad, hess): Objective, radius: f64) -> Search {
+        Search {
+            g,
+            f,
+            grad,
+            hess,
+            mu: 0.0,
+            steps: 0,
+            failures: 0,
+            trials: Vec::new(),
+            radius,
+            done: false,
+        }
+    }
+
+    /// The smallest damping worth trying once a trial was rejected.
+    fn min_damping(&self) -> f64 {
+        1e-6 * self
+            .hess
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300)
+    }
+
+    /// The step solving `(mu I - H) s = grad` and its size, if the system is regular.
+    fn step(&self, mu: f64) -> Option<([f64; 3], f64)> {
+        let a = std::array::from_fn(|i| {
+            std::array::from_fn(|j| -self.hess[i][j] + if i == j { mu } else { 0.0 })
+        });
+        let s = solve3(a, self.grad)?;
+        Some((s, s.iter().fold(0.0f64, |m, v| m.max(v.abs()))))
+    }
+
+    fn add_trial(&mut self, mu: f64) -> bool {
+        let Some((mut s, mut size)) = self.step(mu) else {
+            return false;
+        };
+        // No step beyond the trust radius (a grid step: the peak is near its grid point).
+        if size > self.radius {
+            s = s.map(|v| v * (self.radius / size));
+            size = self.radius;
+        }
+        let g = &self.g;
+        let next = Rotation::new(g.alpha + s[0], g.beta + s[1], g.gamma + s[2]);
+        self.trials.push((next, size, mu));
+        true
+    }
+
+    /// Sets the first trial of the next round, or ends the search: on a concave top the
+    /// undamped Newton step (and the end if it is negligible), elsewhere a step damped
+    /// enough to go uphill (`mu` above the largest eigenvalue of the Hessian).
+    fn propose(&mut self) {
+        self.trials.clear();
+        if self.done {
+            return;
+        }
+        let mut mu = self.mu;
+        if concave(&self.hess) {
+            if let Some((s, size)) = self.step(0.0) {
+                if size < NEGLIGIBLE_STEP {
+                    let g = &self.g;
+                    self.g = Rotation::new(g.alpha + s[0], g.beta + s[1], g.gamma + s[2]);
+                    self.done = true;
+                    return;
+                }
+            }
+            if self.failures == 0 {
+                mu = 0.0;
+            }
+        } else {
+            // Gershgorin: every eigenvalue of the Hessian is below `top`.
+            let top = (0..3)
+                .map(|i| {
+                    self.hess[i][i]
+                        + (0..3)
+                            .filter(|&j| j != i)
+                            .map(|j| self.hess[i][j].abs())
+                            .sum::<f64>()
+                })
+                .fold(f64::MIN, f64::max);
+            mu = mu.max(top + self.min_damping());
+        }
+        for _ in 0..30 {
+            if self.add_trial(mu) {
+                return;
+            }
+            mu = (2.0 * mu).max(1e-8 * self.min_damping() / 1e-6);
+        }
+        self.done = true;
+    }
+
+    /// Adds a more strongly damped trial (a spare lane of the round), after the last one.
+    fn propose_more(&mut self) {
+        if let Some(&(_, _, mu)) = self.trials.last() {
+            self.add_trial((4.0 * mu).max(self.min_damping()));
+        }
+    }
+
+    /// Takes the trials' objectives: moves to the best trial if `|C|^2` did not fall there.
+    fn update(&mut self, results: &[Objective]) {
+        let trials = std::mem::take(&mut self.trials);
+        let best = (0..results.len()).max_by(|&a, &b| results[a].0.total_cmp(&results[b].0));
+        let Some(best) = best else {
+            return;
+        };
+        let (next, size, mu) = trials[best];
+        let (nf, grad, hess) = results[best];
+        if nf >= self.f {
+            (self.g, self.f, self.grad, self.hess) = (next, nf, grad, hess);
+            self.steps += 1;
+            self.failures = 0;
+            self.mu = mu / 4.0;
+            // Near the maximum the steps shrink fast: a step this small leaves an error far
+            // below the next one's.
+            self.done = size < 1e-10 || self.steps >= 60;
+        } else if trials.iter().all(|t| t.1 < 1e-9) {
+            // Steps this small that do not raise `|C|^2` are at what rounding lets them
+            // tell apart: done (damped retries would only be rejected again).
+            self.done = true;
+        } else {
+            let last = trials.iter().fold(0.0f64, |m, t| m.max(t.2));
+            self.mu = (4.0 * last).max(self.min_damping());
+            self.failures += 1;
+            self.done = self.failures >= 30;
+        }
+    }
+}
+
+/// Whether the symmetric `h` is negative definite (Sylvester's criterion on `-h`).
+fn concave(h: &[[f64; 3]; 3]) -> bool {
+    let d1 = -h[0][0];
+    let d2 = h[0][0] * h[1][1] - h[0][1] * h[1][0];
+    let d3 = h[0][0] * (h[1][1] * h[2][2] - h[1][2] * h[2][1])
+        - h[0][1] * (h[1][0] * h[2][2] - h[1][2] * h[2][0])
+        + h[0][2] * (h[1][0] * h[2][1] - h[1][1] * h[2][0]);
+    d1 > 0.0 && d2 > 0.0 && -d3 > 0.0
+}
+
+impl So3Series {
     /// The series of `coeffs` (`(4b^3 - b)/3` values, `so3CoefLoc` order), degrees `<= lmax`.
-    pub fn new(b: usize, lmax: usize, coeffs: &'a [Complex64]) -> So3Series<'a> {
-        assert!(lmax < b && coeffs.len() == crate::num_coeffs(b));
+    pub fn new(b: usize, lmax: usize, coeffs: &[Complex64]) -> So3Series {
+        Self::with_tables(Arc::new(SeriesTables::new(b, lmax)), coeffs)
+    }
+
+    /// The series of `coeffs` with tables built before (their `b` and `lmax`).
+    pub(crate) fn with_tables(tables: Arc<SeriesTables>, coeffs: &[Complex64]) -> So3Series {
+        assert!(coeffs.len() == crate::num_coeffs(tables.b));
         So3Series {
-            b,
-            lmax,
-            coeffs,
-            recurrence: RecTables::new(lmax + 1),
-            norms: start_norms(lmax + 1),
+            packed: tables.pack(coeffs),
+            tables,
             isa: Isa::detect(),
         }
     }
 
-    /// `S[M][M'](beta) = sum_l fhat(l,M,M') (1/2pi) sqrt((2l+1)/2) d^l_{M,M'}(beta)`, row
-    /// `M + lmax`, column `M' + lmax`.
-    fn beta_sums(&self, beta: f64) -> Vec<Complex64> {
-        let top = self.lmax as isize;
-        let w = 2 * self.lmax + 1;
-        let mut s = vec![Complex64::default(); w * w];
-        // The half-angle cosine and sine of beta, and (swapped) of pi - beta, for the
-        // members of a cluster that are reflected (see `symmetry`).
-        let (sn, cs) = if (0.0..=PI).contains(&beta) {
-            sin_cos_dd(Dd::new(beta / 2.0))
-        } else {
-            (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
-        };
-        let betas = BetaTables::new(&[(cs, sn), (sn, cs)], 2 * self.lmax);
-        // The members' sums of the clusters with base order `m`, as (index in `s`, value).
-        let row = |m: usize| -> Vec<(usize, Complex64)> {
-            let mut rec = RecCoeffs::new(self.lmax + 1);
-            let mut out = Vec::with_capacity(8 * (m + 1));
-            for mp in 0..=m {
-                let cluster = Cluster::new(m, mp);
-                rec.resize(self.lmax + 1 - m);
-                self.recurrence.coeffs(m, mp, &mut rec);
-                let norm = self.norms[m * (m + 1) / 2 + mp];
-                let mut cols: [Option<Vec<f64>>; 2] = [None, None];
-                for mem in cluster.members() {
-                    let k = usize::from(mem.reversed);
-                    let col = cols[k].get_or_insert_with(|| {
-                        column_with(self.isa, &betas, k, (m, mp, norm), &rec)
-                    });
-                    // Degree l = m + i is at block_start + i.
-                    let block = &self.coeffs[block_start(self.b, mem.m, mem.mp)..][..col.len()];
-                    let (even, odd) = (mem.sign_at(m), mem.sign_at(m + 1));
-                    let mut sum = Complex64::default();
-                    for (i, (dt, c)) in col.iter().zip(block).enumerate() {
-                        let sign = if i % 2 == 0 { even } else { odd };
-                        sum += c * (sign * dt);
-                    }
-                    let at = (mem.m + top) as usize * w + (mem.mp + top) as usize;
-                    out.push((at, sum / (2.0 * PI)));
-                }
-            }
-            out
-        };
-        // On a worker pool (`Correlation::refine`), the base orders are spread over its
-        // threads; elsewhere they run on the calling thread.
-        let rows: Vec<Vec<(usize, Complex64)>> = if rayon::current_thread_index().is_some() {
-            (0..=self.lmax).into_par_iter().map(row).collect()
-        } else {
-            (0..=self.lmax).map(row).collect()
-        };
-        for (at, v) in rows.into_iter().flatten() {
-            s[at] = v;
-        }
-        s
-    }
-
-    /// Value and `alpha`, `gamma` derivatives from the beta sums `s`.
-    fn local(&self, s: &[Complex64], alpha: f64, gamma: f64) -> Local {
-        let top = self.lmax as isize;
-        let w = 2 * self.lmax + 1;
-        let mut out = Local::default();
-        let phases = |angle: f64| -> Vec<Complex64> {
-            (-top..=top)
-                .map(|m| Complex64::from_polar(1.0, -(m as f64) * angle))
-                .collect()
-        };
-        let (pa, pg) = (phases(alpha), phases(gamma));
-        for m in -top..=top {
-            let ea = pa[(m + top) as usize];
-            for mp in -top..=top {
-                let v =
-                    s[(m + top) as usize * w + (mp + top) as usize] * ea * pg[(mp + top) as usize];
-                let (fm, fmp) = (m as f64, mp as f64);
-                let i = Complex64::new(0.0, 1.0);
-                out.c += v;
-                out.a += v * (-i * fm);
-                out.g += v * (-i * fmp);
-                out.aa += v * (-fm * fm);
-                out.ag += v * (-fm * fmp);
-                out.gg += v * (-fmp * fmp);
-            }
-        }
-        out
+    fn evaluate(&self, points: &[Rotation]) -> Vec<Local> {
+        let pts: Vec<[f64; 3]> = points.iter().map(|g| [g.alpha, g.beta, g.gamma]).collect();
+        self.tables.evaluate(self.isa, &self.packed, &pts)
     }
 
     /// The value at rotation `g`.
     pub fn value(&self, g: &Rotation) -> Complex64 {
-        self.local(&self.beta_sums(g.beta), g.alpha, g.gamma).c
+        self.evaluate(std::slice::from_ref(g))[0].c
     }
 
-    /// `|C|^2` at `g` and the beta sums there (for [`So3Series::derivatives`]).
-    fn objective(&self, g: &Rotation) -> (f64, Vec<Complex64>) {
-        let s = self.beta_sums(g.beta);
-        (self.local(&s, g.alpha, g.gamma).c.norm_sqr(), s)
-    }
-
-    /// Gradient and Hessian of `|C|^2` in `(alpha, beta, gamma)` at `g`, given the beta
-    /// sums `mid` there (the beta derivatives by central differences of step `h`).
-    fn derivatives(&self, g: &Rotation, mid: &[Complex64], h: f64) -> ([f64; 3], [[f64; 3]; 3]) {
-        let at = |beta: f64| self.local(&self.beta_sums(beta), g.alpha, g.gamma);
-        let (lo, hi) = (at(g.beta - h), at(g.beta + h));
-        let mid = self.local(mid, g.alpha, g.gamma);
-        let c = mid.c;
-        let d = [mid.a, (hi.c - lo.c) / (2.0 * h), mid.g];
-        let dab = (hi.a - lo.a) / (2.0 * h);
-        let dgb = (hi.g - lo.g) / (2.0 * h);
-        let dbb = (hi.c - 2.0 * mid.c + lo.c) / (h * h);
-        let dd = [
-            [mid.aa, dab, mid.ag],
-            [dab, dbb, dgb],
-            [mid.ag, dgb, mid.gg],
-        ];
-        let grad = d.map(|di| 2.0 * (c.conj() * di).re);
-        let mut hess = [[0.0; 3]; 3];
-        for i in 0..3 {
-            for j in 0..3 {
-                hess[i][j] = 2.0 * (d[i].conj() * d[j] + c.conj() * dd[i][j]).re;
-            }
-        }
-        (grad, hess)
+    /// The values at every rotation of `gs`, in one pass over the coefficients.
+    pub fn values(&self, gs: &[Rotation]) -> Vec<Complex64> {
+        self.evaluate(gs).iter().map(|l| l.c).collect()
     }
 
     /// The rotation near `start` where `|C|^2` is largest, by damped Newton steps
-    /// (Levenberg-Marquardt), and `|C|^2` there. A trial step costs one evaluation of the
-    /// beta sums, an accepted one two more (the beta derivatives).
+    /// (Levenberg-Marquardt), and `|C|^2` there.
     pub fn maximise(&self, start: &Rotation) -> (Rotation, f64) {
-        // Step of the beta differences: small enough that their error (h^2 l_max / 6 in
-        // the position of the maximum) is far below 1e-8 rad.
-        let h = 1e-5;
-        let mut g = *start;
-        let (mut f, mid) = self.objective(&g);
-        let (mut grad, mut hess) = self.derivatives(&g, &mid, h);
-        let mut mu = 0.0f64;
-        for _ in 0..60 {
-            let scale = hess.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-            let mut moved = false;
-            for _ in 0..30 {
-                // Solve (mu I - H) s = grad.
-                let mut a = [[0.0; 3]; 3];
-                for i in 0..3 {
-                    for j in 0..3 {
-                        a[i][j] = -hess[i][j] + if i == j { mu } else { 0.0 };
-                    }
-                }
-                let Some(s) = solve3(a, grad) else {
-                    mu = (2.0 * mu).max(1e-8 * scale.max(1e-300));
-                    continue;
-                };
-                let step = s.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let next = Rotation::new(g.alpha + s[0], g.beta + s[1], g.gamma + s[2]);
-                let (nf, nmid) = self.objective(&next);
-                if nf >= f {
-                    (g, f) = (next, nf);
-                    // Near the maximum the steps shrink fast: a step this small leaves an
-                    // error far below the next one's.
-                    if step < 1e-10 {
-                        return (g, f);
-                    }
-                    (grad, hess) = self.derivatives(&g, &nmid, h);
-                    mu /= 4.0;
-                    moved = true;
-                    break;
-                }
-                // A step this small that does not raise `|C|^2` is at what rounding lets
-                // it tell apart: done (damped retries would only be rejected again).
-                if step < 1e-9 {
-                    return (g, f);
-                }
-                mu = (4.0 * mu).max(1e-6 * scale.max(1e-300));
-            }
-            if !moved {
+        self.maximise_many(std::slice::from_ref(start))[0]
+    }
+
+    /// [`So3Series::maximise`] from every rotation of `starts`, in lock step: each round
+    /// evaluates the trial rotations of all unfinished searches in one pass over the
+    /// coefficients (value, gradient and Hessian from the differentiated recurrence). The
+    /// vector lanes a round leaves over carry more strongly damped trials of the searches.
+    pub fn maximise_many(&self, starts: &[Rotation]) -> Vec<(Rotation, f64)> {
+        let radius = PI / (self.tables.lmax + 1) as f64;
+        let first = self.evaluate(starts);
+        let mut searches: Vec<Search> = starts
+            .iter()
+            .zip(&first)
+            .map(|(g, l)| Search::new(*g, objective(l), radius))
+            .collect();
+        let w = self.isa.lanes();
+        loop {
+            searches.iter_mut().for_each(Search::propose);
+            let open: Vec<usize> = (0..searches.len())
+                .filter(|&i| !searches[i].trials.is_empty())
+                .collect();
+            if open.is_empty() {
                 break;
             }
+            let spare = open.len().div_ceil(w) * w - open.len();
+            for k in 0..spare {
+                searches[open[k % open.len()]].propose_more();
+            }
+            let trials: Vec<Rotation> = open
+                .iter()
+                .flat_map(|&i| searches[i].trials.iter().map(|t| t.0))
+                .collect();
+            let mut results = self.evaluate(&trials).into_iter().map(|l| objective(&l));
+            for &i in &open {
+                let r: Vec<Objective> = results.by_ref().take(searches[i].trials.len()).collect();
+                searches[i].update(&r);
+            }
         }
-        (g, f)
+        searches.iter().map(|s| (s.g, s.f)).collect()
     }
 }
 
