@@ -240,28 +240,39 @@ impl SeriesTables {
     ) {
         assert!(std::mem::size_of::<S::V>() / 8 == lanes.w);
         let n = self.lmax + 1 - m;
-        let mut scratch = vec![0.0; 3 * n * lanes.w];
+        let size = 3 * n * lanes.w;
+        let mut scratch = vec![0.0; 2 * size];
         for (mp, table) in self.clusters[m * (m + 1) / 2..][..m + 1].iter().enumerate() {
-            for (k, group) in table.groups.iter().enumerate() {
-                for chunk in 0..lanes.chunks {
-                    let at = GroupAt { m, mp, k, chunk };
-                    // SAFETY: `S` is the instruction set this function was compiled for
-                    // (the callers' contract) and has `lanes.w` lanes (asserted); the
-                    // slices' lengths are checked inside.
-                    unsafe { group_terms::<S>(lanes, table, group, at, coeffs, &mut scratch, acc) };
+            let [g0, g1] = &table.groups;
+            for chunk in 0..lanes.chunks {
+                let at = GroupAt { m, mp, chunk };
+                let (s0, s1) = scratch.split_at_mut(size);
+                // SAFETY: `S` is the instruction set this function was compiled for (the
+                // callers' contract) and has `lanes.w` lanes (asserted); the scratch areas
+                // hold `3 n w` doubles, the other lengths are checked inside.
+                unsafe {
+                    match (g0.len > 0, g1.len > 0) {
+                        (true, true) => column_lanes::<S, 2>(lanes, table, at, [0, 1], [s0, s1]),
+                        (true, false) => column_lanes::<S, 1>(lanes, table, at, [0], [s0]),
+                        (false, true) => column_lanes::<S, 1>(lanes, table, at, [1], [s1]),
+                        (false, false) => {}
+                    }
+                    for (k, (group, s)) in [(g0, &*s0), (g1, &*s1)].into_iter().enumerate() {
+                        if group.len > 0 {
+                            group_terms::<S>(lanes, table, group, (at, k), coeffs, s, acc);
+                        }
+                    }
                 }
             }
         }
     }
 }
 
-/// Where one group's terms go: base pair, column (`k = 0`: beta, `1`: pi - beta) and
-/// chunk of lanes.
+/// Where a cluster's terms go: base pair and chunk of lanes.
 #[derive(Clone, Copy)]
 struct GroupAt {
     m: usize,
     mp: usize,
-    k: usize,
     chunk: usize,
 }
 
@@ -401,9 +412,9 @@ impl Lanes {
     }
 }
 
-/// The terms of one group of cluster `table` for the lanes of one chunk: the column and its
-/// two derivatives by the recurrence (into `scratch`), their sums against each member's
-/// coefficients, and those with the gamma phases into the row sums `acc`.
+/// The terms of one group of cluster `table` for the lanes of one chunk: the sums of its
+/// column and the column's two derivatives (in `scratch`, from [`column_lanes`]) against
+/// each member's coefficients, and those with the gamma phases into the row sums `acc`.
 ///
 /// # Safety
 /// The CPU supports the instruction set of `S`.
@@ -412,26 +423,22 @@ unsafe fn group_terms<S: Simd>(
     lanes: &Lanes,
     table: &ClusterTable,
     group: &Group,
-    at: GroupAt,
+    (at, k): (GroupAt, usize),
     coeffs: &[Complex64],
-    scratch: &mut [f64],
+    scratch: &[f64],
     acc: &mut [f64],
 ) {
-    if group.len == 0 {
-        return;
-    }
     let w = lanes.w;
     let n = table.rec.len();
-    assert!(scratch.len() >= 3 * n * w && acc.len() == lanes.acc_len());
+    assert!(scratch.len() == 3 * n * w && acc.len() == lanes.acc_len());
     let packed = &coeffs[group.packed..][..group.len * n];
-    // SAFETY: the instruction set by the caller; `scratch` holds `3 n w` doubles (asserted).
-    unsafe { column_lanes::<S>(lanes, table, at, &mut scratch[..3 * n * w]) };
-    // SAFETY: as above; every block holds `n` coefficients.
+    // SAFETY: the instruction set by the caller; `scratch` holds `3 n w` doubles and
+    // `packed` `len n` coefficients (asserted and sliced above).
     let sums = unsafe {
         match group.len {
-            4 => member_sums::<S, 4>(packed, &scratch[..3 * n * w]),
-            2 => member_sums::<S, 2>(packed, &scratch[..3 * n * w]),
-            _ => member_sums::<S, 1>(packed, &scratch[..3 * n * w]),
+            4 => member_sums::<S, 4>(packed, scratch),
+            2 => member_sums::<S, 2>(packed, scratch),
+            _ => member_sums::<S, 1>(packed, scratch),
         }
     };
     let top = lanes.lmax as isize;
@@ -444,7 +451,7 @@ unsafe fn group_terms<S: Simd>(
             let (m, mp) = group.orders[j];
             let f = group.factor[j];
             // Members at pi - beta: the first beta derivative changes sign.
-            let f1 = if at.k == 1 { -f } else { f };
+            let f1 = if k == 1 { -f } else { f };
             let g = ((mp + top) as usize) * 2;
             let (er, ei) = (ld(&lanes.gamma_phase, g), ld(&lanes.gamma_phase, g + 1));
             let x: [(S::V, S::V); 3] = std::array::from_fn(|d| {
@@ -484,37 +491,42 @@ unsafe fn group_terms<S: Simd>(
     }
 }
 
-/// The column `dt^l(theta)` and its first two derivatives of one group at the lanes of
-/// one chunk, degree `i` at `scratch[(3 i + d) w ..]` (`d` the order of the derivative),
-/// with `(-1)^i` for the reversed group (`k = 1`), in the arithmetic of
-/// [`column_derivatives`](crate::wigner::derivatives::column_derivatives).
+/// The columns `dt^l(theta)` and their first two derivatives of `K` groups (`ks`) of one
+/// cluster at the lanes of one chunk, in one loop (independent recurrences side by side hide
+/// each other's latency): degree `i` of group `ks[q]` at `scratch[q][(3 i + d) w ..]` (`d`
+/// the order of the derivative), with `(-1)^i` for the reversed group (`k = 1`), in the
+/// arithmetic of the DWT kernels' recurrence (see `wigner::column`).
 ///
 /// # Safety
-/// The CPU supports the instruction set of `S`; `scratch` holds `3 n w` doubles.
+/// The CPU supports the instruction set of `S`; every scratch area holds `3 n w` doubles.
 #[inline(always)]
-unsafe fn column_lanes<S: Simd>(
+unsafe fn column_lanes<S: Simd, const K: usize>(
     lanes: &Lanes,
     table: &ClusterTable,
     at: GroupAt,
-    scratch: &mut [f64],
+    ks: [usize; K],
+    scratch: [&mut [f64]; K],
 ) {
     let w = lanes.w;
     let rec = &table.rec;
     let n = rec.len();
-    assert!(scratch.len() == 3 * n * w && w <= 8);
+    assert!(scratch.iter().all(|x| x.len() == 3 * n * w) && w <= 8);
     let bits = *SKIP_BITS_RANGE.end();
-    let k0 = at.k * lanes.padded + at.chunk * w;
-    let (mut start, mut index) = ([0.0; 8], [0.0; 8]);
-    lanes.betas.starts(
-        lanes.isa,
-        k0,
-        at.m,
-        at.mp,
-        table.norm,
-        bits,
-        &mut start[..w],
-        &mut index[..w],
-    );
+    let k0 = ks.map(|k| k * lanes.padded + at.chunk * w);
+    let mut start = [[0.0; 8]; K];
+    let mut index = [[0.0; 8]; K];
+    for q in 0..K {
+        lanes.betas.starts(
+            lanes.isa,
+            k0[q],
+            at.m,
+            at.mp,
+            table.norm,
+            bits,
+            &mut start[q][..w],
+            &mut index[q][..w],
+        );
+    }
     let (a, b) = ((at.m + at.mp) as f64, (at.m - at.mp) as f64);
     let (rec_a, apc, cma, s) = (
         &rec.a[..n],
@@ -523,73 +535,95 @@ unsafe fn column_lanes<S: Simd>(
         &rec.s[..n],
     );
     // SAFETY: the instruction set by the caller; the lane vectors are read at
-    // `k0 .. k0 + w <= 2 padded`, `start` and `index` hold 8 doubles, and every scratch
-    // store is at `(3 i + d) w + w <= 3 n w`.
+    // `k0 .. k0 + w <= 2 padded`, `start` and `index` hold 8 doubles per group, and every
+    // scratch store is at `(3 i + d) w + w <= 3 n w`.
     unsafe {
-        let ld = |v: &Vec<f64>| S::load(v.as_ptr().add(k0));
-        let [sigtau, sigma, nsin, ncos, cot, tan, isq, icq] = lanes.point.each_ref().map(ld);
+        let point: [[S::V; 8]; K] = std::array::from_fn(|q| {
+            lanes
+                .point
+                .each_ref()
+                .map(|v| S::load(v.as_ptr().add(k0[q])))
+        });
         let (zero, one) = (S::zero(), S::splat(1.0));
         let inf = S::splat(f64::INFINITY);
         let threshold = S::splat(big(bits));
         let tiny = S::splat(crate::wigner::starts::TINY);
-        let u0 = S::load(start.as_ptr());
-        let mut index = S::load(index.as_ptr());
-        // u'_m = r1 u_m, u''_m = r2 u_m (see `wigner::derivatives`); terms with a zero
-        // exponent are absent (the splats are 0 then).
-        let r1 = S::mul(
-            S::splat(0.5),
-            S::fms(S::splat(b), cot, S::mul(S::splat(a), tan)),
-        );
-        let r2 = S::fms(
-            S::splat(0.25),
-            S::fma(
-                S::splat(b * (b - 1.0).max(0.0)),
-                isq,
-                S::mul(S::splat(a * (a - 1.0).max(0.0)), icq),
-            ),
-            S::splat((at.m * at.m) as f64),
-        );
-        let mut cur = [u0, S::mul(r1, u0), S::mul(r2, u0)];
-        let mut prev = [zero; 3];
-        // Lanes still below the skip threshold read 0 and are rescaled when they grow
-        // past `threshold`; the others never are (their limit is infinite).
-        let mut weight = S::blend_ge(index, zero, one, zero);
-        let mut limit = S::blend_ge(index, zero, inf, threshold);
-        let mut scaled = S::any_ge(S::splat(-0.5), index);
-        let alternate = at.k == 1;
-        let out = scratch.as_mut_ptr();
-        for i in 0..n {
-            let sign = if alternate && i % 2 == 1 { -s[i] } else { s[i] };
-            let ws = S::mul(weight, S::splat(sign));
-            for (d, u) in cur.iter().enumerate() {
-                S::store(out.add((3 * i + d) * w), S::mul(*u, ws));
-            }
-            let ai = S::splat(rec_a[i]);
-            let offset = S::blend_ge(sigma, zero, S::splat(cma[i]), S::splat(apc[i]));
-            let p = S::fma(ai, sigtau, offset);
-            let dp = S::mul(ai, nsin);
-            let ddp = S::mul(ai, ncos);
-            let next = [
-                S::fms(p, cur[0], prev[0]),
-                S::fma(p, cur[1], S::fms(dp, cur[0], prev[1])),
+        let mut cur = [[zero; 3]; K];
+        let mut prev = [[zero; 3]; K];
+        let mut index: [S::V; K] = std::array::from_fn(|q| S::load(index[q].as_ptr()));
+        let mut weight = [zero; K];
+        let mut limit = [zero; K];
+        let mut scaled = false;
+        for q in 0..K {
+            let [_, _, _, _, cot, tan, isq, icq] = point[q];
+            let u0 = S::load(start[q].as_ptr());
+            // u'_m = r1 u_m, u''_m = r2 u_m with r1 = (b cot - a tan) / 2 and
+            // r2 = (b(b-1)/sin^2 + a(a-1)/cos^2) / 4 - m^2 (half angles; no cancellation
+            // near the poles); terms with a zero exponent are absent (the splats are 0).
+            let r1 = S::mul(
+                S::splat(0.5),
+                S::fms(S::splat(b), cot, S::mul(S::splat(a), tan)),
+            );
+            let r2 = S::fms(
+                S::splat(0.25),
                 S::fma(
-                    p,
-                    cur[2],
-                    S::fma(S::add(dp, dp), cur[1], S::fms(ddp, cur[0], prev[2])),
+                    S::splat(b * (b - 1.0).max(0.0)),
+                    isq,
+                    S::mul(S::splat(a * (a - 1.0).max(0.0)), icq),
                 ),
-            ];
-            prev = cur;
-            cur = next;
+                S::splat((at.m * at.m) as f64),
+            );
+            cur[q] = [u0, S::mul(r1, u0), S::mul(r2, u0)];
+            // Lanes still below the skip threshold read 0 and are rescaled when they grow
+            // past `threshold`; the others never are (their limit is infinite).
+            weight[q] = S::blend_ge(index[q], zero, one, zero);
+            limit[q] = S::blend_ge(index[q], zero, inf, threshold);
+            scaled |= S::any_ge(S::splat(-0.5), index[q]);
+        }
+        let out = scratch.map(|x| x.as_mut_ptr());
+        for i in 0..n {
+            let ai = S::splat(rec_a[i]);
+            let (cma, apc) = (S::splat(cma[i]), S::splat(apc[i]));
+            for q in 0..K {
+                let [sigtau, sigma, nsin, ncos, ..] = point[q];
+                let sign = if ks[q] == 1 && i % 2 == 1 {
+                    -s[i]
+                } else {
+                    s[i]
+                };
+                let ws = S::mul(weight[q], S::splat(sign));
+                for (d, u) in cur[q].iter().enumerate() {
+                    S::store(out[q].add((3 * i + d) * w), S::mul(*u, ws));
+                }
+                let p = S::fma(ai, sigtau, S::blend_ge(sigma, zero, cma, apc));
+                let dp = S::mul(ai, nsin);
+                let ddp = S::mul(ai, ncos);
+                let [u0, u1, u2] = cur[q];
+                let next = [
+                    S::fms(p, u0, prev[q][0]),
+                    S::fma(p, u1, S::fms(dp, u0, prev[q][1])),
+                    S::fma(
+                        p,
+                        u2,
+                        S::fma(S::add(dp, dp), u1, S::fms(ddp, u0, prev[q][2])),
+                    ),
+                ];
+                prev[q] = cur[q];
+                cur[q] = next;
+            }
             if scaled {
-                let size = S::abs(cur[0]);
-                if S::any_ge(size, limit) {
-                    let factor = S::blend_ge(size, limit, tiny, one);
-                    prev = prev.map(|v| S::mul(v, factor));
-                    cur = cur.map(|v| S::mul(v, factor));
-                    index = S::add(index, S::blend_ge(size, limit, one, zero));
-                    weight = S::blend_ge(index, zero, one, zero);
-                    limit = S::blend_ge(index, zero, inf, threshold);
-                    scaled = S::any_ge(S::splat(-0.5), index);
+                scaled = false;
+                for q in 0..K {
+                    let size = S::abs(cur[q][0]);
+                    if S::any_ge(size, limit[q]) {
+                        let factor = S::blend_ge(size, limit[q], tiny, one);
+                        prev[q] = prev[q].map(|v| S::mul(v, factor));
+                        cur[q] = cur[q].map(|v| S::mul(v, factor));
+                        index[q] = S::add(index[q], S::blend_ge(size, limit[q], one, zero));
+                        weight[q] = S::blend_ge(index[q], zero, one, zero);
+                        limit[q] = S::blend_ge(index[q], zero, inf, threshold);
+                    }
+                    scaled |= S::any_ge(S::splat(-0.5), index[q]);
                 }
             }
         }
