@@ -48,9 +48,11 @@ struct Search {
     done: bool,
 }
 
-/// A Newton step of this size (max-norm, radians) from a point where `|C|^2` is concave
-/// is below what rounding resolves: the search ends there without evaluating it.
-const NEGLIGIBLE_STEP: f64 = 1e-11;
+/// An undamped Newton step below this size (max-norm, radians) from a point where `|C|^2`
+/// is concave is taken without evaluating it, and ends the search: its error is of the
+/// order of its square, while `|C|^2` itself cannot tell such steps apart (it changes by
+/// less than its rounding error).
+const NEGLIGIBLE_STEP: f64 = 1e-8;
 
 impl Search {
     fn new(g: Rotation, (f, grad, hess): Objective, radius: f64) -> Search {
@@ -87,10 +89,13 @@ impl Search {
         Some((s, s.iter().fold(0.0f64, |m, v| m.max(v.abs()))))
     }
 
-    fn add_trial(&mut self, mu: f64) -> bool {
+    /// Adds the trial `length` times the step of damping `mu`; false if singular.
+    fn add_trial(&mut self, mu: f64, length: f64) -> bool {
         let Some((mut s, mut size)) = self.step(mu) else {
             return false;
         };
+        s = s.map(|v| v * length);
+        size *= length;
         // No step beyond the trust radius (a grid step: the peak is near its grid point).
         if size > self.radius {
             s = s.map(|v| v * (self.radius / size));
@@ -137,7 +142,7 @@ impl Search {
             mu = mu.max(top + self.min_damping());
         }
         for _ in 0..30 {
-            if self.add_trial(mu) {
+            if self.add_trial(mu, 1.0) {
                 return;
             }
             mu = (2.0 * mu).max(1e-8 * self.min_damping() / 1e-6);
@@ -145,10 +150,19 @@ impl Search {
         self.done = true;
     }
 
-    /// Adds a more strongly damped trial (a spare lane of the round), after the last one.
+    /// Adds a trial in a spare lane of the round: after an undamped Newton step, the same
+    /// direction at another length (a line search in the same pass: from a grid point the
+    /// first Newton steps are off by a third), else a more strongly damped step.
     fn propose_more(&mut self) {
-        if let Some(&(_, _, mu)) = self.trials.last() {
-            self.add_trial((4.0 * mu).max(self.min_damping()));
+        const LENGTHS: [f64; 8] = [0.5, 1.5, 0.75, 1.25, 2.0, 0.25, 1.75, 0.875];
+        let Some(&(_, _, mu)) = self.trials.last() else {
+            return;
+        };
+        if mu == 0.0 {
+            let length = LENGTHS[(self.trials.len() - 1) % LENGTHS.len()];
+            self.add_trial(0.0, length);
+        } else {
+            self.add_trial((4.0 * mu).max(self.min_damping()), 1.0);
         }
     }
 
