@@ -102,43 +102,23 @@ fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync
 
 /// Up to `k` peaks of `|C|^2` on the grid `values` (bandwidth `b`), largest first: grid
 /// points at least as large as their 26 neighbours (`alpha`, `gamma` periodic), each at
-/// least `min_angle` radians (geodesic) from every larger peak taken.
+/// least `min_angle` radians (geodesic) from every larger peak taken. On a worker pool the
+/// beta slices are spread over its threads.
 pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
     let n = 2 * b;
     assert_eq!(values.len(), n * n * n);
-    let v = |kb: usize, ja: usize, jg: usize| values[(kb * n + ja) * n + jg].norm_sqr();
-    let mut maxima = Vec::new();
-    for kb in 0..n {
-        for ja in 0..n {
-            for jg in 0..n {
-                let x = v(kb, ja, jg);
-                if x.is_nan() || x <= 0.0 {
-                    continue;
-                }
-                let mut local = true;
-                'around: for db in -1isize..=1 {
-                    let kk = kb as isize + db;
-                    if kk < 0 || kk >= n as isize {
-                        continue;
-                    }
-                    for da in [n - 1, 0, 1] {
-                        for dg in [n - 1, 0, 1] {
-                            if db == 0 && da == 0 && dg == 0 {
-                                continue;
-                            }
-                            if v(kk as usize, (ja + da) % n, (jg + dg) % n) > x {
-                                local = false;
-                                break 'around;
-                            }
-                        }
-                    }
-                }
-                if local {
-                    maxima.push(Peak::at(b, (kb * n + ja) * n + jg, x));
-                }
-            }
-        }
-    }
+    // Runs of beta slices, each scanned with the squared magnitudes of three slices.
+    let runs = if rayon::current_thread_index().is_some() {
+        (4 * rayon::current_num_threads()).min(n)
+    } else {
+        1
+    };
+    let run = |r: usize| local_maxima(b, values, (r * n / runs)..((r + 1) * n / runs));
+    let mut maxima: Vec<Peak> = if runs > 1 {
+        (0..runs).into_par_iter().flat_map_iter(run).collect()
+    } else {
+        run(0)
+    };
     maxima.sort_by(|a, c| c.value.total_cmp(&a.value).then(a.index.cmp(&c.index)));
     let mut taken: Vec<Peak> = Vec::new();
     for p in maxima {
@@ -155,6 +135,77 @@ pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Ve
     taken
 }
 
+/// The local maxima of `|C|^2` (see [`top_peaks`]) in the beta slices `slices`, in index
+/// order. The squared magnitudes of the slice below, the slice and the slice above are
+/// kept in a rolling window (three slices of `(2b)^2` doubles).
+fn local_maxima(b: usize, values: &[Complex64], slices: std::ops::Range<usize>) -> Vec<Peak> {
+    let n = 2 * b;
+    let area = n * n;
+    let norms = |kb: usize, out: &mut Vec<f64>| {
+        out.clear();
+        out.extend(values[kb * area..][..area].iter().map(|z| z.norm_sqr()));
+    };
+    let (mut below, mut here, mut above) = (Vec::new(), Vec::new(), Vec::new());
+    let mut found = Vec::new();
+    let mut candidates: Vec<bool> = Vec::with_capacity(n);
+    for kb in slices.clone() {
+        if kb == slices.start {
+            if kb > 0 {
+                norms(kb - 1, &mut below);
+            }
+            norms(kb, &mut here);
+        } else {
+            std::mem::swap(&mut below, &mut here);
+            std::mem::swap(&mut here, &mut above);
+        }
+        if kb + 1 < n {
+            norms(kb + 1, &mut above);
+        } else {
+            above.clear();
+        }
+        // The neighbouring slices that exist (beta is not periodic).
+        let others: Vec<&[f64]> = [&below, &above]
+            .into_iter()
+            .filter(|s| !s.is_empty())
+            .map(|s| &s[..])
+            .collect();
+        for ja in 0..n {
+            let rows = [(ja + n - 1) % n, ja, (ja + 1) % n];
+            let row = &here[ja * n..][..n];
+            // Points positive and not below their two neighbours along gamma, without
+            // branches (a smooth row has only a few); the rest of the test for those.
+            candidates.clear();
+            candidates.extend((0..n).map(|jg| {
+                let x = row[jg];
+                let left = row[if jg == 0 { n - 1 } else { jg - 1 }];
+                let right = row[if jg + 1 == n { 0 } else { jg + 1 }];
+                // (A NaN neighbour does not count as larger.)
+                let below = |y: f64| y.partial_cmp(&x) != Some(std::cmp::Ordering::Greater);
+                (x > 0.0) & below(left) & below(right)
+            }));
+            for jg in (0..n).filter(|&jg| candidates[jg]) {
+                let x = row[jg];
+                let cols = [
+                    if jg == 0 { n - 1 } else { jg - 1 },
+                    jg,
+                    if jg + 1 == n { 0 } else { jg + 1 },
+                ];
+                let larger = |s: &[f64], skip_centre: bool| {
+                    rows.iter().any(|&r| {
+                        cols.iter()
+                            .any(|&c| !(skip_centre && r == ja && c == jg) && s[r * n + c] > x)
+                    })
+                };
+                if larger(&here, true) || others.iter().any(|s| larger(s, false)) {
+                    continue;
+                }
+                found.push(Peak::at(b, kb * area + ja * n + jg, x));
+            }
+        }
+    }
+    found
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -168,6 +219,76 @@ mod tests {
             }
         }
         (at, best)
+    }
+
+    /// The rule of `top_peaks` point by point: every grid point with a positive value and no
+    /// larger one among its 26 neighbours, largest first, then separated greedily.
+    fn plain_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
+        let n = 2 * b as isize;
+        let v = |kb: isize, ja: isize, jg: isize| {
+            values[((kb * n + ja.rem_euclid(n)) * n + jg.rem_euclid(n)) as usize].norm_sqr()
+        };
+        let mut maxima = Vec::new();
+        for kb in 0..n {
+            for ja in 0..n {
+                for jg in 0..n {
+                    let x = v(kb, ja, jg);
+                    let neighbours = (-1..=1)
+                        .filter(|d| (0..n).contains(&(kb + d)))
+                        .flat_map(|d| (-1..=1).flat_map(move |e| (-1..=1).map(move |f| (d, e, f))))
+                        .filter(|&t| t != (0, 0, 0));
+                    // (A NaN neighbour does not count as larger.)
+                    if x > 0.0
+                        && !neighbours
+                            .clone()
+                            .any(|(d, e, f)| v(kb + d, ja + e, jg + f) > x)
+                    {
+                        maxima.push(Peak::at(b, ((kb * n + ja) * n + jg) as usize, x));
+                    }
+                }
+            }
+        }
+        maxima.sort_by(|a, c| c.value.total_cmp(&a.value).then(a.index.cmp(&c.index)));
+        let mut taken: Vec<Peak> = Vec::new();
+        for p in maxima {
+            if taken.len() < k
+                && taken
+                    .iter()
+                    .all(|t| t.rotation().angle_to(&p.rotation()) >= min_angle)
+            {
+                taken.push(p);
+            }
+        }
+        taken
+    }
+
+    #[test]
+    fn top_peaks_follow_the_rule_on_every_thread_count() {
+        let b = 6;
+        let n = 8 * b * b * b;
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (state >> 40) % 7
+        };
+        // Few distinct values (plateaus and ties), a NaN; peaks at the beta edges and across
+        // the periodic alpha and gamma edges.
+        let mut v: Vec<Complex64> = (0..n).map(|_| Complex64::new(next() as f64, 0.0)).collect();
+        v[5] = Complex64::new(f64::NAN, 0.0);
+        v[0] = Complex64::new(50.0, 0.0);
+        v[n - 1] = Complex64::new(40.0, 0.0);
+        v[11] = Complex64::new(45.0, 0.0);
+        for (k, angle) in [(usize::MAX, 0.0), (10, 0.3), (3, 2.0)] {
+            let want = plain_peaks(b, &v, k, angle);
+            assert_eq!(top_peaks(b, &v, k, angle), want);
+            for threads in [2, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                assert_eq!(pool.install(|| top_peaks(b, &v, k, angle)), want);
+            }
+        }
     }
 
     #[test]
