@@ -77,6 +77,57 @@ int main(int argc, char **argv) {
         free(c.sig);
         free(c.pat);
     }
+    /* top peaks: two planted maxima on a flat grid, a larger value beside the first
+       (so that point is no maximum), complex and real */
+    {
+        const int B = 4, n = 2 * B;
+        const size_t total = (size_t)n * n * n;
+        so3fft_complex *cg = alloc_cx(total);
+        double *rg = (double *)malloc(total * sizeof(double));
+        CHECK(rg != NULL);
+        for (size_t i = 0; i < total; i++) {
+            cg[i][0] = 0.1;
+            cg[i][1] = 0.0;
+            rg[i] = -0.1;
+        }
+        const size_t first = (size_t)(1 * n + 2) * n + 3, second = (size_t)(6 * n + 5) * n + 1;
+        const size_t beside = (size_t)(1 * n + 3) * n + 3;
+        cg[first][0] = 0.0;
+        cg[first][1] = 5.0;
+        rg[first] = -5.0;
+        cg[second][0] = 4.0;
+        rg[second] = 4.0;
+        cg[beside][0] = 3.0;
+        rg[beside] = 3.0;
+        for (int real = 0; real < 2; real++) {
+            double angles[6], values[2];
+            ptrdiff_t idx[2];
+            ptrdiff_t got = real ? so3fft_grid_top_peaks_real(B, rg, 2, 0.1, angles, values, idx)
+                                 : so3fft_grid_top_peaks(B, cg, 2, 0.1, angles, values, idx);
+            CHECK(got == 2);
+            CHECK(idx[0] == (ptrdiff_t)first && idx[1] == (ptrdiff_t)second);
+            CHECK(values[0] == 25.0 && values[1] == 16.0);
+            const double pi = 3.14159265358979323846;
+            CHECK(fabs(angles[0] - 2 * pi / B) < 1e-15 && fabs(angles[1] - pi * 3 / (4 * B)) < 1e-15 &&
+                  fabs(angles[2] - 3 * pi / B) < 1e-15);
+            /* NULL for the optional outputs, k = 0, bad arguments */
+            CHECK(so3fft_grid_top_peaks(B, cg, 1, 0.0, angles, NULL, NULL) == 1);
+            CHECK(so3fft_grid_top_peaks(B, cg, 0, 0.0, angles, NULL, NULL) == 0);
+        }
+        double a[3];
+        CHECK(so3fft_grid_top_peaks(B, NULL, 1, 0.0, a, NULL, NULL) == -1);
+        CHECK_ERR(SO3FFT_ENULL);
+        CHECK(so3fft_grid_top_peaks(B, cg, 1, 0.0, NULL, NULL, NULL) == -1);
+        CHECK_ERR(SO3FFT_ENULL);
+        CHECK(so3fft_grid_top_peaks(B, cg, 1, NAN, a, NULL, NULL) == -1);
+        CHECK_ERR(SO3FFT_EINVAL);
+        CHECK(so3fft_grid_top_peaks_real(0, rg, 1, 0.0, a, NULL, NULL) == -1);
+        CHECK_ERR(SO3FFT_EBANDWIDTH);
+        CHECK(so3fft_grid_top_peaks_real(B, rg, (size_t)-1, 0.0, a, NULL, NULL) == -1);
+        CHECK_ERR(SO3FFT_EINVAL);
+        free(cg);
+        free(rg);
+    }
     CHECK(so3fft_plan_correlation(8, 4, 7, 0, 1) == NULL);
     CHECK_ERR(SO3FFT_EINVAL);
     CHECK(so3fft_plan_correlation(8, 0, -2, 0, 1) == NULL);

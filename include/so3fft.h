@@ -398,6 +398,16 @@ ptrdiff_t so3fft_grid_argmax(int B, so3fft_complex *grid, double *angles);
 // [`so3fft_grid_argmax`] of a real grid.
 ptrdiff_t so3fft_grid_argmax_real(int B, const double *grid, double *angles);
 
+// The (up to) `k` largest local maxima of `|C|^2` on a complex grid of bandwidth `B`, at
+// least `min_angle` radians (geodesic) apart, largest first: Euler angles into `angles`
+// (`3 k` doubles), `|C|^2` into `values` and flat indices into `indices` (each NULL or `k`
+// entries). A local maximum is at least as large as its 26 grid neighbours (alpha and
+// gamma periodic). Returns the number of peaks written, or -1 on error.
+ptrdiff_t so3fft_grid_top_peaks(int B, so3fft_complex *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
+
+// [`so3fft_grid_top_peaks`] of a real grid (`C^2`).
+ptrdiff_t so3fft_grid_top_peaks_real(int B, const double *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
+
 // Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from
 // `so3fft_grid_argmax`), the nearby maximum of the band-limited `|C|^2` of `signal` and
 // `pattern` (complex samples as interleaved doubles, or real ones for a plan made with

@@ -5,7 +5,8 @@ use super::{SO3FFT_DESTROY_INPUT, SO3FFT_ENULL};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
 use crate::matching::{
-    grid_argmax, grid_argmax_real, Correlation, CorrelationOptions, Peak, Rotation,
+    grid_argmax, grid_argmax_real, top_peaks, top_peaks_real, Correlation, CorrelationOptions,
+    Peak, Rotation,
 };
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_uint};
@@ -228,6 +229,113 @@ pub unsafe extern "C" fn so3fft_grid_argmax_real(
         let values = unsafe { std::slice::from_raw_parts(grid, n) };
         // SAFETY: as in `so3fft_grid_argmax`.
         Ok(unsafe { put_angles(grid_argmax_real(b, values), angles) })
+    })
+}
+
+/// Writes `peaks` to the caller's arrays: Euler angles to `angles` (3 per peak), `|C|^2`
+/// to `values` and flat indices to `indices` (each NULL or one per peak); their count.
+///
+/// # Safety
+/// `angles` holds 3 doubles per peak; `values` and `indices` are NULL or hold one entry
+/// per peak.
+unsafe fn put_peaks(
+    peaks: &[Peak],
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> isize {
+    for (i, p) in peaks.iter().enumerate() {
+        // SAFETY: the sizes of this function's contract.
+        unsafe {
+            put_angles(*p, angles.add(3 * i));
+            if !values.is_null() {
+                *values.add(i) = p.value;
+            }
+            if !indices.is_null() {
+                *indices.add(i) = p.index as isize;
+            }
+        }
+    }
+    peaks.len() as isize
+}
+
+/// Checks the arrays of a top-peaks call for `k` peaks and the separation angle.
+fn check_peak_arrays(
+    k: usize,
+    min_angle: c_double,
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> Result<(), CallError> {
+    if !(min_angle >= 0.0 && min_angle.is_finite()) {
+        return Err(CallError::invalid(format!(
+            "min_angle {min_angle} is not a finite angle >= 0"
+        )));
+    }
+    let count = k
+        .checked_mul(3)
+        .filter(|&n| n <= isize::MAX as usize / 8)
+        .ok_or_else(|| CallError::invalid(format!("k {k} too large")))?;
+    Array::new(angles.cast_const(), count, "angles").check()?;
+    if !values.is_null() {
+        Array::new(values.cast_const(), k, "values").check()?;
+    }
+    if !indices.is_null() {
+        Array::new(indices.cast_const(), k, "indices").check()?;
+    }
+    Ok(())
+}
+
+/// The (up to) `k` largest local maxima of `|C|^2` on a complex grid of bandwidth `B`, at
+/// least `min_angle` radians (geodesic) apart, largest first: Euler angles into `angles`
+/// (`3 k` doubles), `|C|^2` into `values` and flat indices into `indices` (each NULL or `k`
+/// entries). A local maximum is at least as large as its 26 grid neighbours (alpha and
+/// gamma periodic). Returns the number of peaks written, or -1 on error.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_grid_top_peaks(
+    B: c_int,
+    grid: *mut so3fft_complex,
+    k: usize,
+    min_angle: c_double,
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> isize {
+    guarded(-1, || {
+        let b = checks::bandwidth(B)?;
+        let n = crate::num_samples(b);
+        Array::new(grid.cast_const(), n, "grid").check()?;
+        check_peak_arrays(k, min_angle, angles, values, indices)?;
+        // SAFETY: checked non-NULL and aligned; (2B)^3 values (the API's contract), only
+        // read (non-const in the prototype like every complex array of this API).
+        let grid = unsafe { std::slice::from_raw_parts(grid.cast_const().cast::<Complex64>(), n) };
+        let peaks = top_peaks(b, grid, k, min_angle);
+        // SAFETY: the arrays' sizes were checked for `k >= peaks.len()` peaks.
+        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
+    })
+}
+
+/// [`so3fft_grid_top_peaks`] of a real grid (`C^2`).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_grid_top_peaks_real(
+    B: c_int,
+    grid: *const c_double,
+    k: usize,
+    min_angle: c_double,
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> isize {
+    guarded(-1, || {
+        let b = checks::bandwidth(B)?;
+        let n = crate::num_samples(b);
+        Array::new(grid, n, "grid").check()?;
+        check_peak_arrays(k, min_angle, angles, values, indices)?;
+        // SAFETY: as in `so3fft_grid_top_peaks`.
+        let grid = unsafe { std::slice::from_raw_parts(grid, n) };
+        let peaks = top_peaks_real(b, grid, k, min_angle);
+        // SAFETY: as in `so3fft_grid_top_peaks`.
+        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
     })
 }
 

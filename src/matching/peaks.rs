@@ -105,6 +105,20 @@ fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync
 /// least `min_angle` radians (geodesic) from every larger peak taken. On a worker pool the
 /// beta slices are spread over its threads.
 pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
+    select_peaks(b, values, |z| z.norm_sqr(), (k, min_angle))
+}
+
+/// [`top_peaks`] of a real grid (`C^2`).
+pub fn top_peaks_real(b: usize, values: &[f64], k: usize, min_angle: f64) -> Vec<Peak> {
+    select_peaks(b, values, |x| x * x, (k, min_angle))
+}
+
+fn select_peaks<T: Copy + Sync>(
+    b: usize,
+    values: &[T],
+    square: impl Fn(T) -> f64 + Sync,
+    (k, min_angle): (usize, f64),
+) -> Vec<Peak> {
     let n = 2 * b;
     assert_eq!(values.len(), n * n * n);
     // Runs of beta slices, each scanned with the squared magnitudes of three slices.
@@ -113,7 +127,7 @@ pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Ve
     } else {
         1
     };
-    let run = |r: usize| local_maxima(b, values, (r * n / runs)..((r + 1) * n / runs));
+    let run = |r: usize| local_maxima(b, values, &square, (r * n / runs)..((r + 1) * n / runs));
     let mut maxima: Vec<Peak> = if runs > 1 {
         (0..runs).into_par_iter().flat_map_iter(run).collect()
     } else {
@@ -138,12 +152,17 @@ pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Ve
 /// The local maxima of `|C|^2` (see [`top_peaks`]) in the beta slices `slices`, in index
 /// order. The squared magnitudes of the slice below, the slice and the slice above are
 /// kept in a rolling window (three slices of `(2b)^2` doubles).
-fn local_maxima(b: usize, values: &[Complex64], slices: std::ops::Range<usize>) -> Vec<Peak> {
+fn local_maxima<T: Copy>(
+    b: usize,
+    values: &[T],
+    square: impl Fn(T) -> f64,
+    slices: std::ops::Range<usize>,
+) -> Vec<Peak> {
     let n = 2 * b;
     let area = n * n;
     let norms = |kb: usize, out: &mut Vec<f64>| {
         out.clear();
-        out.extend(values[kb * area..][..area].iter().map(|z| z.norm_sqr()));
+        out.extend(values[kb * area..][..area].iter().map(|&z| square(z)));
     };
     let (mut below, mut here, mut above) = (Vec::new(), Vec::new(), Vec::new());
     let mut found = Vec::new();
@@ -281,6 +300,8 @@ mod tests {
         for (k, angle) in [(usize::MAX, 0.0), (10, 0.3), (3, 2.0)] {
             let want = plain_peaks(b, &v, k, angle);
             assert_eq!(top_peaks(b, &v, k, angle), want);
+            let re: Vec<f64> = v.iter().map(|z| -z.re).collect();
+            assert_eq!(top_peaks_real(b, &re, k, angle), want);
             for threads in [2, 3] {
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
