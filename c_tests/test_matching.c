@@ -128,6 +128,34 @@ int main(int argc, char **argv) {
         free(cg);
         free(rg);
     }
+    /* rotation matrix and quaternion of Euler angles: orthonormal, R e_z is
+       (cos a sin b, sin a sin b, cos b), and the quaternion gives the same matrix */
+    {
+        const double ang[3] = {0.3, 1.1, -2.0};
+        double r[9], q[4];
+        CHECK(so3fft_rotation_matrix(ang, r) == SO3FFT_OK);
+        CHECK(so3fft_rotation_quaternion(ang, q) == SO3FFT_OK);
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++) {
+                double dot = 0.0;
+                for (int k = 0; k < 3; k++) {
+                    dot += r[3 * i + k] * r[3 * j + k];
+                }
+                CHECK(fabs(dot - (i == j ? 1.0 : 0.0)) < 1e-15);
+            }
+        }
+        CHECK(fabs(r[2] - cos(0.3) * sin(1.1)) < 1e-15 && fabs(r[5] - sin(0.3) * sin(1.1)) < 1e-15 &&
+              fabs(r[8] - cos(1.1)) < 1e-15);
+        const double w = q[0], x = q[1], y = q[2], z = q[3];
+        CHECK(w >= 0.0 && fabs(w * w + x * x + y * y + z * z - 1.0) < 1e-15);
+        CHECK(fabs(r[1] - 2 * (x * y - w * z)) < 1e-15 && fabs(r[6] - 2 * (x * z - w * y)) < 1e-15);
+        const double bad[3] = {0.0, NAN, 0.0};
+        CHECK(so3fft_rotation_matrix(bad, r) == SO3FFT_EINVAL);
+        CHECK_ERR(SO3FFT_EINVAL);
+        CHECK(so3fft_rotation_quaternion(ang, NULL) == SO3FFT_ENULL);
+        CHECK_ERR(SO3FFT_ENULL);
+        CHECK(so3fft_rotation_matrix(NULL, r) == SO3FFT_ENULL);
+    }
     CHECK(so3fft_plan_correlation(8, 4, 7, 0, 1) == NULL);
     CHECK_ERR(SO3FFT_EINVAL);
     CHECK(so3fft_plan_correlation(8, 0, -2, 0, 1) == NULL);

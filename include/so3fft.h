@@ -398,6 +398,16 @@ ptrdiff_t so3fft_grid_argmax(int B, so3fft_complex *grid, double *angles);
 // [`so3fft_grid_argmax`] of a real grid.
 ptrdiff_t so3fft_grid_argmax_real(int B, const double *grid, double *angles);
 
+// The rotation matrix (row-major, acting on column vectors) of the rotation with Euler
+// angles `angles` = `(alpha, beta, gamma)`, `Rz(alpha) Ry(beta) Rz(gamma)`, into `matrix`
+// (9 doubles). `SO3FFT_OK` or an error code.
+int so3fft_rotation_matrix(const double *angles, double *matrix);
+
+// The unit quaternion `(w, x, y, z)`, `w >= 0`, of the rotation with Euler angles
+// `angles` (as in `so3fft_rotation_matrix`) into `q` (4 doubles). `SO3FFT_OK` or an error
+// code.
+int so3fft_rotation_quaternion(const double *angles, double *q);
+
 // The (up to) `k` largest local maxima of `|C|^2` on a complex grid of bandwidth `B`, at
 // least `min_angle` radians (geodesic) apart, largest first: Euler angles into `angles`
 // (`3 k` doubles), `|C|^2` into `values` and flat indices into `indices` (each NULL or `k`

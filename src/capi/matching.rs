@@ -232,6 +232,53 @@ pub unsafe extern "C" fn so3fft_grid_argmax_real(
     })
 }
 
+/// The rotation matrix (row-major, acting on column vectors) of the rotation with Euler
+/// angles `angles` = `(alpha, beta, gamma)`, `Rz(alpha) Ry(beta) Rz(gamma)`, into `matrix`
+/// (9 doubles). `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_rotation_matrix(
+    angles: *const c_double,
+    matrix: *mut c_double,
+) -> c_int {
+    guarded_code(|| {
+        let g = read_rotation(angles)?;
+        Array::new(matrix.cast_const(), 9, "matrix").check()?;
+        // SAFETY: checked non-NULL, aligned, 9 doubles (the API's contract).
+        let out = unsafe { std::slice::from_raw_parts_mut(matrix, 9) };
+        out.copy_from_slice(g.matrix().as_flattened());
+        Ok(())
+    })
+}
+
+/// The unit quaternion `(w, x, y, z)`, `w >= 0`, of the rotation with Euler angles
+/// `angles` (as in `so3fft_rotation_matrix`) into `q` (4 doubles). `SO3FFT_OK` or an error
+/// code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_rotation_quaternion(
+    angles: *const c_double,
+    q: *mut c_double,
+) -> c_int {
+    guarded_code(|| {
+        let g = read_rotation(angles)?;
+        Array::new(q.cast_const(), 4, "q").check()?;
+        // SAFETY: checked non-NULL, aligned, 4 doubles (the API's contract).
+        let out = unsafe { std::slice::from_raw_parts_mut(q, 4) };
+        out.copy_from_slice(&g.quaternion());
+        Ok(())
+    })
+}
+
+/// The rotation with the 3 finite Euler angles at `angles`.
+fn read_rotation(angles: *const c_double) -> Result<Rotation, CallError> {
+    Array::new(angles, 3, "angles").check()?;
+    // SAFETY: checked non-NULL and aligned; 3 doubles (the API's contract).
+    let a = unsafe { std::slice::from_raw_parts(angles, 3) };
+    if !a.iter().all(|v| v.is_finite()) {
+        return Err(CallError::invalid(format!("angles {a:?} are not finite")));
+    }
+    Ok(Rotation::new(a[0], a[1], a[2]))
+}
+
 /// Writes `peaks` to the caller's arrays: Euler angles to `angles` (3 per peak), `|C|^2`
 /// to `values` and flat indices to `indices` (each NULL or one per peak); their count.
 ///
