@@ -2,7 +2,8 @@
 //! band-limited pattern rotated by a random off-grid rotation is recovered; medians of the
 //! pipeline (two S^2 forwards, combine, inverse SO(3), grid argmax) for complex and real
 //! inputs, the time of one refinement (the true peak) and of ten peaks refined together,
-//! and the grid and refined angle errors.
+//! and the grid and refined angle errors; then many templates (eight patterns against one
+//! signal) and shells (four) against a single correlation.
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
@@ -135,6 +136,65 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                 std::f64::consts::PI / l as f64,
                 peak.rotation().angle_to(&truth),
                 refined.angle_to(&truth)
+            );
+        }
+    }
+    many_and_shells(opts)
+}
+
+/// Many templates and shells: per `L`, one complex correlation (no argmax), eight patterns
+/// against one signal (`correlate_many`: the signal transformed once) per pattern, and four
+/// weighted shells (`correlate_shells`: four pairs of S^2 transforms, one inverse); medians.
+fn many_and_shells(opts: &Options) -> so3fft::Result<()> {
+    println!();
+    println!("many templates and shells: medians in ms");
+    println!(
+        "{:>5} {:>3} {:>10} {:>14} {:>10} {:>10}",
+        "L", "thr", "single", "8 patterns/1", "ratio", "4 shells"
+    );
+    for &l in &opts.bandwidths {
+        for &threads in &opts.threads {
+            let runs = opts.runs.unwrap_or(5);
+            let plan = Correlation::new(
+                l,
+                &CorrelationOptions {
+                    threads,
+                    rigor: opts.rigor,
+                    ..Default::default()
+                },
+            )?;
+            let ns = 4 * l * l;
+            let (sig, pats) = (random_coeffs(ns, 11), random_coeffs(8 * ns, 12));
+            let mut grid = vec![Complex64::default(); plan.num_grid()];
+            let mut grids = vec![Complex64::default(); 8 * plan.num_grid()];
+            let (mut one, mut many, mut shells) = (Vec::new(), Vec::new(), Vec::new());
+            let shell_list: Vec<(&[Complex64], &[Complex64], f64)> = (0..4)
+                .map(|s| {
+                    (
+                        &pats[s * ns..][..ns],
+                        &pats[(s + 4) * ns..][..ns],
+                        1.0 + s as f64,
+                    )
+                })
+                .collect();
+            for _ in 0..runs {
+                let t = Instant::now();
+                plan.correlate(&sig, &pats[..ns], &mut grid)?;
+                one.push(t.elapsed().as_secs_f64());
+                let t = Instant::now();
+                plan.correlate_many(&sig, &pats, &mut grids)?;
+                many.push(t.elapsed().as_secs_f64() / 8.0);
+                let t = Instant::now();
+                plan.correlate_shells(&shell_list, &mut grid)?;
+                shells.push(t.elapsed().as_secs_f64());
+            }
+            let (t_one, t_many, t_shells) = (median(&one), median(&many), median(&shells));
+            println!(
+                "{l:>5} {threads:>3} {:>10.3} {:>14.3} {:>10.3} {:>10.3}",
+                t_one * 1e3,
+                t_many * 1e3,
+                t_many / t_one,
+                t_shells * 1e3
             );
         }
     }
