@@ -284,13 +284,13 @@ impl Correlation {
                 "start rotation {g:?} is not finite"
             )));
         }
-        let tables = self
-            .series
-            .get_or_init(|| Arc::new(SeriesTables::new(self.b_out, self.deg_lim)))
-            .clone();
-        Ok(self
-            .s2
-            .install(|| super::So3Series::with_tables(tables, coeffs).maximise_many(starts)))
+        Ok(self.s2.install(|| {
+            let tables = self
+                .series
+                .get_or_init(|| Arc::new(SeriesTables::new(self.b_out, self.deg_lim)))
+                .clone();
+            super::So3Series::with_tables(tables, coeffs).maximise_many(starts)
+        }))
     }
 
     /// Whether the plan takes real inputs.

@@ -69,32 +69,52 @@ impl SeriesTables {
         assert!(lmax < b);
         let recurrence = RecTables::new(lmax + 1);
         let norms = start_norms(lmax + 1);
+        // The clusters of base order `m`, their packed offsets from the row's start, and the
+        // row's packed length.
+        let row = |m: usize| {
+            let n = lmax + 1 - m;
+            let mut packed = 0;
+            let tables: Vec<ClusterTable> = (0..=m)
+                .map(|mp| {
+                    let mut rec = RecCoeffs::new(n);
+                    recurrence.coeffs(m, mp, &mut rec);
+                    let mut groups = [Group::default(); 2];
+                    for mem in Cluster::new(m, mp).members() {
+                        let g = &mut groups[usize::from(mem.reversed)];
+                        g.orders[g.len] = (mem.m, mem.mp);
+                        g.block[g.len] = block_start(b, mem.m, mem.mp);
+                        g.factor[g.len] = mem.sign_at(m) / (2.0 * PI);
+                        g.len += 1;
+                    }
+                    for g in &mut groups {
+                        g.packed = packed;
+                        packed += g.len * n;
+                    }
+                    ClusterTable {
+                        rec,
+                        norm: norms[m * (m + 1) / 2 + mp],
+                        groups,
+                    }
+                })
+                .collect();
+            (tables, packed)
+        };
+        // On a worker pool the rows are made by its threads.
+        let rows: Vec<(Vec<ClusterTable>, usize)> = if rayon::current_thread_index().is_some() {
+            (0..=lmax).into_par_iter().map(row).collect()
+        } else {
+            (0..=lmax).map(row).collect()
+        };
         let mut clusters = Vec::with_capacity((lmax + 1) * (lmax + 2) / 2);
         let mut row_packed = Vec::with_capacity(lmax + 2);
         let mut packed = 0;
-        for m in 0..=lmax {
+        for (tables, len) in rows {
             row_packed.push(packed);
-            for mp in 0..=m {
-                let mut rec = RecCoeffs::new(lmax + 1 - m);
-                recurrence.coeffs(m, mp, &mut rec);
-                let mut groups = [Group::default(); 2];
-                for mem in Cluster::new(m, mp).members() {
-                    let g = &mut groups[usize::from(mem.reversed)];
-                    g.orders[g.len] = (mem.m, mem.mp);
-                    g.block[g.len] = block_start(b, mem.m, mem.mp);
-                    g.factor[g.len] = mem.sign_at(m) / (2.0 * PI);
-                    g.len += 1;
-                }
-                for g in &mut groups {
-                    g.packed = packed;
-                    packed += g.len * (lmax + 1 - m);
-                }
-                clusters.push(ClusterTable {
-                    rec,
-                    norm: norms[m * (m + 1) / 2 + mp],
-                    groups,
-                });
+            for mut t in tables {
+                t.groups.iter_mut().for_each(|g| g.packed += packed);
+                clusters.push(t);
             }
+            packed += len;
         }
         row_packed.push(packed);
         SeriesTables {
