@@ -23,7 +23,7 @@ pub fn combine(
 ) -> Result<()> {
     check(sig.len(), pat.len(), (b_in, deg_lim, b_out), out.len())?;
     out.fill(Complex64::default());
-    add_combined((sig, pat), b_in, (0, deg_lim), b_out, (1.0, out));
+    add_combined((sig, pat), b_in, (0, deg_lim), b_out, (1.0, out), false);
     Ok(())
 }
 
@@ -56,14 +56,17 @@ pub(super) fn check(
 }
 
 /// Adds `scale` times the combination of degrees `from..=to` to `out` (lengths checked by
-/// the caller with [`check`]). For each order pair the degrees are consecutive in all three
-/// arrays, so the inner loop runs over contiguous runs.
+/// the caller with [`check`]); with `half`, only the order pairs a real-signal inverse
+/// reads (`M' > 0`, or `M' = 0` and `M >= 0`; the others are left as they are). For each
+/// order pair the degrees are consecutive in all three arrays, so the inner loop runs over
+/// contiguous runs.
 pub(super) fn add_combined(
     (sig, pat): (&[Complex64], &[Complex64]),
     b_in: usize,
     (from, to): (usize, usize),
     b_out: usize,
     (scale, out): (f64, &mut [Complex64]),
+    half: bool,
 ) {
     if from > to {
         return;
@@ -77,7 +80,11 @@ pub(super) fn add_combined(
     let row = |m1: isize| {
         // fhat(l, -m1) for l = |m1|.. is consecutive from order_start(-m1).
         let f_row = &sig[order_start(b_in, -m1)..];
-        for m2 in -top..=top {
+        let lowest = if half { 0 } else { -top };
+        for m2 in lowest..=top {
+            if half && m2 == 0 && m1 < 0 {
+                continue;
+            }
             let h_row = &pat[order_start(b_in, -m2)..];
             let (a1, a2) = (m1.unsigned_abs(), m2.unsigned_abs());
             let l0 = a1.max(a2).max(from);

@@ -156,7 +156,7 @@ impl Correlation {
     fn add_shell<T>(
         &self,
         (signal, pattern, weight): (&[T], &[T], f64),
-        forward: &impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        (forward, half): (&impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
         buf: &mut Buffers,
         norms: &mut [f64; 2],
     ) -> Result<()> {
@@ -193,6 +193,7 @@ impl Correlation {
                     (from, self.deg_lim),
                     self.deg_lim + 1,
                     (weight, so3),
+                    half,
                 )
             });
         }
@@ -200,11 +201,11 @@ impl Correlation {
     }
 
     /// The SO(3) coefficients of the weighted sum over `shells` into `buf.so3` (normalised
-    /// if the plan says so).
+    /// if the plan says so); with `half`, only those a real-signal inverse reads.
     fn combine_shells<T>(
         &self,
         shells: &[(&[T], &[T], f64)],
-        forward: impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
         buf: &mut Buffers,
     ) -> Result<()> {
         if shells.is_empty() {
@@ -213,7 +214,7 @@ impl Correlation {
         buf.so3.fill(Complex64::default());
         let mut norms = [0.0; 2];
         for &shell in shells {
-            self.add_shell(shell, &forward, buf, &mut norms)?;
+            self.add_shell(shell, (&forward, half), buf, &mut norms)?;
         }
         if self.normalized {
             let denominator = (norms[0] * norms[1]).sqrt();
@@ -237,7 +238,7 @@ impl Correlation {
     ) -> Result<()> {
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
             self.widen(&buf.so3, out)
         })
     }
@@ -251,7 +252,7 @@ impl Correlation {
     ) -> Result<()> {
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], fwd, buf)?;
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
             self.widen(&buf.so3, out)
         })
     }
@@ -363,7 +364,7 @@ impl Correlation {
         self.need(false)?;
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-            self.combine_shells(shells, fwd, buf)?;
+            self.combine_shells(shells, (fwd, false), buf)?;
             self.so3.inverse(&buf.so3, out)
         })
     }
@@ -377,7 +378,7 @@ impl Correlation {
         self.need(true)?;
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-            self.combine_shells(shells, fwd, buf)?;
+            self.combine_shells(shells, (fwd, true), buf)?;
             self.so3.inverse_real(&buf.so3, out)
         })
     }
@@ -394,7 +395,7 @@ impl Correlation {
         self.need(false)?;
         let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
         let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
-        self.many((signal, patterns, out), forward, inverse)
+        self.many((signal, patterns, out), (forward, false), inverse)
     }
 
     /// [`Correlation::correlate_many`] of real samples.
@@ -407,7 +408,7 @@ impl Correlation {
         self.need(true)?;
         let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
         let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
-        self.many((signal, patterns, out), forward, inverse)
+        self.many((signal, patterns, out), (forward, true), inverse)
     }
 
     /// The body of the `correlate_many` functions, with the S^2 forward and SO(3) inverse
@@ -415,7 +416,7 @@ impl Correlation {
     fn many<T, G>(
         &self,
         (signal, patterns, out): (&[T], &[T], &mut [G]),
-        forward: impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
         inverse: impl Fn(&[Complex64], &mut [G]) -> Result<()>,
     ) -> Result<()> {
         let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
@@ -433,7 +434,7 @@ impl Correlation {
                 }
             };
             for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
-                self.combine_shells(&[(signal, pattern, 1.0)], known, buf)?;
+                self.combine_shells(&[(signal, pattern, 1.0)], (known, half), buf)?;
                 inverse(&buf.so3, grid)?;
             }
             Ok(())
