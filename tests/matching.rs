@@ -688,3 +688,39 @@ fn peaks_refined_together_reach_the_same_maxima() {
     let nan = Rotation::new(0.0, f64::NAN, 0.0);
     assert!(plan.refine_many(&coeffs, &[nan]).is_err());
 }
+
+/// Rotations near the poles of the Euler angles (`beta` near 0 or pi, where only
+/// `alpha + gamma` or `alpha - gamma` is defined and the Hessian in the angles is nearly
+/// singular) are refined like any other.
+#[test]
+fn rotations_near_the_poles_refined() {
+    let l = 16;
+    let mut rng = common::Rng::new(9);
+    let hat = rng.complex_vec(l * l);
+    let p = s2_plan(l);
+    let plan = Correlation::new(
+        l,
+        &CorrelationOptions {
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for beta in [1e-3, 0.02, std::f64::consts::PI - 1e-3, 1e-9] {
+        let truth = Rotation::new(1.1, beta, 2.3);
+        let n = 4 * l * l;
+        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+        p.inverse(&rotate_s2_coeffs(l, &hat, &truth).unwrap(), &mut sig)
+            .unwrap();
+        p.inverse(&hat, &mut pat).unwrap();
+        let mut grid = vec![Complex64::default(); plan.num_grid()];
+        plan.correlate(&sig, &pat, &mut grid).unwrap();
+        let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
+        plan.coefficients(&sig, &pat, &mut coeffs).unwrap();
+        let (g, _) = plan
+            .refine(&coeffs, &grid_argmax(l, &grid).rotation())
+            .unwrap();
+        let err = g.angle_to(&truth);
+        assert!(err < 1e-8, "beta {beta:e}: refined {err:e} rad off the truth");
+    }
+}

@@ -129,17 +129,10 @@ impl Search {
                 mu = 0.0;
             }
         } else {
-            // Gershgorin: every eigenvalue of the Hessian is below `top`.
-            let top = (0..3)
-                .map(|i| {
-                    self.hess[i][i]
-                        + (0..3)
-                            .filter(|&j| j != i)
-                            .map(|j| self.hess[i][j].abs())
-                            .sum::<f64>()
-                })
-                .fold(f64::MIN, f64::max);
-            mu = mu.max(top + self.min_damping());
+            // Just above the largest eigenvalue: the step follows the directions where
+            // `|C|^2` curves upward (away from a saddle or a minimum); the spare lanes try
+            // more strongly damped steps.
+            mu = mu.max(largest_eigenvalue(&self.hess) + self.min_damping());
         }
         for _ in 0..30 {
             if self.add_trial(mu, 1.0) {
@@ -194,6 +187,27 @@ impl Search {
             self.done = self.failures >= 30;
         }
     }
+}
+
+/// The largest eigenvalue of the symmetric `h` (the trigonometric solution of the
+/// characteristic cubic).
+fn largest_eigenvalue(h: &[[f64; 3]; 3]) -> f64 {
+    let off = h[0][1] * h[0][1] + h[0][2] * h[0][2] + h[1][2] * h[1][2];
+    let q = (h[0][0] + h[1][1] + h[2][2]) / 3.0;
+    let diag = (0..3).map(|i| (h[i][i] - q).powi(2)).sum::<f64>();
+    let p = ((diag + 2.0 * off) / 6.0).sqrt();
+    if p == 0.0 || !p.is_finite() {
+        return h[0][0].max(h[1][1]).max(h[2][2]);
+    }
+    // B = (h - q I) / p; det(B) / 2 in [-1, 1].
+    let b: [[f64; 3]; 3] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| (h[i][j] - if i == j { q } else { 0.0 }) / p)
+    });
+    let det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1])
+        - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0])
+        + b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+    let phi = (det / 2.0).clamp(-1.0, 1.0).acos() / 3.0;
+    q + 2.0 * p * phi.cos()
 }
 
 /// Whether the symmetric `h` is negative definite (Sylvester's criterion on `-h`).
