@@ -415,7 +415,7 @@ int so3fft_rotation_quaternion(const double *angles, double *q);
 // gamma periodic). Returns the number of peaks written, or -1 on error.
 ptrdiff_t so3fft_grid_top_peaks(int B, so3fft_complex *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
 
-// [`so3fft_grid_top_peaks`] of a real grid (`C^2`).
+// `so3fft_grid_top_peaks` of a real grid (`C^2`).
 ptrdiff_t so3fft_grid_top_peaks_real(int B, const double *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
 
 // Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from

@@ -670,6 +670,10 @@ fn peaks_refined_together_reach_the_same_maxima() {
             "from {start:?}: {g:?} together, {alone:?} alone"
         );
         assert!((value - alone_value).abs() <= 1e-12 * value);
+        // Angles in their canonical ranges.
+        let tau = 2.0 * std::f64::consts::PI;
+        assert!((0.0..=std::f64::consts::PI).contains(&g.beta));
+        assert!((0.0..tau).contains(&g.alpha) && (0.0..tau).contains(&g.gamma));
         // A maximum: the value there is |C|^2 of the series, and no larger nearby.
         assert!((series.value(g).norm_sqr() - value).abs() <= 1e-12 * value);
         let around: Vec<Rotation> = (0..6)
@@ -721,6 +725,9 @@ fn rotations_near_the_poles_refined() {
             .refine(&coeffs, &grid_argmax(l, &grid).rotation())
             .unwrap();
         let err = g.angle_to(&truth);
-        assert!(err < 1e-8, "beta {beta:e}: refined {err:e} rad off the truth");
+        assert!(
+            err < 1e-8,
+            "beta {beta:e}: refined {err:e} rad off the truth"
+        );
     }
 }

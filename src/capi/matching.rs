@@ -362,7 +362,7 @@ pub unsafe extern "C" fn so3fft_grid_top_peaks(
     })
 }
 
-/// [`so3fft_grid_top_peaks`] of a real grid (`C^2`).
+/// `so3fft_grid_top_peaks` of a real grid (`C^2`).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_grid_top_peaks_real(
     B: c_int,
@@ -431,9 +431,27 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
             Array::new(values.cast_const(), npeaks, "values").check()?;
         }
         // SAFETY: as in `so3fft_correlate`; `angles` holds `3 npeaks` doubles (checked for
-        // NULL, alignment and range above), `values` NULL or `npeaks`.
+        // NULL, alignment and range above), `values` NULL or `npeaks`; both are read and
+        // written through raw pointers (they may overlap).
         unsafe {
+            let starts: Vec<Rotation> = (0..npeaks)
+                .map(|k| {
+                    let a = angles.add(3 * k);
+                    Rotation::new(*a, *a.add(1), *a.add(2))
+                })
+                .collect();
+            if let Some(g) = starts
+                .iter()
+                .find(|g| ![g.alpha, g.beta, g.gamma].iter().all(|v| v.is_finite()))
+            {
+                return Err(CallError::invalid(format!(
+                    "start rotation {g:?} is not finite"
+                )));
+            }
             let plan = plan_ref(p)?;
+            if npeaks == 0 {
+                return Ok(());
+            }
             let b_out = plan.b_out();
             let mut coeffs = vec![Complex64::default(); crate::num_coeffs(b_out)];
             let ns = 4 * plan.b_in() * plan.b_in();
@@ -444,14 +462,10 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
                 let (s, h) = inputs(signal.cast::<Complex64>(), pattern.cast(), ns, None)?;
                 plan.coefficients(s, h, &mut coeffs)?;
             }
-            let angles = std::slice::from_raw_parts_mut(angles, count);
-            let starts: Vec<Rotation> = angles
-                .chunks_exact(3)
-                .map(|a| Rotation::new(a[0], a[1], a[2]))
-                .collect();
             let refined = plan.refine_many(&coeffs, &starts)?;
             for (k, (g, v)) in refined.into_iter().enumerate() {
-                angles[3 * k..3 * k + 3].copy_from_slice(&[g.alpha, g.beta, g.gamma]);
+                let a = angles.add(3 * k);
+                (*a, *a.add(1), *a.add(2)) = (g.alpha, g.beta, g.gamma);
                 if !values.is_null() {
                     *values.add(k) = v;
                 }

@@ -162,7 +162,15 @@ impl Search {
     /// Takes the trials' objectives: moves to the best trial if `|C|^2` did not fall there.
     fn update(&mut self, results: &[Objective]) {
         let trials = std::mem::take(&mut self.trials);
-        let best = (0..results.len()).max_by(|&a, &b| results[a].0.total_cmp(&results[b].0));
+        // A NaN value never wins.
+        let key = |i: usize| {
+            if results[i].0.is_nan() {
+                f64::NEG_INFINITY
+            } else {
+                results[i].0
+            }
+        };
+        let best = (0..results.len()).max_by(|&a, &b| key(a).total_cmp(&key(b)));
         let Some(best) = best else {
             return;
         };
@@ -252,7 +260,10 @@ impl So3Series {
     }
 
     /// The rotation near `start` where `|C|^2` is largest, by damped Newton steps
-    /// (Levenberg-Marquardt), and `|C|^2` there.
+    /// (Levenberg-Marquardt), with `beta` in `[0, pi]` and `alpha`, `gamma` in `[0, 2 pi)`,
+    /// and `|C|^2` there (a final Newton step below 1e-8 rad is taken without evaluating
+    /// it: the value is then the one before it, equal to rounding). Near `beta = 0` or `pi`
+    /// the Euler angles are degenerate and the result is accurate to about 1e-9 rad.
     pub fn maximise(&self, start: &Rotation) -> (Rotation, f64) {
         self.maximise_many(std::slice::from_ref(start))[0]
     }
@@ -292,7 +303,7 @@ impl So3Series {
                 searches[i].update(&r);
             }
         }
-        searches.iter().map(|s| (s.g, s.f)).collect()
+        searches.iter().map(|s| (s.g.normalized(), s.f)).collect()
     }
 }
 

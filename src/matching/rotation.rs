@@ -33,6 +33,21 @@ impl Rotation {
         Rotation { alpha, beta, gamma }
     }
 
+    /// The same rotation with `beta` in `[0, pi]` and `alpha`, `gamma` in `[0, 2 pi)`
+    /// (`(alpha, -beta, gamma)` is `(alpha + pi, beta, gamma - pi)`; angles are 2 pi
+    /// periodic).
+    pub fn normalized(&self) -> Rotation {
+        use std::f64::consts::{PI, TAU};
+        let mut beta = self.beta.rem_euclid(TAU);
+        let (mut alpha, mut gamma) = (self.alpha, self.gamma);
+        if beta > PI {
+            beta = TAU - beta;
+            alpha += PI;
+            gamma -= PI;
+        }
+        Rotation::new(alpha.rem_euclid(TAU), beta, gamma.rem_euclid(TAU))
+    }
+
     /// The unit quaternion `(w, x, y, z)` of the rotation (`w >= 0`).
     pub fn quaternion(&self) -> [f64; 4] {
         let z = |a: f64| [(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()];

@@ -23,8 +23,11 @@ use std::f64::consts::PI;
 /// Value, gradient and Hessian of a series in `(alpha, beta, gamma)` at one rotation.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Local {
+    /// The value.
     pub c: Complex64,
+    /// First derivatives in `(alpha, beta, gamma)`.
     pub d: [Complex64; 3],
+    /// Second derivatives.
     pub dd: [[Complex64; 3]; 3],
 }
 
@@ -176,6 +179,14 @@ impl SeriesTables {
         if points.is_empty() {
             return Vec::new();
         }
+        // Bounded buffers: at most `BATCH` rotations per pass.
+        const BATCH: usize = 64;
+        if points.len() > BATCH {
+            return points
+                .chunks(BATCH)
+                .flat_map(|p| self.evaluate(isa, coeffs, p))
+                .collect();
+        }
         let lanes = Lanes::new(isa, self.lmax, points);
         let size = lanes.acc_len();
         // On a worker pool the base orders are dealt out round-robin (balancing the
@@ -223,7 +234,7 @@ impl SeriesTables {
     /// # Safety
     /// The CPU supports AVX-512F and FMA.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx2,fma")]
+    #[target_feature(enable = "avx512f,fma")]
     unsafe fn row_terms_avx512(
         &self,
         lanes: &Lanes,
