@@ -273,10 +273,11 @@ fn read_rotation(angles: *const c_double) -> Result<Rotation, CallError> {
     Array::new(angles, 3, "angles").check()?;
     // SAFETY: checked non-NULL and aligned; 3 doubles (the API's contract).
     let a = unsafe { std::slice::from_raw_parts(angles, 3) };
-    if !a.iter().all(|v| v.is_finite()) {
+    let g = Rotation::new(a[0], a[1], a[2]);
+    if !g.is_finite() {
         return Err(CallError::invalid(format!("angles {a:?} are not finite")));
     }
-    Ok(Rotation::new(a[0], a[1], a[2]))
+    Ok(g)
 }
 
 /// Writes `peaks` to the caller's arrays: Euler angles to `angles` (3 per peak), `|C|^2`
@@ -440,10 +441,7 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
                     Rotation::new(*a, *a.add(1), *a.add(2))
                 })
                 .collect();
-            if let Some(g) = starts
-                .iter()
-                .find(|g| ![g.alpha, g.beta, g.gamma].iter().all(|v| v.is_finite()))
-            {
+            if let Some(g) = starts.iter().find(|g| !g.is_finite()) {
                 return Err(CallError::invalid(format!(
                     "start rotation {g:?} is not finite"
                 )));

@@ -277,10 +277,7 @@ impl Correlation {
         starts: &[super::Rotation],
     ) -> Result<Vec<(super::Rotation, f64)>> {
         check_length("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
-        if let Some(g) = starts
-            .iter()
-            .find(|g| ![g.alpha, g.beta, g.gamma].iter().all(|v| v.is_finite()))
-        {
+        if let Some(g) = starts.iter().find(|g| !g.is_finite()) {
             return Err(Error::InvalidArgument(format!(
                 "start rotation {g:?} is not finite"
             )));

@@ -1,5 +1,6 @@
 //! Peaks of a correlation on the SO(3) grid.
 
+use super::rotation::quaternion_angle;
 use crate::grid::{alpha, beta, gamma};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -134,19 +135,21 @@ fn select_peaks<T: Copy + Sync>(
         run(0)
     };
     maxima.sort_by(|a, c| c.value.total_cmp(&a.value).then(a.index.cmp(&c.index)));
-    let mut taken: Vec<Peak> = Vec::new();
+    // The taken peaks' quaternions, made once.
+    let mut taken: Vec<(Peak, [f64; 4])> = Vec::new();
     for p in maxima {
         if taken.len() == k {
             break;
         }
+        let q = p.rotation().quaternion();
         if taken
             .iter()
-            .all(|t| t.rotation().angle_to(&p.rotation()) >= min_angle)
+            .all(|(_, t)| quaternion_angle(*t, q) >= min_angle)
         {
-            taken.push(p);
+            taken.push((p, q));
         }
     }
-    taken
+    taken.into_iter().map(|(p, _)| p).collect()
 }
 
 /// The local maxima of `|C|^2` (see [`top_peaks`]) in the beta slices `slices`, in index

@@ -85,13 +85,22 @@ impl Rotation {
     /// The angle of the rotation that takes `self` to `other` (geodesic distance on SO(3),
     /// radians, accurate for small angles).
     pub fn angle_to(&self, other: &Rotation) -> f64 {
-        let a = self.quaternion();
-        let b = other.quaternion();
-        let conj = [a[0], -a[1], -a[2], -a[3]];
-        let d = qmul(conj, b);
-        let v = (d[1] * d[1] + d[2] * d[2] + d[3] * d[3]).sqrt();
-        2.0 * v.atan2(d[0].abs())
+        quaternion_angle(self.quaternion(), other.quaternion())
     }
+
+    /// Whether all three angles are finite.
+    pub fn is_finite(&self) -> bool {
+        self.alpha.is_finite() && self.beta.is_finite() && self.gamma.is_finite()
+    }
+}
+
+/// The angle of the rotation between the rotations of unit quaternions `a` and `b`
+/// (see [`Rotation::angle_to`]).
+pub(crate) fn quaternion_angle(a: [f64; 4], b: [f64; 4]) -> f64 {
+    let conj = [a[0], -a[1], -a[2], -a[3]];
+    let d = qmul(conj, b);
+    let v = (d[1] * d[1] + d[2] * d[2] + d[3] * d[3]).sqrt();
+    2.0 * v.atan2(d[0].abs())
 }
 
 /// The S^2 coefficients (bandwidth `b`, `seanindex` order) of `Lambda(g) f`,
