@@ -24,6 +24,7 @@ pub(crate) mod fixtures;
 mod forward;
 mod inverse;
 pub(crate) mod lanes;
+mod parity;
 mod state;
 #[cfg(test)]
 mod tests;
@@ -49,6 +50,20 @@ pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &m
     assert!(xin.len() >= lanes.tau.len() * p);
     // SAFETY: the rows are consecutive, within `xin`.
     unsafe { forward_raw(isa, p, rec, lanes, xin.as_ptr(), ft) }
+}
+
+/// The inverse kernel of the `m' = 0` recurrences, whose degrees alternate parity (the
+/// S^2 Legendre stage): `y[(par c + q) nb + s] = sum_{i % 2 = par} dt_{l0+i}(beta_s)
+/// fin[i c + q]` for `c` = 2 or 4 columns, `nb = lanes.tau.len()` lanes, all in the lower
+/// half and not interleaved. Rows `0..rec.len()` of `fin` are read.
+pub fn inverse_parity(isa: Isa, c: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
+    check_shared(isa, c, rec, lanes);
+    let nb = lanes.tau.len();
+    assert!(c == 2 || c == 4);
+    assert!(!lanes.interleaved && lanes.upper_from >= nb);
+    assert!(fin.len() >= rec.len() * c && y.len() >= 2 * c * nb);
+    // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
+    unsafe { parity::run(isa, c, rec, lanes, fin.as_ptr(), y.as_mut_ptr()) }
 }
 
 /// Panics unless the arguments both kernels take are consistent: `isa` supported, the
@@ -85,6 +100,7 @@ pub(crate) unsafe fn forward_raw(
 }
 
 /// [`inverse_raw`] into consecutive rows of `y` (bounds checked).
+#[cfg(any(test, feature = "internals"))]
 pub fn inverse(
     isa: Isa,
     p: usize,

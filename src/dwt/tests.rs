@@ -422,3 +422,78 @@ fn one_beta_forward_is_the_reference_column() {
         }
     }
 }
+
+/// The parity kernel (`m' = 0`, degrees alternating between the even and the odd sums)
+/// gives what the general 8-column inverse kernel gives with each degree's coefficients
+/// in the columns of its parity and zeros in the others (the same multiply-adds in the
+/// same order, so to the bit up to the sign of zero), and the sums of the reference
+/// columns of `wigner` to rounding (the skipped values are below the data's size times
+/// the skip threshold): every instruction set, 2 and 4 columns, lane counts
+/// that leave chains of a group unused.
+#[test]
+fn parity_kernel_sums_each_degree_into_its_parity() {
+    use super::inverse_parity;
+    let b = 40;
+    let grid = BetaTables::grid(b);
+    let tables = RecTables::new(b);
+    for &m in &[0usize, 1, 7, 30, 39] {
+        for nb_rings in [40usize, 24, 8] {
+            let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
+            let ClusterInputs {
+                coeffs: rc,
+                mut tau,
+                mut p,
+                mut sc,
+            } = cluster_setup_at(b, m, 0, &ks);
+            let n = b - m;
+            let rec = Rec::new(&rc, n);
+            for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                if !isa.is_supported() {
+                    continue;
+                }
+                let nb = nb_rings.next_multiple_of(isa.lanes());
+                for v in [&mut tau, &mut p, &mut sc] {
+                    v.resize(nb, 0.0);
+                }
+                let mut lanes = grid_lanes(&tau, &p, &sc, nb);
+                (lanes.interleaved, lanes.stream) = (false, false);
+                for c in [2usize, 4] {
+                    let g = pseudo(n * c, 3 + m as u64);
+                    let fin: Vec<f64> = (0..n * c).map(|j| g[j] * rc.s[j / c]).collect();
+                    let mut y = vec![f64::NAN; 2 * c * nb];
+                    inverse_parity(isa, c, &rec, &lanes, &fin, &mut y);
+                    // The general kernel: column par * c + q of row i holds fin[i c + q]
+                    // when i % 2 == par.
+                    let mut rows = vec![0.0; n * 8];
+                    for i in 0..n {
+                        for q in 0..c {
+                            rows[i * 8 + (i % 2) * c + q] = fin[i * c + q];
+                        }
+                    }
+                    let mut want = vec![0.0; nb * 8];
+                    inverse_from(isa, 8, &rec, &lanes, &rows, &mut want);
+                    for s in 0..nb_rings {
+                        let col = column(isa, &grid, &tables, ks[s], (m, 0), b);
+                        for j in 0..2 * c {
+                            let (got, general) = (y[j * nb + s], want[s * 8 + j]);
+                            assert!(
+                                got == general,
+                                "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} {general:e}"
+                            );
+                            let (par, q) = (j / c, j % c);
+                            let (mut sum, mut size) = (0.0, 0.0);
+                            for i in (par..n).step_by(2) {
+                                sum += col[i] * g[i * c + q];
+                                size += (col[i] * g[i * c + q]).abs();
+                            }
+                            assert!(
+                                (got - sum).abs() <= 1e-14 * size.max(1.0),
+                                "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} vs {sum:e}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -334,47 +334,34 @@ impl LegendreStage {
         let b = self.b;
         self.with_scratch(|sc| {
             let n = self.setup(sc, m);
-            let mut blocks = [(std::ptr::null::<Complex64>(), 0.0); 2];
-            for (slot, g) in blocks.iter_mut().zip(groups) {
-                // SAFETY: |order| < b; the block has n entries, only read here.
-                *slot = (
-                    unsafe { g.coef.block(g.order) }.cast_const(),
-                    g.sign(m) * factor,
-                );
-            }
-            let blocks = &blocks[..groups.len()];
-            let scales = &sc.rec.s;
-            let mut fill = |fin: &mut [f64], from: usize, to: usize| {
-                for i in from..to {
-                    let row = &mut fin[i * P..][..P];
-                    row.fill(0.0);
-                    let odd = i % 2;
-                    for (q, &(block, f)) in blocks.iter().enumerate() {
-                        // SAFETY: i < n (the kernel fills rows of its n degrees).
-                        let v = unsafe { *block.add(i) } * (scales[i] * f);
-                        row[4 * q + 2 * odd] = v.re;
-                        row[4 * q + 2 * odd + 1] = v.im;
-                    }
+            // Kernel input: per degree, the scaled coefficients of each group (re, im).
+            let c = 2 * groups.len();
+            let mut fin = std::mem::take(&mut sc.sums);
+            for (q, g) in groups.iter().enumerate() {
+                // SAFETY: |order| < b; the block has at least n entries, only read here.
+                let block = unsafe { g.coef.block(g.order) }.cast_const();
+                let f = g.sign(m) * factor;
+                for (i, &s) in sc.rec.s[..n].iter().enumerate() {
+                    // SAFETY: entry i < n of the block (above).
+                    let v = unsafe { *block.add(i) } * (s * f);
+                    fin[i * c + 2 * q] = v.re;
+                    fin[i * c + 2 * q + 1] = v.im;
                 }
-            };
+            }
             let rec = Rec::new(&sc.rec, n);
-            let mut sums = std::mem::take(&mut sc.sums);
             let mut rows = std::mem::take(&mut sc.rows);
             let lanes = self.lanes(sc);
-            dwt::inverse(
-                self.isa,
-                P,
-                &rec,
-                &lanes,
-                &mut sums[..n * P],
-                &mut fill,
-                &mut rows,
-            );
-            for k in 0..b {
-                let row = &rows[k * P..][..P];
-                let mirror = 2 * b - 1 - k;
-                for (g, c) in groups.iter().zip(row.chunks_exact(4)) {
-                    let (e, o) = (Complex64::new(c[0], c[1]), Complex64::new(c[2], c[3]));
+            dwt::inverse_parity(self.isa, c, &rec, &lanes, &fin[..n * c], &mut rows);
+            // Columns of the output: even sums, then odd sums, `nb` lanes each.
+            let nb = self.lanes;
+            let column =
+                |par: usize, q: usize, part: usize| &rows[(par * c + 2 * q + part) * nb..][..b];
+            for (q, g) in groups.iter().enumerate() {
+                let (er, ei) = (column(0, q, 0), column(0, q, 1));
+                let (or, oi) = (column(1, q, 0), column(1, q, 1));
+                for k in 0..b {
+                    let (e, o) = (Complex64::new(er[k], ei[k]), Complex64::new(or[k], oi[k]));
+                    let mirror = 2 * b - 1 - k;
                     // SAFETY: rings k and mirror, the group's order's column: this task's.
                     unsafe {
                         *g.spectra.at(k, g.order) = e + o;
@@ -382,7 +369,7 @@ impl LegendreStage {
                     }
                 }
             }
-            sc.sums = sums;
+            sc.sums = fin;
             sc.rows = rows;
         });
     }

@@ -7,7 +7,7 @@ use crate::error::{check_length, Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
 use crate::simd::Isa;
 use crate::system::check_headroom;
-use crate::workers::{SendPtr, WorkerPool, WORKER_STACK_BYTES};
+use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -203,13 +203,26 @@ impl S2Plan {
         }
     }
 
-    /// Ring DFTs of all rings in parallel: complex in place (`analysis`: sign -1).
-    fn rings_complex(&self, buf: &AlignedBuf, analysis: bool) -> Result<()> {
+    /// Ring DFTs of all rings in parallel: complex in place at `data` (`analysis`: sign
+    /// -1), each task copying its rings in from or out to another array (`copy`) while
+    /// they are in its cache.
+    fn rings_complex(&self, data: *mut Complex64, analysis: bool, copy: RingCopy) -> Result<()> {
         let (n, per) = (self.rings.len(), self.rings.per_call());
-        let base = SendPtr(buf.as_mut_ptr());
+        let base = SendPtr(data);
         (0..n / per).into_par_iter().try_for_each(|c| {
-            // SAFETY: rings c*per .. (c+1)*per of the (2B)^2 scratch: this task's alone.
-            unsafe { self.rings.complex(base.get().add(c * per * n), analysis) }
+            let (at, len) = (c * per * n, per * n);
+            // SAFETY: rings c*per .. (c+1)*per of the (2B)^2 values at `data` and of the
+            // copy's array (as long, not overlapping `data`): this task's alone.
+            unsafe {
+                if let RingCopy::From(src) = copy {
+                    std::ptr::copy_nonoverlapping(src.get().add(at), base.get().add(at), len);
+                }
+                self.rings.complex(base.get().add(at), analysis)?;
+                if let RingCopy::To(dst) = copy {
+                    std::ptr::copy_nonoverlapping(base.get().add(at), dst.get().add(at), len);
+                }
+            }
+            Ok(())
         })
     }
 
@@ -272,8 +285,6 @@ impl S2Plan {
         let factor = (2.0 * PI).sqrt() / n as f64;
         self.with_scratch(false, |buf, _| {
             for (field, out) in samples.chunks_exact(n * n).zip(coeffs.chunks_exact_mut(nc)) {
-                // SAFETY: the scratch holds n*n values; nothing else uses it during the call.
-                unsafe { std::ptr::copy_nonoverlapping(field.as_ptr(), buf.as_mut_ptr(), n * n) };
                 let spectra = Spectra {
                     base: buf.as_mut_ptr(),
                     row: n,
@@ -281,7 +292,8 @@ impl S2Plan {
                 };
                 let coef = self.coeff_rows(out.as_mut_ptr());
                 self.workers.pool().install(|| {
-                    self.rings_complex(buf, true)?;
+                    let src = SendConstPtr(field.as_ptr());
+                    self.rings_complex(buf.as_mut_ptr(), true, RingCopy::From(src))?;
                     (0..b).into_par_iter().for_each(|m| {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
                         // SAFETY: each task handles orders +-m only; the spectra and the
@@ -312,11 +324,19 @@ impl S2Plan {
         let factor = 1.0 / (2.0 * PI).sqrt();
         self.with_scratch(false, |buf, _| {
             for (field, out) in coeffs.chunks_exact(nc).zip(samples.chunks_exact_mut(n * n)) {
+                // Straight into the output where FFTW may run on it, else through the scratch.
+                let direct = RingFft::aligned(out.as_ptr().cast());
+                let (data, copy) = if direct {
+                    (out.as_mut_ptr(), RingCopy::None)
+                } else {
+                    (buf.as_mut_ptr(), RingCopy::To(SendPtr(out.as_mut_ptr())))
+                };
                 let spectra = Spectra {
-                    base: buf.as_mut_ptr(),
+                    base: data,
                     row: n,
                     real: false,
                 };
+                let data = SendPtr(data);
                 let coef = self.coeff_rows(field.as_ptr().cast_mut());
                 self.workers.pool().install(|| {
                     (0..b).into_par_iter().for_each(|m| {
@@ -327,13 +347,11 @@ impl S2Plan {
                     });
                     // The frequency B is never used.
                     for k in 0..n {
-                        // SAFETY: column B of ring k, inside the scratch.
-                        unsafe { *buf.as_mut_ptr().add(k * n + b) = Complex64::default() };
+                        // SAFETY: column B of ring k, inside the n*n values at `data`.
+                        unsafe { *data.get().add(k * n + b) = Complex64::default() };
                     }
-                    self.rings_complex(buf, false)
+                    self.rings_complex(data.get(), false, copy)
                 })?;
-                // SAFETY: the scratch holds n*n values; `out` as many.
-                unsafe { std::ptr::copy_nonoverlapping(buf.as_mut_ptr(), out.as_mut_ptr(), n * n) };
             }
             Ok(())
         })
@@ -413,18 +431,31 @@ impl S2Plan {
         let n = 2 * self.b;
         let per = self.rings.per_call();
         let half = self.b + 1;
-        // Real rings in the first n*n/2 values of the scratch, their spectra after them.
+        // Real rings in the first n*n/2 values of the scratch (unless FFTW may read the
+        // field itself), their spectra after them.
+        let direct = RingFft::aligned(field.as_ptr());
         let reals = SendPtr(buf.as_mut_ptr().cast::<f64>());
+        let src = SendConstPtr(field.as_ptr());
         let spec = SendPtr(buf.as_mut_ptr().wrapping_add(n * n / 2));
-        // SAFETY: n*n reals fit in the first n*n/2 complex values of the scratch.
-        unsafe { std::ptr::copy_nonoverlapping(field.as_ptr(), reals.get(), n * n) };
         self.workers.pool().install(|| {
             (0..n / per).into_par_iter().try_for_each(|c| {
-                // SAFETY: rings c*per.. of the reals (read) and of the spectra (n rows of
-                // B+1 values after n*n/2, within the n*n + n scratch): this task's.
+                let at = c * per * n;
+                // SAFETY: rings c*per.. of the field (n*n reals, read only: the r2c plan
+                // preserves its input), of the reals (n*n reals in the first n*n/2 values
+                // of the scratch) and of the spectra (n rows of B+1 values after n*n/2,
+                // within the n*n + n scratch): this task's.
                 unsafe {
-                    self.rings
-                        .r2c(reals.get().add(c * per * n), spec.get().add(c * per * half))
+                    let input = if direct {
+                        src.get().add(at)
+                    } else {
+                        std::ptr::copy_nonoverlapping(
+                            src.get().add(at),
+                            reals.get().add(at),
+                            per * n,
+                        );
+                        reals.get().add(at)
+                    };
+                    self.rings.r2c(input, spec.get().add(c * per * half))
                 }
             })
         })?;
@@ -456,36 +487,66 @@ impl S2Plan {
         howmany: usize,
     ) -> Result<()> {
         self.check(samples.len(), coeffs.len(), howmany)?;
-        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
-        let factor = 1.0 / (2.0 * PI).sqrt();
-        let half = b + 1;
+        let (n, nc) = (2 * self.b, self.num_coeffs());
         self.with_scratch(howmany > 1, |first, second| {
-            let bufs = [Some(first), second];
             for (fields, outs) in coeffs.chunks(2 * nc).zip(samples.chunks_mut(2 * n * n)) {
-                let count = fields.len() / nc;
-                let mut groups = [None; 2];
-                for (i, field) in fields.chunks_exact(nc).enumerate() {
-                    let buf = bufs[i].expect("a second scratch for two fields");
-                    groups[i] = Some(Group {
-                        spectra: Spectra {
-                            base: buf.as_mut_ptr().wrapping_add(n * n / 2),
-                            row: half,
-                            real: true,
-                        },
-                        coef: self.coeff_rows(field.as_ptr().cast_mut()),
-                        order: 0,
-                        partner: false,
-                    });
-                }
-                // SAFETY: as in `inverse_many`; each field has its own spectra.
-                unsafe { self.real_orders(groups, factor, false) };
-                for (i, out) in outs.chunks_exact_mut(n * n).enumerate().take(count) {
-                    let buf = bufs[i].expect("a second scratch for two fields");
-                    self.real_rings_inverse(buf, out)?;
-                }
+                let fields: Vec<&[Complex64]> = fields.chunks_exact(nc).collect();
+                let mut outs: Vec<&mut [f64]> = outs.chunks_exact_mut(n * n).collect();
+                self.real_synthesis([Some(first), second], &fields, &mut outs)?;
             }
             Ok(())
         })
+    }
+
+    /// [`S2Plan::inverse_real`] of two fields into two separate arrays, sharing the kernel
+    /// calls (as [`S2Plan::inverse_real_many`]).
+    pub fn inverse_real_pair(
+        &self,
+        coeffs: [&[Complex64]; 2],
+        samples: [&mut [f64]; 2],
+    ) -> Result<()> {
+        for (c, s) in coeffs.iter().zip(&samples) {
+            self.check(s.len(), c.len(), 1)?;
+        }
+        let [a, b] = samples;
+        self.with_scratch(true, |first, second| {
+            self.real_synthesis([Some(first), second], &coeffs, &mut [a, b])
+        })
+    }
+
+    /// The real synthesis of one or two fields (`fields[i]` into `outs[i]`, checked
+    /// lengths) with the ring scratches `bufs` (the second one for a second field).
+    fn real_synthesis(
+        &self,
+        bufs: [Option<&AlignedBuf>; 2],
+        fields: &[&[Complex64]],
+        outs: &mut [&mut [f64]],
+    ) -> Result<()> {
+        let (b, n) = (self.b, 2 * self.b);
+        let factor = 1.0 / (2.0 * PI).sqrt();
+        let half = b + 1;
+        let mut groups = [None; 2];
+        for (i, field) in fields.iter().enumerate().take(2) {
+            let buf = bufs[i].expect("a second scratch for two fields");
+            groups[i] = Some(Group {
+                spectra: Spectra {
+                    base: buf.as_mut_ptr().wrapping_add(n * n / 2),
+                    row: half,
+                    real: true,
+                },
+                coef: self.coeff_rows(field.as_ptr().cast_mut()),
+                order: 0,
+                partner: false,
+            });
+        }
+        // SAFETY: as in `inverse_many`; each field has its own spectra; the coefficient
+        // arrays hold B^2 values (checked by the callers) and are only read.
+        unsafe { self.real_orders(groups, factor, false) };
+        for (i, out) in outs.iter_mut().enumerate().take(fields.len().min(2)) {
+            let buf = bufs[i].expect("a second scratch for two fields");
+            self.real_rings_inverse(buf, out)?;
+        }
+        Ok(())
     }
 
     /// The `c2r` of one field's spectra in `buf` into `out`.
@@ -500,18 +561,39 @@ impl S2Plan {
                 // SAFETY: column B of spectrum row k, inside the scratch.
                 unsafe { *spec.get().add(k * half + b) = Complex64::default() };
             }
+            let direct = RingFft::aligned(out.as_ptr());
+            let dst = SendPtr(out.as_mut_ptr());
             (0..n / per).into_par_iter().try_for_each(|c| {
-                // SAFETY: as in `real_rings_forward`, the other way.
+                let at = c * per * n;
+                // SAFETY: as in `real_rings_forward`, the other way; rings c*per.. of `out`
+                // (n*n reals): this task's.
                 unsafe {
-                    self.rings
-                        .c2r(spec.get().add(c * per * half), reals.get().add(c * per * n))
+                    let spectra = spec.get().add(c * per * half);
+                    if direct {
+                        self.rings.c2r(spectra, dst.get().add(at))
+                    } else {
+                        self.rings.c2r(spectra, reals.get().add(at))?;
+                        std::ptr::copy_nonoverlapping(
+                            reals.get().add(at),
+                            dst.get().add(at),
+                            per * n,
+                        );
+                        Ok(())
+                    }
                 }
             })
-        })?;
-        // SAFETY: n*n reals in the scratch; `out` has as many.
-        unsafe { std::ptr::copy_nonoverlapping(reals.get(), out.as_mut_ptr(), n * n) };
-        Ok(())
+        })
     }
+}
+
+/// Copies made by the ring DFT tasks around their DFTs (see `S2Plan::rings_complex`).
+#[derive(Clone, Copy)]
+enum RingCopy {
+    None,
+    /// Copy the rings in from this array first.
+    From(SendConstPtr<Complex64>),
+    /// Copy the transformed rings out to this array.
+    To(SendPtr<Complex64>),
 }
 
 /// The scratch behind `m` if no other execution holds it.

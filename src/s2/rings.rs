@@ -111,11 +111,15 @@ impl RingFft {
         self.per_call
     }
 
-    /// An error unless `p` is aligned as FFTW's plans were made for (always true for the
-    /// row offsets used: multiples of 16 bytes from a page-aligned buffer).
-    fn check_alignment(p: *const f64) -> Result<()> {
+    /// Whether FFTW's plans may run on data at `p` (aligned as the planned arrays: 16 bytes).
+    pub(super) fn aligned(p: *const f64) -> bool {
         // SAFETY: fftw_alignment_of only inspects the address.
-        if unsafe { fftw::fftw_alignment_of(p.cast_mut()) } != 0 {
+        unsafe { fftw::fftw_alignment_of(p.cast_mut()) == 0 }
+    }
+
+    /// An error unless `p` is aligned as FFTW's plans were made for (see [`RingFft::aligned`]).
+    fn check_alignment(p: *const f64) -> Result<()> {
+        if !Self::aligned(p) {
             return Err(Error::Fftw("ring data not aligned for FFTW".into()));
         }
         Ok(())

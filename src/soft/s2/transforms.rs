@@ -129,9 +129,12 @@ impl S2Entry {
         let threads = self.plan.threads();
         self.with_buffers(|buf| {
             if !real_format {
-                interleave(re, im, &mut buf.coeffs, threads);
-                self.plan.inverse(&buf.coeffs, &mut buf.samples)?;
-                deinterleave(&buf.samples, out_re, out_im, threads);
+                // rdata and idata are the real syntheses of the two Hermitian parts of the
+                // coefficients, written straight into the caller's arrays.
+                let (h1, rest) = buf.samples.split_at_mut(b * b);
+                let h2 = &mut rest[..b * b];
+                hermitian_parts(b, (re, im), h1, h2);
+                self.plan.inverse_real_pair([h1, h2], [out_re, out_im])?;
                 return Ok(());
             }
             // The synthesis of the Hermitian extension of the orders m >= 0 is
@@ -143,19 +146,47 @@ impl S2Entry {
                 *c = Complex64::new(*r, *i);
             }
             buf.coeffs[split..].fill(Complex64::default());
-            self.plan.inverse_real(&buf.coeffs, out_re)?;
             // fhat(l, 0) sits at index l.
             if im[..b].iter().all(|&v| v == 0.0) {
+                self.plan.inverse_real(&buf.coeffs, out_re)?;
                 fill_zero(out_im, threads);
             } else {
-                buf.coeffs.fill(Complex64::default());
-                for (c, v) in buf.coeffs[..b].iter_mut().zip(&im[..b]) {
+                let second = &mut buf.samples[..b * b];
+                second[..split].fill(Complex64::default());
+                for (c, v) in second[..b].iter_mut().zip(&im[..b]) {
                     *c = Complex64::new(*v, 0.0);
                 }
-                self.plan.inverse_real(&buf.coeffs, out_im)?;
+                self.plan
+                    .inverse_real_pair([&buf.coeffs, second], [out_re, out_im])?;
             }
             Ok(())
         })
+    }
+}
+
+/// The Hermitian parts `h1 = (f + g) / 2` and `h2 = (f - g) / 2i` of the coefficients
+/// `f = re + i im`, `g(l, m) = (-1)^m conj(f(l, -m))`, for the orders `m >= 0` (the first
+/// `B (B + 1) / 2` entries; the real synthesis reads no others): `f = h1 + i h2`, and both
+/// parts satisfy `h(l, -m) = (-1)^m conj(h(l, m))`, so each synthesises a real function:
+/// the real and the imaginary part of the synthesis of `f`.
+fn hermitian_parts(
+    b: usize,
+    (re, im): (&[f64], &[f64]),
+    h1: &mut [Complex64],
+    h2: &mut [Complex64],
+) {
+    for m in 0..b {
+        let sign = if m % 2 == 0 { 0.5 } else { -0.5 };
+        let pos = s2_coef_index(b, m, m as isize);
+        let neg = s2_coef_index(b, m, -(m as isize));
+        for k in 0..b - m {
+            let f = Complex64::new(re[pos + k], im[pos + k]) * 0.5;
+            let g = Complex64::new(re[neg + k], -im[neg + k]) * sign;
+            h1[pos + k] = f + g;
+            // (f - g) / i = -i (f - g)
+            let d = f - g;
+            h2[pos + k] = Complex64::new(d.im, -d.re);
+        }
     }
 }
 
