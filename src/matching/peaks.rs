@@ -105,11 +105,17 @@ fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync
 /// points at least as large as their 26 neighbours (`alpha`, `gamma` periodic), each at
 /// least `min_angle` radians (geodesic) from every larger peak taken. On a worker pool the
 /// beta slices are spread over its threads.
+///
+/// # Panics
+/// If `values` does not hold `(2b)^3` values or `min_angle` is negative or NaN.
 pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
     select_peaks(b, values, |z| z.norm_sqr(), (k, min_angle))
 }
 
 /// [`top_peaks`] of a real grid (`C^2`).
+///
+/// # Panics
+/// As [`top_peaks`].
 pub fn top_peaks_real(b: usize, values: &[f64], k: usize, min_angle: f64) -> Vec<Peak> {
     select_peaks(b, values, |x| x * x, (k, min_angle))
 }
@@ -121,7 +127,15 @@ fn select_peaks<T: Copy + Sync>(
     (k, min_angle): (usize, f64),
 ) -> Vec<Peak> {
     let n = 2 * b;
-    assert_eq!(values.len(), n * n * n);
+    assert_eq!(
+        values.len(),
+        n * n * n,
+        "a grid of bandwidth {b} holds (2b)^3 values"
+    );
+    assert!(
+        min_angle >= 0.0,
+        "min_angle {min_angle} is not an angle >= 0"
+    );
     // Runs of beta slices, each scanned with the squared magnitudes of three slices.
     let runs = if rayon::current_thread_index().is_some() {
         (4 * rayon::current_num_threads()).min(n)

@@ -45,6 +45,8 @@ struct Search {
     trials: Vec<(Rotation, f64, f64)>,
     /// Largest step (max-norm) of a trial.
     radius: f64,
+    /// Line-search lengths tried this round (see [`Search::propose_more`]).
+    lengths_tried: usize,
     done: bool,
 }
 
@@ -66,6 +68,7 @@ impl Search {
             failures: 0,
             trials: Vec::new(),
             radius,
+            lengths_tried: 0,
             done: false,
         }
     }
@@ -89,7 +92,9 @@ impl Search {
         Some((s, s.iter().fold(0.0f64, |m, v| m.max(v.abs()))))
     }
 
-    /// Adds the trial `length` times the step of damping `mu`; false if singular.
+    /// Adds the trial `length` times the step of damping `mu`; false if singular, or if
+    /// the step reaches beyond the trust radius and a trial of the same damping already
+    /// stops there (the same point).
     fn add_trial(&mut self, mu: f64, length: f64) -> bool {
         let Some((mut s, mut size)) = self.step(mu) else {
             return false;
@@ -98,6 +103,9 @@ impl Search {
         size *= length;
         // No step beyond the trust radius (a grid step: the peak is near its grid point).
         if size > self.radius {
+            if self.trials.iter().any(|t| t.2 == mu && t.1 == self.radius) {
+                return false;
+            }
             s = s.map(|v| v * (self.radius / size));
             size = self.radius;
         }
@@ -112,6 +120,7 @@ impl Search {
     /// enough to go uphill (`mu` above the largest eigenvalue of the Hessian).
     fn propose(&mut self) {
         self.trials.clear();
+        self.lengths_tried = 0;
         if self.done {
             return;
         }
@@ -152,8 +161,14 @@ impl Search {
             return;
         };
         if mu == 0.0 {
-            let length = LENGTHS[(self.trials.len() - 1) % LENGTHS.len()];
-            self.add_trial(0.0, length);
+            // The next length that gives a new point.
+            while self.lengths_tried < LENGTHS.len() {
+                let length = LENGTHS[self.lengths_tried];
+                self.lengths_tried += 1;
+                if self.add_trial(0.0, length) {
+                    return;
+                }
+            }
         } else {
             self.add_trial((4.0 * mu).max(self.min_damping()), 1.0);
         }
@@ -332,4 +347,47 @@ fn solve3(mut a: [[f64; 3]; 3], mut r: [f64; 3]) -> Option<[f64; 3]> {
         s[i] = (r[i] - tail) / a[i][i];
     }
     s.iter().all(|v| v.is_finite()).then_some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a concave top whose Newton step reaches far beyond the trust radius, the spare
+    /// lanes' line search adds only distinct points: the lengths that would stop at the
+    /// radius again are left out, and no length is tried twice.
+    #[test]
+    fn line_search_points_are_distinct() {
+        let radius = 0.05;
+        let hess = [[-1.0, 0.0, 0.0], [0.0, -2.0, 0.0], [0.0, 0.0, -3.0]];
+        for grad in [[1.0, 0.5, 0.3], [1e-3, 2e-3, 0.0]] {
+            let mut s = Search::new(Rotation::new(0.1, 1.0, 0.2), (1.0, grad, hess), radius);
+            s.propose();
+            for _ in 0..20 {
+                s.propose_more();
+            }
+            assert!(!s.trials.is_empty() && s.trials.len() <= 9);
+            for (i, a) in s.trials.iter().enumerate() {
+                assert!(a.1 <= radius);
+                for b in &s.trials[..i] {
+                    let d = (a.0.alpha - b.0.alpha).abs()
+                        + (a.0.beta - b.0.beta).abs()
+                        + (a.0.gamma - b.0.gamma).abs();
+                    assert!(d > 0.0, "grad {grad:?}: trials {i} repeats a point");
+                }
+            }
+        }
+        // The large step: one trial at the radius, then only the lengths that stay inside.
+        let mut s = Search::new(
+            Rotation::new(0.1, 1.0, 0.2),
+            (1.0, [1.0, 0.5, 0.3], hess),
+            radius,
+        );
+        s.propose();
+        for _ in 0..20 {
+            s.propose_more();
+        }
+        let at_radius = s.trials.iter().filter(|t| t.1 == radius).count();
+        assert_eq!(at_radius, 1);
+    }
 }
