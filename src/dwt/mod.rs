@@ -45,6 +45,7 @@ pub(crate) use lanes::{Lanes, Prefetch, Rec};
 ///
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
+#[cfg(any(test, feature = "internals"))]
 pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) -> usize {
     assert!(lanes.pair_stride == 0 && lanes.row_gap == 0);
     assert!(xin.len() >= lanes.tau.len() * p);
@@ -64,6 +65,44 @@ pub fn inverse_parity(isa: Isa, c: usize, rec: &Rec, lanes: &Lanes, fin: &[f64],
     assert!(fin.len() >= rec.len() * c && y.len() >= 2 * c * nb);
     // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
     unsafe { parity::run(isa, c, rec, lanes, fin.as_ptr(), y.as_mut_ptr()) }
+}
+
+/// Values of the forward parity kernel's partial sums for `n` degrees, `c` columns and
+/// vectors of `w` lanes (see [`forward_parity`]).
+pub fn parity_partial_len(n: usize, c: usize, w: usize) -> usize {
+    (n * c).next_multiple_of(w) * w
+}
+
+/// The forward kernel of the `m' = 0` recurrences (the S^2 analysis):
+/// `ft[i c + q] = sum_s dt_{l0+i}(beta_s) x[(i % 2) c + q][s]`, with `x` in `2 c` columns of
+/// `nb = lanes.tau.len()` values (the even combinations, then the odd ones), lanes as for
+/// [`inverse_parity`]. `part` is scratch of [`parity_partial_len`] values; `ft` holds at
+/// least `(n c).next_multiple_of(isa.lanes())` values, rows from `n` on are scratch.
+pub fn forward_parity(
+    isa: Isa,
+    c: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    x: &[f64],
+    (part, ft): (&mut [f64], &mut [f64]),
+) {
+    check_shared(isa, c, rec, lanes);
+    let (nb, n, w) = (lanes.tau.len(), rec.len(), isa.lanes());
+    assert!(c == 2 || c == 4);
+    assert!(!lanes.interleaved && lanes.upper_from >= nb);
+    assert!(x.len() >= 2 * c * nb && part.len() >= parity_partial_len(n, c, w));
+    assert!(ft.len() >= (n * c).next_multiple_of(w));
+    // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
+    unsafe {
+        parity::run_forward(
+            isa,
+            c,
+            rec,
+            lanes,
+            x.as_ptr(),
+            (part.as_mut_ptr(), ft.as_mut_ptr()),
+        )
+    }
 }
 
 /// Panics unless the arguments both kernels take are consistent: `isa` supported, the

@@ -108,6 +108,8 @@ pub(super) struct Scratch {
     rows: Vec<f64>,
     /// Forward: the kernel's sums; inverse: its input.
     sums: Vec<f64>,
+    /// The forward kernel's partial sums (lanes = rings).
+    part: Vec<f64>,
 }
 
 impl Scratch {
@@ -119,6 +121,7 @@ impl Scratch {
             scale: vec![0.0; lanes],
             rows: vec![0.0; lanes * P],
             sums: vec![0.0; (b + width) * P],
+            part: vec![0.0; dwt::parity_partial_len(b, 4, width)],
         }
     }
 }
@@ -166,7 +169,7 @@ impl LegendreStage {
         32 * (b + 1) * (b + 2)
             + 64 * 2 * b * (66 + b / 32)
             + 16 * b
-            + workers * 8 * (9 * lanes + 16 * b)
+            + workers * 8 * (9 * lanes + 16 * b + 4 * (b + 2) * 8)
     }
 
     /// Runs `f` with a free scratch (the worker's own, else another, else a new one).
@@ -234,25 +237,31 @@ impl LegendreStage {
         let b = self.b;
         self.with_scratch(|sc| {
             let n = self.setup(sc, m);
-            // Rows: E and O of each group's spectra, weighted.
-            for k in 0..b {
-                let w = self.weights[k];
-                let mirror = 2 * b - 1 - k;
-                let row = &mut sc.rows[k * P..][..P];
-                row.fill(0.0);
-                for (g, cols) in groups.iter().zip(row.chunks_exact_mut(4)) {
+            // Kernel input: the even combinations of each group's spectra (re, im), then the
+            // odd ones, weighted, one column of `nb` rings each.
+            let c = 2 * groups.len();
+            let nb = self.lanes;
+            let mut x = std::mem::take(&mut sc.rows);
+            x[..2 * c * nb].fill(0.0);
+            for (q, g) in groups.iter().enumerate() {
+                for k in 0..b {
+                    let w = self.weights[k];
+                    let mirror = 2 * b - 1 - k;
                     // SAFETY: rings k and mirror < 2B hold the group's order; read only.
-                    let (x, y) =
+                    let (u, v) =
                         unsafe { (*g.spectra.at(k, g.order), *g.spectra.at(mirror, g.order)) };
-                    let (e, o) = ((x + y) * w, (x - y) * w);
-                    cols.copy_from_slice(&[e.re, e.im, o.re, o.im]);
+                    let (e, o) = ((u + v) * w, (u - v) * w);
+                    x[(2 * q) * nb + k] = e.re;
+                    x[(2 * q + 1) * nb + k] = e.im;
+                    x[(c + 2 * q) * nb + k] = o.re;
+                    x[(c + 2 * q + 1) * nb + k] = o.im;
                 }
             }
-            sc.rows[b * P..].fill(0.0);
             let rec = Rec::new(&sc.rec, n);
             let mut sums = std::mem::take(&mut sc.sums);
+            let mut part = std::mem::take(&mut sc.part);
             let lanes = self.lanes(sc);
-            let lo = dwt::forward(self.isa, P, &rec, &lanes, &sc.rows, &mut sums);
+            dwt::forward_parity(self.isa, c, &rec, &lanes, &x, (&mut part, &mut sums));
             for (q, g) in groups.iter().enumerate() {
                 let f = g.sign(m) * factor;
                 // SAFETY: |order| < b; the block has b - m >= n entries, this task's alone
@@ -268,13 +277,8 @@ impl LegendreStage {
                     }
                 }
                 for i in 0..n {
-                    let odd = i % 2;
-                    let v = if i < lo {
-                        Complex64::default()
-                    } else {
-                        let c = &sums[i * P + 4 * q + 2 * odd..][..2];
-                        Complex64::new(c[0], c[1]) * (sc.rec.s[i] * f)
-                    };
+                    let z = &sums[i * c + 2 * q..][..2];
+                    let v = Complex64::new(z[0], z[1]) * (sc.rec.s[i] * f);
                     // SAFETY: entry i < n of the blocks (above).
                     unsafe {
                         *own.add(i) = v;
@@ -289,6 +293,8 @@ impl LegendreStage {
                 }
             }
             sc.sums = sums;
+            sc.part = part;
+            sc.rows = x;
         });
     }
 
