@@ -393,6 +393,30 @@ impl S2Plan {
         })
     }
 
+    /// [`S2Plan::forward_real`] of two fields held in two separate arrays, sharing the
+    /// kernel calls (as [`S2Plan::forward_real_many`]).
+    pub fn forward_real_pair(
+        &self,
+        samples: [&[f64]; 2],
+        coeffs: [&mut [Complex64]; 2],
+    ) -> Result<()> {
+        for (s, c) in samples.iter().zip(&coeffs) {
+            self.check(s.len(), c.len(), 1)?;
+        }
+        let factor = (2.0 * PI).sqrt() / (2 * self.b) as f64;
+        let [a, b] = coeffs;
+        self.with_scratch(true, |first, second| {
+            let second = second.expect("a second scratch for two fields");
+            let groups = [
+                Some(self.real_rings_forward(first, samples[0], a)?),
+                Some(self.real_rings_forward(second, samples[1], b)?),
+            ];
+            // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
+            unsafe { self.real_orders(groups, factor, true) };
+            Ok(())
+        })
+    }
+
     /// The Legendre stage of every order for one or two real fields (`groups[1]` `None` for
     /// one), analysis or synthesis: two fields share each kernel call.
     ///

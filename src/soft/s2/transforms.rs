@@ -103,14 +103,26 @@ impl S2Entry {
             // Zero imaginary parts (real data): the real-sample path, no conversion.
             if im.iter().all(|&v| v == 0.0) {
                 self.plan.forward_real(re, &mut buf.coeffs)?;
-            } else {
-                interleave(re, im, &mut buf.samples, threads);
-                self.plan.forward(&buf.samples, &mut buf.coeffs)?;
+                if real_format {
+                    hermitian_from_nonnegative(self.plan.bandwidth(), &mut buf.coeffs);
+                }
+                deinterleave(&buf.coeffs, output.0, output.1, threads);
+                return Ok(());
+            }
+            // The transform of re + i im is A(re) + i A(im), both real analyses read straight
+            // from the caller's arrays.
+            let nc = buf.coeffs.len();
+            let second = &mut buf.samples[..nc];
+            self.plan
+                .forward_real_pair([re, im], [&mut buf.coeffs, second])?;
+            let (a, b) = (&mut buf.coeffs, &buf.samples[..nc]);
+            for (x, y) in a.iter_mut().zip(b) {
+                *x += Complex64::i() * y;
             }
             if real_format {
-                hermitian_from_nonnegative(self.plan.bandwidth(), &mut buf.coeffs);
+                hermitian_from_nonnegative(self.plan.bandwidth(), a);
             }
-            deinterleave(&buf.coeffs, output.0, output.1, threads);
+            deinterleave(a, output.0, output.1, threads);
             Ok(())
         })
     }
@@ -228,19 +240,6 @@ fn run_pieces<T: Send>(items: impl Iterator<Item = T>, work: impl Fn(T) + Sync) 
             scope.spawn(move || work(item));
         }
         work(first);
-    });
-}
-
-/// `out[i] = re[i] + i im[i]` on `threads` threads.
-fn interleave(re: &[f64], im: &[f64], out: &mut [Complex64], threads: usize) {
-    let piece = piece_len(out.len(), threads);
-    let items = out
-        .chunks_mut(piece)
-        .zip(re.chunks(piece).zip(im.chunks(piece)));
-    run_pieces(items, |(o, (r, i))| {
-        for (o, (r, i)) in o.iter_mut().zip(r.iter().zip(i)) {
-            *o = Complex64::new(*r, *i);
-        }
     });
 }
 
