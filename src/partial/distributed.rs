@@ -26,6 +26,7 @@ use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
 use super::plan::{General, LaneRows, PartialOptions};
 use super::shape::Shape;
+use crate::dwt::Prefetch;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::plan::Direction;
@@ -838,7 +839,7 @@ impl<X: Exchange> DistributedPlan<X> {
                                 ch,
                                 n,
                                 coef.get(),
-                                (real, false),
+                                (real, false, Prefetch::none()),
                                 b_ptr.get().add(cl.offset),
                             )
                         }

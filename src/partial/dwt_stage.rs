@@ -222,6 +222,30 @@ impl DwtStage {
         n
     }
 
+    /// The coefficient blocks the inverse of `cl` reads from `coef` (with `real`, the
+    /// partners of the non-representatives), as prefetch hints (never read through them):
+    /// issued while the kernel of the cluster before runs, they bring the blocks into the
+    /// cache before the kernel's fill gathers them.
+    pub fn coefficient_hints(
+        &self,
+        cl: &ClusterPlan,
+        coef: *const Complex64,
+        real: bool,
+    ) -> Prefetch {
+        let mut pf = Prefetch::none();
+        for s in &cl.slots {
+            let block = if real && !s.representative {
+                s.partner_block
+            } else {
+                s.block
+            };
+            let lo = cl.m.max(s.first);
+            let len = self.l.saturating_sub(lo);
+            pf.push(coef.wrapping_add(block + lo - s.first).cast(), 2 * len);
+        }
+        pf
+    }
+
     /// The kernels' lanes for a chunk in a lane-major buffer: lower row `j` at
     /// `j row_len`, its mirror `hp row_len` further.
     fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes, stream: bool) -> Lanes<'a> {
@@ -259,7 +283,7 @@ impl DwtStage {
         ch: ChunkLanes,
         n: usize,
         coef: *const Complex64,
-        (real, stream): (bool, bool),
+        (real, stream, next): (bool, bool, Prefetch),
         block: *mut f64,
     ) {
         let p = cl.p;
@@ -319,7 +343,8 @@ impl DwtStage {
             }
         };
         let rec = Rec::new(&sc.rec, n);
-        let lanes = self.lanes(sc, ch, stream);
+        let mut lanes = self.lanes(sc, ch, stream);
+        lanes.prefetch = next;
         // SAFETY: the chunk's `2 hp` rows of `p` doubles at `block`, addressed as the lanes
         // say, are the caller's (caller's contract).
         unsafe {

@@ -6,6 +6,7 @@ use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan, DwtStage};
 use super::fft_stage::{FftStage, Work};
 use super::shape::{CoefLayout, Shape};
+use crate::dwt::Prefetch;
 use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
 use crate::plan::{Direction, Plan, PlanOptions, StageTimes};
@@ -634,29 +635,46 @@ impl General {
                     let lanes = ch.lanes();
                     let per_t = self.dwt.row_total * lanes;
                     let t0 = Instant::now();
-                    self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
-                        self.dwt.with_scratch(|sc| {
-                            let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                            for t in 0..batch.count {
-                                // SAFETY: coefficient array `t` of the batch (checked
-                                // lengths), read only; this cluster's `cl.p` doubles of
-                                // the `lanes` lane rows of transform `t`, inside the chunk
-                                // buffer (`count * row_total * lanes` doubles), written by
-                                // this task only.
-                                unsafe {
-                                    self.dwt.inverse(
-                                        sc,
-                                        cl,
-                                        ch,
-                                        n,
-                                        coef.get().add(t * batch.in_dist),
-                                        (real, stream),
-                                        buf.get().add(t * per_t + cl.offset),
-                                    )
+                    let clusters = &self.dwt.clusters;
+                    clusters
+                        .par_iter()
+                        .enumerate()
+                        .with_min_len(4)
+                        .for_each(|(i, cl)| {
+                            self.dwt.with_scratch(|sc| {
+                                let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                                for t in 0..batch.count {
+                                    // What the next kernel call will gather: this cluster in
+                                    // the next transform, else the next cluster (likely this
+                                    // task's next one) in the first.
+                                    let next = if t + 1 < batch.count {
+                                        Some((cl, t + 1))
+                                    } else {
+                                        clusters.get(i + 1).map(|c| (c, 0))
+                                    };
+                                    let next = next.map_or(Prefetch::none(), |(c, u)| {
+                                        let at = coef.get().wrapping_add(u * batch.in_dist);
+                                        self.dwt.coefficient_hints(c, at, real)
+                                    });
+                                    // SAFETY: coefficient array `t` of the batch (checked
+                                    // lengths), read only; this cluster's `cl.p` doubles of
+                                    // the `lanes` lane rows of transform `t`, inside the chunk
+                                    // buffer (`count * row_total * lanes` doubles), written by
+                                    // this task only.
+                                    unsafe {
+                                        self.dwt.inverse(
+                                            sc,
+                                            cl,
+                                            ch,
+                                            n,
+                                            coef.get().add(t * batch.in_dist),
+                                            (real, stream, next),
+                                            buf.get().add(t * per_t + cl.offset),
+                                        )
+                                    }
                                 }
-                            }
-                        })
-                    });
+                            })
+                        });
                     let t1 = Instant::now();
                     times.dwt += (t1 - t0).as_secs_f64();
                     let tasks = self.slice_tasks(ch, batch.count);
