@@ -401,6 +401,10 @@ fn arrays_off_fftw_alignment_give_the_same_values() {
     p.forward(&samples, &mut coefs).unwrap();
     let mut back = vec![Complex64::default(); ns];
     p.inverse(&coefs, &mut back).unwrap();
+    // The references take the direct path (glibc's allocations are 16-byte aligned).
+    for a in [samples.as_ptr(), coefs.as_ptr(), back.as_ptr()] {
+        assert!((a as usize).is_multiple_of(16));
+    }
     let (mut s1, mut s2) = (vec![], vec![]);
     let odd_samples = shifted(&mut s1, ns);
     odd_samples.copy_from_slice(&samples);
@@ -418,6 +422,8 @@ fn arrays_off_fftw_alignment_give_the_same_values() {
     p.forward_real(&real, &mut rc).unwrap();
     let mut rback = vec![0.0; ns];
     p.inverse_real(&rc, &mut rback).unwrap();
+    assert!((real.as_ptr() as usize).is_multiple_of(16));
+    assert!((rback.as_ptr() as usize).is_multiple_of(16));
     let mut store = vec![0.0; ns + 2];
     let off = if (store.as_ptr() as usize).is_multiple_of(16) {
         1
@@ -432,4 +438,59 @@ fn arrays_off_fftw_alignment_give_the_same_values() {
     assert!(odd_real == &real[..], "real forward input");
     p.inverse_real(&rc, odd_real).unwrap();
     assert!(odd_real == &rback[..], "real inverse");
+}
+
+/// Every instruction set this CPU has gives the same transforms to rounding: plans forced
+/// to the scalar, AVX2 and AVX-512 kernels against each other, complex and real, at
+/// bandwidths whose ring counts leave vectors and kernel chains partly unused.
+#[test]
+fn instruction_sets_agree() {
+    use so3fft::Isa;
+    let mut rng = Rng::new(33);
+    for b in [1usize, 3, 5, 13, 33, 130] {
+        let (ns, nc) = (4 * b * b, b * b);
+        let samples = rng.complex_vec(ns);
+        let real: Vec<f64> = (0..ns).map(|_| rng.sym()).collect();
+        let mut results: Vec<(Isa, [Vec<Complex64>; 3], Vec<f64>)> = Vec::new();
+        for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+            if !isa.is_supported() {
+                continue;
+            }
+            let p = S2Plan::new(
+                b,
+                &S2Options {
+                    threads: 2,
+                    isa: Some(isa),
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let mut fwd = vec![Complex64::default(); nc];
+            p.forward(&samples, &mut fwd).unwrap();
+            let mut inv = vec![Complex64::default(); ns];
+            p.inverse(&fwd, &mut inv).unwrap();
+            let mut rfwd = vec![Complex64::default(); nc];
+            p.forward_real(&real, &mut rfwd).unwrap();
+            let mut rinv = vec![0.0; ns];
+            p.inverse_real(&rfwd, &mut rinv).unwrap();
+            results.push((isa, [fwd, inv, rfwd], rinv));
+        }
+        let (first, rest) = results.split_first().unwrap();
+        for (isa, arrays, rinv) in rest {
+            for (k, (a, r)) in arrays.iter().zip(&first.1).enumerate() {
+                let err = max_diff(a, r);
+                assert!(
+                    err <= 1e-13 * max_abs(r).max(1.0),
+                    "B = {b}: {isa:?} against {:?}, array {k}: {err:e}",
+                    first.0
+                );
+            }
+            let err = rinv
+                .iter()
+                .zip(&first.2)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            assert!(err <= 1e-13, "B = {b}: {isa:?} real inverse: {err:e}");
+        }
+    }
 }

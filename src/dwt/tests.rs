@@ -433,11 +433,34 @@ fn one_beta_forward_is_the_reference_column() {
 #[test]
 fn parity_kernel_sums_each_degree_into_its_parity() {
     use super::inverse_parity;
-    let b = 40;
-    let grid = BetaTables::grid(b);
-    let tables = RecTables::new(b);
-    for &m in &[0usize, 1, 7, 30, 39] {
-        for nb_rings in [40usize, 24, 8] {
+    for (b, ms, rings) in parity_cases() {
+        let grid = BetaTables::grid(b);
+        let tables = RecTables::new(b);
+        parity_inverse_case(b, (&grid, &tables), ms, rings, inverse_parity);
+    }
+}
+
+/// Bandwidths, orders and ring counts of the parity kernel tests: ring counts that leave
+/// chains of a group unused on every vector width (odd vector counts with AVX2), and at
+/// B = 160 more than the 16 vectors set up at once on AVX2 and AVX-512.
+fn parity_cases() -> Vec<(usize, &'static [usize], &'static [usize])> {
+    vec![
+        (40, &[0, 1, 7, 30, 39], &[40, 36, 24, 20, 12, 8]),
+        (160, &[0, 3, 90], &[160, 152]),
+    ]
+}
+
+type InverseParity = fn(Isa, usize, &Rec, &Lanes, &[f64], &mut [f64]);
+
+fn parity_inverse_case(
+    b: usize,
+    (grid, tables): (&BetaTables, &RecTables),
+    ms: &[usize],
+    rings: &[usize],
+    inverse_parity: InverseParity,
+) {
+    for &m in ms {
+        for &nb_rings in rings {
             let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
             let ClusterInputs {
                 coeffs: rc,
@@ -473,7 +496,7 @@ fn parity_kernel_sums_each_degree_into_its_parity() {
                     let mut want = vec![0.0; nb * 8];
                     inverse_from(isa, 8, &rec, &lanes, &rows, &mut want);
                     for s in 0..nb_rings {
-                        let col = column(isa, &grid, &tables, ks[s], (m, 0), b);
+                        let col = column(isa, grid, tables, ks[s], (m, 0), b);
                         for j in 0..2 * c {
                             let (got, general) = (y[j * nb + s], want[s * 8 + j]);
                             assert!(
@@ -504,12 +527,17 @@ fn parity_kernel_sums_each_degree_into_its_parity() {
 /// rows past the degrees untouched by the contract (scratch).
 #[test]
 fn forward_parity_kernel_sums_each_degree_over_its_parity() {
+    for (b, ms, rings) in parity_cases() {
+        forward_parity_case(b, ms, rings);
+    }
+}
+
+fn forward_parity_case(b: usize, ms: &[usize], rings: &[usize]) {
     use super::{forward_parity, parity_partial_len};
-    let b = 40;
     let grid = BetaTables::grid(b);
     let tables = RecTables::new(b);
-    for &m in &[0usize, 1, 7, 30, 39] {
-        for nb_rings in [40usize, 24, 8] {
+    for &m in ms {
+        for &nb_rings in rings {
             let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
             let ClusterInputs {
                 coeffs: rc,
@@ -535,26 +563,43 @@ fn forward_parity_kernel_sums_each_degree_over_its_parity() {
                 let mut lanes = grid_lanes(&tau, &p, &sc, nb);
                 (lanes.interleaved, lanes.stream) = (false, false);
                 for c in [2usize, 4] {
-                    let mut x = pseudo(2 * c * nb, 5 + m as u64);
-                    for col in 0..2 * c {
-                        x[col * nb + nb_rings..(col + 1) * nb].fill(0.0);
-                    }
-                    let mut part = vec![f64::NAN; parity_partial_len(n, c, w)];
-                    let mut ft = vec![f64::NAN; (n * c).next_multiple_of(w)];
-                    forward_parity(isa, c, &rec, &lanes, &x, (&mut part, &mut ft));
-                    for i in 0..n {
-                        for q in 0..c {
-                            let (mut sum, mut size) = (0.0, 0.0);
-                            for (s, col) in cols.iter().enumerate() {
-                                let t = col[i] * x[((i % 2) * c + q) * nb + s];
-                                sum += t;
-                                size += t.abs();
+                    // All lanes at once (every lane's share must reach the sums), then one
+                    // lane at a time, where each sum is that lane's term alone and a term
+                    // sent to the wrong parity or degree shows however small it is
+                    // (skipped terms are below 2^-64 of the data).
+                    let all = pseudo(2 * c * nb, 5 + m as u64);
+                    let singles = (0..nb_rings).step_by(if b > 40 { 37 } else { 1 });
+                    for only in std::iter::once(None).chain(singles.map(Some)) {
+                        let mut x = all.clone();
+                        for col in 0..2 * c {
+                            for s in 0..nb {
+                                if s >= nb_rings || only.is_some_and(|o| o != s) {
+                                    x[col * nb + s] = 0.0;
+                                }
                             }
-                            let got = ft[i * c + q] * rc.s[i];
-                            assert!(
-                                (got - sum).abs() <= 1e-14 * size.max(1.0),
-                                "{isa:?} m={m} c={c} rings {nb_rings} degree {i} column {q}: {got:e} vs {sum:e}"
-                            );
+                        }
+                        let mut part = vec![f64::NAN; parity_partial_len(n, c, w)];
+                        let mut ft = vec![f64::NAN; (n * c).next_multiple_of(w)];
+                        forward_parity(isa, c, &rec, &lanes, &x, (&mut part, &mut ft));
+                        for i in 0..n {
+                            for q in 0..c {
+                                let (mut sum, mut size) = (0.0, 0.0);
+                                for (s, col) in cols.iter().enumerate() {
+                                    let t = col[i] * x[((i % 2) * c + q) * nb + s];
+                                    sum += t;
+                                    size += t.abs();
+                                }
+                                let got = ft[i * c + q] * rc.s[i];
+                                let tol = if only.is_some() {
+                                    1e-10 * size + 1e-18
+                                } else {
+                                    1e-12 * size.max(1.0)
+                                };
+                                assert!(
+                                    (got - sum).abs() <= tol,
+                                    "{isa:?} m={m} c={c} rings {nb_rings} lane {only:?} degree {i} column {q}: {got:e} vs {sum:e}"
+                                );
+                            }
                         }
                     }
                 }

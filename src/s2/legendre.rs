@@ -1,14 +1,14 @@
 //! The Legendre stage of the S^2 transforms: for each order `m`, sums over the rings of the
 //! associated Legendre functions `Pt_l^m(cos theta_k) = dt^l_{m,0}(theta_k)`, run by the
-//! DWT kernels of the SO(3) transforms (the `m' = 0` case of the Wigner recurrence, with
-//! its extended-exponent starting values).
+//! parity kernels of `dwt` (the `m' = 0` case of the Wigner recurrence, with its
+//! extended-exponent starting values).
 //!
 //! The rings pair up with their mirrors `theta -> pi - theta`, where
 //! `dt^l_{m,0}(pi - theta) = (-1)^(l+m) dt^l_{m,0}(theta)`: the kernels run over the `B`
-//! rings of the northern half only, on rows of eight columns holding, for the orders `m`
-//! and `-m`, the even and odd combinations of a ring and its mirror (`E = x + x'`,
-//! `O = x - x'`, real and imaginary parts). Degree `l` takes the even sums when `l + m` is
-//! even, else the odd ones.
+//! rings of the northern half only, on columns (one value per ring) holding, for one or two
+//! column groups (orders `m` and `-m`, or two real fields), the even and odd combinations
+//! of a ring and its mirror (`E = x + x'`, `O = x - x'`, real and imaginary parts). Degree
+//! `l` takes the even combinations when `l + m` is even, else the odd ones.
 
 use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
@@ -17,7 +17,7 @@ use crate::wigner::{big, start_norm, BetaTables, RecCoeffs, RecTables, DEFAULT_S
 use num_complex::Complex64;
 use std::sync::Mutex;
 
-/// Columns of a kernel row: `E_m`, `O_m`, `E_-m`, `O_-m`, real and imaginary parts.
+/// Most columns of the kernels: `E` and `O`, real and imaginary parts, of two groups.
 const P: usize = 8;
 
 /// Where an order's ring spectra are: `F_m(theta_k)` at `base + k * row + column(m)`.
@@ -75,7 +75,7 @@ impl CoeffRows {
     }
 }
 
-/// Four kernel columns: the even and odd ring combinations of one order's spectra, and
+/// Four kernel columns (`E` and `O`, real and imaginary parts) of one order's spectra, and
 /// where that order's coefficients go (or come from).
 #[derive(Clone, Copy)]
 pub(super) struct Group {
@@ -104,9 +104,9 @@ pub(super) struct Scratch {
     tau: Vec<f64>,
     start: Vec<f64>,
     scale: Vec<f64>,
-    /// Kernel rows of the rings (forward input, inverse output).
+    /// Kernel columns of the rings (forward input, inverse output).
     rows: Vec<f64>,
-    /// Forward: the kernel's sums; inverse: its input.
+    /// Forward: the kernel's sums (degree-major); inverse: its input.
     sums: Vec<f64>,
     /// The forward kernel's partial sums (lanes = rings).
     part: Vec<f64>,

@@ -106,6 +106,8 @@ impl S2Plan {
     }
 
     /// Bytes a plan of bandwidth `b` on `threads` threads holds (ring scratch, tables).
+    /// Calls on two fields at once (`*_many` with `howmany > 1`, `*_pair`) add a second
+    /// ring scratch of the same size, made on their first use and kept with the plan.
     pub fn memory_needed(b: usize, threads: usize) -> usize {
         16 * scratch_len(b) + LegendreStage::bytes(b, threads) + 8 * 2 * b
     }

@@ -19,19 +19,20 @@ const KEEP_BUFFERS_BYTES: usize = 128 << 20;
 /// takes about as long as starting threads on a busy machine.
 const PARALLEL_MIN_LEN: usize = 1 << 20;
 
-/// Interleaved samples and coefficients between the caller's split arrays and the plan.
+/// Coefficient arrays between the caller's split arrays and the plan: the transforms of
+/// split data run as pairs of real transforms, one array each.
 struct Buffers {
-    /// `(2B)^2` samples.
-    samples: Vec<Complex64>,
     /// `B^2` coefficients.
     coeffs: Vec<Complex64>,
+    /// `B^2` coefficients of the second field of a pair.
+    second: Vec<Complex64>,
 }
 
 impl Buffers {
     fn new(b: usize) -> SoftResult<Buffers> {
         Ok(Buffers {
-            samples: try_zeroed(4 * b * b)?,
             coeffs: try_zeroed(b * b)?,
+            second: try_zeroed(b * b)?,
         })
     }
 }
@@ -69,7 +70,7 @@ impl S2Entry {
     /// keep.
     fn with_buffers<R>(&self, f: impl FnOnce(&mut Buffers) -> SoftResult<R>) -> SoftResult<R> {
         let b = self.plan.bandwidth();
-        let keep = 16 * 5 * b * b <= KEEP_BUFFERS_BYTES;
+        let keep = 16 * 2 * b * b <= KEEP_BUFFERS_BYTES;
         let guard = match self.buffers.try_lock() {
             Ok(g) => Some(g),
             Err(TryLockError::Poisoned(e)) => Some(e.into_inner()),
@@ -111,11 +112,9 @@ impl S2Entry {
             }
             // The transform of re + i im is A(re) + i A(im), both real analyses read straight
             // from the caller's arrays.
-            let nc = buf.coeffs.len();
-            let second = &mut buf.samples[..nc];
             self.plan
-                .forward_real_pair([re, im], [&mut buf.coeffs, second])?;
-            let (a, b) = (&mut buf.coeffs, &buf.samples[..nc]);
+                .forward_real_pair([re, im], [&mut buf.coeffs, &mut buf.second])?;
+            let (a, b) = (&mut buf.coeffs, &buf.second);
             for (x, y) in a.iter_mut().zip(b) {
                 *x += Complex64::i() * y;
             }
@@ -143,8 +142,7 @@ impl S2Entry {
             if !real_format {
                 // rdata and idata are the real syntheses of the two Hermitian parts of the
                 // coefficients, written straight into the caller's arrays.
-                let (h1, rest) = buf.samples.split_at_mut(b * b);
-                let h2 = &mut rest[..b * b];
+                let (h1, h2) = (&mut buf.coeffs, &mut buf.second);
                 hermitian_parts(b, (re, im), h1, h2);
                 self.plan.inverse_real_pair([h1, h2], [out_re, out_im])?;
                 return Ok(());
@@ -163,7 +161,7 @@ impl S2Entry {
                 self.plan.inverse_real(&buf.coeffs, out_re)?;
                 fill_zero(out_im, threads);
             } else {
-                let second = &mut buf.samples[..b * b];
+                let second = &mut buf.second;
                 second[..split].fill(Complex64::default());
                 for (c, v) in second[..b].iter_mut().zip(&im[..b]) {
                     *c = Complex64::new(*v, 0.0);
