@@ -23,7 +23,14 @@ pub fn combine(
 ) -> Result<()> {
     check(sig.len(), pat.len(), (b_in, deg_lim, b_out), out.len())?;
     out.fill(Complex64::default());
-    add_combined((sig, pat), b_in, (0, deg_lim), b_out, (1.0, out), false);
+    add_combined(
+        (sig, pat),
+        b_in,
+        (0, deg_lim),
+        b_out,
+        (1.0, out),
+        (false, Combine::Add),
+    );
     Ok(())
 }
 
@@ -55,20 +62,31 @@ pub(super) fn check(
     Ok(())
 }
 
+/// How [`add_combined`] treats the output.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Combine {
+    /// Add to what `out` holds.
+    Add,
+    /// Overwrite it: the degrees `from..=to` of each order pair with the combination, its
+    /// degrees below `from` with 0 (one pass over the array instead of zeroing it first
+    /// and then adding). Degrees above `to` are not written.
+    Assign,
+}
+
 /// Adds `scale` times the combination of degrees `from..=to` to `out` (lengths checked by
-/// the caller with [`check`]); with `half`, only the order pairs a real-signal inverse
-/// reads (`M' > 0`, or `M' = 0` and `M >= 0`; the others are left as they are). For each
-/// order pair the degrees are consecutive in all three arrays, so the inner loop runs over
-/// contiguous runs.
+/// the caller with [`check`]), or writes it (`mode`); with `half`, only the order pairs a
+/// real-signal inverse reads (`M' > 0`, or `M' = 0` and `M >= 0`; the others are left as
+/// they are). For each order pair the degrees are consecutive in all three arrays, so the
+/// inner loop runs over contiguous runs.
 pub(super) fn add_combined(
     (sig, pat): (&[Complex64], &[Complex64]),
     b_in: usize,
     (from, to): (usize, usize),
     b_out: usize,
     (scale, out): (f64, &mut [Complex64]),
-    half: bool,
+    (half, mode): (bool, Combine),
 ) {
-    if from > to {
+    if from > to && mode == Combine::Add {
         return;
     }
     let norms: Vec<f64> = (0..=to)
@@ -87,8 +105,9 @@ pub(super) fn add_combined(
             }
             let h_row = &pat[order_start(b_in, -m2)..];
             let (a1, a2) = (m1.unsigned_abs(), m2.unsigned_abs());
-            let l0 = a1.max(a2).max(from);
-            if l0 > to {
+            let first = a1.max(a2);
+            let l0 = first.max(from);
+            if first > to {
                 continue;
             }
             let sign = if (m1 + m2).rem_euclid(2) == 0 {
@@ -96,14 +115,25 @@ pub(super) fn add_combined(
             } else {
                 -1.0
             };
-            let base = block_start(b_out, m1, m2) - a1.max(a2);
+            let base = block_start(b_out, m1, m2) - first;
             assert!(base + to < len);
-            for l in l0..=to {
-                // SAFETY: inside `out` (asserted above); the block of `(m1, m2)` is this
-                // row's alone, no other task touches it.
-                unsafe {
-                    *dst.get().add(base + l) +=
-                        f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+            let value = |l: usize| f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+            // Entry `base + l`, `l <= to`, is inside `out` (asserted above) and in the block
+            // of `(m1, m2)`, which is this row's alone: no other task touches it.
+            let at = |l: usize| dst.get().wrapping_add(base + l);
+            if mode == Combine::Assign {
+                for l in first..l0.min(to + 1) {
+                    // SAFETY: `at` above.
+                    unsafe { *at(l) = Complex64::default() };
+                }
+                for l in l0..=to {
+                    // SAFETY: `at` above.
+                    unsafe { *at(l) = value(l) };
+                }
+            } else {
+                for l in l0..=to {
+                    // SAFETY: `at` above.
+                    unsafe { *at(l) += value(l) };
                 }
             }
         }

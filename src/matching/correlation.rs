@@ -2,7 +2,7 @@
 //! grid, by two S^2 forward transforms, the combination of their coefficients and one
 //! inverse SO(3) transform.
 
-use super::combine::add_combined;
+use super::combine::{add_combined, Combine};
 use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
@@ -150,13 +150,18 @@ impl Correlation {
         }
     }
 
-    /// Adds shell `(signal, pattern, weight)`'s combined coefficients to `buf.so3` (with
-    /// `forward` the S^2 transform of the samples); with `normalized`, from degree 1 on,
-    /// and the weighted squared norms of degrees `1..=deg_lim` added to `norms`.
+    /// Adds shell `(signal, pattern, weight)`'s combined coefficients to `buf.so3`, or
+    /// writes them (`mode`) (with `forward` the S^2 transform of the samples); with
+    /// `normalized`, from degree 1 on, and the weighted squared norms of degrees
+    /// `1..=deg_lim` added to `norms`.
     fn add_shell<T>(
         &self,
         (signal, pattern, weight): (&[T], &[T], f64),
-        (forward, half): (&impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
+        (forward, half, mode): (
+            &impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+            bool,
+            Combine,
+        ),
         buf: &mut Buffers,
         norms: &mut [f64; 2],
     ) -> Result<()> {
@@ -183,20 +188,18 @@ impl Correlation {
                 *norm += weight.abs() * sq.max(0.0);
             }
         }
-        if from <= self.deg_lim {
-            let (sig, pat, so3) = (&buf.sig, &buf.pat, &mut buf.so3);
-            // On the plan's workers (the orders spread over them).
-            self.s2.install(|| {
-                add_combined(
-                    (sig, pat),
-                    self.b_in,
-                    (from, self.deg_lim),
-                    self.deg_lim + 1,
-                    (weight, so3),
-                    half,
-                )
-            });
-        }
+        let (sig, pat, so3) = (&buf.sig, &buf.pat, &mut buf.so3);
+        // On the plan's workers (the orders spread over them).
+        self.s2.install(|| {
+            add_combined(
+                (sig, pat),
+                self.b_in,
+                (from, self.deg_lim),
+                self.deg_lim + 1,
+                (weight, so3),
+                (half, mode),
+            )
+        });
         Ok(())
     }
 
@@ -211,10 +214,15 @@ impl Correlation {
         if shells.is_empty() {
             return Err(Error::InvalidArgument("no shells given".into()));
         }
-        buf.so3.fill(Complex64::default());
         let mut norms = [0.0; 2];
-        for &shell in shells {
-            self.add_shell(shell, (&forward, half), buf, &mut norms)?;
+        // The first shell writes every coefficient the inverse reads, the others add.
+        for (k, &shell) in shells.iter().enumerate() {
+            let mode = if k == 0 {
+                Combine::Assign
+            } else {
+                Combine::Add
+            };
+            self.add_shell(shell, (&forward, half, mode), buf, &mut norms)?;
         }
         if self.normalized {
             let denominator = (norms[0] * norms[1]).sqrt();
