@@ -19,23 +19,151 @@ use std::mem::MaybeUninit;
 /// Vectors of betas whose states are set up together (through their negligible prefixes).
 const VECTORS: usize = 16;
 
-/// `acc[par C + q] += v * row[q]` for the degree `i` of parity `par` in row `fin + i C`.
+/// What a group of `K` chains does with the recurrence values of a degree: the inverse
+/// accumulates them against the degree's coefficients, the forward adds their products
+/// with the chains' data into the degree's partial sums.
+trait Sink<S: Simd, const K: usize>: Copy {
+    /// Chain `c` alone (while it catches up with the others): the values `v` of degree `i`.
+    ///
+    /// # Safety
+    /// The CPU supports `S`'s instruction set; degree `i` is one of the kernel's.
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize);
+    /// All chains: the values `v` of degree `i`, whose parity is `PAR`.
+    ///
+    /// # Safety
+    /// As for [`Sink::one`].
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize);
+}
+
+/// The vectors of lanes in groups of `K` chains, each state past its negligible prefix:
+/// `group(chains, first lane, k)` with `k` chains of their own (the others repeat the last
+/// one; their results are to be dropped or their data zero).
 ///
 /// # Safety
-/// The CPU supports `S`'s instruction set; row `i` of `fin` holds `C` values.
+/// The CPU supports `S`'s instruction set; the lane arrays hold a multiple of `W` entries.
 #[inline(always)]
-unsafe fn acc_degree<S: Simd, const C: usize>(
-    acc: &mut [S::V],
-    v: S::V,
-    fin: *const f64,
-    i: usize,
+unsafe fn chain_groups<'r, S: Simd, const W: usize, const K: usize>(
+    rec: &Rec<'r>,
+    lanes: &Lanes,
+    mut group: impl FnMut(&mut [State<'r, S>; K], usize, usize),
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        let row = fin.add(i * C);
-        let a = &mut acc[(i % 2) * C..][..C];
-        for (q, a) in a.iter_mut().enumerate() {
-            *a = S::fma(v, S::splat(*row.add(q)), *a);
+        let (n, nb) = (rec.len(), lanes.tau.len());
+        let mut v0 = 0;
+        while v0 < nb {
+            let vectors = ((nb - v0) / W).min(VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
+            let (_, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
+            let mut j = 0;
+            while j < vectors {
+                let k = (vectors - j).min(K);
+                let mut st: [State<S>; K] = [states[j]; K];
+                for (c, s) in st.iter_mut().enumerate() {
+                    *s = states[j + c.min(k - 1)];
+                }
+                group(&mut st, v0 + j * W, k);
+                j += k;
+            }
+            v0 += vectors * W;
+        }
+    }
+}
+
+/// Runs the chains `st` to degree `n`: each alone until all its lanes are active, then up
+/// to the degree the furthest one reached, then all together, two degrees (one of each
+/// parity) per round with the recurrence step first (see `State::run_fast`).
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; every lane is in the lower half.
+#[inline(always)]
+unsafe fn run_chains<S: Simd, const K: usize>(
+    st: &mut [State<S>; K],
+    rec: &Rec,
+    sink: &mut impl Sink<S, K>,
+) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let n = rec.len();
+        for (c, s) in st.iter_mut().enumerate() {
+            s.run_slow(n, &mut |v, i| sink.one(c, v, i));
+        }
+        let i0 = st.iter().map(|s| s.i).max().unwrap_or(n);
+        for (c, s) in st.iter_mut().enumerate() {
+            s.run_fast(i0, &mut |v, i| sink.one(c, v, i));
+        }
+        // A fresh copy indexed only by constants in the joint phase, so that its sums live
+        // in registers (the phases above index them by parity at run time).
+        let mut joint = *sink;
+        let (slope, offset) = (rec.neg_a.as_ptr(), rec.a_plus_c.as_ptr());
+        let mut p0 = [S::zero(); K];
+        let mut p1 = [S::zero(); K];
+        let mut tau = [S::zero(); K];
+        for c in 0..K {
+            (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
+        }
+        macro_rules! degree {
+            ($i:expr, $par:literal) => {{
+                let i = $i;
+                let (a, b) = (S::splat(*slope.add(i)), S::splat(*offset.add(i)));
+                let v = p1;
+                for c in 0..K {
+                    let t = S::fma(a, tau[c], b);
+                    let p2 = S::fence(S::fms(t, p1[c], p0[c]));
+                    (p0[c], p1[c]) = (p1[c], p2);
+                }
+                joint.all::<$par>(&v, i);
+            }};
+        }
+        let mut i = i0;
+        if i < n && i % 2 == 1 {
+            degree!(i, 1);
+            i += 1;
+        }
+        while i + 1 < n {
+            degree!(i, 0);
+            degree!(i + 1, 1);
+            i += 2;
+        }
+        if i < n {
+            degree!(i, 0);
+        }
+        *sink = joint;
+    }
+}
+
+/// The inverse's sink: per chain, the sums of each parity and column (`2 C` of 8), against
+/// the coefficient rows `fin` (`C` values per degree).
+#[derive(Clone, Copy)]
+struct InverseSums<S: Simd, const C: usize, const K: usize> {
+    sums: [[S::V; 8]; K],
+    fin: *const f64,
+}
+
+impl<S: Simd, const C: usize, const K: usize> Sink<S, K> for InverseSums<S, C, K> {
+    #[inline(always)]
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize) {
+        // SAFETY: row `i` of `fin` holds `C` values (the kernel's contract).
+        unsafe {
+            let row = self.fin.add(i * C);
+            let sums = &mut self.sums[c][(i % 2) * C..][..C];
+            for (q, a) in sums.iter_mut().enumerate() {
+                *a = S::fma(v, S::splat(*row.add(q)), *a);
+            }
+        }
+    }
+
+    #[inline(always)]
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize) {
+        // SAFETY: as in `one`.
+        unsafe {
+            let row = self.fin.add(i * C);
+            for q in 0..C {
+                let x = S::splat(*row.add(q));
+                for (c, vc) in v.iter().enumerate() {
+                    self.sums[c][PAR * C + q] = S::fma(*vc, x, self.sums[c][PAR * C + q]);
+                }
+            }
         }
     }
 }
@@ -53,82 +181,70 @@ unsafe fn body<S: Simd, const W: usize, const C: usize, const K: usize>(
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        let n = rec.len();
         let nb = lanes.tau.len();
-        let (slope, offset) = (rec.neg_a.as_ptr(), rec.a_plus_c.as_ptr());
-        let mut v0 = 0;
-        while v0 < nb {
-            let vectors = ((nb - v0) / W).min(VECTORS);
-            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
-            let (_, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
-            let mut j = 0;
-            while j < vectors {
-                // `k` vectors of their own; the other chains repeat the last one (not stored).
-                let k = (vectors - j).min(K);
-                let mut st: [State<S>; K] = [states[j]; K];
-                for (c, s) in st.iter_mut().enumerate() {
-                    *s = states[j + c.min(k - 1)];
+        chain_groups::<S, W, K>(rec, lanes, |st, s0, k| {
+            let mut sink = InverseSums::<S, C, K> {
+                sums: [[S::zero(); 8]; K],
+                fin,
+            };
+            run_chains(st, rec, &mut sink);
+            // Only the chains of their own are stored.
+            for (c, a) in sink.sums.iter().enumerate().take(k) {
+                for (col, x) in a.iter().enumerate().take(2 * C) {
+                    S::store(y.add(col * nb + s0 + c * W), *x);
                 }
-                let mut acc = [[S::zero(); 8]; K];
-                // Each chain alone until all its lanes are active, then up to a common degree.
-                for (s, a) in st.iter_mut().zip(acc.iter_mut()) {
-                    s.run_slow(n, &mut |v, i| acc_degree::<S, C>(a, v, fin, i));
-                }
-                let i0 = st.iter().map(|s| s.i).max().unwrap_or(n);
-                for (s, a) in st.iter_mut().zip(acc.iter_mut()) {
-                    s.run_fast(i0, &mut |v, i| acc_degree::<S, C>(a, v, fin, i));
-                }
-                // A fresh copy indexed only by constants, so that it lives in registers.
-                let mut sums = acc;
-                let mut p0 = [S::zero(); K];
-                let mut p1 = [S::zero(); K];
-                let mut tau = [S::zero(); K];
-                for c in 0..K {
-                    (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
-                }
-                // All chains together, one degree: the step first (see `State::run_fast`).
-                macro_rules! degree {
-                    ($i:expr, $par:expr) => {{
-                        let i = $i;
-                        let (a, b) = (S::splat(*slope.add(i)), S::splat(*offset.add(i)));
-                        let v = p1;
-                        for c in 0..K {
-                            let t = S::fma(a, tau[c], b);
-                            let p2 = S::fence(S::fms(t, p1[c], p0[c]));
-                            (p0[c], p1[c]) = (p1[c], p2);
-                        }
-                        let row = fin.add(i * C);
-                        for q in 0..C {
-                            let x = S::splat(*row.add(q));
-                            for c in 0..K {
-                                sums[c][$par * C + q] = S::fma(v[c], x, sums[c][$par * C + q]);
-                            }
-                        }
-                    }};
-                }
-                let mut i = i0;
-                if i < n && i % 2 == 1 {
-                    degree!(i, 1);
-                    i += 1;
-                }
-                while i + 1 < n {
-                    degree!(i, 0);
-                    degree!(i + 1, 1);
-                    i += 2;
-                }
-                if i < n {
-                    degree!(i, 0);
-                }
-                for (c, a) in sums.iter().enumerate().take(k) {
-                    let s0 = v0 + (j + c) * W;
-                    for (col, x) in a.iter().enumerate().take(2 * C) {
-                        S::store(y.add(col * nb + s0), *x);
-                    }
-                }
-                j += k;
             }
-            v0 += vectors * W;
+        });
+    }
+}
+
+/// The forward's sink: per chain its data (`2 C` columns of 8, zero for the chains that
+/// repeat another), added into the partial sums `part` (`W` lanes per degree and column).
+#[derive(Clone, Copy)]
+struct ForwardSums<S: Simd, const W: usize, const C: usize, const K: usize> {
+    data: [[S::V; 8]; K],
+    part: *mut f64,
+}
+
+impl<S: Simd, const W: usize, const C: usize, const K: usize> ForwardSums<S, W, C, K> {
+    /// `part[(i C + q) W ..][..W] += sum over chains of v * data[par C + q]`.
+    ///
+    /// # Safety
+    /// The CPU supports `S`'s instruction set; the rows of degree `i` are inside `part`.
+    #[inline(always)]
+    unsafe fn add(
+        &mut self,
+        chains: impl Iterator<Item = (usize, S::V)> + Clone,
+        i: usize,
+        par: usize,
+    ) {
+        // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+        unsafe {
+            for q in 0..C {
+                let p = self.part.add((i * C + q) * W);
+                let mut f = S::load(p);
+                for (c, v) in chains.clone() {
+                    f = S::fma(v, self.data[c][par * C + q], f);
+                }
+                S::store(p, f);
+            }
         }
+    }
+}
+
+impl<S: Simd, const W: usize, const C: usize, const K: usize> Sink<S, K>
+    for ForwardSums<S, W, C, K>
+{
+    #[inline(always)]
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize) {
+        // SAFETY: degree `i`'s rows are inside `part` (the kernel's contract).
+        unsafe { self.add(std::iter::once((c, v)), i, i % 2) }
+    }
+
+    #[inline(always)]
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize) {
+        // SAFETY: as in `one`.
+        unsafe { self.add(v.iter().copied().enumerate(), i, PAR) }
     }
 }
 
@@ -155,86 +271,18 @@ unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
         let nb = lanes.tau.len();
         let rows = (n * C).next_multiple_of(W);
         std::ptr::write_bytes(part, 0, rows * W);
-        let (slope, offset) = (rec.neg_a.as_ptr(), rec.a_plus_c.as_ptr());
-        // `part[(i C + q) W ..][..W] += v * xc[par C + q]` for chain data `xc`.
-        let add_degree = |xc: &[S::V; 8], v: S::V, i: usize| {
-            let par = i % 2;
-            for q in 0..C {
-                let p = part.add((i * C + q) * W);
-                S::store(p, S::fma(v, xc[par * C + q], S::load(p)));
+        chain_groups::<S, W, K>(rec, lanes, |st, s0, k| {
+            let mut sink = ForwardSums::<S, W, C, K> {
+                data: [[S::zero(); 8]; K],
+                part,
+            };
+            for (c, d) in sink.data.iter_mut().enumerate().take(k) {
+                for (col, v) in d.iter_mut().enumerate().take(2 * C) {
+                    *v = S::load(x.add(col * nb + s0 + c * W));
+                }
             }
-        };
-        let mut v0 = 0;
-        while v0 < nb {
-            let vectors = ((nb - v0) / W).min(VECTORS);
-            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
-            let (_, states) = prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
-            let mut j = 0;
-            while j < vectors {
-                // `k` vectors of their own; the other chains repeat the last one with zero
-                // data (they add nothing).
-                let k = (vectors - j).min(K);
-                let mut st: [State<S>; K] = [states[j]; K];
-                let mut xv = [[S::zero(); 8]; K];
-                for c in 0..K {
-                    st[c] = states[j + c.min(k - 1)];
-                    if c < k {
-                        let s0 = v0 + (j + c) * W;
-                        for (col, v) in xv[c].iter_mut().enumerate().take(2 * C) {
-                            *v = S::load(x.add(col * nb + s0));
-                        }
-                    }
-                }
-                for (s, xc) in st.iter_mut().zip(&xv) {
-                    s.run_slow(n, &mut |v, i| add_degree(xc, v, i));
-                }
-                let i0 = st.iter().map(|s| s.i).max().unwrap_or(n);
-                for (s, xc) in st.iter_mut().zip(&xv) {
-                    s.run_fast(i0, &mut |v, i| add_degree(xc, v, i));
-                }
-                let mut p0 = [S::zero(); K];
-                let mut p1 = [S::zero(); K];
-                let mut tau = [S::zero(); K];
-                for c in 0..K {
-                    (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
-                }
-                macro_rules! degree {
-                    ($i:expr, $par:expr) => {{
-                        let i = $i;
-                        let (a, b) = (S::splat(*slope.add(i)), S::splat(*offset.add(i)));
-                        let v = p1;
-                        for c in 0..K {
-                            let t = S::fma(a, tau[c], b);
-                            let p2 = S::fence(S::fms(t, p1[c], p0[c]));
-                            (p0[c], p1[c]) = (p1[c], p2);
-                        }
-                        for q in 0..C {
-                            let p = part.add((i * C + q) * W);
-                            let mut f = S::load(p);
-                            for c in 0..K {
-                                f = S::fma(v[c], xv[c][$par * C + q], f);
-                            }
-                            S::store(p, f);
-                        }
-                    }};
-                }
-                let mut i = i0;
-                if i < n && i % 2 == 1 {
-                    degree!(i, 1);
-                    i += 1;
-                }
-                while i + 1 < n {
-                    degree!(i, 0);
-                    degree!(i + 1, 1);
-                    i += 2;
-                }
-                if i < n {
-                    degree!(i, 0);
-                }
-                j += k;
-            }
-            v0 += vectors * W;
-        }
+            run_chains(st, rec, &mut sink);
+        });
         // Lane sums: W rows of partial sums transposed, then added.
         let mut r = 0;
         while r < rows {

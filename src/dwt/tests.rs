@@ -423,6 +423,73 @@ fn one_beta_forward_is_the_reference_column() {
     }
 }
 
+/// One case of the parity kernel tests (see [`parity_cases`]): the northern rings `ks`
+/// of bandwidth `b`, order `m`, lanes padded to the vector width of `isa` (`nb`), and the
+/// reference columns `cols[s]` of `wigner` at each ring.
+struct ParityCase<'a> {
+    b: usize,
+    m: usize,
+    isa: Isa,
+    rings: usize,
+    nb: usize,
+    rc: &'a RecCoeffs,
+    rec: &'a Rec<'a>,
+    lanes: &'a Lanes<'a>,
+    cols: &'a [Vec<f64>],
+}
+
+/// Runs `f` on every case: bandwidths, orders and ring counts that leave chains of a group
+/// unused on every vector width (odd vector counts with AVX2), and at B = 160 more than the
+/// 16 vectors set up at once on AVX2 and AVX-512; every instruction set this CPU has.
+fn parity_cases(mut f: impl FnMut(&ParityCase)) {
+    let cases: [(usize, &[usize], &[usize]); 2] = [
+        (40, &[0, 1, 7, 30, 39], &[40, 36, 24, 20, 12, 8]),
+        (160, &[0, 3, 90], &[160, 152]),
+    ];
+    for (b, ms, rings) in cases {
+        let grid = BetaTables::grid(b);
+        let tables = RecTables::new(b);
+        for &m in ms {
+            for &nb_rings in rings {
+                let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
+                let ClusterInputs {
+                    coeffs: rc,
+                    mut tau,
+                    mut p,
+                    mut sc,
+                } = cluster_setup_at(b, m, 0, &ks);
+                let rec = Rec::new(&rc, b - m);
+                for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                    if !isa.is_supported() {
+                        continue;
+                    }
+                    let cols: Vec<Vec<f64>> = ks
+                        .iter()
+                        .map(|&k| column(isa, &grid, &tables, k, (m, 0), b))
+                        .collect();
+                    let nb = nb_rings.next_multiple_of(isa.lanes());
+                    for v in [&mut tau, &mut p, &mut sc] {
+                        v.resize(nb, 0.0);
+                    }
+                    let mut lanes = grid_lanes(&tau, &p, &sc, nb);
+                    (lanes.interleaved, lanes.stream) = (false, false);
+                    f(&ParityCase {
+                        b,
+                        m,
+                        isa,
+                        rings: nb_rings,
+                        nb,
+                        rc: &rc,
+                        rec: &rec,
+                        lanes: &lanes,
+                        cols: &cols,
+                    });
+                }
+            }
+        }
+    }
+}
+
 /// The parity kernel (`m' = 0`, degrees alternating between the even and the odd sums)
 /// gives what the general 8-column inverse kernel gives with each degree's coefficients
 /// in the columns of its parity and zeros in the others (the same multiply-adds in the
@@ -433,92 +500,44 @@ fn one_beta_forward_is_the_reference_column() {
 #[test]
 fn parity_kernel_sums_each_degree_into_its_parity() {
     use super::inverse_parity;
-    for (b, ms, rings) in parity_cases() {
-        let grid = BetaTables::grid(b);
-        let tables = RecTables::new(b);
-        parity_inverse_case(b, (&grid, &tables), ms, rings, inverse_parity);
-    }
-}
-
-/// Bandwidths, orders and ring counts of the parity kernel tests: ring counts that leave
-/// chains of a group unused on every vector width (odd vector counts with AVX2), and at
-/// B = 160 more than the 16 vectors set up at once on AVX2 and AVX-512.
-fn parity_cases() -> Vec<(usize, &'static [usize], &'static [usize])> {
-    vec![
-        (40, &[0, 1, 7, 30, 39], &[40, 36, 24, 20, 12, 8]),
-        (160, &[0, 3, 90], &[160, 152]),
-    ]
-}
-
-type InverseParity = fn(Isa, usize, &Rec, &Lanes, &[f64], &mut [f64]);
-
-fn parity_inverse_case(
-    b: usize,
-    (grid, tables): (&BetaTables, &RecTables),
-    ms: &[usize],
-    rings: &[usize],
-    inverse_parity: InverseParity,
-) {
-    for &m in ms {
-        for &nb_rings in rings {
-            let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
-            let ClusterInputs {
-                coeffs: rc,
-                mut tau,
-                mut p,
-                mut sc,
-            } = cluster_setup_at(b, m, 0, &ks);
-            let n = b - m;
-            let rec = Rec::new(&rc, n);
-            for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
-                if !isa.is_supported() {
-                    continue;
+    parity_cases(|t| {
+        let (isa, m, nb, n) = (t.isa, t.m, t.nb, t.b - t.m);
+        for c in [2usize, 4] {
+            let g = pseudo(n * c, 3 + m as u64);
+            let fin: Vec<f64> = (0..n * c).map(|j| g[j] * t.rc.s[j / c]).collect();
+            let mut y = vec![f64::NAN; 2 * c * nb];
+            inverse_parity(isa, c, t.rec, t.lanes, &fin, &mut y);
+            // The general kernel: column par * c + q of row i holds fin[i c + q] when
+            // i % 2 == par.
+            let mut rows = vec![0.0; n * 8];
+            for i in 0..n {
+                for q in 0..c {
+                    rows[i * 8 + (i % 2) * c + q] = fin[i * c + q];
                 }
-                let nb = nb_rings.next_multiple_of(isa.lanes());
-                for v in [&mut tau, &mut p, &mut sc] {
-                    v.resize(nb, 0.0);
-                }
-                let mut lanes = grid_lanes(&tau, &p, &sc, nb);
-                (lanes.interleaved, lanes.stream) = (false, false);
-                for c in [2usize, 4] {
-                    let g = pseudo(n * c, 3 + m as u64);
-                    let fin: Vec<f64> = (0..n * c).map(|j| g[j] * rc.s[j / c]).collect();
-                    let mut y = vec![f64::NAN; 2 * c * nb];
-                    inverse_parity(isa, c, &rec, &lanes, &fin, &mut y);
-                    // The general kernel: column par * c + q of row i holds fin[i c + q]
-                    // when i % 2 == par.
-                    let mut rows = vec![0.0; n * 8];
-                    for i in 0..n {
-                        for q in 0..c {
-                            rows[i * 8 + (i % 2) * c + q] = fin[i * c + q];
-                        }
+            }
+            let mut want = vec![0.0; nb * 8];
+            inverse_from(isa, 8, t.rec, t.lanes, &rows, &mut want);
+            for (s, col) in t.cols.iter().enumerate() {
+                for j in 0..2 * c {
+                    let (got, general) = (y[j * nb + s], want[s * 8 + j]);
+                    assert!(
+                        got == general,
+                        "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} {general:e}"
+                    );
+                    let (par, q) = (j / c, j % c);
+                    let (mut sum, mut size) = (0.0, 0.0);
+                    for i in (par..n).step_by(2) {
+                        sum += col[i] * g[i * c + q];
+                        size += (col[i] * g[i * c + q]).abs();
                     }
-                    let mut want = vec![0.0; nb * 8];
-                    inverse_from(isa, 8, &rec, &lanes, &rows, &mut want);
-                    for s in 0..nb_rings {
-                        let col = column(isa, grid, tables, ks[s], (m, 0), b);
-                        for j in 0..2 * c {
-                            let (got, general) = (y[j * nb + s], want[s * 8 + j]);
-                            assert!(
-                                got == general,
-                                "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} {general:e}"
-                            );
-                            let (par, q) = (j / c, j % c);
-                            let (mut sum, mut size) = (0.0, 0.0);
-                            for i in (par..n).step_by(2) {
-                                sum += col[i] * g[i * c + q];
-                                size += (col[i] * g[i * c + q]).abs();
-                            }
-                            assert!(
-                                (got - sum).abs() <= 1e-14 * size.max(1.0),
-                                "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} vs {sum:e}"
-                            );
-                        }
-                    }
+                    assert!(
+                        (got - sum).abs() <= 1e-14 * size.max(1.0),
+                        "{isa:?} m={m} c={c} lane {s} column {j}: {got:e} vs {sum:e}"
+                    );
                 }
             }
         }
-    }
+    });
 }
 
 /// The forward parity kernel sums each degree over the lanes of its parity's columns: the
@@ -527,83 +546,50 @@ fn parity_inverse_case(
 /// rows past the degrees untouched by the contract (scratch).
 #[test]
 fn forward_parity_kernel_sums_each_degree_over_its_parity() {
-    for (b, ms, rings) in parity_cases() {
-        forward_parity_case(b, ms, rings);
-    }
-}
-
-fn forward_parity_case(b: usize, ms: &[usize], rings: &[usize]) {
     use super::{forward_parity, parity_partial_len};
-    let grid = BetaTables::grid(b);
-    let tables = RecTables::new(b);
-    for &m in ms {
-        for &nb_rings in rings {
-            let ks: Vec<usize> = (0..nb_rings).map(|s| s * b / nb_rings).collect();
-            let ClusterInputs {
-                coeffs: rc,
-                mut tau,
-                mut p,
-                mut sc,
-            } = cluster_setup_at(b, m, 0, &ks);
-            let n = b - m;
-            let rec = Rec::new(&rc, n);
-            let cols: Vec<Vec<f64>> = ks
-                .iter()
-                .map(|&k| column(Isa::Scalar, &grid, &tables, k, (m, 0), b))
-                .collect();
-            for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
-                if !isa.is_supported() {
-                    continue;
-                }
-                let w = isa.lanes();
-                let nb = nb_rings.next_multiple_of(w);
-                for v in [&mut tau, &mut p, &mut sc] {
-                    v.resize(nb, 0.0);
-                }
-                let mut lanes = grid_lanes(&tau, &p, &sc, nb);
-                (lanes.interleaved, lanes.stream) = (false, false);
-                for c in [2usize, 4] {
-                    // All lanes at once (every lane's share must reach the sums), then one
-                    // lane at a time, where each sum is that lane's term alone and a term
-                    // sent to the wrong parity or degree shows however small it is
-                    // (skipped terms are below 2^-64 of the data).
-                    let all = pseudo(2 * c * nb, 5 + m as u64);
-                    let singles = (0..nb_rings).step_by(if b > 40 { 37 } else { 1 });
-                    for only in std::iter::once(None).chain(singles.map(Some)) {
-                        let mut x = all.clone();
-                        for col in 0..2 * c {
-                            for s in 0..nb {
-                                if s >= nb_rings || only.is_some_and(|o| o != s) {
-                                    x[col * nb + s] = 0.0;
-                                }
-                            }
+    parity_cases(|t| {
+        let (isa, m, nb, n, w) = (t.isa, t.m, t.nb, t.b - t.m, t.isa.lanes());
+        for c in [2usize, 4] {
+            // All lanes at once (every lane's share must reach the sums), then one lane at
+            // a time, where each sum is that lane's term alone and a term sent to the
+            // wrong parity or degree shows however small it is (skipped terms are below
+            // 2^-64 of the data).
+            let all = pseudo(2 * c * nb, 5 + m as u64);
+            let singles = (0..t.rings).step_by(if t.b > 40 { 37 } else { 1 });
+            for only in std::iter::once(None).chain(singles.map(Some)) {
+                let mut x = all.clone();
+                for col in 0..2 * c {
+                    for s in 0..nb {
+                        if s >= t.rings || only.is_some_and(|o| o != s) {
+                            x[col * nb + s] = 0.0;
                         }
-                        let mut part = vec![f64::NAN; parity_partial_len(n, c, w)];
-                        let mut ft = vec![f64::NAN; (n * c).next_multiple_of(w)];
-                        forward_parity(isa, c, &rec, &lanes, &x, (&mut part, &mut ft));
-                        for i in 0..n {
-                            for q in 0..c {
-                                let (mut sum, mut size) = (0.0, 0.0);
-                                for (s, col) in cols.iter().enumerate() {
-                                    let t = col[i] * x[((i % 2) * c + q) * nb + s];
-                                    sum += t;
-                                    size += t.abs();
-                                }
-                                let got = ft[i * c + q] * rc.s[i];
-                                let tol = if only.is_some() {
-                                    1e-10 * size + 1e-18
-                                } else {
-                                    1e-12 * size.max(1.0)
-                                };
-                                assert!(
-                                    (got - sum).abs() <= tol,
-                                    "{isa:?} m={m} c={c} rings {nb_rings} lane {only:?} degree {i} column {q}: {got:e} vs {sum:e}"
-                                );
-                            }
+                    }
+                }
+                let mut part = vec![f64::NAN; parity_partial_len(n, c, w)];
+                let mut ft = vec![f64::NAN; (n * c).next_multiple_of(w)];
+                forward_parity(isa, c, t.rec, t.lanes, &x, (&mut part, &mut ft));
+                for i in 0..n {
+                    for q in 0..c {
+                        let (mut sum, mut size) = (0.0, 0.0);
+                        for (s, col) in t.cols.iter().enumerate() {
+                            let term = col[i] * x[((i % 2) * c + q) * nb + s];
+                            sum += term;
+                            size += term.abs();
                         }
+                        let got = ft[i * c + q] * t.rc.s[i];
+                        let tol = if only.is_some() {
+                            1e-10 * size + 1e-18
+                        } else {
+                            1e-12 * size.max(1.0)
+                        };
+                        assert!(
+                            (got - sum).abs() <= tol,
+                            "{isa:?} m={m} c={c} rings {} lane {only:?} degree {i} column {q}: {got:e} vs {sum:e}",
+                            t.rings
+                        );
                     }
                 }
             }
         }
-    }
+    });
 }

@@ -242,7 +242,10 @@ impl LegendreStage {
             let c = 2 * groups.len();
             let nb = self.lanes;
             let mut x = std::mem::take(&mut sc.rows);
-            x[..2 * c * nb].fill(0.0);
+            // The padding lanes are 0; the others are written below.
+            for column in x[..2 * c * nb].chunks_exact_mut(nb) {
+                column[b..].fill(0.0);
+            }
             for (q, g) in groups.iter().enumerate() {
                 for k in 0..b {
                     let w = self.weights[k];

@@ -375,21 +375,15 @@ impl S2Plan {
     ) -> Result<()> {
         self.check(samples.len(), coeffs.len(), howmany)?;
         let (n, nc) = (2 * self.b, self.num_coeffs());
-        let factor = (2.0 * PI).sqrt() / n as f64;
         self.with_scratch(howmany > 1, |first, second| {
-            let bufs = [Some(first), second];
             for (fields, outs) in samples.chunks(2 * n * n).zip(coeffs.chunks_mut(2 * nc)) {
-                let mut groups = [None; 2];
-                for (i, (field, out)) in fields
-                    .chunks_exact(n * n)
-                    .zip(outs.chunks_exact_mut(nc))
-                    .enumerate()
-                {
-                    let buf = bufs[i].expect("a second scratch for two fields");
-                    groups[i] = Some(self.real_rings_forward(buf, field, out)?);
+                let (mut ins, mut outs2) = ([&[][..]; 2], [&mut [][..], &mut [][..]]);
+                let mut count = 0;
+                for (field, out) in fields.chunks_exact(n * n).zip(outs.chunks_exact_mut(nc)) {
+                    (ins[count], outs2[count]) = (field, out);
+                    count += 1;
                 }
-                // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
-                unsafe { self.real_orders(groups, factor, true) };
+                self.real_analysis([Some(first), second], &ins[..count], &mut outs2[..count])?;
             }
             Ok(())
         })
@@ -405,18 +399,29 @@ impl S2Plan {
         for (s, c) in samples.iter().zip(&coeffs) {
             self.check(s.len(), c.len(), 1)?;
         }
-        let factor = (2.0 * PI).sqrt() / (2 * self.b) as f64;
         let [a, b] = coeffs;
         self.with_scratch(true, |first, second| {
-            let second = second.expect("a second scratch for two fields");
-            let groups = [
-                Some(self.real_rings_forward(first, samples[0], a)?),
-                Some(self.real_rings_forward(second, samples[1], b)?),
-            ];
-            // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
-            unsafe { self.real_orders(groups, factor, true) };
-            Ok(())
+            self.real_analysis([Some(first), second], &samples, &mut [a, b])
         })
+    }
+
+    /// The real analysis of one or two fields (`fields[i]` into `outs[i]`, checked
+    /// lengths) with the ring scratches `bufs` (the second one for a second field).
+    fn real_analysis(
+        &self,
+        bufs: [Option<&AlignedBuf>; 2],
+        fields: &[&[f64]],
+        outs: &mut [&mut [Complex64]],
+    ) -> Result<()> {
+        let factor = (2.0 * PI).sqrt() / (2 * self.b) as f64;
+        let mut groups = [None; 2];
+        for (i, (field, out)) in fields.iter().zip(outs.iter_mut()).enumerate().take(2) {
+            let buf = bufs[i].expect("a second scratch for two fields");
+            groups[i] = Some(self.real_rings_forward(buf, field, out)?);
+        }
+        // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
+        unsafe { self.real_orders(groups, factor, true) };
+        Ok(())
     }
 
     /// The Legendre stage of every order for one or two real fields (`groups[1]` `None` for
@@ -516,9 +521,13 @@ impl S2Plan {
         let (n, nc) = (2 * self.b, self.num_coeffs());
         self.with_scratch(howmany > 1, |first, second| {
             for (fields, outs) in coeffs.chunks(2 * nc).zip(samples.chunks_mut(2 * n * n)) {
-                let fields: Vec<&[Complex64]> = fields.chunks_exact(nc).collect();
-                let mut outs: Vec<&mut [f64]> = outs.chunks_exact_mut(n * n).collect();
-                self.real_synthesis([Some(first), second], &fields, &mut outs)?;
+                let (mut ins, mut outs2) = ([&[][..]; 2], [&mut [][..], &mut [][..]]);
+                let mut count = 0;
+                for (field, out) in fields.chunks_exact(nc).zip(outs.chunks_exact_mut(n * n)) {
+                    (ins[count], outs2[count]) = (field, out);
+                    count += 1;
+                }
+                self.real_synthesis([Some(first), second], &ins[..count], &mut outs2[..count])?;
             }
             Ok(())
         })
