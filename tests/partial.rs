@@ -233,7 +233,8 @@ fn other_grids_against_direct_summation() {
     }
 }
 
-/// A batch gives bitwise the results of single executes.
+/// A batch gives bitwise the results of single executes (the batched kernels share each
+/// cluster's recurrence among the transforms of a group).
 #[test]
 fn batches_equal_single_executes() {
     // A small cap: chunks of one pair, groups of one transform; the default: one of each.
@@ -251,7 +252,8 @@ fn batch_case(cap: Option<usize>) {
     };
     let pp = PartialPlan::new(&s, &o).unwrap();
     let (nc, ns) = (s.num_coeffs(), s.num_samples());
-    let count = 3;
+    // More than one batched kernel call (8 transforms each), the last one odd.
+    let count = 11;
     let (idist, odist) = (nc + 5, ns + 3);
     let mut r = Rng(9);
     let coeffs: Vec<Complex64> = (0..idist * count).map(|_| r.c()).collect();

@@ -11,7 +11,7 @@ use std::mem::MaybeUninit;
 const FWD_VECTORS: usize = 16;
 
 /// Registers for the forward kernel's sums (`DB x P / W` of them are used).
-const ACC: usize = 16;
+pub(super) const ACC: usize = 16;
 
 /// Small buffer for one vector's Wigner-d block (`DB` degrees x `W` betas), read back as
 /// broadcasts.
@@ -53,7 +53,7 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 
 /// Whether the forward kernel pairs betas ([`pair_fmas`]): with one vector of columns
 /// (`P == W`) a broadcast d value would feed a single multiply-add.
-const fn paired(w: usize, p: usize) -> bool {
+pub(super) const fn paired(w: usize, p: usize) -> bool {
     p == w && w >= 2
 }
 
@@ -95,7 +95,7 @@ unsafe fn pair_fmas<S: Simd, const W: usize, const DB: usize>(
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
 /// entries read or written (`P` values a data row, `DB x W` a d block).
 #[inline(always)]
-unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
+pub(super) unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
         let (a, b) = (acc[2 * j], acc[2 * j + 1]);
@@ -134,7 +134,7 @@ unsafe fn lane_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
 /// entries read or written (`P` values a data row, `DB x W` a d block).
 #[inline(always)]
-unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
+pub(super) unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
     db: *const f64,
     x: *const f64,
@@ -202,17 +202,9 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         // coefficient rows) is left to demand loads.
         let mut prefetch = lanes.prefetch;
         let prefetch_per_vector = prefetch.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
-        let (pair_stride, row_gap) = lanes.pair_layout(P);
         let data_rows = |s0: usize| {
-            let (r0, step) = lanes.rows(s0);
-            if step == 2 {
-                (
-                    xin.add((r0 / 2) * pair_stride + (r0 % 2) * row_gap),
-                    pair_stride,
-                )
-            } else {
-                (xin.add(r0 * P), P)
-            }
+            let (at, stride) = lanes.vector_rows(s0, P);
+            (xin.add(at), stride)
         };
         let mut d_blocks = [DBlock([0.0; 128]); 2];
         let mut lo = n;

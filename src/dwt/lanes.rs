@@ -170,6 +170,20 @@ impl Lanes<'_> {
         assert!(gap != p || ps >= 2 * p);
     }
 
+    /// Offset (in doubles) of the first row of the vector of lanes starting at `s0`, rows of
+    /// `p` doubles addressed as the data layout says, and the offset from one of its rows
+    /// to the next.
+    #[inline(always)]
+    pub(crate) fn vector_rows(&self, s0: usize, p: usize) -> (usize, usize) {
+        let (r0, step) = self.rows(s0);
+        if step == 2 {
+            let (pair_stride, row_gap) = self.pair_layout(p);
+            ((r0 / 2) * pair_stride + (r0 % 2) * row_gap, pair_stride)
+        } else {
+            (r0 * p, p)
+        }
+    }
+
     /// First row and row step (in rows) of the vector of lanes starting at `s0`.
     #[inline(always)]
     pub(crate) fn rows(&self, s0: usize) -> (usize, usize) {

@@ -16,9 +16,11 @@
 //! in `l` is skipped).
 //!
 //! Files: [`lanes`] (the kernels' inputs), `state` (the recurrence state of a vector of
-//! betas, shared by both kernels), `forward`, `inverse`; this file checks the arguments
-//! and dispatches on the instruction set.
+//! betas, shared by both kernels), `forward`, `inverse`, `batch` (many transforms sharing
+//! one recurrence), `parity` (the `m' = 0` kernels of the S^2 transforms); this file checks
+//! the arguments and dispatches on the instruction set.
 
+mod batch;
 #[cfg(any(test, feature = "internals"))]
 pub(crate) mod fixtures;
 mod forward;
@@ -31,6 +33,7 @@ mod tests;
 
 use crate::simd::Isa;
 
+pub(crate) use batch::{forward_tile_len, inverse_tile_len, BatchFill, BatchRows};
 pub(crate) use inverse::Fill;
 pub(crate) use lanes::{Lanes, Prefetch, Rec};
 
@@ -182,4 +185,63 @@ pub(crate) unsafe fn inverse_raw(
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
     unsafe { inverse::run(isa, p, rec, lanes, fin, fill, y) }
+}
+
+/// [`inverse_raw`] for a batch of `fin.count` transforms sharing the recurrence: transform
+/// `t` reads its rows from `fin.base + t fin.dist` (filled by `fill(t, rows, from, to)` as
+/// for [`inverse_raw`]) and writes its output rows (addressed as in [`inverse_raw`]) from
+/// `y.base + t y.dist`. `hints[t]` (what transform `t`'s next call will read) is
+/// prefetched while the multiply-adds run. `tile` is scratch of [`inverse_tile_len`]
+/// values. Bitwise the
+/// results of `fin.count` calls of [`inverse_raw`].
+///
+/// # Safety
+/// `fin` holds `fin.count` arrays of `rec.len() p` values `fin.dist` apart, nobody else's;
+/// every output row of every transform is valid for writes and nobody else's.
+pub(crate) unsafe fn inverse_batch_raw(
+    isa: Isa,
+    p: usize,
+    (rec, lanes): (&Rec, &Lanes),
+    (fin, fill, hints): (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
+    tile: &mut [f64],
+    y: BatchRows<*mut f64>,
+) {
+    check_shared(isa, p, rec, lanes);
+    assert!(fin.count == y.count && fin.dist >= rec.len() * p && hints.len() == fin.count);
+    assert!(tile.len() >= inverse_tile_len(rec.len(), isa.lanes()));
+    // SAFETY: lengths checked above, rows by the caller, instruction set by `check_shared`.
+    unsafe {
+        batch::run_inverse(
+            isa,
+            p,
+            (rec, lanes),
+            (fin, fill, hints),
+            tile.as_mut_ptr(),
+            y,
+        )
+    }
+}
+
+/// [`forward_raw`] for a batch of `x.count` transforms sharing the recurrence: transform
+/// `t` reads its rows from `x.base + t x.dist` and writes its sums to `ft.base + t ft.dist`
+/// (`(rec.len() + isa.lanes()) p` values each). `tile` is scratch of
+/// [`forward_tile_len`] values. Returns `lo` as [`forward_raw`] does (the same for every
+/// transform); bitwise the results of `x.count` calls of [`forward_raw`].
+///
+/// # Safety
+/// Every row of every transform is valid for reads and written by no one meanwhile; `ft`
+/// holds `ft.count` arrays `ft.dist` apart, nobody else's.
+pub(crate) unsafe fn forward_batch_raw(
+    isa: Isa,
+    p: usize,
+    (rec, lanes): (&Rec, &Lanes),
+    x: BatchRows<*const f64>,
+    tile: &mut [f64],
+    ft: BatchRows<*mut f64>,
+) -> usize {
+    check_shared(isa, p, rec, lanes);
+    assert!(x.count == ft.count && ft.dist >= (rec.len() + isa.lanes()) * p);
+    assert!(tile.len() >= forward_tile_len(isa.lanes()));
+    // SAFETY: lengths checked above, rows by the caller, instruction set by `check_shared`.
+    unsafe { batch::run_forward(isa, p, (rec, lanes), x, tile.as_mut_ptr(), ft) }
 }

@@ -593,3 +593,127 @@ fn forward_parity_kernel_sums_each_degree_over_its_parity() {
         }
     });
 }
+
+/// The batched kernels against single calls, bit for bit, for `counts` transforms: every
+/// output row of the inverse (both store modes) and every sum of the forward, with its
+/// lowest active degree.
+fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
+    use super::{forward_batch_raw, forward_tile_len, inverse_batch_raw, inverse_tile_len};
+    use super::{BatchRows, Prefetch};
+    let (n, nbs, w) = (rec.len(), lanes.tau.len(), isa.lanes());
+    for count in [1usize, 2, 3] {
+        for stream in [false, true] {
+            lanes.stream = stream;
+            let fins: Vec<Vec<f64>> = (0..count)
+                .map(|t| pseudo(n * pw, seed + t as u64))
+                .collect();
+            let mut want = vec![f64::NAN; count * nbs * pw];
+            for (t, f) in fins.iter().enumerate() {
+                inverse_from(
+                    isa,
+                    pw,
+                    rec,
+                    lanes,
+                    f,
+                    &mut want[t * nbs * pw..][..nbs * pw],
+                );
+            }
+            let mut buf = vec![f64::NAN; count * n * pw];
+            let mut y = vec![f64::NAN; count * nbs * pw];
+            let mut tile = vec![f64::NAN; inverse_tile_len(n, w)];
+            let mut hints = vec![Prefetch::none(); count];
+            let mut fill = |t: usize, rows: &mut [f64], from: usize, to: usize| {
+                rows[from * pw..to * pw].copy_from_slice(&fins[t][from * pw..to * pw]);
+            };
+            let fin = BatchRows {
+                base: buf.as_mut_ptr(),
+                dist: n * pw,
+                count,
+            };
+            let out = BatchRows {
+                base: y.as_mut_ptr(),
+                dist: nbs * pw,
+                count,
+            };
+            // SAFETY: `buf` holds `count` inputs of `n pw` values, `y` the `count` outputs
+            // of `nbs` consecutive rows.
+            unsafe {
+                inverse_batch_raw(
+                    isa,
+                    pw,
+                    (rec, lanes),
+                    (fin, &mut fill, &mut hints),
+                    &mut tile,
+                    out,
+                )
+            };
+            for (i, (u, v)) in y.iter().zip(&want).enumerate() {
+                assert_eq!(
+                    u.to_bits(),
+                    v.to_bits(),
+                    "{isa:?} P={pw} inverse x{count} at {i}"
+                );
+            }
+        }
+        let xs: Vec<f64> = pseudo(count * nbs * pw, seed + 100);
+        let stride = (n + 8) * pw;
+        let mut want = vec![0.0; count * stride];
+        let mut lo_single = n;
+        for t in 0..count {
+            let x = &xs[t * nbs * pw..][..nbs * pw];
+            lo_single = forward(isa, pw, rec, lanes, x, &mut want[t * stride..][..stride]);
+        }
+        let mut ft = vec![f64::NAN; count * stride];
+        let mut tile = vec![f64::NAN; forward_tile_len(w)];
+        let x = BatchRows {
+            base: xs.as_ptr(),
+            dist: nbs * pw,
+            count,
+        };
+        let sums = BatchRows {
+            base: ft.as_mut_ptr(),
+            dist: stride,
+            count,
+        };
+        // SAFETY: `xs` holds `count` inputs of `nbs` consecutive rows, `ft` the `count`
+        // outputs of `(n + 8) pw` values.
+        let lo = unsafe { forward_batch_raw(isa, pw, (rec, lanes), x, &mut tile, sums) };
+        assert_eq!(lo, lo_single, "{isa:?} P={pw} forward x{count}");
+        for t in 0..count {
+            let (got, exp) = (&ft[t * stride..][..n * pw], &want[t * stride..][..n * pw]);
+            for (i, (u, v)) in got.iter().zip(exp).enumerate() {
+                assert_eq!(
+                    u.to_bits(),
+                    v.to_bits(),
+                    "{isa:?} P={pw} forward x{count} t={t} at {i}"
+                );
+            }
+        }
+    }
+}
+
+/// A batch gives bitwise the results of single kernel calls: every instruction set, 8
+/// and 16 columns, one to three transforms, on the layout cases and on a cluster with
+/// more vectors than one group (B = 96, 176 betas).
+#[test]
+fn batched_kernels_equal_single_calls() {
+    layout_cases(|isa, pw, m, rec, mut lanes| batch_case(isa, pw, rec, &mut lanes, m as u64));
+    let (b, nbs) = (96, 176);
+    for &(m, mp) in &[(5usize, 2usize), (40, 17)] {
+        let ClusterInputs {
+            coeffs: rc,
+            tau,
+            p,
+            sc,
+        } = cluster_setup(b, m, mp, nbs);
+        let rec = Rec::new(&rc, b - m);
+        for pw in [8usize, 16] {
+            for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+                if isa.is_supported() {
+                    let mut lanes = grid_lanes(&tau, &p, &sc, nbs / 2);
+                    batch_case(isa, pw, &rec, &mut lanes, 7 + m as u64);
+                }
+            }
+        }
+    }
+}

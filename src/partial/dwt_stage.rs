@@ -13,7 +13,7 @@
 
 use super::betas::LanePairs;
 use super::shape::CoefLayout;
-use crate::dwt::{self, Lanes, Prefetch, Rec};
+use crate::dwt::{self, BatchRows, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
 use crate::plan::coeffs::{self, DegreeFactors};
 use crate::simd::Isa;
@@ -22,6 +22,11 @@ use crate::wigner::{big, start_norm, RecCoeffs, RecTables};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 use std::sync::Mutex;
+
+/// Transforms of a batch per kernel call: they share the cluster's recurrence values
+/// (enough to make the recurrence a small part of the call), and their kernel inputs or
+/// sums stay in L2.
+pub(super) const KERNEL_BATCH: usize = 8;
 
 /// One order pair of a cluster that the shape holds.
 #[derive(Clone, Copy, Debug)]
@@ -78,8 +83,10 @@ pub(super) struct Scratch {
     tau: Vec<f64>,
     start: Vec<f64>,
     scale: Vec<f64>,
-    /// Inverse input / forward sums.
+    /// Inverse input / forward sums (one transform's or a batch's).
     data: Vec<f64>,
+    /// The batched kernels' d values.
+    tile: Vec<f64>,
 }
 
 impl Scratch {
@@ -90,6 +97,7 @@ impl Scratch {
             start: vec![0.0; lanes],
             scale: vec![0.0; lanes],
             data: vec![0.0; (l + 8) * 16],
+            tile: Vec::new(),
         }
     }
 }
@@ -265,12 +273,92 @@ impl DwtStage {
         }
     }
 
+    /// Fills rows `from..to` of the inverse kernel's input for cluster `cl` (`p` doubles a
+    /// row, degree `cl.m + i` in row `i`) from the coefficients at `coef`, scaled by
+    /// `scales` (the cluster's recurrence scales) and `1 / 2 pi`. With `real`, the
+    /// non-representative order pairs are read from their representatives
+    /// (`fhat(l,M,M') = (-1)^(M-M') conj(fhat(l,-M,-M'))`).
+    ///
+    /// # Safety
+    /// `coef` holds the shape's coefficients (read only meanwhile).
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn fill_rows(
+        cl: &ClusterPlan,
+        scales: &[f64],
+        coef: *const Complex64,
+        real: bool,
+        fin: &mut [f64],
+        from: usize,
+        to: usize,
+    ) {
+        let p = cl.p;
+        let scale = 1.0 / (2.0 * PI);
+        // Rows with no value in some column (unused slots, degrees below `L0`) start as 0.
+        let partly = 2 * cl.slots.len() < p || cl.slots.iter().any(|s| s.first > cl.m);
+        let rows = &mut fin[from * p..to * p];
+        if partly {
+            rows.fill(0.0);
+        }
+        for (q, s) in cl.slots.iter().enumerate() {
+            let lo = from.max(s.first - cl.m);
+            if lo >= to {
+                continue;
+            }
+            let mem = &s.member;
+            // The real inverse reads a non-representative from its partner:
+            // `(-1)^(M-M') conj(fhat(l,-M,-M'))`.
+            let conj = real && !s.representative;
+            let (block, sign) = if conj {
+                let ps = if (mem.m - mem.mp).rem_euclid(2) == 0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                (s.partner_block, ps * scale)
+            } else {
+                (s.block, scale)
+            };
+            let factors = DegreeFactors {
+                signs: [
+                    mem.sign_at(cl.m + lo) * sign,
+                    mem.sign_at(cl.m + lo + 1) * sign,
+                ],
+                scales: &scales[lo..to],
+            };
+            let dst = &mut rows[(lo - from) * p + 2 * q..];
+            // SAFETY: degrees `cl.m + lo .. cl.m + to` of the block (or of its partner,
+            // which stores the same degrees) are inside the coefficient array (caller's
+            // contract); `dst` holds rows `lo - from .. to - from` of `p >= 2q + 2`
+            // doubles.
+            unsafe {
+                let src = coef.add(block + cl.m + lo - s.first);
+                coeffs::gather(dst.as_mut_ptr(), src, p, factors);
+            }
+            if conj {
+                for row in dst.chunks_mut(p).take(to - lo) {
+                    row[1] = -row[1];
+                }
+            }
+        }
+    }
+
+    /// Doubles of the batched kernels' scratch (either direction: a worker's scratch
+    /// serves both).
+    fn tile_len(&self) -> usize {
+        let w = self.isa.lanes();
+        dwt::inverse_tile_len(self.l, w).max(dwt::forward_tile_len(w))
+    }
+
+    /// Doubles of one transform's kernel input or sums in the scratch.
+    fn data_len(&self) -> usize {
+        (self.l + 8) * 16
+    }
+
     /// Inverse kernel of `cl` (set up by [`DwtStage::setup`], `n` degrees) from the
     /// coefficients at `coef` into the cluster's slots of the chunk's lane rows at `block`
     /// (lane row `r` at `block + r row_total`, `cl.p` doubles). With `real`, the
-    /// non-representative order pairs are read from their representatives
-    /// (`fhat(l,M,M') = (-1)^(M-M') conj(fhat(l,-M,-M'))`). With `stream`, written by
-    /// non-temporal stores.
+    /// non-representative order pairs are read from their representatives (see
+    /// [`DwtStage::fill_rows`]). With `stream`, written by non-temporal stores.
     ///
     /// # Safety
     /// `coef` holds the shape's coefficients (read only meanwhile); the `2 hp` rows of
@@ -288,59 +376,13 @@ impl DwtStage {
     ) {
         let p = cl.p;
         let mut data = std::mem::take(&mut sc.data);
-        if data.len() < (self.l + 8) * 16 {
-            data = vec![0.0; (self.l + 8) * 16];
+        if data.len() < self.data_len() {
+            data = vec![0.0; self.data_len()];
         }
         let scales = &sc.rec.s;
-        let scale = 1.0 / (2.0 * PI);
-        // Rows with no value in some column (unused slots, degrees below `L0`) start as 0.
-        let partly = 2 * cl.slots.len() < p || cl.slots.iter().any(|s| s.first > cl.m);
-        let mut fill = |fin: &mut [f64], from: usize, to: usize| {
-            let rows = &mut fin[from * p..to * p];
-            if partly {
-                rows.fill(0.0);
-            }
-            for (q, s) in cl.slots.iter().enumerate() {
-                let lo = from.max(s.first - cl.m);
-                if lo >= to {
-                    continue;
-                }
-                let mem = &s.member;
-                // The real inverse reads a non-representative from its partner:
-                // `(-1)^(M-M') conj(fhat(l,-M,-M'))`.
-                let conj = real && !s.representative;
-                let (block, sign) = if conj {
-                    let ps = if (mem.m - mem.mp).rem_euclid(2) == 0 {
-                        1.0
-                    } else {
-                        -1.0
-                    };
-                    (s.partner_block, ps * scale)
-                } else {
-                    (s.block, scale)
-                };
-                let factors = DegreeFactors {
-                    signs: [
-                        mem.sign_at(cl.m + lo) * sign,
-                        mem.sign_at(cl.m + lo + 1) * sign,
-                    ],
-                    scales: &scales[lo..to],
-                };
-                let dst = &mut rows[(lo - from) * p + 2 * q..];
-                // SAFETY: degrees `cl.m + lo .. cl.m + to` of the block (or of its partner,
-                // which stores the same degrees) are inside the coefficient array (caller's
-                // contract); `dst` holds rows `lo - from .. to - from` of `p >= 2q + 2`
-                // doubles.
-                unsafe {
-                    let src = coef.add(block + cl.m + lo - s.first);
-                    coeffs::gather(dst.as_mut_ptr(), src, p, factors);
-                }
-                if conj {
-                    for row in dst.chunks_mut(p).take(to - lo) {
-                        row[1] = -row[1];
-                    }
-                }
-            }
+        // SAFETY: `coef` holds the shape's coefficients (caller's contract).
+        let mut fill = |fin: &mut [f64], from: usize, to: usize| unsafe {
+            Self::fill_rows(cl, scales, coef, real, fin, from, to)
         };
         let rec = Rec::new(&sc.rec, n);
         let mut lanes = self.lanes(sc, ch, stream);
@@ -359,6 +401,71 @@ impl DwtStage {
             )
         };
         sc.data = data;
+    }
+
+    /// [`DwtStage::inverse`] for a batch sharing the recurrence: transform `t` from the
+    /// coefficients at `coef.base + t coef.dist` into the lane rows at
+    /// `block.base + t block.dist`, prefetching the blocks of cluster `next` of the same
+    /// transforms meanwhile. Bitwise the results of single calls.
+    ///
+    /// # Safety
+    /// As for [`DwtStage::inverse`], for every transform of the batch.
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn inverse_many(
+        &self,
+        sc: &mut Scratch,
+        cl: &ClusterPlan,
+        ch: ChunkLanes,
+        n: usize,
+        coef: BatchRows<*const Complex64>,
+        (real, stream, next): (bool, bool, Option<&ClusterPlan>),
+        block: BatchRows<*mut f64>,
+    ) {
+        let (p, dist) = (cl.p, self.data_len());
+        let mut data = std::mem::take(&mut sc.data);
+        if data.len() < coef.count * dist {
+            data = vec![0.0; coef.count * dist];
+        }
+        let w = self.isa.lanes();
+        let mut tile = std::mem::take(&mut sc.tile);
+        if tile.len() < dwt::inverse_tile_len(n, w) {
+            tile = vec![0.0; self.tile_len()];
+        }
+        let scales = &sc.rec.s;
+        // SAFETY: coefficient array `t` of the batch holds the shape's coefficients
+        // (caller's contract).
+        let mut fill = |t: usize, fin: &mut [f64], from: usize, to: usize| unsafe {
+            let c = coef.base.add(t * coef.dist);
+            Self::fill_rows(cl, scales, c, real, fin, from, to)
+        };
+        let mut hints: Vec<Prefetch> = (0..coef.count)
+            .map(|t| {
+                next.map_or(Prefetch::none(), |c| {
+                    self.coefficient_hints(c, coef.base.wrapping_add(t * coef.dist), real)
+                })
+            })
+            .collect();
+        let rec = Rec::new(&sc.rec, n);
+        let lanes = self.lanes(sc, ch, stream);
+        let fin = BatchRows {
+            base: data.as_mut_ptr(),
+            dist,
+            count: coef.count,
+        };
+        // SAFETY: `data` holds `count` inputs `dist >= n p` doubles apart; the lane rows of
+        // every transform are the caller's (caller's contract).
+        unsafe {
+            dwt::inverse_batch_raw(
+                self.isa,
+                p,
+                (&rec, &lanes),
+                (fin, &mut fill, &mut hints),
+                &mut tile,
+                block,
+            )
+        };
+        sc.data = data;
+        sc.tile = tile;
     }
 
     /// Forward kernel of `cl` over its slots of the chunk's lane rows at `block` (as for
@@ -381,13 +488,88 @@ impl DwtStage {
     ) {
         let p = cl.p;
         let mut data = std::mem::take(&mut sc.data);
-        if data.len() < (self.l + 8) * 16 {
-            data = vec![0.0; (self.l + 8) * 16];
+        if data.len() < self.data_len() {
+            data = vec![0.0; self.data_len()];
         }
         let rec = Rec::new(&sc.rec, n);
         let lanes = self.lanes(sc, ch, false);
         // SAFETY: the `2 hp` rows of `p` doubles at `block`, read only (caller's contract).
         let lo = unsafe { dwt::forward_raw(self.isa, p, &rec, &lanes, block, &mut data) }.min(n);
+        // SAFETY: `data` holds the kernel's sums; the blocks are the caller's.
+        unsafe { Self::scatter_sums(cl, (n, lo), &sc.rec.s, data.as_ptr(), (coef, first)) };
+        sc.data = data;
+    }
+
+    /// [`DwtStage::forward`] for a batch sharing the recurrence: transform `t` from the
+    /// lane rows at `block.base + t block.dist` into the coefficients at
+    /// `coef.base + t coef.dist`. Bitwise the results of single calls.
+    ///
+    /// # Safety
+    /// As for [`DwtStage::forward`], for every transform of the batch.
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn forward_many(
+        &self,
+        sc: &mut Scratch,
+        cl: &ClusterPlan,
+        ch: ChunkLanes,
+        n: usize,
+        block: BatchRows<*const f64>,
+        coef: BatchRows<*mut Complex64>,
+        first: bool,
+    ) {
+        let (p, dist) = (cl.p, self.data_len());
+        let mut data = std::mem::take(&mut sc.data);
+        if data.len() < block.count * dist {
+            data = vec![0.0; block.count * dist];
+        }
+        let mut tile = std::mem::take(&mut sc.tile);
+        let w = self.isa.lanes();
+        if tile.len() < dwt::forward_tile_len(w) {
+            tile = vec![0.0; self.tile_len()];
+        }
+        let rec = Rec::new(&sc.rec, n);
+        let lanes = self.lanes(sc, ch, false);
+        let sums = BatchRows {
+            base: data.as_mut_ptr(),
+            dist,
+            count: block.count,
+        };
+        // SAFETY: every transform's `2 hp` rows of `p` doubles, read only (caller's
+        // contract); `data` holds `count` arrays of `dist >= (n + W) p` doubles.
+        let lo =
+            unsafe { dwt::forward_batch_raw(self.isa, p, (&rec, &lanes), block, &mut tile, sums) }
+                .min(n);
+        for t in 0..block.count {
+            // SAFETY: sums `t` of the kernel; the blocks of transform `t` are the caller's.
+            unsafe {
+                Self::scatter_sums(
+                    cl,
+                    (n, lo),
+                    &sc.rec.s,
+                    data.as_ptr().add(t * dist),
+                    (coef.base.add(t * coef.dist), first),
+                )
+            };
+        }
+        sc.data = data;
+        sc.tile = tile;
+    }
+
+    /// Adds the forward kernel's sums of `cl` (`n` rows of `cl.p`, rows below `lo` zero),
+    /// scaled by the recurrence scales `scales`, into its slots' coefficient blocks at
+    /// `coef` (`first`: assigns, zero below `lo`).
+    ///
+    /// # Safety
+    /// `sums` holds the `n` rows; the blocks of this cluster's slots in `coef` are valid
+    /// and nobody else's meanwhile.
+    unsafe fn scatter_sums(
+        cl: &ClusterPlan,
+        (n, lo): (usize, usize),
+        scales: &[f64],
+        sums: *const f64,
+        (coef, first): (*mut Complex64, bool),
+    ) {
+        let p = cl.p;
         for (q, s) in cl.slots.iter().enumerate() {
             let mem = &s.member;
             let i0 = s.first - cl.m;
@@ -404,22 +586,14 @@ impl DwtStage {
             }
             let factors = DegreeFactors {
                 signs: [mem.sign_at(cl.m + from), mem.sign_at(cl.m + from + 1)],
-                scales: &sc.rec.s[from..n],
+                scales: &scales[from..n],
             };
             // SAFETY: degrees `cl.m + from .. L` of the pair's block (this cluster's, caller's
-            // contract); `data` holds the kernel's `n` rows of `p >= 2q + 2` sums.
+            // contract); `sums` holds the kernel's `n` rows of `p >= 2q + 2` sums.
             unsafe {
                 let dst = coef.add(s.block + cl.m + from - s.first);
-                coeffs::scatter(
-                    dst,
-                    data.as_ptr().add(from * p + 2 * q),
-                    p,
-                    factors,
-                    !first,
-                    None,
-                );
+                coeffs::scatter(dst, sums.add(from * p + 2 * q), p, factors, !first, None);
             }
         }
-        sc.data = data;
     }
 }

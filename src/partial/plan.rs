@@ -3,10 +3,10 @@
 //! chunk's slices).
 
 use super::betas::{Betas, LanePairs};
-use super::dwt_stage::{ChunkLanes, ClusterPlan, DwtStage};
+use super::dwt_stage::{ChunkLanes, ClusterPlan, DwtStage, KERNEL_BATCH};
 use super::fft_stage::{FftStage, Work};
 use super::shape::{CoefLayout, Shape};
-use crate::dwt::Prefetch;
+use crate::dwt::{BatchRows, Prefetch};
 use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
 use crate::plan::{Direction, Plan, PlanOptions, StageTimes};
@@ -643,35 +643,56 @@ impl General {
                         .for_each(|(i, cl)| {
                             self.dwt.with_scratch(|sc| {
                                 let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                                for t in 0..batch.count {
-                                    // What the next kernel call will gather: this cluster in
-                                    // the next transform, else the next cluster (likely this
-                                    // task's next one) in the first.
-                                    let next = if t + 1 < batch.count {
-                                        Some((cl, t + 1))
-                                    } else {
-                                        clusters.get(i + 1).map(|c| (c, 0))
-                                    };
-                                    let next = next.map_or(Prefetch::none(), |(c, u)| {
-                                        let at = coef.get().wrapping_add(u * batch.in_dist);
-                                        self.dwt.coefficient_hints(c, at, real)
-                                    });
-                                    // SAFETY: coefficient array `t` of the batch (checked
-                                    // lengths), read only; this cluster's `cl.p` doubles of
-                                    // the `lanes` lane rows of transform `t`, inside the chunk
-                                    // buffer (`count * row_total * lanes` doubles), written by
-                                    // this task only.
-                                    unsafe {
-                                        self.dwt.inverse(
-                                            sc,
-                                            cl,
-                                            ch,
-                                            n,
-                                            coef.get().add(t * batch.in_dist),
-                                            (real, stream, next),
-                                            buf.get().add(t * per_t + cl.offset),
-                                        )
+                                if batch.count > 1 {
+                                    for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                        let count = KERNEL_BATCH.min(batch.count - t0);
+                                        let c = BatchRows {
+                                            base: coef.get().wrapping_add(t0 * batch.in_dist),
+                                            dist: batch.in_dist,
+                                            count,
+                                        };
+                                        let b = BatchRows {
+                                            base: buf.get().wrapping_add(t0 * per_t + cl.offset),
+                                            dist: per_t,
+                                            count,
+                                        };
+                                        // SAFETY: coefficient arrays `t0..t0 + count` of the
+                                        // batch (checked lengths), read only; this cluster's
+                                        // `cl.p` doubles of the lane rows of those
+                                        // transforms, inside the chunk buffer, written by
+                                        // this task only.
+                                        unsafe {
+                                            self.dwt.inverse_many(
+                                                sc,
+                                                cl,
+                                                ch,
+                                                n,
+                                                c,
+                                                (real, stream, clusters.get(i + 1)),
+                                                b,
+                                            )
+                                        }
                                     }
+                                    return;
+                                }
+                                // What the next kernel call will gather: the next cluster
+                                // (likely this task's next one).
+                                let next = clusters.get(i + 1).map_or(Prefetch::none(), |c| {
+                                    self.dwt.coefficient_hints(c, coef.get(), real)
+                                });
+                                // SAFETY: the coefficient array (checked length), read
+                                // only; this cluster's `cl.p` doubles of the `lanes` lane
+                                // rows, inside the chunk buffer, written by this task only.
+                                unsafe {
+                                    self.dwt.inverse(
+                                        sc,
+                                        cl,
+                                        ch,
+                                        n,
+                                        coef.get(),
+                                        (real, stream, next),
+                                        buf.get().add(cl.offset),
+                                    )
                                 }
                             })
                         });
@@ -771,22 +792,37 @@ impl General {
                     self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
                         self.dwt.with_scratch(|sc| {
                             let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                            for t in 0..batch.count {
-                                let block = buf.get().wrapping_add(t * per_t + cl.offset);
-                                // SAFETY: this cluster's slots of the lane rows of transform
-                                // `t` (written by the FFT stage or zeroed above, finished);
-                                // coefficient array `t` is inside the checked output, and
-                                // this cluster's slots' blocks are this task's.
+                            for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                let count = KERNEL_BATCH.min(batch.count - t0);
+                                let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
+                                let c = coef.get().wrapping_add(t0 * batch.out_dist);
+                                // SAFETY: this cluster's slots of the lane rows of
+                                // transforms `t0..t0 + count` (written by the FFT stage or
+                                // zeroed above, finished); their coefficient arrays are
+                                // inside the checked output, and this cluster's slots'
+                                // blocks are this task's.
                                 unsafe {
-                                    self.dwt.forward(
-                                        sc,
-                                        cl,
-                                        ch,
-                                        n,
-                                        block,
-                                        coef.get().add(t * batch.out_dist),
-                                        first,
-                                    )
+                                    if count == 1 {
+                                        self.dwt.forward(sc, cl, ch, n, block, c, first)
+                                    } else {
+                                        self.dwt.forward_many(
+                                            sc,
+                                            cl,
+                                            ch,
+                                            n,
+                                            BatchRows {
+                                                base: block.cast_const(),
+                                                dist: per_t,
+                                                count,
+                                            },
+                                            BatchRows {
+                                                base: c,
+                                                dist: batch.out_dist,
+                                                count,
+                                            },
+                                            first,
+                                        )
+                                    }
                                 }
                             }
                         })

@@ -1,0 +1,481 @@
+//! Batched kernels: the transforms of a batch share each cluster's recurrence.
+//!
+//! The single kernels fuse the recurrence with one transform's multiply-adds. Here the
+//! Wigner-d values are computed once into a small buffer that stays in L1 (inverse: every
+//! degree of two vectors of betas, their recurrences run together; forward: one block of
+//! degrees of every vector of a group), and each transform of the batch runs only the
+//! multiply-adds against it:
+//! - inverse: `y_t[row(s)][q] = sum_i dt_{l0+i}(beta_s) fin_t[i][q]`, with the sums held
+//!   as vectors over the columns of one lane (no transposes on the way out), each d value
+//!   a broadcast feeding `16 / W` multiply-adds (two transforms at once for 8 columns);
+//! - forward: `ft_t[i][q] = sum_s dt_{l0+i}(beta_s) x_t[row(s)][q]`, the forward kernel's
+//!   block multiply-adds without the interleaved steps.
+//!
+//! Every output value is the same chain of fused multiply-adds in the same order as in
+//! the single kernels (`inverse`, `forward`): a batch gives bitwise the results of single
+//! calls.
+
+use super::forward::block_fmas;
+use super::lanes::{Lanes, Prefetch, Rec};
+use super::state::{prefix_states, State};
+use crate::simd::Simd;
+use std::mem::MaybeUninit;
+
+/// Vectors of betas set up together (through their negligible prefixes), as in the single
+/// kernels.
+const VECTORS: usize = 16;
+
+/// Vectors whose recurrences the inverse runs together (independent chains in flight).
+const CHAINS: usize = 2;
+
+/// Runs the chains `st[..used]` from their states to degree `n`, storing each degree's
+/// values (masked to the active lanes while some are not) at `tiles[k] + i W`; returns the
+/// first degree stored for each chain (`n` for the unused ones). The values are those the
+/// single inverse kernel accumulates (`State::run`), bit for bit.
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; `tiles[k]` holds `n W` values; degree indices
+/// stay below the padded length of the coefficients.
+#[inline(always)]
+unsafe fn fill_tiles<S: Simd, const W: usize, const K: usize>(
+    st: &mut [State<S>; K],
+    used: usize,
+    n: usize,
+    tiles: [*mut f64; K],
+) -> [usize; K] {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let mut lo = [n; K];
+        // Each chain alone until all its lanes are active, then up to the degree the
+        // furthest one reached, then all together (as `State::run_slow`, `run_fast`).
+        for k in 0..used {
+            let (t, l) = (tiles[k], &mut lo[k]);
+            let mut store = |v: S::V, i: usize| {
+                S::store(t.add(i * W), v);
+                *l = (*l).min(i);
+            };
+            st[k].run_slow(n, &mut store);
+        }
+        let i0 = st[..used].iter().map(|s| s.i).max().unwrap_or(n);
+        for k in 0..used {
+            let (t, l) = (tiles[k], &mut lo[k]);
+            let mut store = |v: S::V, i: usize| {
+                S::store(t.add(i * W), v);
+                *l = (*l).min(i);
+            };
+            st[k].run_fast(i0, &mut store);
+            lo[k] = lo[k].min(i0);
+        }
+        // Unused chains repeat the last one into their own tiles.
+        let (mut p0, mut p1) = ([S::zero(); K], [S::zero(); K]);
+        for k in 0..K {
+            let s = &st[k.min(used - 1)];
+            (p0[k], p1[k]) = (s.p0, s.p1);
+        }
+        for i in i0..n {
+            for k in 0..K {
+                S::store(tiles[k].add(i * W), p1[k]);
+                let p2 = S::fence(st[k.min(used - 1)].step(p0[k], p1[k], i));
+                (p0[k], p1[k]) = (p1[k], p2);
+            }
+        }
+        lo
+    }
+}
+
+/// Fills rows `from..to` of transform `t`'s input (see [`crate::dwt::inverse_batch_raw`]).
+pub type BatchFill<'a> = &'a mut dyn FnMut(usize, &mut [f64], usize, usize);
+
+/// The rows of a batch's transforms: transform `t`'s array at `base + t * dist`.
+#[derive(Clone, Copy)]
+pub struct BatchRows<T> {
+    /// Transform 0's array.
+    pub base: T,
+    /// Values from one transform's array to the next.
+    pub dist: usize,
+    /// Transforms.
+    pub count: usize,
+}
+
+/// Doubles of the inverse's d-value buffer for `n` degrees and vectors of `w` lanes.
+pub fn inverse_tile_len(n: usize, w: usize) -> usize {
+    CHAINS * n * w
+}
+
+/// Doubles of the forward's d-value buffer for vectors of `w` lanes.
+pub fn forward_tile_len(w: usize) -> usize {
+    VECTORS * w * w
+}
+
+/// The multiply-adds of one vector of lanes for transforms `t .. t + K` from degree `lo`:
+/// `acc[w][k][h] += d_i[w] * fin_{t+k}[i][h W ..]`, then the sums stored as the lanes'
+/// output rows.
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; `tile` holds the vector's values for degrees
+/// `lo..n` (`W` doubles each); the inputs hold `n` rows of `P` values; the output rows
+/// `rows(w)` are valid for `P` doubles each and nobody else's.
+#[inline(always)]
+unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, const NT: bool>(
+    tile: *const f64,
+    (lo, n): (usize, usize),
+    fin: [*const f64; K],
+    out: [*mut f64; K],
+    rows: &impl Fn(usize) -> usize,
+    (hint, lines): (&mut Prefetch, usize),
+) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let cv = P / W;
+        let mut acc = [S::zero(); 16];
+        hint.issue(lines);
+        for i in lo..n {
+            let mut f = [S::zero(); 16];
+            for k in 0..K {
+                for h in 0..cv {
+                    f[k * cv + h] = S::load(fin[k].add(i * P + h * W));
+                }
+            }
+            for w in 0..W {
+                let v = S::splat(*tile.add(i * W + w));
+                for k in 0..K {
+                    for h in 0..cv {
+                        let a = &mut acc[(w * K + k) * cv + h];
+                        *a = S::fma(v, f[k * cv + h], *a);
+                    }
+                }
+            }
+        }
+        for w in 0..W {
+            let r = rows(w);
+            for k in 0..K {
+                for h in 0..cv {
+                    let x = acc[(w * K + k) * cv + h];
+                    let p = out[k].add(r + h * W);
+                    if NT {
+                        S::stream(p, x);
+                    } else {
+                        S::store(p, x);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Inverse of a batch (see [`crate::dwt::inverse_batch_raw`]).
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; `fin` holds `count` inputs of `n P` values
+/// `fin_dist` apart; `tile` holds [`inverse_tile_len`] values; every output row of every
+/// transform is valid for writes and nobody else's.
+#[inline(always)]
+unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
+    rec: &Rec,
+    lanes: &Lanes,
+    (fin, fill, hints): (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
+    tile: *mut f64,
+    y: BatchRows<*mut f64>,
+) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let (n, nb) = (rec.len(), lanes.tau.len());
+        // Lines of transform `t`'s hints issued per vector of lanes.
+        let per_vector: Vec<usize> = hints
+            .iter()
+            .map(|h| h.lines().div_ceil((nb / W).max(1)))
+            .collect();
+        let count = fin.count;
+        let mut have = n;
+        let mut v0 = 0;
+        while v0 < nb {
+            let vectors = ((nb - v0) / W).min(VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
+            let (first, states) =
+                prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
+            if first < have {
+                for t in 0..count {
+                    let rows = std::slice::from_raw_parts_mut(fin.base.add(t * fin.dist), n * P);
+                    fill(t, rows, first, have);
+                }
+                have = first;
+            }
+            let mut vector = 0;
+            while vector < vectors {
+                let used = (vectors - vector).min(CHAINS);
+                let mut st = [states[vector]; CHAINS];
+                for (k, s) in st.iter_mut().enumerate().take(used) {
+                    *s = states[vector + k];
+                }
+                let tiles: [*mut f64; CHAINS] = std::array::from_fn(|k| tile.add(k * n * W));
+                let lo = fill_tiles::<S, W, CHAINS>(&mut st, used, n, tiles);
+                let at = |b: BatchRows<*mut f64>, t: usize| b.base.add(t * b.dist);
+                let mut t = 0;
+                while t < count {
+                    // Two transforms at once with 8 columns (16 sums), one with 16.
+                    let two = P == 8 && t + 1 < count;
+                    for (k, &lo_k) in lo.iter().enumerate().take(used) {
+                        let (at0, stride) = lanes.vector_rows(v0 + (vector + k) * W, P);
+                        let rows = |w: usize| at0 + w * stride;
+                        if two {
+                            hints[t + 1].issue(per_vector[t + 1]);
+                            lane_sums::<S, W, P, 2, NT>(
+                                tiles[k],
+                                (lo_k, n),
+                                [at(fin, t).cast_const(), at(fin, t + 1).cast_const()],
+                                [at(y, t), at(y, t + 1)],
+                                &rows,
+                                (&mut hints[t], per_vector[t]),
+                            );
+                        } else {
+                            lane_sums::<S, W, P, 1, NT>(
+                                tiles[k],
+                                (lo_k, n),
+                                [at(fin, t).cast_const()],
+                                [at(y, t)],
+                                &rows,
+                                (&mut hints[t], per_vector[t]),
+                            );
+                        }
+                    }
+                    t += 1 + two as usize;
+                }
+                vector += used;
+            }
+            v0 += vectors * W;
+        }
+    }
+}
+
+/// Forward of a batch (see [`crate::dwt::forward_batch_raw`]); returns the lowest degree
+/// index any lane reached active (every transform's rows below it are zero).
+///
+/// # Safety
+/// The CPU supports `S`'s instruction set; every input row of every transform is valid
+/// for reads; `ft` holds `count` outputs of `(n + W) P` values `ft.dist` apart; `tile`
+/// holds [`forward_tile_len`] values.
+#[inline(always)]
+unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
+    rec: &Rec,
+    lanes: &Lanes,
+    x: BatchRows<*const f64>,
+    tile: *mut f64,
+    ft: BatchRows<*mut f64>,
+) -> usize {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
+    unsafe {
+        let (n, nb) = (rec.len(), lanes.tau.len());
+        let cv = P / W;
+        let pair = super::forward::paired(W, P);
+        let data_rows = |xin: *const f64, s0: usize| {
+            let (at, stride) = lanes.vector_rows(s0, P);
+            (xin.add(at), stride)
+        };
+        let mut lo = n;
+        let mut v0 = 0;
+        while v0 < nb {
+            let vectors = ((nb - v0) / W).min(VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
+            let (first, states) =
+                prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
+            lo = lo.min(first);
+            let mut i0 = first - first % DB;
+            let assign = v0 == 0;
+            if assign {
+                for t in 0..ft.count {
+                    std::ptr::write_bytes(ft.base.add(t * ft.dist), 0, i0 * P);
+                }
+            }
+            // The vectors of a block in the single kernel's order: those that start inside
+            // the block or still have inactive lanes, then the fully active ones.
+            let mut order = [0usize; VECTORS];
+            while i0 < n {
+                let mut used = 0;
+                for (v, s) in states.iter_mut().enumerate() {
+                    if s.i >= n || s.i >= i0 + DB || (s.i == i0 && s.all_active()) {
+                        continue;
+                    }
+                    let d = s.masked_block::<DB>(i0, n);
+                    let db = tile.add(used * DB * W);
+                    for (j, dj) in d.iter().enumerate() {
+                        S::store(db.add(j * W), *dj);
+                    }
+                    order[used] = v;
+                    used += 1;
+                }
+                for (v, s) in states.iter_mut().enumerate() {
+                    if !(s.i == i0 && s.i < n && s.all_active()) {
+                        continue;
+                    }
+                    let db = tile.add(used * DB * W);
+                    let (mut p0, mut p1) = (s.p0, s.p1);
+                    for j in 0..DB {
+                        S::store(db.add(j * W), p1);
+                        let p2 = S::fence(s.step(p0, p1, i0 + j));
+                        (p0, p1) = (p1, p2);
+                    }
+                    (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
+                    order[used] = v;
+                    used += 1;
+                }
+                for t in 0..ft.count {
+                    let sums = ft.base.add(t * ft.dist);
+                    let xin = x.base.add(t * x.dist);
+                    let mut acc = [S::zero(); super::forward::ACC];
+                    if !assign && !pair {
+                        for j in 0..DB {
+                            for h in 0..cv {
+                                acc[j * cv + h] = S::load(sums.add((i0 + j) * P + h * W));
+                            }
+                        }
+                    }
+                    for (k, &v) in order[..used].iter().enumerate() {
+                        let (xr, xs) = data_rows(xin, v0 + v * W);
+                        block_fmas::<S, W, P, DB>(&mut acc, tile.add(k * DB * W), xr, xs);
+                    }
+                    if pair {
+                        for j in 0..DB {
+                            let r = sums.add((i0 + j) * P);
+                            let v = super::forward::fold_pair::<S>(&acc, j);
+                            S::store(r, if assign { v } else { S::add(S::load(r), v) });
+                        }
+                    } else {
+                        for j in 0..DB {
+                            for h in 0..cv {
+                                S::store(sums.add((i0 + j) * P + h * W), acc[j * cv + h]);
+                            }
+                        }
+                    }
+                }
+                i0 += DB;
+            }
+            v0 += vectors * W;
+        }
+        lo
+    }
+}
+
+/// `#[target_feature]` entry points: [`inverse_body`] and [`forward_body`] for one
+/// instruction set, vector width and column count.
+macro_rules! entry {
+    ($inv:ident, $fwd:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:literal) => {
+        /// # Safety
+        /// As [`inverse_body`], for the instruction set of `$S`.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        unsafe fn $inv<const NT: bool>(
+            rec: &Rec,
+            lanes: &Lanes,
+            fin: (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
+            tile: *mut f64,
+            y: BatchRows<*mut f64>,
+        ) {
+            // SAFETY: the caller upholds `inverse_body`'s contract.
+            unsafe { inverse_body::<$S, $W, $N, NT>(rec, lanes, fin, tile, y) }
+        }
+
+        /// # Safety
+        /// As [`forward_body`], for the instruction set of `$S`.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feat)]
+        unsafe fn $fwd(
+            rec: &Rec,
+            lanes: &Lanes,
+            x: BatchRows<*const f64>,
+            tile: *mut f64,
+            ft: BatchRows<*mut f64>,
+        ) -> usize {
+            // SAFETY: the caller upholds `forward_body`'s contract.
+            unsafe { forward_body::<$S, $W, $N, $DB>(rec, lanes, x, tile, ft) }
+        }
+    };
+}
+
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{avx2::Avx2, avx512::Avx512};
+use crate::simd::{scalar::Scalar, Isa};
+
+entry!(
+    inv_avx512_16,
+    fwd_avx512_16,
+    "avx512f,fma",
+    Avx512,
+    8,
+    16,
+    8
+);
+entry!(inv_avx512_8, fwd_avx512_8, "avx512f,fma", Avx512, 8, 8, 8);
+entry!(inv_avx2_16, fwd_avx2_16, "avx2,fma", Avx2, 4, 16, 2);
+entry!(inv_avx2_8, fwd_avx2_8, "avx2,fma", Avx2, 4, 8, 4);
+
+/// The batched inverse for `isa` and `p` columns (8 or 16).
+///
+/// # Safety
+/// As [`inverse_body`]; `isa` is supported by this CPU.
+pub(super) unsafe fn run_inverse(
+    isa: Isa,
+    p: usize,
+    (rec, lanes): (&Rec, &Lanes),
+    fin: (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
+    tile: *mut f64,
+    y: BatchRows<*mut f64>,
+) {
+    // SAFETY: the caller's contract covers every kernel's (`inverse_body`'s) and the
+    // instruction set of the one chosen.
+    unsafe {
+        macro_rules! nt {
+            ($f:ident $(::<$($g:tt),*>)?) => {
+                if lanes.stream {
+                    $f::<$($($g,)*)? true>(rec, lanes, fin, tile, y)
+                } else {
+                    $f::<$($($g,)*)? false>(rec, lanes, fin, tile, y)
+                }
+            };
+        }
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => nt!(inv_avx512_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 8) => nt!(inv_avx512_8),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => nt!(inv_avx2_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 8) => nt!(inv_avx2_8),
+            (_, 16) => nt!(inverse_body::<Scalar, 1, 16>),
+            (_, 8) => nt!(inverse_body::<Scalar, 1, 8>),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
+    crate::simd::sfence();
+}
+
+/// The batched forward for `isa` and `p` columns (8 or 16).
+///
+/// # Safety
+/// As [`forward_body`]; `isa` is supported by this CPU.
+pub(super) unsafe fn run_forward(
+    isa: Isa,
+    p: usize,
+    (rec, lanes): (&Rec, &Lanes),
+    x: BatchRows<*const f64>,
+    tile: *mut f64,
+    ft: BatchRows<*mut f64>,
+) -> usize {
+    // SAFETY: the caller's contract covers every kernel's (`forward_body`'s) and the
+    // instruction set of the one chosen.
+    unsafe {
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, x, tile, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, x, tile, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, x, tile, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, x, tile, ft),
+            (_, 16) => forward_body::<Scalar, 1, 16, 1>(rec, lanes, x, tile, ft),
+            (_, 8) => forward_body::<Scalar, 1, 8, 1>(rec, lanes, x, tile, ft),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
+}
