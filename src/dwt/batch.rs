@@ -1,10 +1,10 @@
 //! Batched kernels: the transforms of a batch share each cluster's recurrence.
 //!
 //! The single kernels fuse the recurrence with one transform's multiply-adds. Here the
-//! Wigner-d values are computed once into a small buffer that stays in L1 (inverse: every
-//! degree of two vectors of betas, their recurrences run together; forward: one block of
-//! degrees of every vector of a group), and each transform of the batch runs only the
-//! multiply-adds against it:
+//! Wigner-d values are computed once into a small buffer (inverse: every degree of two
+//! vectors of betas, their recurrences run together, `2 n W` doubles, in L1 up to a few
+//! hundred degrees; forward: one block of degrees of every vector of a group), and each
+//! transform of the batch runs only the multiply-adds against it:
 //! - inverse: `y_t[row(s)][q] = sum_i dt_{l0+i}(beta_s) fin_t[i][q]`, with the sums held
 //!   as vectors over the columns of one lane (no transposes on the way out), each d value
 //!   a broadcast feeding `16 / W` multiply-adds (two transforms at once for 8 columns);
@@ -15,15 +15,12 @@
 //! the single kernels (`inverse`, `forward`): a batch gives bitwise the results of single
 //! calls.
 
-use super::forward::block_fmas;
+use super::forward::{assert_block, block_fmas, degree_block, FWD_VECTORS};
+use super::inverse::INV_VECTORS;
 use super::lanes::{Lanes, Prefetch, Rec};
 use super::state::{prefix_states, State};
 use crate::simd::Simd;
 use std::mem::MaybeUninit;
-
-/// Vectors of betas set up together (through their negligible prefixes), as in the single
-/// kernels.
-const VECTORS: usize = 16;
 
 /// Vectors whose recurrences the inverse runs together (independent chains in flight).
 const CHAINS: usize = 2;
@@ -104,7 +101,7 @@ pub fn inverse_tile_len(n: usize, w: usize) -> usize {
 
 /// Doubles of the forward's d-value buffer for vectors of `w` lanes.
 pub fn forward_tile_len(w: usize) -> usize {
-    VECTORS * w * w
+    FWD_VECTORS * w * w
 }
 
 /// The multiply-adds of one vector of lanes for transforms `t .. t + K` from degree `lo`:
@@ -126,6 +123,8 @@ unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, con
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
+        // Instantiated (never called) for `P = 16` with two transforms as well.
+        debug_assert!(K * P <= 16);
         let cv = P / W;
         let mut acc = [S::zero(); 16];
         hint.issue(lines);
@@ -167,7 +166,7 @@ unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, con
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; `fin` holds `count` inputs of `n P` values
-/// `fin_dist` apart; `tile` holds [`inverse_tile_len`] values; every output row of every
+/// `fin.dist` apart, `hints` one entry per transform; `tile` holds [`inverse_tile_len`] values; every output row of every
 /// transform is valid for writes and nobody else's.
 #[inline(always)]
 unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
@@ -189,8 +188,8 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
         let mut have = n;
         let mut v0 = 0;
         while v0 < nb {
-            let vectors = ((nb - v0) / W).min(VECTORS);
-            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
+            let vectors = ((nb - v0) / W).min(INV_VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; INV_VECTORS];
             let (first, states) =
                 prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
             if first < have {
@@ -264,6 +263,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
 ) -> usize {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
+        const { assert_block::<W, P, DB>() };
         let (n, nb) = (rec.len(), lanes.tau.len());
         let cv = P / W;
         let pair = super::forward::paired(W, P);
@@ -274,8 +274,8 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let mut lo = n;
         let mut v0 = 0;
         while v0 < nb {
-            let vectors = ((nb - v0) / W).min(VECTORS);
-            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; VECTORS];
+            let vectors = ((nb - v0) / W).min(FWD_VECTORS);
+            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
             let (first, states) =
                 prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
             lo = lo.min(first);
@@ -288,7 +288,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
             }
             // The vectors of a block in the single kernel's order: those that start inside
             // the block or still have inactive lanes, then the fully active ones.
-            let mut order = [0usize; VECTORS];
+            let mut order = [0usize; FWD_VECTORS];
             while i0 < n {
                 let mut used = 0;
                 for (v, s) in states.iter_mut().enumerate() {
@@ -358,7 +358,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
 /// `#[target_feature]` entry points: [`inverse_body`] and [`forward_body`] for one
 /// instruction set, vector width and column count.
 macro_rules! entry {
-    ($inv:ident, $fwd:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:literal) => {
+    ($inv:ident, $fwd:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:tt) => {
         /// # Safety
         /// As [`inverse_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
@@ -473,8 +473,10 @@ pub(super) unsafe fn run_forward(
             (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, x, tile, ft),
             #[cfg(target_arch = "x86_64")]
             (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, x, tile, ft),
-            (_, 16) => forward_body::<Scalar, 1, 16, 1>(rec, lanes, x, tile, ft),
-            (_, 8) => forward_body::<Scalar, 1, 8, 1>(rec, lanes, x, tile, ft),
+            (_, 16) => {
+                forward_body::<Scalar, 1, 16, { degree_block(1, 16) }>(rec, lanes, x, tile, ft)
+            }
+            (_, 8) => forward_body::<Scalar, 1, 8, { degree_block(1, 8) }>(rec, lanes, x, tile, ft),
             _ => unreachable!("P must be 8 or 16"),
         }
     }

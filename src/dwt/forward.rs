@@ -8,7 +8,7 @@ use crate::wigner::REC_PAD;
 use std::mem::MaybeUninit;
 
 /// Vectors of betas whose states the forward kernel keeps at once.
-const FWD_VECTORS: usize = 16;
+pub(super) const FWD_VECTORS: usize = 16;
 
 /// Registers for the forward kernel's sums (`DB x P / W` of them are used).
 pub(super) const ACC: usize = 16;
@@ -49,6 +49,25 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
             }
         }
     }
+}
+
+/// Degrees per block of the forward kernels for vectors of `w` lanes and `p` columns (the
+/// batched forward must use the same: the block decides the order of the sums).
+pub(super) const fn degree_block(w: usize, p: usize) -> usize {
+    match (w, p) {
+        (8, _) => 8,
+        (4, 16) => 2,
+        (4, _) => 4,
+        _ => 1,
+    }
+}
+
+/// Compile-time checks of a forward block shape: the sums fit the registers, the d block
+/// its buffer, and the last block's steps the coefficients' padding.
+pub(super) const fn assert_block<const W: usize, const P: usize, const DB: usize>() {
+    assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
+    assert!(DB <= REC_PAD);
+    assert!(!paired(W, P) || (2 * DB <= ACC && W.is_multiple_of(2)));
 }
 
 /// Whether the forward kernel pairs betas ([`pair_fmas`]): with one vector of columns
@@ -187,11 +206,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let n = rec.len();
         let nb = lanes.tau.len();
         let col_vectors = P / W;
-        const {
-            assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
-            assert!(DB <= REC_PAD);
-            assert!(!paired(W, P) || (2 * DB <= ACC && W.is_multiple_of(2)));
-        }
+        const { assert_block::<W, P, DB>() };
         let pair = paired(W, P);
         debug_assert!(nb.is_multiple_of(W));
         debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
@@ -365,7 +380,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
 /// A `#[target_feature]` entry point: [`forward_body`] for one instruction set, vector
 /// width, column count and degree block.
 macro_rules! entry {
-    ($name:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:literal) => {
+    ($name:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:tt) => {
         /// # Safety
         /// As [`forward_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
@@ -381,10 +396,16 @@ macro_rules! entry {
 use crate::simd::{avx2::Avx2, avx512::Avx512};
 use crate::simd::{scalar::Scalar, Isa};
 
-entry!(fwd_avx512_16, "avx512f,fma", Avx512, 8, 16, 8);
-entry!(fwd_avx512_8, "avx512f,fma", Avx512, 8, 8, 8);
-entry!(fwd_avx2_16, "avx2,fma", Avx2, 4, 16, 2);
-entry!(fwd_avx2_8, "avx2,fma", Avx2, 4, 8, 4);
+entry!(fwd_avx512_16, "avx512f,fma", Avx512, 8, 16, {
+    degree_block(8, 16)
+});
+entry!(fwd_avx512_8, "avx512f,fma", Avx512, 8, 8, {
+    degree_block(8, 8)
+});
+entry!(fwd_avx2_16, "avx2,fma", Avx2, 4, 16, {
+    degree_block(4, 16)
+});
+entry!(fwd_avx2_8, "avx2,fma", Avx2, 4, 8, { degree_block(4, 8) });
 
 /// The forward kernel for `isa` and `p` columns (8 or 16).
 ///
@@ -412,8 +433,8 @@ pub(super) unsafe fn run(
             (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, ft),
             #[cfg(target_arch = "x86_64")]
             (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, ft),
-            (_, 16) => forward_body::<Scalar, 1, 16, 1>(rec, lanes, xin, ft),
-            (_, 8) => forward_body::<Scalar, 1, 8, 1>(rec, lanes, xin, ft),
+            (_, 16) => forward_body::<Scalar, 1, 16, { degree_block(1, 16) }>(rec, lanes, xin, ft),
+            (_, 8) => forward_body::<Scalar, 1, 8, { degree_block(1, 8) }>(rec, lanes, xin, ft),
             _ => unreachable!("P must be 8 or 16"),
         }
     }

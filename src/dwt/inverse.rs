@@ -25,7 +25,7 @@ pub type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
 
 /// Vectors of betas whose states the inverse kernel sets up before it needs their input
 /// rows.
-const INV_VECTORS: usize = 16;
+pub(super) const INV_VECTORS: usize = 16;
 
 /// # Safety
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and

@@ -16,7 +16,7 @@
 //! in `l` is skipped).
 //!
 //! Files: [`lanes`] (the kernels' inputs), `state` (the recurrence state of a vector of
-//! betas, shared by both kernels), `forward`, `inverse`, `batch` (many transforms sharing
+//! betas, shared by the kernels), `forward`, `inverse`, `batch` (many transforms sharing
 //! one recurrence), `parity` (the `m' = 0` kernels of the S^2 transforms); this file checks
 //! the arguments and dispatches on the instruction set.
 
@@ -108,7 +108,7 @@ pub fn forward_parity(
     }
 }
 
-/// Panics unless the arguments both kernels take are consistent: `isa` supported, the
+/// Panics unless the arguments every kernel takes are consistent: `isa` supported, the
 /// coefficients padded, every lane array of the same length (a multiple of the vector
 /// width), and rows of `p` values that cannot overlap.
 fn check_shared(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes) {
@@ -190,10 +190,10 @@ pub(crate) unsafe fn inverse_raw(
 /// [`inverse_raw`] for a batch of `fin.count` transforms sharing the recurrence: transform
 /// `t` reads its rows from `fin.base + t fin.dist` (filled by `fill(t, rows, from, to)` as
 /// for [`inverse_raw`]) and writes its output rows (addressed as in [`inverse_raw`]) from
-/// `y.base + t y.dist`. `hints[t]` (what transform `t`'s next call will read) is
-/// prefetched while the multiply-adds run. `tile` is scratch of [`inverse_tile_len`]
-/// values. Bitwise the
-/// results of `fin.count` calls of [`inverse_raw`].
+/// `y.base + t y.dist`. `hints[t]` (memory a later call will read) is prefetched while
+/// transform `t`'s multiply-adds run; `lanes.prefetch` is not used. `tile` is scratch of
+/// [`inverse_tile_len`] values. Bitwise the results of `fin.count` calls of
+/// [`inverse_raw`].
 ///
 /// # Safety
 /// `fin` holds `fin.count` arrays of `rec.len() p` values `fin.dist` apart, nobody else's;

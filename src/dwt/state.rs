@@ -1,5 +1,5 @@
 //! The recurrence state of one vector of betas and the skipping of the negligible prefix
-//! in `l`, shared by both kernels.
+//! in `l`, shared by the kernels.
 
 use super::lanes::{Lanes, Rec};
 use crate::simd::Simd;

@@ -693,13 +693,34 @@ fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
 }
 
 /// A batch gives bitwise the results of single kernel calls: every instruction set, 8
-/// and 16 columns, one to three transforms, on the layout cases and on a cluster with
-/// more vectors than one group (B = 96, 176 betas).
+/// and 16 columns, one to three transforms, on the layout cases, on clusters with more
+/// vectors than one group (B = 96, 176 betas) or a single degree, without skipping, and on
+/// an odd number of vectors in consecutive rows (one recurrence chain left alone).
 #[test]
 fn batched_kernels_equal_single_calls() {
     layout_cases(|isa, pw, m, rec, mut lanes| batch_case(isa, pw, rec, &mut lanes, m as u64));
-    let (b, nbs) = (96, 176);
-    for &(m, mp) in &[(5usize, 2usize), (40, 17)] {
+    let b = 96;
+    let ks: Vec<usize> = (0..40).map(|s| s * b / 40).collect();
+    let ClusterInputs {
+        coeffs: rc,
+        tau,
+        p,
+        sc,
+    } = cluster_setup_at(b, 7, 3, &ks);
+    let rec = Rec::new(&rc, b - 7);
+    for pw in [8usize, 16] {
+        for isa in [Isa::Scalar, Isa::Avx2, Isa::Avx512] {
+            if isa.is_supported() {
+                let mut lanes = grid_lanes(&tau, &p, &sc, 40);
+                lanes.interleaved = false;
+                batch_case(isa, pw, &rec, &mut lanes, 3);
+                lanes.skip = false;
+                batch_case(isa, pw, &rec, &mut lanes, 4);
+            }
+        }
+    }
+    let nbs = 176;
+    for &(m, mp) in &[(5usize, 2usize), (40, 17), (95, 95), (95, 0)] {
         let ClusterInputs {
             coeffs: rc,
             tau,

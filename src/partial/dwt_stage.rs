@@ -184,7 +184,7 @@ impl DwtStage {
     pub fn bytes(l: usize, clusters: usize, workers: usize, max_lanes: usize) -> usize {
         32 * (l + 1) * (l + 2)
             + clusters * 256
-            + workers * 8 * (3 * max_lanes + 16 * (l + 8) + 5 * l)
+            + workers * 8 * (3 * max_lanes + (KERNEL_BATCH + 1) * 16 * (l + 8) + 21 * l)
     }
 
     /// Runs `f` with a free scratch (a private one when all are busy).
@@ -405,8 +405,9 @@ impl DwtStage {
 
     /// [`DwtStage::inverse`] for a batch sharing the recurrence: transform `t` from the
     /// coefficients at `coef.base + t coef.dist` into the lane rows at
-    /// `block.base + t block.dist`, prefetching the blocks of cluster `next` of the same
-    /// transforms meanwhile. Bitwise the results of single calls.
+    /// `block.base + t block.dist`, prefetching meanwhile the coefficient blocks that the
+    /// next call reads (`next`: its cluster and coefficient arrays). Bitwise the results of
+    /// single calls.
     ///
     /// # Safety
     /// As for [`DwtStage::inverse`], for every transform of the batch.
@@ -418,7 +419,11 @@ impl DwtStage {
         ch: ChunkLanes,
         n: usize,
         coef: BatchRows<*const Complex64>,
-        (real, stream, next): (bool, bool, Option<&ClusterPlan>),
+        (real, stream, next): (
+            bool,
+            bool,
+            Option<(&ClusterPlan, BatchRows<*const Complex64>)>,
+        ),
         block: BatchRows<*mut f64>,
     ) {
         let (p, dist) = (cl.p, self.data_len());
@@ -439,10 +444,11 @@ impl DwtStage {
             Self::fill_rows(cl, scales, c, real, fin, from, to)
         };
         let mut hints: Vec<Prefetch> = (0..coef.count)
-            .map(|t| {
-                next.map_or(Prefetch::none(), |c| {
-                    self.coefficient_hints(c, coef.base.wrapping_add(t * coef.dist), real)
-                })
+            .map(|t| match next {
+                Some((c, rows)) if t < rows.count => {
+                    self.coefficient_hints(c, rows.base.wrapping_add(t * rows.dist), real)
+                }
+                _ => Prefetch::none(),
             })
             .collect();
         let rec = Rec::new(&sc.rec, n);

@@ -509,8 +509,9 @@ impl General {
         }
     }
 
-    /// Transforms of a batch run together (sharing recurrence coefficients and starting
-    /// values): as many as the workspace cap holds at the chunk size (at least one).
+    /// Transforms of a batch run together (sharing each cluster's recurrence coefficients,
+    /// starting values and d values, see `dwt/batch.rs`): as many as the workspace cap holds
+    /// at the chunk size (at least one).
     fn group_size(&self) -> usize {
         let hp = self.chunk_pairs().next_multiple_of(self.lanes_w);
         (self.budget / (hp * self.pair_bytes())).max(1)
@@ -643,56 +644,64 @@ impl General {
                         .for_each(|(i, cl)| {
                             self.dwt.with_scratch(|sc| {
                                 let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                                if batch.count > 1 {
-                                    for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                                        let count = KERNEL_BATCH.min(batch.count - t0);
-                                        let c = BatchRows {
-                                            base: coef.get().wrapping_add(t0 * batch.in_dist),
+                                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                    let count = KERNEL_BATCH.min(batch.count - t0);
+                                    // What the next kernel call will gather: this cluster
+                                    // for the next transforms, else the next cluster (likely
+                                    // this task's next one) for the first ones.
+                                    let next = if t0 + count < batch.count {
+                                        Some((cl, t0 + count))
+                                    } else {
+                                        clusters.get(i + 1).map(|c| (c, 0))
+                                    };
+                                    let next = next.map(|(c, u)| {
+                                        let rows = BatchRows {
+                                            base: coef.get().wrapping_add(u * batch.in_dist),
                                             dist: batch.in_dist,
-                                            count,
+                                            count: KERNEL_BATCH.min(batch.count - u),
                                         };
-                                        let b = BatchRows {
-                                            base: buf.get().wrapping_add(t0 * per_t + cl.offset),
-                                            dist: per_t,
-                                            count,
-                                        };
-                                        // SAFETY: coefficient arrays `t0..t0 + count` of the
-                                        // batch (checked lengths), read only; this cluster's
-                                        // `cl.p` doubles of the lane rows of those
-                                        // transforms, inside the chunk buffer, written by
-                                        // this task only.
-                                        unsafe {
+                                        (c, rows)
+                                    });
+                                    let c = BatchRows {
+                                        base: coef.get().wrapping_add(t0 * batch.in_dist),
+                                        dist: batch.in_dist,
+                                        count,
+                                    };
+                                    let b = BatchRows {
+                                        base: buf.get().wrapping_add(t0 * per_t + cl.offset),
+                                        dist: per_t,
+                                        count,
+                                    };
+                                    // SAFETY: coefficient arrays `t0..t0 + count` of the
+                                    // batch (checked lengths), read only; this cluster's
+                                    // `cl.p` doubles of the lane rows of those transforms,
+                                    // inside the chunk buffer, written by this task only.
+                                    unsafe {
+                                        if count == 1 {
+                                            let hints = next.map_or(Prefetch::none(), |(c, r)| {
+                                                self.dwt.coefficient_hints(c, r.base, real)
+                                            });
+                                            self.dwt.inverse(
+                                                sc,
+                                                cl,
+                                                ch,
+                                                n,
+                                                c.base,
+                                                (real, stream, hints),
+                                                b.base,
+                                            )
+                                        } else {
                                             self.dwt.inverse_many(
                                                 sc,
                                                 cl,
                                                 ch,
                                                 n,
                                                 c,
-                                                (real, stream, clusters.get(i + 1)),
+                                                (real, stream, next),
                                                 b,
                                             )
                                         }
                                     }
-                                    return;
-                                }
-                                // What the next kernel call will gather: the next cluster
-                                // (likely this task's next one).
-                                let next = clusters.get(i + 1).map_or(Prefetch::none(), |c| {
-                                    self.dwt.coefficient_hints(c, coef.get(), real)
-                                });
-                                // SAFETY: the coefficient array (checked length), read
-                                // only; this cluster's `cl.p` doubles of the `lanes` lane
-                                // rows, inside the chunk buffer, written by this task only.
-                                unsafe {
-                                    self.dwt.inverse(
-                                        sc,
-                                        cl,
-                                        ch,
-                                        n,
-                                        coef.get(),
-                                        (real, stream, next),
-                                        buf.get().add(cl.offset),
-                                    )
                                 }
                             })
                         });
