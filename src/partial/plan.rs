@@ -3,7 +3,7 @@
 //! chunk's slices).
 
 use super::betas::{Betas, LanePairs};
-use super::dwt_stage::{ChunkLanes, ClusterPlan, DwtStage, KERNEL_BATCH};
+use super::dwt_stage::{ChunkLanes, DwtStage, KERNEL_BATCH};
 use super::fft_stage::{FftStage, Work};
 use super::shape::{CoefLayout, Shape};
 use crate::dwt::{BatchRows, Prefetch};
@@ -78,6 +78,8 @@ pub(super) struct General {
     pub(super) pairs: LanePairs,
     pub(super) dwt: DwtStage,
     pub(super) fft: FftStage,
+    /// The slots of a lane row, flat (for the complex scatters and gathers).
+    slots: SlotTable,
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
     pub(super) pair_weight: Vec<f64>,
     /// Per-worker FFT buffers (made on first use).
@@ -476,6 +478,7 @@ impl General {
         Ok(General {
             layout,
             pairs,
+            slots: SlotTable::new(&dwt, (na, fft.strides().1))?,
             dwt,
             fft,
             pair_weight,
@@ -897,12 +900,10 @@ impl General {
             row[ng - n..ng].fill(Complex64::default());
         }
         for part in rows {
-            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
-                for (q, s) in cl.slots.iter().enumerate() {
-                    let x = part.slot(cl, q, s.member.reversed);
-                    // SAFETY: the slot's two doubles are inside the part's lane row.
-                    w[s.work] = unsafe { Complex64::new(*x, *x.add(1)) };
-                }
+            for &(at, work) in self.slots.of(part.clusters) {
+                let x = part.at(at);
+                // SAFETY: the slot's two doubles are inside the part's lane row.
+                w[work as usize] = unsafe { Complex64::new(*x, *x.add(1)) };
             }
         }
     }
@@ -912,21 +913,15 @@ impl General {
     /// # Safety
     /// As for [`General::scatter`].
     pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: &[LaneRows]) {
-        let (na, _) = self.fft.dims();
-        let (_, hs) = self.fft.strides();
         w.fill(Complex64::default());
         for part in rows {
-            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
-                for (q, s) in cl.slots.iter().enumerate() {
-                    let mem = &s.member;
-                    if mem.mp < 0 {
-                        continue;
-                    }
-                    let x = part.slot(cl, q, mem.reversed);
-                    // SAFETY: as in `scatter`.
-                    let v = unsafe { Complex64::new(*x, -*x.add(1)) };
-                    w[mem.m.rem_euclid(na as isize) as usize * hs + mem.mp as usize] = v;
+            for &(at, idx) in self.slots.real_of(part.clusters) {
+                if idx & SlotTable::CONJ != 0 {
+                    continue;
                 }
+                let x = part.at(at);
+                // SAFETY: as in `scatter`.
+                w[idx as usize] = unsafe { Complex64::new(*x, -*x.add(1)) };
             }
         }
     }
@@ -938,16 +933,13 @@ impl General {
     /// As for [`General::scatter`], for writes; no other task writes these slots.
     pub(super) unsafe fn gather(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
         for part in rows {
-            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
-                for (q, s) in cl.slots.iter().enumerate() {
-                    let v = w[s.work] * weight;
-                    let x = part.slot(cl, q, s.member.reversed);
-                    // SAFETY: as in `scatter`; these slots are this task's (caller's
-                    // contract).
-                    unsafe {
-                        *x = v.re;
-                        *x.add(1) = v.im;
-                    }
+            for &(at, work) in self.slots.of(part.clusters) {
+                let v = w[work as usize] * weight;
+                let x = part.at(at);
+                // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
+                unsafe {
+                    *x = v.re;
+                    *x.add(1) = v.im;
                 }
             }
         }
@@ -959,24 +951,18 @@ impl General {
     /// # Safety
     /// As for [`General::gather`].
     pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
-        let (na, _) = self.fft.dims();
-        let (_, hs) = self.fft.strides();
-        let at = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
         for part in rows {
-            for cl in &self.dwt.clusters[part.clusters.0..part.clusters.1] {
-                for (q, s) in cl.slots.iter().enumerate() {
-                    let mem = &s.member;
-                    let v = if mem.mp >= 0 {
-                        w[at(mem.m, mem.mp)].conj()
-                    } else {
-                        w[at(-mem.m, -mem.mp)]
-                    } * weight;
-                    let x = part.slot(cl, q, mem.reversed);
-                    // SAFETY: as in `gather`.
-                    unsafe {
-                        *x = v.re;
-                        *x.add(1) = v.im;
-                    }
+            for &(at, idx) in self.slots.real_of(part.clusters) {
+                let v = if idx & SlotTable::CONJ != 0 {
+                    w[(idx & !SlotTable::CONJ) as usize]
+                } else {
+                    w[idx as usize].conj()
+                } * weight;
+                let x = part.at(at);
+                // SAFETY: as in `gather`.
+                unsafe {
+                    *x = v.re;
+                    *x.add(1) = v.im;
                 }
             }
         }
@@ -1022,9 +1008,79 @@ impl LaneRows {
         }
     }
 
-    /// Where the `q`-th slot of cluster `cl` is (in the mirror's row if `reversed`).
-    fn slot(&self, cl: &ClusterPlan, q: usize, reversed: bool) -> *mut f64 {
-        let row = if reversed { self.mirror } else { self.own };
-        row.wrapping_add(cl.offset + 2 * q)
+    /// Where a slot of a [`SlotTable`] entry is.
+    #[inline(always)]
+    fn at(&self, at: u32) -> *mut f64 {
+        let row = if at & SlotTable::MIRROR != 0 {
+            self.mirror
+        } else {
+            self.own
+        };
+        row.wrapping_add((at & !SlotTable::MIRROR) as usize)
+    }
+}
+
+/// Every slot of a lane row in cluster order, flat: the FFT stage's scatters and gathers
+/// walk 8 bytes a slot here instead of each cluster's list of slots (a heap allocation per
+/// cluster, 64 bytes a slot: at B = 128 about 4 MB read per slice).
+pub(super) struct SlotTable {
+    /// `(offset in the lane row, or'ed with MIRROR for a reversed member, whose value is in
+    /// the mirror's row; index in the FFT stage's work buffer)`.
+    entries: Vec<(u32, u32)>,
+    /// First entry of each cluster, then the total.
+    start: Vec<usize>,
+    /// The same for the real layout's half buffer (`n_alpha` rows `hs` apart, `M' >= 0`):
+    /// the index of `(M, M')` if `M' >= 0`, else of `(-M, -M')` or'ed with `CONJ` (the real
+    /// forward reads the value there unconjugated; the real inverse skips it).
+    real: Vec<(u32, u32)>,
+}
+
+impl SlotTable {
+    const MIRROR: u32 = 1 << 31;
+    const CONJ: u32 = 1 << 31;
+
+    /// The table of `dwt`'s clusters; the real entries for a half buffer of `na` rows `hs`
+    /// apart.
+    fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
+        let too_large =
+            || Error::InvalidArgument("shape too large for the general engine's slot table".into());
+        let fits = |x: usize| u32::try_from(x).ok().filter(|a| a & (1 << 31) == 0);
+        let half = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
+        let mut entries = Vec::new();
+        let mut real = Vec::new();
+        let mut start = Vec::with_capacity(dwt.clusters.len() + 1);
+        for cl in &dwt.clusters {
+            start.push(entries.len());
+            for (q, s) in cl.slots.iter().enumerate() {
+                let mem = &s.member;
+                let (Some(at), Ok(work)) = (fits(cl.offset + 2 * q), u32::try_from(s.work)) else {
+                    return Err(too_large());
+                };
+                let at = at | if mem.reversed { Self::MIRROR } else { 0 };
+                entries.push((at, work));
+                let idx = if mem.mp >= 0 {
+                    fits(half(mem.m, mem.mp))
+                } else {
+                    fits(half(-mem.m, -mem.mp)).map(|i| i | Self::CONJ)
+                };
+                real.push((at, idx.ok_or_else(too_large)?));
+            }
+        }
+        start.push(entries.len());
+        Ok(SlotTable {
+            entries,
+            start,
+            real,
+        })
+    }
+
+    /// The entries of clusters `a..b`.
+    fn of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+        &self.entries[self.start[a]..self.start[b]]
+    }
+
+    /// The real entries of clusters `a..b`.
+    fn real_of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+        &self.real[self.start[a]..self.start[b]]
     }
 }
