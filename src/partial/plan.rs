@@ -76,9 +76,10 @@ fn skip_bits(option: Option<u32>) -> Result<u32> {
 pub(super) struct General {
     pub(super) layout: CoefLayout,
     pub(super) pairs: LanePairs,
+    /// Its clusters are never changed after `new`: `slots` is made from them.
     pub(super) dwt: DwtStage,
     pub(super) fft: FftStage,
-    /// The slots of a lane row, flat (for the complex scatters and gathers).
+    /// The slots of a lane row, flat (for the scatters and gathers, complex and real).
     slots: SlotTable,
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
     pub(super) pair_weight: Vec<f64>,
@@ -475,10 +476,11 @@ impl General {
         } else {
             Vec::new()
         };
+        let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
         Ok(General {
             layout,
             pairs,
-            slots: SlotTable::new(&dwt, (na, fft.strides().1))?,
+            slots,
             dwt,
             fft,
             pair_weight,
@@ -902,7 +904,8 @@ impl General {
         for part in rows {
             for &(at, work) in self.slots.of(part.clusters) {
                 let x = part.at(at);
-                // SAFETY: the slot's two doubles are inside the part's lane row.
+                // SAFETY: the slot's two doubles are inside the part's lane row (the table
+                // holds the offsets of `dwt.clusters`' slots).
                 w[work as usize] = unsafe { Complex64::new(*x, *x.add(1)) };
             }
         }
@@ -1021,8 +1024,9 @@ impl LaneRows {
 }
 
 /// Every slot of a lane row in cluster order, flat: the FFT stage's scatters and gathers
-/// walk 8 bytes a slot here instead of each cluster's list of slots (a heap allocation per
-/// cluster, 64 bytes a slot: at B = 128 about 4 MB read per slice).
+/// read 8 bytes a slot here (one table for the complex layout, one for the real) instead of
+/// each cluster's list of slots (a heap allocation per cluster, 64 bytes a slot: at
+/// B = 128 about 4 MB read per slice).
 pub(super) struct SlotTable {
     /// `(offset in the lane row, or'ed with MIRROR for a reversed member, whose value is in
     /// the mirror's row; index in the FFT stage's work buffer)`.
