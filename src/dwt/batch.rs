@@ -179,11 +179,8 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
         let (n, nb) = (rec.len(), lanes.tau.len());
-        // Lines of transform `t`'s hints issued per vector of lanes.
-        let per_vector: Vec<usize> = hints
-            .iter()
-            .map(|h| h.lines().div_ceil((nb / W).max(1)))
-            .collect();
+        // Lines of a transform's hints issued per vector of lanes.
+        let per_vector = |h: &Prefetch| h.lines().div_ceil((nb / W).max(1));
         let count = fin.count;
         let mut have = n;
         let mut v0 = 0;
@@ -213,18 +210,20 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                 while t < count {
                     // Two transforms at once with 8 columns (16 sums), one with 16.
                     let two = P == 8 && t + 1 < count;
+                    let lines_t = per_vector(&hints[t]);
                     for (k, &lo_k) in lo.iter().enumerate().take(used) {
                         let (at0, stride) = lanes.vector_rows(v0 + (vector + k) * W, P);
                         let rows = |w: usize| at0 + w * stride;
                         if two {
-                            hints[t + 1].issue(per_vector[t + 1]);
+                            let lines = per_vector(&hints[t + 1]);
+                            hints[t + 1].issue(lines);
                             lane_sums::<S, W, P, 2, NT>(
                                 tiles[k],
                                 (lo_k, n),
                                 [at(fin, t).cast_const(), at(fin, t + 1).cast_const()],
                                 [at(y, t), at(y, t + 1)],
                                 &rows,
-                                (&mut hints[t], per_vector[t]),
+                                (&mut hints[t], lines_t),
                             );
                         } else {
                             lane_sums::<S, W, P, 1, NT>(
@@ -233,7 +232,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                                 [at(fin, t).cast_const()],
                                 [at(y, t)],
                                 &rows,
-                                (&mut hints[t], per_vector[t]),
+                                (&mut hints[t], lines_t),
                             );
                         }
                     }

@@ -349,6 +349,20 @@ impl DwtStage {
         dwt::inverse_tile_len(self.l, w).max(dwt::forward_tile_len(w))
     }
 
+    /// The scratch's kernel inputs or sums for `count` transforms and the batched kernels'
+    /// d values, taken out of `sc` (put back after the call), grown on first use.
+    fn batch_buffers(&self, sc: &mut Scratch, count: usize) -> (Vec<f64>, Vec<f64>) {
+        let mut data = std::mem::take(&mut sc.data);
+        if data.len() < count * self.data_len() {
+            data = vec![0.0; count * self.data_len()];
+        }
+        let mut tile = std::mem::take(&mut sc.tile);
+        if tile.len() < self.tile_len() {
+            tile = vec![0.0; self.tile_len()];
+        }
+        (data, tile)
+    }
+
     /// Doubles of one transform's kernel input or sums in the scratch.
     fn data_len(&self) -> usize {
         (self.l + 8) * 16
@@ -427,15 +441,7 @@ impl DwtStage {
         block: BatchRows<*mut f64>,
     ) {
         let (p, dist) = (cl.p, self.data_len());
-        let mut data = std::mem::take(&mut sc.data);
-        if data.len() < coef.count * dist {
-            data = vec![0.0; coef.count * dist];
-        }
-        let w = self.isa.lanes();
-        let mut tile = std::mem::take(&mut sc.tile);
-        if tile.len() < dwt::inverse_tile_len(n, w) {
-            tile = vec![0.0; self.tile_len()];
-        }
+        let (mut data, mut tile) = self.batch_buffers(sc, coef.count);
         let scales = &sc.rec.s;
         // SAFETY: coefficient array `t` of the batch holds the shape's coefficients
         // (caller's contract).
@@ -443,14 +449,17 @@ impl DwtStage {
             let c = coef.base.add(t * coef.dist);
             Self::fill_rows(cl, scales, c, real, fin, from, to)
         };
-        let mut hints: Vec<Prefetch> = (0..coef.count)
-            .map(|t| match next {
-                Some((c, rows)) if t < rows.count => {
-                    self.coefficient_hints(c, rows.base.wrapping_add(t * rows.dist), real)
-                }
-                _ => Prefetch::none(),
-            })
-            .collect();
+        assert!(coef.count <= KERNEL_BATCH);
+        let mut hints = [Prefetch::none(); KERNEL_BATCH];
+        if let Some((c, rows)) = next {
+            for (t, h) in hints
+                .iter_mut()
+                .enumerate()
+                .take(rows.count.min(coef.count))
+            {
+                *h = self.coefficient_hints(c, rows.base.wrapping_add(t * rows.dist), real);
+            }
+        }
         let rec = Rec::new(&sc.rec, n);
         let lanes = self.lanes(sc, ch, stream);
         let fin = BatchRows {
@@ -465,7 +474,7 @@ impl DwtStage {
                 self.isa,
                 p,
                 (&rec, &lanes),
-                (fin, &mut fill, &mut hints),
+                (fin, &mut fill, &mut hints[..coef.count]),
                 &mut tile,
                 block,
             )
@@ -524,15 +533,7 @@ impl DwtStage {
         first: bool,
     ) {
         let (p, dist) = (cl.p, self.data_len());
-        let mut data = std::mem::take(&mut sc.data);
-        if data.len() < block.count * dist {
-            data = vec![0.0; block.count * dist];
-        }
-        let mut tile = std::mem::take(&mut sc.tile);
-        let w = self.isa.lanes();
-        if tile.len() < dwt::forward_tile_len(w) {
-            tile = vec![0.0; self.tile_len()];
-        }
+        let (mut data, mut tile) = self.batch_buffers(sc, block.count);
         let rec = Rec::new(&sc.rec, n);
         let lanes = self.lanes(sc, ch, false);
         let sums = BatchRows {
