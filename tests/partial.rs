@@ -6,8 +6,8 @@ mod common;
 
 use so3fft::wigner::wigner_d_column;
 use so3fft::{
-    coef_index, num_coeffs, Batch, Betas, Complex64, Direction, PartialOptions, PartialPlan, Plan,
-    PlanOptions, Shape,
+    coef_index, num_coeffs, Batch, Betas, Complex64, Direction, Isa, PartialOptions, PartialPlan,
+    Plan, PlanOptions, Shape,
 };
 use std::f64::consts::PI;
 
@@ -354,6 +354,94 @@ fn selected_betas() {
                 let want = direct(&s, &c, s.alpha(ja), beta, s.gamma(jg));
                 let got = y[i * sl + ja * s.n_gamma + jg];
                 assert!((want - got).norm() < 1e-12, "beta {beta}");
+            }
+        }
+    }
+}
+
+/// Selections where no beta's mirror is selected too run each cluster's direct members at
+/// the selected betas and the reversed ones at the mirrors only: against the full
+/// inverse's slices on every instruction set, with selections of lower and upper betas
+/// (padding between them), chunks of one pair, real plans and batches.
+#[test]
+fn selections_without_mirrors() {
+    let isas = [Isa::Avx512, Isa::Avx2, Isa::Scalar];
+    let shapes = [
+        Shape::new(12).with_grid(12, 24, 25),
+        Shape::new(11).with_orders(7, 4).with_grid(12, 15, 10),
+    ];
+    // Lower and upper betas; lower only (more than a vector); upper only; mixed again;
+    // a beta with its mirror (no split).
+    let selections: [&[usize]; 5] = [
+        &[1, 5, 20, 13, 8, 17],
+        &[2, 4, 9, 0, 11, 6, 3, 8, 10],
+        &[23, 17, 14],
+        &[12, 0, 21],
+        &[7, 16, 2],
+    ];
+    for s in shapes {
+        let c = random_coeffs(&s, 31);
+        let mut hc = c.clone();
+        common::make_hermitian(&s, &mut hc);
+        let all = PartialPlan::new(&s, &opts()).unwrap();
+        let mut x = zeros(s.num_samples());
+        all.inverse(&c, &mut x).unwrap();
+        let mut xr = zeros(s.num_samples());
+        all.inverse(&hc, &mut xr).unwrap();
+        let sl = s.slice_len();
+        for isa in isas.into_iter().filter(|i| i.is_supported()) {
+            for ks in selections {
+                for cap in [None, Some(1)] {
+                    let o = PartialOptions {
+                        betas: Betas::Indices(ks.to_vec()),
+                        isa: Some(isa),
+                        max_workspace_bytes: cap,
+                        ..opts()
+                    };
+                    let sel = PartialPlan::new(&s, &o).unwrap();
+                    let mut y = zeros(sel.num_samples());
+                    sel.inverse(&c, &mut y).unwrap();
+                    for (i, &k) in ks.iter().enumerate() {
+                        let e = max_diff(&y[i * sl..][..sl], &x[k * sl..][..sl]);
+                        assert!(e < 1e-13, "{isa:?} {ks:?} {cap:?} slice {k}: {e:e}");
+                    }
+                    // Real plans: the real part of the complex inverse of Hermitian data.
+                    let r = PartialPlan::new(
+                        &s,
+                        &PartialOptions {
+                            real: true,
+                            ..o.clone()
+                        },
+                    )
+                    .unwrap();
+                    let mut yr = vec![0.0; r.num_samples()];
+                    r.inverse_real(&hc, &mut yr).unwrap();
+                    for (i, &k) in ks.iter().enumerate() {
+                        let e = yr[i * sl..][..sl]
+                            .iter()
+                            .zip(&xr[k * sl..][..sl])
+                            .map(|(a, b)| (a - b.re).abs())
+                            .fold(0.0, f64::max);
+                        assert!(e < 1e-13, "{isa:?} {ks:?} {cap:?} real slice {k}: {e:e}");
+                    }
+                    // A batch of three equals three single executes, bit for bit.
+                    let (nc, ns) = (s.num_coeffs(), sel.num_samples());
+                    let mut cs = c.clone();
+                    cs.extend(c.iter().map(|v| v * 0.5));
+                    cs.extend(hc.iter());
+                    let mut many = zeros(3 * ns);
+                    let b = Batch {
+                        count: 3,
+                        in_dist: nc,
+                        out_dist: ns,
+                    };
+                    sel.inverse_many(b, &cs, &mut many).unwrap();
+                    for t in 0..3 {
+                        let mut one = zeros(ns);
+                        sel.inverse(&cs[t * nc..][..nc], &mut one).unwrap();
+                        assert!(same_bits(&one, &many[t * ns..][..ns]), "batch {t}");
+                    }
+                }
             }
         }
     }

@@ -166,7 +166,9 @@ impl Lanes<'_> {
         assert!(ps == 0 || self.interleaved);
         assert!(gap == 0 || ps > 0);
         assert!(gap > 0 || ps == 0 || ps >= 2 * p);
-        assert!(gap == 0 || (ps >= p && (gap == p || gap >= nb / 2 * ps)));
+        // Lower rows `u ps` (`u < upper_from`), upper rows `gap + u ps`.
+        let uf = self.upper_from;
+        assert!(gap == 0 || (ps >= p && (gap == p || uf >= nb || gap >= uf * ps)));
         assert!(gap != p || ps >= 2 * p);
     }
 

@@ -31,6 +31,12 @@ pub(super) struct LanePairs {
     pub n_slices: usize,
     /// Per pair: the output slices of its lower and upper point (`usize::MAX`: not written).
     pub outputs: Vec<[usize; 2]>,
+    /// When no pair writes both its points (see [`LanePairs::new`]): the number of pairs,
+    /// a multiple of the vector width, before which pairs write their lower point (or
+    /// nothing: padding) and from which they write their upper point. The inverse then
+    /// runs each cluster's direct members only at the written points and its reversed
+    /// members only at their mirrors.
+    pub lower_outputs: Option<usize>,
 }
 
 /// `(cos(x), sin(x))` of a half angle `x` in double-double.
@@ -40,8 +46,11 @@ fn half_angle_point(x: Dd) -> (Dd, Dd) {
 }
 
 impl LanePairs {
-    /// The lanes of `betas` on `shape`'s grid.
-    pub fn new(shape: &Shape, betas: &Betas) -> Result<LanePairs> {
+    /// The lanes of `betas` on `shape`'s grid. With `split = Some(w)` and no pair writing
+    /// both its points, the pairs are ordered by the point they write, lower first, padded
+    /// to a multiple of `w` with pairs that write nothing (see
+    /// [`LanePairs::lower_outputs`]).
+    pub fn new(shape: &Shape, betas: &Betas, split: Option<usize>) -> Result<LanePairs> {
         let bg = shape.grid_bandwidth;
         let nb = 2 * bg;
         // What the tables take per pair (two points, each with its powers of the half-angle
@@ -118,6 +127,34 @@ impl LanePairs {
         if half.is_empty() {
             return Err(Error::InvalidArgument("no betas selected".into()));
         }
+        let mut lower_outputs = None;
+        if let Some(w) = split {
+            if outputs.iter().all(|o| o.contains(&usize::MAX)) {
+                let writes_upper = |j: &usize| outputs[*j][1] != usize::MAX;
+                let (mut order, upper): (Vec<usize>, Vec<usize>) =
+                    (0..half.len()).partition(|j| !writes_upper(j));
+                let lower = order.len();
+                order.extend(upper);
+                let pad = if lower < order.len() {
+                    lower.next_multiple_of(w) - lower
+                } else {
+                    0
+                };
+                let mut h = Vec::with_capacity(half.len() + pad);
+                let mut o = Vec::with_capacity(half.len() + pad);
+                for (i, &j) in order.iter().enumerate() {
+                    if i == lower {
+                        // Padding pairs: any valid point, nothing written.
+                        h.extend(std::iter::repeat_n(half[order[0]], pad));
+                        o.extend(std::iter::repeat_n([usize::MAX; 2], pad));
+                    }
+                    h.push(half[j]);
+                    o.push(outputs[j]);
+                }
+                (half, outputs) = (h, o);
+                lower_outputs = Some(lower + pad);
+            }
+        }
         let pairs = half.len();
         let maxpow = 2 * shape.degree_limit;
         // Lower points, then their mirrors: the mirror's half angle is pi/2 - x, whose
@@ -132,6 +169,7 @@ impl LanePairs {
             pairs,
             n_slices,
             outputs,
+            lower_outputs,
         })
     }
 }

@@ -305,7 +305,7 @@ impl<X: Exchange> DistributedPlan<X> {
             None => crate::wigner::DEFAULT_SKIP_BITS,
             Some(b) => b,
         };
-        let pairs = LanePairs::new(shape, &Betas::All)?;
+        let pairs = LanePairs::new(shape, &Betas::All, None)?;
         let np = pairs.pairs;
         // One chunk of every beta: a cluster's kernel call covers all lanes.
         let opts = PartialOptions {
@@ -421,7 +421,7 @@ impl<X: Exchange> DistributedPlan<X> {
                     })
                 })
                 .collect();
-            general.pairs = LanePairs::new(shape, &Betas::Indices(order))?;
+            general.pairs = LanePairs::new(shape, &Betas::Indices(order), None)?;
         }
         Ok(Parts {
             shape: *shape,
@@ -644,6 +644,7 @@ impl<X: Exchange> DistributedPlan<X> {
                 h,
                 hp: h.next_multiple_of(self.parts.general.lanes_w),
                 row_len: width(&shares[me]),
+                lower_outputs: None,
             },
             parts: offsets.into_iter().zip(counts).collect(),
             blocks,

@@ -69,11 +69,47 @@ pub(super) struct ChunkLanes {
     /// Doubles of a lane row in the buffer the kernels run on (the DWT stage's
     /// `row_total`, or a distributed plan's segment of it).
     pub row_len: usize,
+    /// Split chunks (see [`crate::partial::betas::LanePairs::lower_outputs`]): pairs
+    /// `0..k` write their lower point, pairs `k..hp` their upper one; `k` is a multiple of
+    /// the vector width.
+    pub lower_outputs: Option<usize>,
 }
 
 impl ChunkLanes {
     pub fn lanes(&self) -> usize {
         2 * self.hp
+    }
+}
+
+/// How a cluster's inverse splits over a split chunk (see [`ChunkLanes::lower_outputs`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Split {
+    /// The chunk's pairs writing their lower point.
+    k: usize,
+    /// Direct members (the first slots) and the width of their kernel call.
+    direct: usize,
+    direct_p: usize,
+}
+
+impl Split {
+    /// The split of `cl` over `ch`, if the chunk is split and the cluster's slots allow it:
+    /// direct members first, and the reversed ones (if any) in 8 columns after them
+    /// within the cluster's width.
+    fn of(cl: &ClusterPlan, ch: ChunkLanes) -> Option<Split> {
+        let k = ch.lower_outputs?;
+        let direct = cl.slots.iter().take_while(|s| !s.member.reversed).count();
+        let reversed = cl.slots.len() - direct;
+        if cl.slots[direct..].iter().any(|s| !s.member.reversed) {
+            return None;
+        }
+        let direct_p = if reversed == 0 { cl.p } else { 8 };
+        (reversed == 0 || (direct <= 4 && 2 * direct + 8 <= cl.p && 2 * reversed <= 8)).then_some(
+            Split {
+                k,
+                direct,
+                direct_p,
+            },
+        )
     }
 }
 
@@ -291,15 +327,39 @@ impl DwtStage {
         from: usize,
         to: usize,
     ) {
-        let p = cl.p;
+        // SAFETY: the caller's contract.
+        unsafe {
+            Self::fill_columns(
+                cl,
+                (0..cl.slots.len(), cl.p),
+                (scales, coef, real),
+                fin,
+                (from, to),
+            )
+        }
+    }
+
+    /// [`DwtStage::fill_rows`] for the slots `slots` only, slot `slots.start + q` in
+    /// columns `2q, 2q + 1` of rows of `p` doubles.
+    ///
+    /// # Safety
+    /// As for [`DwtStage::fill_rows`].
+    unsafe fn fill_columns(
+        cl: &ClusterPlan,
+        (slots, p): (std::ops::Range<usize>, usize),
+        (scales, coef, real): (&[f64], *const Complex64, bool),
+        fin: &mut [f64],
+        (from, to): (usize, usize),
+    ) {
+        let slots = &cl.slots[slots];
         let scale = 1.0 / (2.0 * PI);
         // Rows with no value in some column (unused slots, degrees below `L0`) start as 0.
-        let partly = 2 * cl.slots.len() < p || cl.slots.iter().any(|s| s.first > cl.m);
+        let partly = 2 * slots.len() < p || slots.iter().any(|s| s.first > cl.m);
         let rows = &mut fin[from * p..to * p];
         if partly {
             rows.fill(0.0);
         }
-        for (q, s) in cl.slots.iter().enumerate() {
+        for (q, s) in slots.iter().enumerate() {
             let lo = from.max(s.first - cl.m);
             if lo >= to {
                 continue;
@@ -388,6 +448,13 @@ impl DwtStage {
         (real, stream, next): (bool, bool, Prefetch),
         block: *mut f64,
     ) {
+        if let Some(split) = Split::of(cl, ch) {
+            // SAFETY: the caller's contract.
+            unsafe {
+                self.inverse_split(sc, (cl, ch, split), n, coef, (real, stream, next), block)
+            };
+            return;
+        }
         let p = cl.p;
         let mut data = std::mem::take(&mut sc.data);
         if data.len() < self.data_len() {
@@ -417,6 +484,117 @@ impl DwtStage {
         sc.data = data;
     }
 
+    /// [`DwtStage::inverse`] for a split chunk: the direct members at the written points
+    /// and the reversed members at their mirrors, a kernel call of 8 columns each (the
+    /// direct members of a cluster without reversed ones: its own width). For the calls the
+    /// lanes are reordered (and restored after) so that each call's lanes are contiguous,
+    /// the lower half first: lanes `0..hp` are the written points (lower ones of pairs
+    /// `0..k`, then upper ones of pairs `k..hp`), lanes `hp..2 hp` their mirrors (lower ones
+    /// of pairs `k..hp`, then upper ones of pairs `0..k`). The rows' other columns get
+    /// values nobody reads.
+    ///
+    /// # Safety
+    /// As for [`DwtStage::inverse`].
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn inverse_split(
+        &self,
+        sc: &mut Scratch,
+        (cl, ch, split): (&ClusterPlan, ChunkLanes, Split),
+        n: usize,
+        coef: *const Complex64,
+        (real, stream, next): (bool, bool, Prefetch),
+        block: *mut f64,
+    ) {
+        let mut data = std::mem::take(&mut sc.data);
+        if data.len() < self.data_len() {
+            data = vec![0.0; self.data_len()];
+        }
+        let (k, hp, len) = (split.k, ch.hp, ch.row_len);
+        let reorder = |sc: &mut Scratch, back: bool| {
+            for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
+                let (lo, hi) = v.split_at_mut(hp);
+                let hi = &mut hi[..hp];
+                if back {
+                    hi.rotate_right(k);
+                }
+                lo[k..].swap_with_slice(&mut hi[k..]);
+                if !back {
+                    hi.rotate_left(k);
+                }
+            }
+        };
+        reorder(sc, false);
+        let (fin_d, fin_r) = data.split_at_mut(n * split.direct_p);
+        let scales = &sc.rec.s;
+        let rec = Rec::new(&sc.rec, n);
+        let mut next = Some(next);
+        // (slots, columns, input, column offset, lanes, lower lanes, first pair, upper
+        // rows' offset from the first lower one's).
+        let calls = [
+            (
+                0..split.direct,
+                split.direct_p,
+                fin_d,
+                0,
+                0..hp,
+                k,
+                0,
+                (k + hp) * len,
+            ),
+            (
+                split.direct..cl.slots.len(),
+                8,
+                fin_r,
+                2 * split.direct,
+                hp..2 * hp,
+                hp - k,
+                // Without lower lanes the upper rows are addressed from the first pair (a
+                // zero gap would mean rows side by side).
+                if k < hp { k } else { 0 },
+                if k < hp { (hp - k) * len } else { hp * len },
+            ),
+        ];
+        for (slots, p, fin, column, lanes, lower, pair, gap) in calls {
+            if slots.is_empty() {
+                continue;
+            }
+            // SAFETY: `coef` holds the shape's coefficients (caller's contract).
+            let mut fill = |fin: &mut [f64], from: usize, to: usize| unsafe {
+                Self::fill_columns(
+                    cl,
+                    (slots.clone(), p),
+                    (scales, coef, real),
+                    fin,
+                    (from, to),
+                )
+            };
+            let mut l = self.lanes(sc, ch, stream);
+            l.tau = &sc.tau[lanes.clone()];
+            l.p = &sc.start[lanes.clone()];
+            l.sc = &sc.scale[lanes];
+            l.upper_from = lower;
+            l.row_gap = gap;
+            l.prefetch = next.take().unwrap_or(Prefetch::none());
+            // SAFETY: the first call's lanes write rows `0..k` (lower) and `hp + k..2 hp`
+            // (upper), the second call's rows `k..hp` and `hp..hp + k`: rows of the chunk,
+            // each lane `p` doubles from `column`, inside the cluster's `cl.p` columns
+            // (`column + p <= cl.p`, see `Split::of`), all the caller's (caller's contract).
+            unsafe {
+                dwt::inverse_raw(
+                    self.isa,
+                    p,
+                    &rec,
+                    &l,
+                    &mut fin[..n * p],
+                    &mut fill,
+                    block.wrapping_add(column + pair * len),
+                )
+            };
+        }
+        sc.data = data;
+        reorder(sc, true);
+    }
+
     /// [`DwtStage::inverse`] for a batch sharing the recurrence: transform `t` from the
     /// coefficients at `coef.base + t coef.dist` into the lane rows at
     /// `block.base + t block.dist`, prefetching meanwhile the coefficient blocks that the
@@ -440,6 +618,31 @@ impl DwtStage {
         ),
         block: BatchRows<*mut f64>,
     ) {
+        if Split::of(cl, ch).is_some() {
+            // Split chunks (selected betas) run their transforms one by one.
+            for t in 0..coef.count {
+                let hint = if t + 1 < coef.count {
+                    self.coefficient_hints(cl, coef.base.wrapping_add((t + 1) * coef.dist), real)
+                } else {
+                    next.map_or(Prefetch::none(), |(c, rows)| {
+                        self.coefficient_hints(c, rows.base, real)
+                    })
+                };
+                // SAFETY: transform `t`'s coefficients and rows (caller's contract).
+                unsafe {
+                    self.inverse(
+                        sc,
+                        cl,
+                        ch,
+                        n,
+                        coef.base.wrapping_add(t * coef.dist),
+                        (real, stream, hint),
+                        block.base.wrapping_add(t * block.dist),
+                    )
+                };
+            }
+            return;
+        }
         let (p, dist) = (cl.p, self.data_len());
         let (mut data, mut tile) = self.batch_buffers(sc, coef.count);
         let scales = &sc.rec.s;

@@ -149,7 +149,7 @@ impl PartialPlan {
         if let Some(0) = options.max_workspace_bytes {
             return Err(Error::InvalidArgument("max_workspace_bytes is 0".into()));
         }
-        let pairs = LanePairs::new(shape, &options.betas)?;
+        let pairs = LanePairs::new(shape, &options.betas, Some(isa.lanes()))?;
         let n_slices = pairs.n_slices;
         let engine = if shape.is_full() && !restricted && !options.general_engine {
             let po = PlanOptions {
@@ -610,11 +610,22 @@ impl General {
         let w = self.lanes_w;
         (0..self.pairs.pairs).step_by(h).map(move |j0| {
             let h = h.min(self.pairs.pairs - j0);
+            let hp = h.next_multiple_of(w);
+            // The chunk's share of a split: pairs past its last one write nothing.
+            let lower_outputs = self.pairs.lower_outputs.and_then(|k| {
+                let k = if k >= j0 + h {
+                    hp
+                } else {
+                    k.saturating_sub(j0)
+                };
+                k.is_multiple_of(w).then_some(k)
+            });
             ChunkLanes {
                 j0,
                 h,
-                hp: h.next_multiple_of(w),
+                hp,
                 row_len: self.dwt.row_total,
+                lower_outputs,
             }
         })
     }
