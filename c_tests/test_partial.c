@@ -153,6 +153,7 @@ static void selected_betas(void) {
     so3fft_partial_options o;
     so3fft_partial all, sel;
     int ks[4] = {15, 0, 7, 9};
+    int ks_single[3] = {2, 12, 5};
     double vals[2];
     ptrdiff_t nc, ns, sl;
     so3fft_complex *c, *x, *y;
@@ -180,6 +181,15 @@ static void selected_betas(void) {
     for (i = 0; i < 4; i++) CHECK(max_abs_diff(y + i * sl, x + ks[i] * sl, (size_t)sl) < 1e-13);
     /* a selection plan runs the inverse only */
     CHECK(so3fft_partial_forward(sel, y, c) == SO3FFT_EDIRECTION);
+    so3fft_destroy_partial(sel);
+    /* no beta with its mirror (the kernels then run each member at its own point only) */
+    o.nbetas = 3;
+    o.beta_indices = ks_single;
+    sel = so3fft_plan_partial(&s, &o, SO3FFT_ESTIMATE);
+    CHECK(sel != NULL);
+    CHECK(so3fft_partial_inverse(sel, c, y) == SO3FFT_OK);
+    for (i = 0; i < 3; i++)
+        CHECK(max_abs_diff(y + i * sl, x + ks_single[i] * sl, (size_t)sl) < 1e-13);
     so3fft_destroy_partial(sel);
     /* beta values: the grid's own values give the same slices */
     vals[0] = PI_ * (2 * 3 + 1) / (4.0 * 8);
