@@ -68,8 +68,9 @@ pub struct Lanes<'a> {
     /// what skipping saves: inactive lanes then accumulate exact zeros).
     pub skip: bool,
     /// Row of lane `u` in the data arrays: `u`, or, interleaved, `2u` for `u < upper_from`
-    /// and `2(u - upper_from) + 1` above (the lanes count `2 upper_from`), so that lanes
-    /// `u` and `u + upper_from` (a beta and its mirror, see `plan/blocks.rs`) are adjacent.
+    /// and `2(u - upper_from) + 1` above, so that with `2 upper_from` lanes, lanes `u` and
+    /// `u + upper_from` (a beta and its mirror, see `plan/blocks.rs`) are adjacent (a
+    /// partial plan's split selections use other counts of lower lanes).
     pub interleaved: bool,
     /// Memory to prefetch into L2 while the kernel runs, a few lines at a time (the next
     /// cluster's block and coefficient rows); hints only, never read.
@@ -83,7 +84,8 @@ pub struct Lanes<'a> {
     pub pair_stride: usize,
     /// With `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`, side by
     /// side). Far larger in the half-major and split layouts of `plan/blocks.rs`, where
-    /// the low-beta rows and the mirror rows are in two separate halves.
+    /// the low-beta rows and the mirror rows are in two separate halves, and in a partial
+    /// plan's lane-major chunks (`partial/dwt_stage.rs`).
     pub row_gap: usize,
 }
 

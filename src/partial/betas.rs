@@ -31,12 +31,12 @@ pub(super) struct LanePairs {
     pub n_slices: usize,
     /// Per pair: the output slices of its lower and upper point (`usize::MAX`: not written).
     pub outputs: Vec<[usize; 2]>,
-    /// When no pair writes both its points (see [`LanePairs::new`]): the number of pairs,
-    /// a multiple of the vector width, before which pairs write their lower point (or
-    /// nothing: padding) and from which they write their upper point. The inverse then
-    /// runs each cluster's direct members only at the written points and its reversed
-    /// members only at their mirrors.
-    pub lower_outputs: Option<usize>,
+    /// When no pair writes both its points (see [`LanePairs::new`]): the first pair that
+    /// writes its upper point (the pairs before it write their lower point, or nothing:
+    /// padding); a multiple of the vector width unless it is `pairs`. The inverse then runs
+    /// each cluster's direct members only at the written points and its reversed members
+    /// only at their mirrors.
+    pub first_upper_pair: Option<usize>,
 }
 
 /// `(cos(x), sin(x))` of a half angle `x` in double-double.
@@ -49,7 +49,7 @@ impl LanePairs {
     /// The lanes of `betas` on `shape`'s grid. With `split = Some(w)` and no pair writing
     /// both its points, the pairs are ordered by the point they write, lower first, padded
     /// to a multiple of `w` with pairs that write nothing (see
-    /// [`LanePairs::lower_outputs`]).
+    /// [`LanePairs::first_upper_pair`]).
     pub fn new(shape: &Shape, betas: &Betas, split: Option<usize>) -> Result<LanePairs> {
         let bg = shape.grid_bandwidth;
         let nb = 2 * bg;
@@ -127,7 +127,7 @@ impl LanePairs {
         if half.is_empty() {
             return Err(Error::InvalidArgument("no betas selected".into()));
         }
-        let mut lower_outputs = None;
+        let mut first_upper_pair = None;
         if let Some(w) = split {
             if outputs.iter().all(|o| o.contains(&usize::MAX)) {
                 let writes_upper = |j: &usize| outputs[*j][1] != usize::MAX;
@@ -152,7 +152,7 @@ impl LanePairs {
                     o.push(outputs[j]);
                 }
                 (half, outputs) = (h, o);
-                lower_outputs = Some(lower + pad);
+                first_upper_pair = Some(lower + pad);
             }
         }
         let pairs = half.len();
@@ -169,7 +169,7 @@ impl LanePairs {
             pairs,
             n_slices,
             outputs,
-            lower_outputs,
+            first_upper_pair,
         })
     }
 }

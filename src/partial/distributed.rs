@@ -644,7 +644,7 @@ impl<X: Exchange> DistributedPlan<X> {
                 h,
                 hp: h.next_multiple_of(self.parts.general.lanes_w),
                 row_len: width(&shares[me]),
-                lower_outputs: None,
+                first_upper_pair: None,
             },
             parts: offsets.into_iter().zip(counts).collect(),
             blocks,

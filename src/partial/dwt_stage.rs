@@ -69,10 +69,10 @@ pub(super) struct ChunkLanes {
     /// Doubles of a lane row in the buffer the kernels run on (the DWT stage's
     /// `row_total`, or a distributed plan's segment of it).
     pub row_len: usize,
-    /// Split chunks (see [`crate::partial::betas::LanePairs::lower_outputs`]): pairs
-    /// `0..k` write their lower point, pairs `k..hp` their upper one; `k` is a multiple of
-    /// the vector width.
-    pub lower_outputs: Option<usize>,
+    /// Split chunks (see [`crate::partial::betas::LanePairs::first_upper_pair`]): pairs
+    /// `0..k` write their lower point (or nothing: padding, also the chunk's pairs
+    /// `h..hp`), pairs `k..hp` their upper one; `k` is a multiple of the vector width.
+    pub first_upper_pair: Option<usize>,
 }
 
 impl ChunkLanes {
@@ -81,11 +81,11 @@ impl ChunkLanes {
     }
 }
 
-/// How a cluster's inverse splits over a split chunk (see [`ChunkLanes::lower_outputs`]).
+/// How a cluster's inverse splits over a split chunk (see [`ChunkLanes::first_upper_pair`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Split {
-    /// The chunk's pairs writing their lower point.
-    k: usize,
+    /// The chunk's first pair writing its upper point.
+    first_upper: usize,
     /// Direct members (the first slots) and the width of their kernel call.
     direct: usize,
     direct_p: usize,
@@ -96,7 +96,7 @@ impl Split {
     /// direct members first, and the reversed ones (if any) in 8 columns after them
     /// within the cluster's width.
     fn of(cl: &ClusterPlan, ch: ChunkLanes) -> Option<Split> {
-        let k = ch.lower_outputs?;
+        let first_upper = ch.first_upper_pair?;
         let direct = cl.slots.iter().take_while(|s| !s.member.reversed).count();
         let reversed = cl.slots.len() - direct;
         if cl.slots[direct..].iter().any(|s| !s.member.reversed) {
@@ -105,11 +105,50 @@ impl Split {
         let direct_p = if reversed == 0 { cl.p } else { 8 };
         (reversed == 0 || (direct <= 4 && 2 * direct + 8 <= cl.p && 2 * reversed <= 8)).then_some(
             Split {
-                k,
+                first_upper,
                 direct,
                 direct_p,
             },
         )
+    }
+}
+
+/// One kernel call of [`DwtStage::inverse_split`].
+struct SplitCall<'a> {
+    /// The cluster's slots it computes, in `p` columns from `column` of each row.
+    slots: std::ops::Range<usize>,
+    p: usize,
+    column: usize,
+    /// Its input rows.
+    fin: &'a mut [f64],
+    /// Its lanes (reordered), the lower-form ones before `upper_from`.
+    lanes: std::ops::Range<usize>,
+    upper_from: usize,
+    /// The pair of its first lower lane's row, and the offset from that row to its first
+    /// upper lane's row.
+    first_pair: usize,
+    row_gap: usize,
+}
+
+/// Reorders a split chunk's lanes (`first_upper` pairs write their lower point) so that
+/// lanes `0..hp` are the written points (lower ones of pairs `0..first_upper`, then upper
+/// ones of the rest) and lanes `hp..2 hp` their mirrors (lower ones of pairs
+/// `first_upper..hp`, then upper ones of the first pairs): each a contiguous run, the
+/// lower form first.
+fn written_points_first(sc: &mut Scratch, first_upper: usize, hp: usize) {
+    for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
+        let (lo, hi) = v.split_at_mut(hp);
+        lo[first_upper..].swap_with_slice(&mut hi[first_upper..hp]);
+        hi[..hp].rotate_left(first_upper);
+    }
+}
+
+/// Undoes [`written_points_first`].
+fn restore_lanes(sc: &mut Scratch, first_upper: usize, hp: usize) {
+    for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
+        let (lo, hi) = v.split_at_mut(hp);
+        hi[..hp].rotate_right(first_upper);
+        lo[first_upper..].swap_with_slice(&mut hi[first_upper..hp]);
     }
 }
 
@@ -486,16 +525,12 @@ impl DwtStage {
 
     /// [`DwtStage::inverse`] for a split chunk: the direct members at the written points
     /// and the reversed members at their mirrors, a kernel call of 8 columns each (the
-    /// direct members of a cluster without reversed ones: its own width). For the calls the
-    /// lanes are reordered (and restored after) so that each call's lanes are contiguous,
-    /// the lower half first: lanes `0..hp` are the written points (lower ones of pairs
-    /// `0..k`, then upper ones of pairs `k..hp`), lanes `hp..2 hp` their mirrors (lower ones
-    /// of pairs `k..hp`, then upper ones of pairs `0..k`). The rows' other columns get
-    /// values nobody reads.
+    /// direct members of a cluster without reversed ones: its own width), on the lanes
+    /// as [`written_points_first`] orders them. Columns no slice reads (the written
+    /// points' reversed ones, the mirrors' direct ones) may hold anything.
     ///
     /// # Safety
     /// As for [`DwtStage::inverse`].
-    #[allow(clippy::too_many_arguments)]
     unsafe fn inverse_split(
         &self,
         sc: &mut Scratch,
@@ -509,55 +544,43 @@ impl DwtStage {
         if data.len() < self.data_len() {
             data = vec![0.0; self.data_len()];
         }
-        let (k, hp, len) = (split.k, ch.hp, ch.row_len);
-        let reorder = |sc: &mut Scratch, back: bool| {
-            for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
-                let (lo, hi) = v.split_at_mut(hp);
-                let hi = &mut hi[..hp];
-                if back {
-                    hi.rotate_right(k);
-                }
-                lo[k..].swap_with_slice(&mut hi[k..]);
-                if !back {
-                    hi.rotate_left(k);
-                }
-            }
-        };
-        reorder(sc, false);
-        let (fin_d, fin_r) = data.split_at_mut(n * split.direct_p);
+        let (k, hp, len) = (split.first_upper, ch.hp, ch.row_len);
+        debug_assert!(k <= hp && k.is_multiple_of(self.isa.lanes()));
+        written_points_first(sc, k, hp);
+        let (fin_direct, fin_reversed) = data.split_at_mut(n * split.direct_p);
         let scales = &sc.rec.s;
         let rec = Rec::new(&sc.rec, n);
         let mut next = Some(next);
-        // (slots, columns, input, column offset, lanes, lower lanes, first pair, upper
-        // rows' offset from the first lower one's).
         let calls = [
-            (
-                0..split.direct,
-                split.direct_p,
-                fin_d,
-                0,
-                0..hp,
-                k,
-                0,
-                (k + hp) * len,
-            ),
-            (
-                split.direct..cl.slots.len(),
-                8,
-                fin_r,
-                2 * split.direct,
-                hp..2 * hp,
-                hp - k,
+            SplitCall {
+                slots: 0..split.direct,
+                p: split.direct_p,
+                fin: fin_direct,
+                column: 0,
+                lanes: 0..hp,
+                upper_from: k,
+                first_pair: 0,
+                row_gap: (k + hp) * len,
+            },
+            SplitCall {
+                slots: split.direct..cl.slots.len(),
+                p: 8,
+                fin: fin_reversed,
+                column: 2 * split.direct,
+                lanes: hp..2 * hp,
+                upper_from: hp - k,
                 // Without lower lanes the upper rows are addressed from the first pair (a
                 // zero gap would mean rows side by side).
-                if k < hp { k } else { 0 },
-                if k < hp { (hp - k) * len } else { hp * len },
-            ),
+                first_pair: if k < hp { k } else { 0 },
+                row_gap: if k < hp { (hp - k) * len } else { hp * len },
+            },
         ];
-        for (slots, p, fin, column, lanes, lower, pair, gap) in calls {
-            if slots.is_empty() {
+        for c in calls {
+            if c.slots.is_empty() {
                 continue;
             }
+            debug_assert!(c.column + c.p <= cl.p);
+            let (slots, p) = (c.slots, c.p);
             // SAFETY: `coef` holds the shape's coefficients (caller's contract).
             let mut fill = |fin: &mut [f64], from: usize, to: usize| unsafe {
                 Self::fill_columns(
@@ -569,11 +592,11 @@ impl DwtStage {
                 )
             };
             let mut l = self.lanes(sc, ch, stream);
-            l.tau = &sc.tau[lanes.clone()];
-            l.p = &sc.start[lanes.clone()];
-            l.sc = &sc.scale[lanes];
-            l.upper_from = lower;
-            l.row_gap = gap;
+            l.tau = &sc.tau[c.lanes.clone()];
+            l.p = &sc.start[c.lanes.clone()];
+            l.sc = &sc.scale[c.lanes];
+            l.upper_from = c.upper_from;
+            l.row_gap = c.row_gap;
             l.prefetch = next.take().unwrap_or(Prefetch::none());
             // SAFETY: the first call's lanes write rows `0..k` (lower) and `hp + k..2 hp`
             // (upper), the second call's rows `k..hp` and `hp..hp + k`: rows of the chunk,
@@ -585,14 +608,14 @@ impl DwtStage {
                     p,
                     &rec,
                     &l,
-                    &mut fin[..n * p],
+                    &mut c.fin[..n * p],
                     &mut fill,
-                    block.wrapping_add(column + pair * len),
+                    block.wrapping_add(c.column + c.first_pair * len),
                 )
             };
         }
         sc.data = data;
-        reorder(sc, true);
+        restore_lanes(sc, k, hp);
     }
 
     /// [`DwtStage::inverse`] for a batch sharing the recurrence: transform `t` from the

@@ -612,7 +612,7 @@ impl General {
             let h = h.min(self.pairs.pairs - j0);
             let hp = h.next_multiple_of(w);
             // The chunk's share of a split: pairs past its last one write nothing.
-            let lower_outputs = self.pairs.lower_outputs.and_then(|k| {
+            let first_upper_pair = self.pairs.first_upper_pair.and_then(|k| {
                 let k = if k >= j0 + h {
                     hp
                 } else {
@@ -625,7 +625,7 @@ impl General {
                 h,
                 hp,
                 row_len: self.dwt.row_total,
-                lower_outputs,
+                first_upper_pair,
             }
         })
     }
@@ -649,6 +649,11 @@ impl General {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
                 for ch in self.chunks() {
+                    // Chunks of padding pairs only (selections) write nothing.
+                    let tasks = self.slice_tasks(ch, batch.count);
+                    if tasks.is_empty() {
+                        continue;
+                    }
                     let lanes = ch.lanes();
                     let per_t = self.dwt.row_total * lanes;
                     let t0 = Instant::now();
@@ -723,7 +728,6 @@ impl General {
                         });
                     let t1 = Instant::now();
                     times.dwt += (t1 - t0).as_secs_f64();
-                    let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
