@@ -187,6 +187,7 @@ static void selected_betas(void) {
     o.beta_indices = ks_single;
     sel = so3fft_plan_partial(&s, &o, SO3FFT_ESTIMATE);
     CHECK(sel != NULL);
+    CHECK(so3fft_partial_num_samples(sel) == 3 * sl);
     CHECK(so3fft_partial_inverse(sel, c, y) == SO3FFT_OK);
     for (i = 0; i < 3; i++)
         CHECK(max_abs_diff(y + i * sl, x + ks_single[i] * sl, (size_t)sl) < 1e-13);

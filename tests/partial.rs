@@ -362,21 +362,27 @@ fn selected_betas() {
 /// Selections where no beta's mirror is selected too run each cluster's direct members at
 /// the selected betas and the reversed ones at the mirrors only: against the full
 /// inverse's slices on every instruction set, with selections of lower and upper betas
-/// (padding between them), chunks of one pair, real plans and batches.
+/// (padding between them), chunks of one pair, of a few pairs and of a vector, real plans,
+/// batches, beta values and a lower degree limit; and bit for bit against the same
+/// selection with a mirror added (which runs unsplit).
 #[test]
 fn selections_without_mirrors() {
     let isas = [Isa::Avx512, Isa::Avx2, Isa::Scalar];
     let shapes = [
         Shape::new(12).with_grid(12, 24, 25),
         Shape::new(11).with_orders(7, 4).with_grid(12, 15, 10),
+        Shape::new(10).with_degree_min(3).with_grid(16, 21, 20),
     ];
     // Lower and upper betas; lower only (more than a vector); upper only; mixed again;
+    // a vector of lower betas and three upper ones, or eight (split on a 32-beta grid);
     // a beta with its mirror (no split).
-    let selections: [&[usize]; 5] = [
+    let selections: [&[usize]; 7] = [
         &[1, 5, 20, 13, 8, 17],
         &[2, 4, 9, 0, 11, 6, 3, 8, 10],
         &[23, 17, 14],
         &[12, 0, 21],
+        &[0, 1, 2, 3, 4, 5, 6, 7, 20, 15, 13],
+        &[0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23],
         &[7, 16, 2],
     ];
     for s in shapes {
@@ -389,23 +395,60 @@ fn selections_without_mirrors() {
         let mut xr = zeros(s.num_samples());
         all.inverse(&hc, &mut xr).unwrap();
         let sl = s.slice_len();
+        let nb = s.n_beta();
         for isa in isas.into_iter().filter(|i| i.is_supported()) {
             for ks in selections {
-                for cap in [None, Some(1)] {
+                // Chunks of the whole selection, of one pair, of a few, of about a vector.
+                for cap in [None, Some(1), Some(30_000), Some(80_000), Some(150_000)] {
                     let o = PartialOptions {
                         betas: Betas::Indices(ks.to_vec()),
                         isa: Some(isa),
                         max_workspace_bytes: cap,
                         ..opts()
                     };
+                    let what = format!("{s:?} {isa:?} {ks:?} {cap:?}");
                     let sel = PartialPlan::new(&s, &o).unwrap();
                     let mut y = zeros(sel.num_samples());
                     sel.inverse(&c, &mut y).unwrap();
                     for (i, &k) in ks.iter().enumerate() {
                         let e = max_diff(&y[i * sl..][..sl], &x[k * sl..][..sl]);
-                        assert!(e < 1e-13, "{isa:?} {ks:?} {cap:?} slice {k}: {e:e}");
+                        assert!(e < 1e-13, "{what} slice {k}: {e:e}");
                     }
-                    // Real plans: the real part of the complex inverse of Hermitian data.
+                    // With the first beta's mirror added, no pair writes one point only.
+                    let mut with_mirror = ks.to_vec();
+                    if !ks.contains(&(nb - 1 - ks[0])) {
+                        with_mirror.push(nb - 1 - ks[0]);
+                    }
+                    let unsplit = PartialPlan::new(
+                        &s,
+                        &PartialOptions {
+                            betas: Betas::Indices(with_mirror),
+                            ..o.clone()
+                        },
+                    )
+                    .unwrap();
+                    let mut z = zeros(unsplit.num_samples());
+                    unsplit.inverse(&c, &mut z).unwrap();
+                    assert!(
+                        same_bits(&y, &z[..y.len()]),
+                        "{what}: split against unsplit"
+                    );
+                    // The same betas as values.
+                    let vals = Betas::Values(ks.iter().map(|&k| s.beta(k)).collect());
+                    let by_value = PartialPlan::new(
+                        &s,
+                        &PartialOptions {
+                            betas: vals,
+                            ..o.clone()
+                        },
+                    )
+                    .unwrap();
+                    let mut v = zeros(by_value.num_samples());
+                    by_value.inverse(&c, &mut v).unwrap();
+                    let e = max_diff(&v, &y);
+                    assert!(e < 1e-13, "{what}: values against indices {e:e}");
+                    // Real plans: the real part of the complex inverse of Hermitian data,
+                    // one at a time and as a batch of two.
                     let r = PartialPlan::new(
                         &s,
                         &PartialOptions {
@@ -422,10 +465,26 @@ fn selections_without_mirrors() {
                             .zip(&xr[k * sl..][..sl])
                             .map(|(a, b)| (a - b.re).abs())
                             .fold(0.0, f64::max);
-                        assert!(e < 1e-13, "{isa:?} {ks:?} {cap:?} real slice {k}: {e:e}");
+                        assert!(e < 1e-13, "{what} real slice {k}: {e:e}");
                     }
-                    // A batch of three equals three single executes, bit for bit.
                     let (nc, ns) = (s.num_coeffs(), sel.num_samples());
+                    let mut hcs = hc.clone();
+                    hcs.extend(hc.iter().map(|v| v * 2.0));
+                    let mut yr_many = vec![0.0; 2 * ns];
+                    let b = Batch {
+                        count: 2,
+                        in_dist: nc,
+                        out_dist: ns,
+                    };
+                    r.inverse_real_many(b, &hcs, &mut yr_many).unwrap();
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert!(bits(&yr_many[..ns]) == bits(&yr), "{what}: real batch");
+                    let twice: Vec<f64> = yr.iter().map(|v| 2.0 * v).collect();
+                    assert!(
+                        bits(&yr_many[ns..]) == bits(&twice),
+                        "{what}: real batch x2"
+                    );
+                    // A batch of three equals three single executes, bit for bit.
                     let mut cs = c.clone();
                     cs.extend(c.iter().map(|v| v * 0.5));
                     cs.extend(hc.iter());
@@ -439,7 +498,7 @@ fn selections_without_mirrors() {
                     for t in 0..3 {
                         let mut one = zeros(ns);
                         sel.inverse(&cs[t * nc..][..nc], &mut one).unwrap();
-                        assert!(same_bits(&one, &many[t * ns..][..ns]), "batch {t}");
+                        assert!(same_bits(&one, &many[t * ns..][..ns]), "{what}: batch {t}");
                     }
                 }
             }
