@@ -130,28 +130,6 @@ struct SplitCall<'a> {
     row_gap: usize,
 }
 
-/// Reorders a split chunk's lanes (`first_upper` pairs write their lower point) so that
-/// lanes `0..hp` are the written points (lower ones of pairs `0..first_upper`, then upper
-/// ones of the rest) and lanes `hp..2 hp` their mirrors (lower ones of pairs
-/// `first_upper..hp`, then upper ones of the first pairs): each a contiguous run, the
-/// lower form first.
-fn written_points_first(sc: &mut Scratch, first_upper: usize, hp: usize) {
-    for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
-        let (lo, hi) = v.split_at_mut(hp);
-        lo[first_upper..].swap_with_slice(&mut hi[first_upper..hp]);
-        hi[..hp].rotate_left(first_upper);
-    }
-}
-
-/// Undoes [`written_points_first`].
-fn restore_lanes(sc: &mut Scratch, first_upper: usize, hp: usize) {
-    for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
-        let (lo, hi) = v.split_at_mut(hp);
-        hi[..hp].rotate_right(first_upper);
-        lo[first_upper..].swap_with_slice(&mut hi[first_upper..hp]);
-    }
-}
-
 /// Per-worker scratch.
 pub(super) struct Scratch {
     rec: RecCoeffs,
@@ -271,7 +249,11 @@ impl DwtStage {
     }
 
     /// Recurrence coefficients (with `rec`) and lane inputs of cluster `cl` for chunk `ch`;
-    /// the number of degrees.
+    /// the number of degrees. Lanes `0..hp` are the pairs' lower points and `hp..2 hp` their
+    /// mirrors, except where the inverse splits (see [`Split`]): there lanes `0..hp` are
+    /// the written points (lower ones of pairs `0..k`, then upper ones of the rest) and
+    /// lanes `hp..2 hp` their mirrors (lower ones of pairs `k..hp`, then upper ones of
+    /// pairs `0..k`), so that each kernel call's lanes are contiguous, lower form first.
     pub fn setup(
         &self,
         sc: &mut Scratch,
@@ -284,8 +266,24 @@ impl DwtStage {
         self.recurrence.coeffs(cl.m, cl.mp, &mut sc.rec);
         let t = &pairs.tables;
         let (h, hp) = (ch.h, ch.hp);
-        for (half, first_point) in [(0, ch.j0), (1, pairs.pairs + ch.j0)] {
-            let u0 = half * hp;
+        // Runs of lanes: (first lane, upper form, first pair in the chunk, lanes).
+        let runs = match Split::of(cl, ch) {
+            None => [
+                (0, false, 0, hp),
+                (hp, true, 0, hp),
+                (0, false, 0, 0),
+                (0, true, 0, 0),
+            ],
+            Some(Split { first_upper: k, .. }) => [
+                (0, false, 0, k),
+                (k, true, k, hp - k),
+                (hp, false, k, hp - k),
+                (2 * hp - k, true, 0, k),
+            ],
+        };
+        for (u0, upper, j, len) in runs.into_iter().filter(|r| r.3 > 0) {
+            let live = len.min(h.saturating_sub(j));
+            let first_point = ch.j0 + j + if upper { pairs.pairs } else { 0 };
             t.starts(
                 self.isa,
                 first_point,
@@ -293,13 +291,13 @@ impl DwtStage {
                 cl.mp,
                 cl.norm,
                 self.skip_bits,
-                &mut sc.start[u0..u0 + h],
-                &mut sc.scale[u0..u0 + h],
+                &mut sc.start[u0..u0 + live],
+                &mut sc.scale[u0..u0 + live],
             );
-            let tau = if half == 0 { &t.tau_lo } else { &t.tau_hi };
-            sc.tau[u0..u0 + h].copy_from_slice(&tau[first_point..first_point + h]);
+            let tau = if upper { &t.tau_hi } else { &t.tau_lo };
+            sc.tau[u0..u0 + live].copy_from_slice(&tau[first_point..first_point + live]);
             for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
-                v[u0 + h..u0 + hp].fill(0.0);
+                v[u0 + live..u0 + len].fill(0.0);
             }
         }
         n
@@ -526,7 +524,7 @@ impl DwtStage {
     /// [`DwtStage::inverse`] for a split chunk: the direct members at the written points
     /// and the reversed members at their mirrors, a kernel call of 8 columns each (the
     /// direct members of a cluster without reversed ones: its own width), on the lanes
-    /// as [`written_points_first`] orders them. Columns no slice reads (the written
+    /// as [`DwtStage::setup`] orders them. Columns no slice reads (the written
     /// points' reversed ones, the mirrors' direct ones) may hold anything.
     ///
     /// # Safety
@@ -546,7 +544,6 @@ impl DwtStage {
         }
         let (k, hp, len) = (split.first_upper, ch.hp, ch.row_len);
         debug_assert!(k <= hp && k.is_multiple_of(self.isa.lanes()));
-        written_points_first(sc, k, hp);
         let (fin_direct, fin_reversed) = data.split_at_mut(n * split.direct_p);
         let scales = &sc.rec.s;
         let rec = Rec::new(&sc.rec, n);
@@ -615,7 +612,6 @@ impl DwtStage {
             };
         }
         sc.data = data;
-        restore_lanes(sc, k, hp);
     }
 
     /// [`DwtStage::inverse`] for a batch sharing the recurrence: transform `t` from the
