@@ -154,6 +154,61 @@ fn strided_rows_hold_the_consecutive_rows() {
     });
 }
 
+/// Fewer lower-half lanes than upper ones (`Lanes::upper_from` other than half the lanes,
+/// as in a partial plan's split selections): lower lanes `0..a` and upper lanes
+/// `24 + a..48` of the grid, the lower rows one after another and the upper rows after
+/// them, give each lane's row of the full call bit for bit, and nothing elsewhere.
+#[test]
+fn unequal_halves_give_each_lanes_row() {
+    layout_cases(|isa, pw, m, rec, lanes| {
+        let (n, nbs) = (rec.len(), lanes.tau.len());
+        let half = lanes.upper_from;
+        let fin = pseudo(n * pw, 5 + m as u64);
+        let mut y = vec![f64::NAN; nbs * pw];
+        inverse_from(isa, pw, rec, &lanes, &fin, &mut y);
+        for a in [0, 8, 16, 24] {
+            let pick: Vec<usize> = (0..a).chain(half + a..nbs).collect();
+            let take = |v: &[f64]| pick.iter().map(|&u| v[u]).collect::<Vec<_>>();
+            let (tau, p, sc) = (take(lanes.tau), take(lanes.p), take(lanes.sc));
+            // Upper rows 3 values after the last lower one.
+            let gap = a * pw + 3;
+            let split = Lanes {
+                tau: &tau,
+                p: &p,
+                sc: &sc,
+                upper_from: a,
+                pair_stride: pw,
+                row_gap: gap,
+                ..lanes
+            };
+            let mut z = vec![f64::NAN; gap + (pick.len() - a) * pw];
+            let mut buf = fin.clone();
+            // SAFETY: `z` holds the lower rows `u pw` (`u < a`) and the upper rows
+            // `gap + (u - a) pw`.
+            unsafe {
+                inverse_raw(
+                    isa,
+                    pw,
+                    rec,
+                    &split,
+                    &mut buf,
+                    &mut |_, _, _| {},
+                    z.as_mut_ptr(),
+                )
+            };
+            let mut want = vec![f64::NAN; z.len()];
+            for (u, &orig) in pick.iter().enumerate() {
+                let at = if u < a { u * pw } else { gap + (u - a) * pw };
+                let (r, _) = lanes.rows(orig);
+                want[at..at + pw].copy_from_slice(&y[r * pw..(r + 1) * pw]);
+            }
+            for (i, (v, w)) in z.iter().zip(&want).enumerate() {
+                assert_eq!(v.to_bits(), w.to_bits(), "{isa:?} P={pw} a={a} at {i}");
+            }
+        }
+    });
+}
+
 /// The forward kernel is the transpose of the inverse one: `<y, x> = <fin, f>` for
 /// `f = forward(x)` and `y = inverse(fin)`, on every path, with and without skipping,
 /// for odd and even numbers of vectors (the 8-column inverse pairs vectors), halves of
