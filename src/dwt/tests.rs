@@ -41,6 +41,24 @@ fn inverse_from(
     have
 }
 
+/// [`inverse_raw`] with every input row of `fin` present (no fill), rows at `out` as
+/// `lanes` address them.
+///
+/// # Safety
+/// `out` holds every row of the lanes.
+unsafe fn inverse_rows_at(
+    isa: Isa,
+    pw: usize,
+    rec: &Rec,
+    lanes: &Lanes,
+    fin: &[f64],
+    out: *mut f64,
+) {
+    let mut buf = fin.to_vec();
+    // SAFETY: the caller's contract.
+    unsafe { inverse_raw(isa, pw, rec, lanes, &mut buf, &mut |_, _, _| {}, out) }
+}
+
 fn pseudo(n: usize, seed: u64) -> Vec<f64> {
     let mut s = seed;
     (0..n)
@@ -125,19 +143,8 @@ fn strided_rows_hold_the_consecutive_rows() {
             lanes.pair_stride = ps;
             lanes.row_gap = if half { gap } else { 0 };
             let mut z = vec![f64::NAN; 5 + nbs / 2 * ps + gap];
-            let mut buf = fin.clone();
             // SAFETY: z holds nbs / 2 pairs of two rows after offset 5.
-            unsafe {
-                inverse_raw(
-                    isa,
-                    pw,
-                    rec,
-                    &lanes,
-                    &mut buf,
-                    &mut |_, _, _| {},
-                    z.as_mut_ptr().add(5),
-                )
-            };
+            unsafe { inverse_rows_at(isa, pw, rec, &lanes, &fin, z.as_mut_ptr().add(5)) };
             let mut want = vec![f64::NAN; z.len()];
             for r in 0..nbs {
                 let at = 5 + (r / 2) * ps + (r % 2) * gap;
@@ -182,20 +189,9 @@ fn unequal_halves_give_each_lanes_row() {
                 ..lanes
             };
             let mut z = vec![f64::NAN; gap + (pick.len() - a) * pw];
-            let mut buf = fin.clone();
             // SAFETY: `z` holds the lower rows `u pw` (`u < a`) and the upper rows
             // `gap + (u - a) pw`.
-            unsafe {
-                inverse_raw(
-                    isa,
-                    pw,
-                    rec,
-                    &split,
-                    &mut buf,
-                    &mut |_, _, _| {},
-                    z.as_mut_ptr(),
-                )
-            };
+            unsafe { inverse_rows_at(isa, pw, rec, &split, &fin, z.as_mut_ptr()) };
             let mut want = vec![f64::NAN; z.len()];
             for (u, &orig) in pick.iter().enumerate() {
                 let at = if u < a { u * pw } else { gap + (u - a) * pw };

@@ -250,8 +250,8 @@ impl DwtStage {
 
     /// Recurrence coefficients (with `rec`) and lane inputs of cluster `cl` for chunk `ch`;
     /// the number of degrees. Lanes `0..hp` are the pairs' lower points and `hp..2 hp` their
-    /// mirrors, except where the inverse splits (see [`Split`]): there lanes `0..hp` are
-    /// the written points (lower ones of pairs `0..k`, then upper ones of the rest) and
+    /// mirrors, except where the inverse splits at pair `k` (see [`Split`]): there lanes
+    /// `0..hp` are the written points (lower ones of pairs `0..k`, then upper ones of the rest) and
     /// lanes `hp..2 hp` their mirrors (lower ones of pairs `k..hp`, then upper ones of
     /// pairs `0..k`), so that each kernel call's lanes are contiguous, lower form first.
     pub fn setup(
@@ -266,21 +266,15 @@ impl DwtStage {
         self.recurrence.coeffs(cl.m, cl.mp, &mut sc.rec);
         let t = &pairs.tables;
         let (h, hp) = (ch.h, ch.hp);
-        // Runs of lanes: (first lane, upper form, first pair in the chunk, lanes).
-        let runs = match Split::of(cl, ch) {
-            None => [
-                (0, false, 0, hp),
-                (hp, true, 0, hp),
-                (0, false, 0, 0),
-                (0, true, 0, 0),
-            ],
-            Some(Split { first_upper: k, .. }) => [
-                (0, false, 0, k),
-                (k, true, k, hp - k),
-                (hp, false, k, hp - k),
-                (2 * hp - k, true, 0, k),
-            ],
-        };
+        // Runs of lanes: (first lane, upper form, first pair in the chunk, lanes). Unsplit
+        // is the split order with every pair writing its lower point (`k = hp`).
+        let k = Split::of(cl, ch).map_or(hp, |s| s.first_upper);
+        let runs = [
+            (0, false, 0, k),
+            (k, true, k, hp - k),
+            (hp, false, k, hp - k),
+            (2 * hp - k, true, 0, k),
+        ];
         for (u0, upper, j, len) in runs.into_iter().filter(|r| r.3 > 0) {
             let live = len.min(h.saturating_sub(j));
             let first_point = ch.j0 + j + if upper { pairs.pairs } else { 0 };
