@@ -717,7 +717,7 @@ mod x86 {
         };
         // The same peak as `kernel_gflops` reports against; the first row (the same loop in
         // assembly) checks this harness against it.
-        let peak = so3fft::internals::fma_peak();
+        let peak = so3fft::internals::fma_peak(so3fft::Isa::Avx512);
         println!("FMA peak {peak:.1} GFLOP/s (one core)");
         for (name, f, fmas) in loops {
             let g = rate(f, fmas);

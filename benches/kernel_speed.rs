@@ -2,8 +2,9 @@
 //! against the FMA peak of one core, and the kernel time summed over every cluster of a
 //! bandwidth.
 //!
-//! Run: `cargo bench --features internals --bench kernel_speed`
-//! (the skip threshold follows `SO3FFT_SKIP_BITS` if set).
+//! Run: `cargo bench --features internals --bench kernel_speed [-- --isa avx2]`
+//! (the kernels of the best instruction set unless `--isa avx512|avx2` names one; the peak
+//! is measured with the same vectors; the skip threshold follows `SO3FFT_SKIP_BITS` if set).
 
 use so3fft::internals::{
     aligned, cluster_pairs, cluster_setup, fma_peak, forward, grid_lanes, inverse, ClusterInputs,
@@ -12,16 +13,43 @@ use so3fft::internals::{
 use so3fft::Isa;
 
 fn main() {
-    println!("FMA peak of one core: {:.1} GFLOP/s", fma_peak());
-    kernel_gflops();
-    all_clusters_gflops();
+    let isa = isa_arg();
+    println!(
+        "{isa:?} kernels; FMA peak of one core: {:.1} GFLOP/s",
+        fma_peak(isa)
+    );
+    kernel_gflops(isa);
+    all_clusters_gflops(isa);
+}
+
+/// The instruction set `--isa NAME` names (default: the best this CPU has).
+fn isa_arg() -> Isa {
+    let args: Vec<String> = std::env::args().collect();
+    let name = args
+        .iter()
+        .position(|a| a == "--isa")
+        .and_then(|k| args.get(k + 1));
+    let isa = match name.map(String::as_str) {
+        None => Isa::detect(),
+        Some("avx512") => Isa::Avx512,
+        Some("avx2") => Isa::Avx2,
+        Some(other) => {
+            eprintln!("kernel_speed: --isa takes avx512 or avx2, not {other}");
+            std::process::exit(2)
+        }
+    };
+    if !isa.is_supported() {
+        eprintln!("kernel_speed: this CPU does not support {isa:?}");
+        std::process::exit(2)
+    }
+    isa
 }
 
 /// Kernel-only throughput: GFLOP/s of the fused
 /// recurrence + accumulation for one generic cluster, all 2B grid betas, against the
 /// FMA peak. Forward, inverse and the peak are measured in alternation and each keeps
 /// its best batch: the machine is shared and noisy.
-fn kernel_gflops() {
+fn kernel_gflops(isa: Isa) {
     // (B, betas, columns, m): m = B / 8 has long negligible prefixes near the poles,
     // m = 2 nearly none (the fast phase alone).
     for &(b, nbs, pw, m) in &[
@@ -46,7 +74,6 @@ fn kernel_gflops() {
         let xin = aligned(&xbuf, nbs * 16);
         let mut f = vec![0.0; (n + 8) * 16];
         let mut y = vec![0.0; nbs * 16];
-        let isa = Isa::detect();
         let batch = |f: &mut dyn FnMut()| {
             let t = std::time::Instant::now();
             for _ in 0..50 {
@@ -70,7 +97,7 @@ fn kernel_gflops() {
                     &mut y,
                 )
             }));
-            peak = peak.max(fma_peak());
+            peak = peak.max(fma_peak(isa));
         }
         let flops = (n * nbs * pw * 2) as f64;
         let (gf, gi) = (flops / tf / 1e9, flops / ti / 1e9);
@@ -84,8 +111,7 @@ fn kernel_gflops() {
 
 /// Kernel time summed over every cluster of a bandwidth (all 2B betas as one chunk),
 /// against the nominal DWT flop count.
-fn all_clusters_gflops() {
-    let isa = Isa::detect();
+fn all_clusters_gflops(isa: Isa) {
     for b in [128usize, 256] {
         let nbs = 2 * b;
         let (mut tf, mut ti) = (0.0, 0.0);
@@ -139,7 +165,7 @@ fn all_clusters_gflops() {
             );
         }
         let flops = 8.0 * b as f64 * (4.0 * (b as f64).powi(3) - b as f64) / 3.0;
-        let peak = fma_peak();
+        let peak = fma_peak(isa);
         println!(
             "B={b}: kernels over all clusters: forward {:.3} s ({:.1} GFLOP/s, {:.0}%), inverse {:.3} s ({:.1} GFLOP/s, {:.0}%), peak {peak:.1}",
             tf,

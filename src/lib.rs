@@ -54,4 +54,4 @@ pub use partial::{
     Batch, Betas, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
 };
 pub use plan::{Direction, FftThreading, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
-pub use simd::Isa;
+pub use simd::{Isa, ISA_VARIABLE};

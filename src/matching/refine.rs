@@ -255,7 +255,7 @@ impl So3Series {
         So3Series {
             packed: tables.pack(coeffs),
             tables,
-            isa: Isa::detect(),
+            isa: Isa::selected().unwrap_or_else(|_| Isa::detect()),
         }
     }
 

@@ -29,7 +29,8 @@ pub struct PartialOptions {
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,
-    /// Instruction set of the kernels (`None`: the best this CPU has).
+    /// Instruction set of the kernels (`None`: [`Isa::selected`], the best this CPU has
+    /// unless the environment variable `SO3FFT_ISA` names another).
     pub isa: Option<Isa>,
     /// Also prepare the real-signal transforms.
     pub real: bool,

@@ -45,7 +45,8 @@ pub struct PlanOptions {
     pub rigor: Rigor,
     /// Cap on the chunk buffer in bytes (`None`: the library default, see [`Plan::workspace_bytes`](crate::Plan::workspace_bytes)).
     pub max_workspace_bytes: Option<usize>,
-    /// Force an instruction set for the DWT kernels (`None`: the best this CPU has).
+    /// Instruction set of the kernels (`None`: [`Isa::selected`], the best this CPU has
+    /// unless the environment variable `SO3FFT_ISA` names another).
     pub isa: Option<Isa>,
     /// How the FFT stage uses the threads.
     pub fft_threading: FftThreading,

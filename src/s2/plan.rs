@@ -23,7 +23,8 @@ pub struct S2Options {
     pub threads: usize,
     /// FFTW planner rigour of the ring DFTs.
     pub rigor: Rigor,
-    /// Instruction set of the kernels (`None`: the best this CPU has).
+    /// Instruction set of the kernels (`None`: [`Isa::selected`], the best this CPU has
+    /// unless the environment variable `SO3FFT_ISA` names another).
     pub isa: Option<Isa>,
     /// Degree limit `L <= B`: only degrees `l < L` are computed (forward: the others are
     /// written as 0; inverse: they are not read). `None`: `B`.

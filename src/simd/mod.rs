@@ -15,6 +15,9 @@ pub(crate) mod scalar;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
 
+/// The environment variable that overrides [`Isa::detect`] (see [`Isa::selected`]).
+pub const ISA_VARIABLE: &str = "SO3FFT_ISA";
+
 /// Instruction set chosen for the DWT kernels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
@@ -27,13 +30,47 @@ pub enum Isa {
 }
 
 impl Isa {
-    /// The instruction set of an `isa` option (`None`: the best this CPU has); an error
-    /// when the CPU does not support it.
+    /// The instruction set of an `isa` option (`None`: [`Isa::selected`]); an error when
+    /// the CPU does not support it.
     pub(crate) fn resolve(isa: Option<Isa>) -> crate::Result<Isa> {
-        let isa = isa.unwrap_or_else(Isa::detect);
+        let isa = match isa {
+            Some(isa) => isa,
+            None => Isa::selected()?,
+        };
         if !isa.is_supported() {
             return Err(crate::Error::InvalidArgument(format!(
                 "instruction set {isa:?} not supported by this CPU"
+            )));
+        }
+        Ok(isa)
+    }
+
+    /// The instruction set of plans whose options name none: the one the environment
+    /// variable `SO3FFT_ISA` names (`avx512`, `avx2` or `scalar`, any case; for measuring
+    /// one set's kernels on a CPU that has a wider one), else [`Isa::detect`]. An error
+    /// when the variable names no instruction set or one this CPU lacks.
+    pub fn selected() -> crate::Result<Isa> {
+        let Some(value) = std::env::var_os(ISA_VARIABLE) else {
+            return Ok(Isa::detect());
+        };
+        let isa = match value
+            .to_str()
+            .map(|v| v.trim().to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("") => return Ok(Isa::detect()),
+            Some("avx512") => Isa::Avx512,
+            Some("avx2") => Isa::Avx2,
+            Some("scalar") => Isa::Scalar,
+            _ => {
+                return Err(crate::Error::InvalidArgument(format!(
+                    "{ISA_VARIABLE}={value:?}: expected avx512, avx2 or scalar"
+                )))
+            }
+        };
+        if !isa.is_supported() {
+            return Err(crate::Error::InvalidArgument(format!(
+                "{ISA_VARIABLE}: instruction set {isa:?} not supported by this CPU"
             )));
         }
         Ok(isa)

@@ -69,6 +69,9 @@ options:
                       choice by timing)
   --mode M            stages: inv | fwd | both | dfwd (the forward that may overwrite its
                       input) | rinv | rfwd | rboth (real signals); default both
+  --isa I             kernels' instruction set: avx512 | avx2 | scalar (default: the best this
+                      CPU has); sets SO3FFT_ISA for every plan, SOFT call and the FMA peak, so
+                      a host with AVX-512 can measure the AVX2 kernels
   --workspace-mib N   stages: cap on the plan's chunk buffer (default: the plan's default)
   -h, --help          print this help
 
@@ -159,6 +162,8 @@ pub struct Options {
     pub stage_mode: StageMode,
     /// Cap on the chunk buffer of the `stages` tool's plan (`None`: the plan's default).
     pub workspace_bytes: Option<usize>,
+    /// Instruction set named by `--isa` (given to the library as `SO3FFT_ISA`).
+    pub isa: Option<String>,
 }
 
 impl Default for Options {
@@ -181,6 +186,7 @@ impl Default for Options {
             fft_threading: FftThreading::Auto,
             stage_mode: StageMode::Both,
             workspace_bytes: None,
+            isa: None,
         }
     }
 }
@@ -278,6 +284,13 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
             "--runs" => opts.runs = Some(parse_positive(&value()?, "--runs")?),
             "--csv" => opts.csv = PathBuf::from(value()?),
             "--rigor" => opts.rigor = parse_rigor(&value()?)?,
+            "--isa" => {
+                let text = value()?.trim().to_ascii_lowercase();
+                if !matches!(text.as_str(), "avx512" | "avx2" | "scalar") {
+                    return Err(format!("--isa: '{text}' is not avx512, avx2 or scalar"));
+                }
+                opts.isa = Some(text);
+            }
             _ => return Err(format!("unknown option '{arg}'")),
         }
     }

@@ -49,20 +49,35 @@ fn main() -> ExitCode {
             println!("{}", cli::USAGE);
             ExitCode::SUCCESS
         }
-        Ok(Command::Run(opts)) => match opts.tool {
-            Tool::Full => run_full(&opts),
-            Tool::Stages => report_failure("stages", stages::run(&opts)),
-            Tool::Scaling => report_failure("scaling", scaling::run(&opts)),
-            Tool::Real => report_failure("real", run_real(&opts)),
-            Tool::S2 => report_failure("s2", s2::run(&opts)),
-            Tool::Match => report_failure("match", matching::run(&opts)),
-            Tool::Partial => report_failure("partial", partial::run(&opts)),
-            Tool::MpiModel => report_failure("mpi-model", mpi_model::run(&opts)),
-        },
+        Ok(Command::Run(opts)) => {
+            if let Some(isa) = &opts.isa {
+                // Before any thread exists: every plan, SOFT call and the peak follow it.
+                std::env::set_var(so3fft::ISA_VARIABLE, isa);
+            }
+            if let Err(e) = so3fft::Isa::selected() {
+                eprintln!("so3fft-bench: {e}");
+                return ExitCode::from(2);
+            }
+            run_tool(&opts)
+        }
         Err(msg) => {
             eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
             ExitCode::from(2)
         }
+    }
+}
+
+/// Runs the tool `opts` names.
+fn run_tool(opts: &Options) -> ExitCode {
+    match opts.tool {
+        Tool::Full => run_full(opts),
+        Tool::Stages => report_failure("stages", stages::run(opts)),
+        Tool::Scaling => report_failure("scaling", scaling::run(opts)),
+        Tool::Real => report_failure("real", run_real(opts)),
+        Tool::S2 => report_failure("s2", s2::run(opts)),
+        Tool::Match => report_failure("match", matching::run(opts)),
+        Tool::Partial => report_failure("partial", partial::run(opts)),
+        Tool::MpiModel => report_failure("mpi-model", mpi_model::run(opts)),
     }
 }
 

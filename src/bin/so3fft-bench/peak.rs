@@ -29,18 +29,14 @@ pub enum Isa {
 }
 
 impl Isa {
-    /// Widest FMA instruction set the CPU supports (runtime detection).
+    /// The instruction set of the library's kernels: the widest FMA set the CPU supports,
+    /// or the one `SO3FFT_ISA` (`--isa`) names.
     pub fn detect() -> Isa {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if is_x86_feature_detected!("avx512f") {
-                return Isa::Avx512;
-            }
-            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
-                return Isa::Avx2Fma;
-            }
+        match so3fft::Isa::selected().unwrap_or_else(|_| so3fft::Isa::detect()) {
+            so3fft::Isa::Avx512 => Isa::Avx512,
+            so3fft::Isa::Avx2 => Isa::Avx2Fma,
+            so3fft::Isa::Scalar => Isa::Scalar,
         }
-        Isa::Scalar
     }
 
     pub fn name(self) -> &'static str {
