@@ -234,9 +234,9 @@ impl BetaTables {
 
     /// [`BetaTables::start`] (weight 1, base pair `(m, mp)` with `norm`, skip threshold
     /// `2^-bits`) for the consecutive points `k0 .. k0 + values.len()`, into `values` and
-    /// `scale_indices`: with AVX-512 eight points at a time (`getexp`,
-    /// `getmant` and `scalef` do the exponent arithmetic exactly), else one at a time. Both
-    /// give the same bits.
+    /// `scale_indices`: with AVX-512 eight points at a time (`getexp`, `getmant` and
+    /// `scalef` do the exponent arithmetic exactly), with AVX2 four at a time (the same on
+    /// the bits of the doubles), else one at a time. All give the same bits.
     #[allow(clippy::too_many_arguments)]
     pub fn starts(
         &self,
@@ -263,6 +263,19 @@ impl BetaTables {
             // `scale_indices` (asserted above).
             unsafe { starts_avx512(rows, base, values, scale_indices) };
             return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if isa == Isa::Avx2 && isa.is_supported() {
+            let rows = [
+                self.cos_powers.rows(base.m + base.mp, k0),
+                self.sin_powers.rows(base.m - base.mp, k0),
+            ];
+            // SAFETY: AVX2 and FMA are supported (checked just above); every row has at
+            // least `len` entries from k0 on (k0 + len <= number of points), as do `values`
+            // and `scale_indices` (asserted above).
+            if unsafe { starts_avx2(rows, base, values, scale_indices) } {
+                return;
+            }
         }
         let _ = isa;
         for (i, (v, s)) in values.iter_mut().zip(scale_indices.iter_mut()).enumerate() {
@@ -344,6 +357,165 @@ unsafe fn starts_avx512(
     }
 }
 
+/// Four starting values at a time, for CPUs without AVX-512: the arithmetic of
+/// [`starts_avx512`], with `frexp` and the power-of-two scaling done on the bits of the
+/// doubles (AVX2 has no `getexp`, `getmant` or `scalef`). Returns false, with `values` and
+/// `scale_indices` unspecified, if some value lies outside the range where this arithmetic
+/// is that of the scalar code (valid norms and tables never give one); the caller then
+/// uses the scalar code.
+///
+/// # Safety
+/// The CPU supports AVX2 and FMA, and every row of `rows` and `scale_indices` holds at
+/// least `values.len()` entries.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn starts_avx2(
+    rows: [[&[f64]; 4]; 2],
+    base: &BaseStart,
+    values: &mut [f64],
+    scale_indices: &mut [f64],
+) -> bool {
+    use std::arch::x86_64::*;
+    // Why the bits are those of `start` and `to_scaled` (S = SCALE_STEP, T = bits):
+    // - Exponents: all sums are integers below 2^53 in magnitude, so exact in doubles (the
+    //   table exponents are at most 1075 times the highest power, the norm's is checked).
+    // - frexp: where the product `mant` of the mantissas is a normal double (checked; five
+    //   factors in [0.5, 1) give one, or zero), `mant = fm * 2^(E - 1022)` with E its
+    //   exponent field and `fm` its bits with the field of 0.5, as `frexp` computes it.
+    // - Scaling: the result is `fm * 2^k`, `k = e + S j`; for |k| <= 1000 `ldexp` does one
+    //   multiplication by the double of bits `(k + 1023) << 52`, built here the same way
+    //   (a normal double: 23 <= k + 1023 <= 2023). Below the threshold (e <= -T), with
+    //   x = -T - e >= 0: j = floor(x / S) + 1 and k = S - T - (x mod S), in [1 - T, S - T],
+    //   within [-559, 576] for T in SKIP_BITS_RANGE. Elsewhere j = 0 and k = e > -T >= -560,
+    //   and e <= 1000 as a valid starting value is at most sqrt((2m + 1) / 2). |k| <= 1000
+    //   is checked all the same (any norm, any T).
+    // - Floor: 1/S rounds up, so (x + S) * (1/S) rounds to at least j when S divides x + S
+    //   and stays below j + 1 otherwise (x far below 2^40), as the integer division does.
+    if base.norm.exp.unsigned_abs() >= 1 << 40 {
+        return false;
+    }
+    let [c, s] = rows;
+    let len = values.len();
+    let nm = _mm256_set1_pd(base.norm.mant);
+    let ne = _mm256_set1_pd(base.norm.exp as f64);
+    let neg_t = _mm256_set1_pd(-(base.skip_bits as f64));
+    let step = _mm256_set1_pd(SCALE_STEP as f64);
+    let inv_step = _mm256_set1_pd(1.0 / SCALE_STEP as f64);
+    let max_k = _mm256_set1_pd(1000.0);
+    let zero = _mm256_setzero_pd();
+    let neg_zero = _mm256_set1_pd(-0.0);
+    let negative = (base.m - base.mp) % 2 == 1;
+    let sign = _mm256_set1_pd(if negative { -1.0 } else { 1.0 });
+    // Integer <-> double without AVX-512: for an integer 0 <= n < 2^52, the double
+    // `2^52 + n` holds `n` in its low bits.
+    const TWO52: f64 = (1u64 << 52) as f64;
+    let two52 = _mm256_set1_epi64x(TWO52.to_bits() as i64);
+    let two52_1022 = _mm256_set1_pd(TWO52 + 1022.0);
+    let two52_1023 = _mm256_set1_pd(TWO52 + 1023.0);
+    let exp_field = _mm256_set1_epi64x(0x7ff << 52);
+    let half_field = _mm256_set1_epi64x(1022 << 52);
+    // The scaled values and scale indices of four points from their loaded rows, and a mask
+    // of the lanes outside the range argued above.
+    let block = |[c1m, c1e, c2m, c2e, s1m, s1e, s2m, s2e]: [__m256d; 8]| {
+        // Same order of multiplication as the scalar code (its weight is 1 here).
+        let mant = _mm256_mul_pd(
+            _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(nm, c1m), c2m), s1m),
+            s2m,
+        );
+        let exps = _mm256_add_pd(
+            _mm256_add_pd(_mm256_add_pd(c1e, c2e), _mm256_add_pd(s1e, s2e)),
+            ne,
+        );
+        // Unordered: a NaN product counts as nonzero (and is caught below).
+        let nonzero = _mm256_cmp_pd::<_CMP_NEQ_UQ>(mant, zero);
+        // frexp: mant = fm * 2^(E - 1022), E the exponent field, fm with the field of 0.5.
+        let bits = _mm256_castpd_si256(mant);
+        let field = _mm256_and_si256(bits, exp_field);
+        let fm = _mm256_castsi256_pd(_mm256_or_si256(
+            _mm256_andnot_si256(exp_field, bits),
+            half_field,
+        ));
+        let biased = _mm256_castsi256_pd(_mm256_or_si256(_mm256_srli_epi64::<52>(field), two52));
+        let e = _mm256_add_pd(exps, _mm256_sub_pd(biased, two52_1022));
+        // Below the threshold (e <= -bits): j = floor((S - bits - e) / S) >= 1, else 0.
+        let low = _mm256_cmp_pd::<_CMP_LE_OQ>(e, neg_t);
+        let q = _mm256_mul_pd(_mm256_add_pd(_mm256_sub_pd(neg_t, e), step), inv_step);
+        let j = _mm256_and_pd(
+            low,
+            _mm256_round_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(q),
+        );
+        let k = _mm256_fmadd_pd(j, step, e);
+        // 2^k from the bits (k + 1023) << 52 (the low bits of 2^52 + 1023 + k).
+        let pow2 = _mm256_castsi256_pd(_mm256_slli_epi64::<52>(_mm256_castpd_si256(
+            _mm256_add_pd(k, two52_1023),
+        )));
+        let pv = _mm256_and_pd(nonzero, _mm256_mul_pd(_mm256_mul_pd(fm, pow2), sign));
+        let scv = _mm256_and_pd(nonzero, _mm256_sub_pd(zero, j));
+        // Outside the range: subnormal, infinite or NaN products, |k| > 1000.
+        let special = _mm256_or_si256(
+            _mm256_cmpeq_epi64(field, _mm256_setzero_si256()),
+            _mm256_cmpeq_epi64(field, exp_field),
+        );
+        let out = _mm256_or_pd(
+            _mm256_castsi256_pd(special),
+            _mm256_cmp_pd::<_CMP_NLE_UQ>(_mm256_andnot_pd(neg_zero, k), max_k),
+        );
+        (pv, scv, _mm256_and_pd(nonzero, out))
+    };
+    let mut outside = zero;
+    let mut i = 0;
+    while i + 4 <= len {
+        // SAFETY: lanes `i .. i + 4` lie inside every row (at least `len` entries, the
+        // caller's contract).
+        let ld = |a: &[f64]| unsafe { _mm256_loadu_pd(a.as_ptr().add(i)) };
+        let (pv, scv, out) = block([
+            ld(c[0]),
+            ld(c[1]),
+            ld(c[2]),
+            ld(c[3]),
+            ld(s[0]),
+            ld(s[1]),
+            ld(s[2]),
+            ld(s[3]),
+        ]);
+        outside = _mm256_or_pd(outside, out);
+        // SAFETY: as the loads: lanes `i .. i + 4` lie inside `values` and `scale_indices`.
+        unsafe {
+            _mm256_storeu_pd(values.as_mut_ptr().add(i), pv);
+            _mm256_storeu_pd(scale_indices.as_mut_ptr().add(i), scv);
+        }
+        i += 4;
+    }
+    if i < len {
+        // Lanes `0 .. len - i` (the sign bit set); the others load zeros, giving a zero
+        // product that is neither stored nor checked.
+        let mask = _mm256_cmpgt_epi64(
+            _mm256_set1_epi64x((len - i) as i64),
+            _mm256_setr_epi64x(0, 1, 2, 3),
+        );
+        // SAFETY: the masked lanes `i .. len` lie inside every row (at least `len` entries,
+        // the caller's contract); masked-off lanes are not read.
+        let ld = |a: &[f64]| unsafe { _mm256_maskload_pd(a.as_ptr().add(i), mask) };
+        let (pv, scv, out) = block([
+            ld(c[0]),
+            ld(c[1]),
+            ld(c[2]),
+            ld(c[3]),
+            ld(s[0]),
+            ld(s[1]),
+            ld(s[2]),
+            ld(s[3]),
+        ]);
+        outside = _mm256_or_pd(outside, out);
+        // SAFETY: as the loads: the masked lanes lie inside `values` and `scale_indices`.
+        unsafe {
+            _mm256_maskstore_pd(values.as_mut_ptr().add(i), mask, pv);
+            _mm256_maskstore_pd(scale_indices.as_mut_ptr().add(i), mask, scv);
+        }
+    }
+    _mm256_movemask_pd(outside) == 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::{
@@ -416,8 +588,48 @@ mod tests {
         }
     }
 
-    /// The vectorised starting values are bitwise those of the scalar code, including
-    /// values far below the skip threshold and partial vectors.
+    /// `starts` of every instruction set this CPU supports against `start`, bit for bit,
+    /// for the points `k0 .. k0 + len`.
+    #[allow(clippy::too_many_arguments)]
+    fn check_starts(
+        bt: &BetaTables,
+        k0: usize,
+        len: usize,
+        m: usize,
+        mp: usize,
+        norm: Ext,
+        bits: u32,
+    ) {
+        let base = BaseStart::new(m, mp, norm, bits);
+        let want: Vec<(u64, u64)> = (k0..k0 + len)
+            .map(|k| {
+                let (p, sc) = bt.start(k, &base, 1.0);
+                (p.to_bits(), sc.to_bits())
+            })
+            .collect();
+        for isa in [Isa::Avx512, Isa::Avx2, Isa::Scalar] {
+            if !isa.is_supported() {
+                continue;
+            }
+            let (mut p, mut sc) = (vec![f64::NAN; len], vec![f64::NAN; len]);
+            bt.starts(isa, k0, m, mp, norm, bits, &mut p, &mut sc);
+            for i in 0..len {
+                assert_eq!(
+                    (p[i].to_bits(), sc[i].to_bits()),
+                    want[i],
+                    "{isa:?} m={m} mp={mp} norm={norm:?} bits={bits} k={} ({:e} {})",
+                    k0 + i,
+                    p[i],
+                    sc[i]
+                );
+            }
+        }
+    }
+
+    /// The vectorised starting values are bitwise those of the scalar code, for every
+    /// instruction set of this CPU: values far below the skip threshold (scale indices down
+    /// to -5), zero mantissas, partial vectors, norms outside the range of the vector
+    /// arithmetic.
     #[test]
     fn vector_starts_match_scalar() {
         for b in [5usize, 37, 300] {
@@ -433,19 +645,50 @@ mod tests {
             ] {
                 let norm = norms[m * (m + 1) / 2 + mp];
                 for bits in [24u32, 300, 560] {
-                    for (k0, len) in [(0usize, 2 * b), (3, b - 1), (b, b)] {
-                        let (mut p, mut sc) = (vec![0.0; len], vec![0.0; len]);
-                        let base = BaseStart::new(m, mp, norm, bits);
-                        bt.starts(Isa::detect(), k0, m, mp, norm, bits, &mut p, &mut sc);
-                        for i in 0..len {
-                            let (p0, sc0) = bt.start(k0 + i, &base, 1.0);
-                            assert_eq!(
-                                (p[i].to_bits(), sc[i]),
-                                (p0.to_bits(), sc0),
-                                "b={b} m={m} mp={mp} bits={bits} k={}",
-                                k0 + i
-                            );
-                        }
+                    let n = 2 * b;
+                    let mut ranges = vec![(0usize, n), (3, b - 1), (b, b)];
+                    // Every length up to 9 (not multiples of 4 or 8), ending at the last point.
+                    ranges.extend((1..=9.min(n)).map(|len| (n - len, len)));
+                    for (k0, len) in ranges {
+                        check_starts(&bt, k0, len, m, mp, norm, bits);
+                    }
+                }
+            }
+            // Values up to 2^1100 (beyond the vector arithmetic: the scalar fallback) and
+            // down to 2^-5000.
+            for exp in [1000i64, 1001, 1010, 1100, -600, -5000] {
+                let norm = Ext { mant: 0.75, exp };
+                check_starts(&bt, 0, 2 * b, 0, 0, norm, 64);
+                check_starts(&bt, 1, 2 * b - 1, 1, 0, norm, 560);
+            }
+        }
+        // Zero mantissas: beta = 0 (sin = 0) and beta = pi (cos = 0) among the points
+        // beta = pi k / 10.
+        let pts: Vec<(Dd, Dd)> = (0..=10)
+            .map(|k| {
+                let (s, c) = sin_cos_dd(PI_DD.mul_f(k as f64).div(Dd::new(20.0)));
+                match k {
+                    0 => (Dd::new(1.0), Dd::new(0.0)),
+                    10 => (Dd::new(0.0), Dd::new(1.0)),
+                    _ => (c, s),
+                }
+            })
+            .collect();
+        let bt = BetaTables::new(&pts, 80);
+        let norms = start_norms(41);
+        for &(m, mp) in &[
+            (0usize, 0usize),
+            (1, 0),
+            (7, 3),
+            (20, 20),
+            (40, 0),
+            (40, 39),
+        ] {
+            let norm = norms[m * (m + 1) / 2 + mp];
+            for bits in [24u32, 300, 560] {
+                for k0 in 0..pts.len() {
+                    for len in 1..=pts.len() - k0 {
+                        check_starts(&bt, k0, len, m, mp, norm, bits);
                     }
                 }
             }
