@@ -20,6 +20,78 @@ unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *c
     }
 }
 
+/// Whether the 8-column kernel runs two vectors of betas together (16 sums in registers:
+/// AVX-512 and scalar code; AVX2's 16 registers would spill the sums).
+const fn paired_vectors(w: usize, p: usize) -> bool {
+    p <= 8 && w != 4
+}
+
+/// Passes over the columns per vector of betas: with AVX2's 16 registers, 16 sums do not
+/// fit beside the recurrence, so the columns go in two halves of 8 (see [`two_passes`]).
+const fn column_passes(w: usize, p: usize) -> usize {
+    if w == 4 && p == 16 {
+        2
+    } else {
+        1
+    }
+}
+
+/// Degrees per block of [`two_passes`] (its buffer of d values: 2 KiB with AVX2).
+const PASS_BLOCK: usize = 64;
+
+/// One vector's sums of `P = 16` columns in two passes of 8 per block of degrees: the
+/// first runs the recurrence, adds to columns `0..8` and keeps each degree's values in a
+/// small buffer; the second reads them back for columns `8..16`. Eight sums and the
+/// recurrence fit 16 registers; each column's sum is the same chain of multiply-adds as
+/// in the one-pass kernel.
+///
+/// # Safety
+/// As [`inverse_body`]; `fin` holds `n` rows of `P` values.
+#[inline(always)]
+unsafe fn two_passes<S: Simd, const P: usize>(
+    s: &mut State<S>,
+    n: usize,
+    fin: *const f64,
+    acc: &mut [S::V; P],
+) {
+    // SAFETY: this function's contract (see `# Safety`), upheld by the caller; the
+    // buffer index `i - i0` is below `PASS_BLOCK` (`i0 <= i < i1 <= i0 + PASS_BLOCK`).
+    unsafe {
+        const H: usize = 8;
+        // Each half's sums are kept in memory between its loops and in locals during them
+        // (the opaque use of their address makes the reload real): left alone, LLVM keeps
+        // both halves in registers throughout and spills sums inside the loops instead.
+        let (mut lo_mem, mut hi_mem) = ([S::zero(); H], [S::zero(); H]);
+        let mut d = [S::zero(); PASS_BLOCK];
+        // First degree accumulated: the run calls back from there on, in every block.
+        let mut first = n;
+        let mut i0 = s.i;
+        while i0 < n {
+            let i1 = (i0 + PASS_BLOCK).min(n);
+            let mut lo = lo_mem;
+            let mut add = |v: S::V, i: usize| {
+                acc_row::<S, H>(&mut lo, v, fin.add(i * P));
+                *d.get_unchecked_mut(i - i0) = v;
+                first = first.min(i);
+            };
+            s.run_slow(i1, &mut add);
+            s.run_fast(i1, &mut add);
+            lo_mem = lo;
+            std::hint::black_box(&mut lo_mem);
+            let mut hi = hi_mem;
+            for i in first.max(i0)..i1 {
+                acc_row::<S, H>(&mut hi, *d.get_unchecked(i - i0), fin.add(i * P + H));
+            }
+            hi_mem = hi;
+            std::hint::black_box(&mut hi_mem);
+            i0 = i1;
+        }
+        let (lo, hi) = (lo_mem, hi_mem);
+        acc[..H].copy_from_slice(&lo);
+        acc[H..2 * H].copy_from_slice(&hi);
+    }
+}
+
 /// Fills rows `from..to` of the inverse kernel's input (see [`crate::dwt::inverse_raw`]).
 pub type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
 
@@ -67,7 +139,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                 // data broadcast then feeds two multiply-adds, and the two recurrences are
                 // independent chains (one vector's step and 8 multiply-adds per degree leave
                 // the pipes half idle).
-                let pair = P <= 8 && vector + 1 < vectors;
+                let pair = paired_vectors(W, P) && vector + 1 < vectors;
                 let mut run_states = [states[vector], states[(vector + 1).min(vectors - 1)]];
                 let mut acc = [[S::zero(); P]; 2];
                 prefetch.issue(prefetch_per_vector * (1 + pair as usize));
@@ -95,6 +167,9 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                             a1[q] = S::fma(u, c, a1[q]);
                         }
                     }
+                } else if column_passes(W, P) == 2 {
+                    let mut s = run_states[0];
+                    two_passes::<S, P>(&mut s, n, fin_rows, &mut acc[0]);
                 } else {
                     // A local copy, so the state lives in registers during the run.
                     let mut s = run_states[0];

@@ -74,9 +74,15 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
                 plan.fft_threading()
             );
             let (times, flops) = if opts.stage_mode.real() {
-                (repeat_real(&plan, opts.stage_mode, repetitions)?, dwt_flops_real(b))
+                (
+                    repeat_real(&plan, opts.stage_mode, repetitions)?,
+                    dwt_flops_real(b),
+                )
             } else {
-                (repeat_complex(&plan, opts.stage_mode, repetitions)?, dwt_flops_exact(b))
+                (
+                    repeat_complex(&plan, opts.stage_mode, repetitions)?,
+                    dwt_flops_exact(b),
+                )
             };
             eprintln!("workspace {} MiB", plan.workspace_bytes() >> 20);
             times.summary(flops, peak1.one_core * plan.threads() as f64);
