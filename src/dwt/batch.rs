@@ -126,38 +126,49 @@ unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, con
         // Instantiated (never called) for `P = 16` with two transforms as well.
         debug_assert!(K * P <= 16);
         let cv = P / W;
-        let mut acc = [S::zero(); 16];
+        // Lanes per pass over the degrees: all of them where the sums fit the registers
+        // beside the coefficients (AVX-512's 32), a part with AVX2's 16 (8 sums a pass).
+        let lanes_per_pass = if W == 4 {
+            (8 / (K * cv)).clamp(1, W)
+        } else {
+            W
+        };
         hint.issue(lines);
-        for i in lo..n {
-            let mut f = [S::zero(); 16];
-            for k in 0..K {
-                for h in 0..cv {
-                    f[k * cv + h] = S::load(fin[k].add(i * P + h * W));
-                }
-            }
-            for w in 0..W {
-                let v = S::splat(*tile.add(i * W + w));
+        let mut w0 = 0;
+        while w0 < W {
+            let mut acc = [S::zero(); 16];
+            for i in lo..n {
+                let mut f = [S::zero(); 16];
                 for k in 0..K {
                     for h in 0..cv {
-                        let a = &mut acc[(w * K + k) * cv + h];
-                        *a = S::fma(v, f[k * cv + h], *a);
+                        f[k * cv + h] = S::load(fin[k].add(i * P + h * W));
+                    }
+                }
+                for w in 0..lanes_per_pass {
+                    let v = S::splat(*tile.add(i * W + w0 + w));
+                    for k in 0..K {
+                        for h in 0..cv {
+                            let a = &mut acc[(w * K + k) * cv + h];
+                            *a = S::fma(v, f[k * cv + h], *a);
+                        }
                     }
                 }
             }
-        }
-        for w in 0..W {
-            let r = rows(w);
-            for k in 0..K {
-                for h in 0..cv {
-                    let x = acc[(w * K + k) * cv + h];
-                    let p = out[k].add(r + h * W);
-                    if NT {
-                        S::stream(p, x);
-                    } else {
-                        S::store(p, x);
+            for w in 0..lanes_per_pass {
+                let r = rows(w0 + w);
+                for k in 0..K {
+                    for h in 0..cv {
+                        let x = acc[(w * K + k) * cv + h];
+                        let p = out[k].add(r + h * W);
+                        if NT {
+                            S::stream(p, x);
+                        } else {
+                            S::store(p, x);
+                        }
                     }
                 }
             }
+            w0 += lanes_per_pass;
         }
     }
 }
