@@ -217,10 +217,8 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         // coefficient rows) is left to demand loads.
         let mut prefetch = lanes.prefetch;
         let prefetch_per_vector = prefetch.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
-        let data_rows = |s0: usize| {
-            let (at, stride) = lanes.vector_rows(s0, P);
-            (xin.add(at), stride)
-        };
+        // Every vector's rows are the same distance apart (`Lanes::vector_rows`).
+        let xs = lanes.vector_rows(0, P).1;
         let mut d_blocks = [DBlock([0.0; 128]); 2];
         let mut lo = n;
         let mut v0 = 0;
@@ -231,6 +229,13 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
             let (first, states) =
                 prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
             lo = lo.min(first);
+            // Each vector's first data row, found once rather than at every block.
+            let mut rows_at = [xin; FWD_VECTORS];
+            for (v, r) in rows_at.iter_mut().enumerate().take(vectors) {
+                let (at, stride) = lanes.vector_rows(v0 + v * W, P);
+                debug_assert_eq!(stride, xs);
+                *r = xin.add(at);
+            }
             let mut i0 = first - first % DB;
             // The first group of vectors writes the sums (zeros below its first block), the
             // others add to them: `ft` needs no clearing beforehand.
@@ -284,7 +289,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                         for (j, dj) in d.iter().enumerate() {
                             S::store(db.add(j * W), *dj);
                         }
-                        let (x, xs) = data_rows(v0 + v * W);
+                        let x = rows_at[v];
                         block_fmas::<S, W, P, DB>(&mut acc, db, x, xs);
                     }
                 }
@@ -317,7 +322,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                             (fast[0], i0 + DB)
                         };
                         prefetch.issue(prefetch_per_vector);
-                        let (x, xs) = data_rows(v0 + fma_vector * W);
+                        let x = rows_at[fma_vector];
                         let s = &mut states[v];
                         let (mut p0, mut p1) = (s.p0, s.p1);
                         let d_cur = d_blocks[cur].0.as_ptr();
@@ -351,7 +356,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                     primed = next;
                     if !next {
                         prefetch.issue(prefetch_per_vector);
-                        let (x, xs) = data_rows(v0 + fma_vector * W);
+                        let x = rows_at[fma_vector];
                         let d_cur = d_blocks[cur].0.as_ptr();
                         block_fmas::<S, W, P, DB>(&mut acc, d_cur, x, xs);
                     }
