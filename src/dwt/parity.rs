@@ -99,6 +99,7 @@ unsafe fn run_chains<S: Simd, const K: usize>(
         let mut p0 = [S::zero(); K];
         let mut p1 = [S::zero(); K];
         let mut tau = [S::zero(); K];
+        let narrow = std::mem::size_of::<S::V>() == 32;
         for c in 0..K {
             (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
         }
@@ -108,7 +109,16 @@ unsafe fn run_chains<S: Simd, const K: usize>(
                 let (a, b) = (S::splat(*slope.add(i)), S::splat(*offset.add(i)));
                 let v = p1;
                 for c in 0..K {
-                    let t = S::fma(a, tau[c], b);
+                    // With AVX2's 16 registers the arguments are read from memory at each
+                    // step (a volatile read, which LLVM keeps in the loop): held in
+                    // registers they push a sum onto the stack, where the store-to-load
+                    // latency lands on its chain.
+                    let tc = if narrow {
+                        std::ptr::read_volatile(&tau[c])
+                    } else {
+                        tau[c]
+                    };
+                    let t = S::fma(a, tc, b);
                     let p2 = S::fence(S::fms(t, p1[c], p0[c]));
                     (p0[c], p1[c]) = (p1[c], p2);
                 }
