@@ -282,7 +282,13 @@ impl SeriesTables {
                 // callers' contract) and has `lanes.w` lanes (asserted); the scratch areas
                 // hold `3 n w` doubles, the other lengths are checked inside.
                 unsafe {
+                    // With AVX2's 16 registers the two groups' recurrences go one after
+                    // the other (side by side they spill); each lane's values are the same.
                     match (g0.len > 0, g1.len > 0) {
+                        (true, true) if lanes.w == 4 => {
+                            column_lanes::<S, 1>(lanes, table, at, [0], [s0]);
+                            column_lanes::<S, 1>(lanes, table, at, [1], [s1]);
+                        }
                         (true, true) => column_lanes::<S, 2>(lanes, table, at, [0, 1], [s0, s1]),
                         (true, false) => column_lanes::<S, 1>(lanes, table, at, [0], [s0]),
                         (false, true) => column_lanes::<S, 1>(lanes, table, at, [1], [s1]),
@@ -681,19 +687,33 @@ unsafe fn member_sums<S: Simd, const J: usize>(
     unsafe {
         let mut acc = [[(S::zero(), S::zero()); 3]; 4];
         let c = packed.as_ptr().cast::<f64>();
-        for i in 0..n {
-            let v: [S::V; 3] =
-                std::array::from_fn(|d| S::load(scratch.as_ptr().add((3 * i + d) * w)));
-            for (j, member) in acc.iter_mut().enumerate().take(J) {
-                let (re, im) = (
-                    S::splat(*c.add(2 * (J * i + j))),
-                    S::splat(*c.add(2 * (J * i + j) + 1)),
-                );
-                for (a, x) in member.iter_mut().zip(v) {
-                    a.0 = S::fma(re, x, a.0);
-                    a.1 = S::fma(im, x, a.1);
+        // The sums of members `js` (indices into `J`) in one pass over the degrees.
+        let pass = |acc: &mut [[(S::V, S::V); 3]; 4], js: std::ops::Range<usize>| {
+            for i in 0..n {
+                let v: [S::V; 3] =
+                    std::array::from_fn(|d| S::load(scratch.as_ptr().add((3 * i + d) * w)));
+                for j in js.clone() {
+                    let (re, im) = (
+                        S::splat(*c.add(2 * (J * i + j))),
+                        S::splat(*c.add(2 * (J * i + j) + 1)),
+                    );
+                    for (a, x) in acc[j].iter_mut().zip(v) {
+                        a.0 = S::fma(re, x, a.0);
+                        a.1 = S::fma(im, x, a.1);
+                    }
                 }
             }
+        };
+        if w == 4 {
+            // AVX2's 16 registers hold one member's six sums beside the three values:
+            // one member per pass, so that no sum is spilled.
+            for j in 0..J {
+                let mut one = [[(S::zero(), S::zero()); 3]; 4];
+                pass(&mut one, j..j + 1);
+                acc[j] = one[j];
+            }
+        } else {
+            pass(&mut acc, 0..J);
         }
         acc
     }
