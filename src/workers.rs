@@ -31,8 +31,15 @@ pub(crate) const WORKER_STACK_BYTES: usize = 2 << 20;
 /// ends, since dropping them would wait for threads that do not exist there.
 static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
 
-/// A plan's worker threads.
-pub(crate) struct WorkerPool {
+/// A plan's worker threads. Clones share the threads (plans run one after another by one
+/// caller, such as a correlation's transforms, share a pool: a task already on its
+/// workers calls the next plan's stages directly instead of waking the workers again);
+/// the last clone dropped waits for them.
+#[derive(Clone)]
+pub(crate) struct WorkerPool(Arc<Workers>);
+
+/// The threads behind a [`WorkerPool`].
+struct Workers {
     /// The pool (an `Option` so `Drop` can release it before waiting for the workers).
     pool: Option<rayon::ThreadPool>,
     /// Number of pool threads still running; `Drop` waits for zero.
@@ -58,32 +65,54 @@ impl WorkerPool {
             })
             .build()
             .map_err(|e| Error::Resources(format!("cannot start {threads} worker threads: {e}")))?;
-        Ok(WorkerPool {
+        Ok(WorkerPool(Arc::new(Workers {
             pool: Some(pool),
             live,
             pid: std::process::id(),
-        })
+        })))
+    }
+
+    /// `shared` if given (an error unless it has `threads` workers), else new workers.
+    pub(crate) fn shared_or_new(
+        shared: Option<&WorkerPool>,
+        threads: usize,
+        name: &'static str,
+    ) -> Result<WorkerPool> {
+        match shared {
+            Some(w) if w.pool().current_num_threads() == threads => Ok(w.clone()),
+            Some(w) => Err(Error::InvalidArgument(format!(
+                "a plan of {threads} threads on a pool of {}",
+                w.pool().current_num_threads()
+            ))),
+            None => WorkerPool::new(threads, name),
+        }
     }
 
     /// The rayon pool.
     pub(crate) fn pool(&self) -> &rayon::ThreadPool {
-        self.pool.as_ref().expect("pool lives until drop")
+        self.0.pool.as_ref().expect("pool lives until drop")
     }
 
     /// Whether the worker threads exist in this process: `false` in a child made by
     /// `fork()` after the pool was started.
     pub(crate) fn in_own_process(&self) -> bool {
-        std::process::id() == self.pid
+        self.0.in_own_process()
     }
 
     /// Number of worker threads still running (for tests).
     #[cfg(test)]
     pub(crate) fn live_count(&self) -> Arc<(Mutex<usize>, Condvar)> {
-        self.live.clone()
+        self.0.live.clone()
     }
 }
 
-impl Drop for WorkerPool {
+impl Workers {
+    fn in_own_process(&self) -> bool {
+        std::process::id() == self.pid
+    }
+}
+
+impl Drop for Workers {
     /// Releases the pool and waits until its threads have finished, so that nothing of the
     /// plan runs after it is gone (a C host may unload the library right after).
     fn drop(&mut self) {

@@ -8,6 +8,7 @@ use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::partial::{PartialOptions, PartialPlan, Shape};
 use crate::s2::{S2Options, S2Plan};
+use crate::workers::WorkerPool;
 use crate::{Direction, Rigor};
 use num_complex::Complex64;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -72,7 +73,12 @@ impl Correlation {
                  limit {deg_lim}: need 1 <= bandwidths and degree limit < both"
             )));
         }
-        let s2 = S2Plan::new(
+        // One pool for both plans: an execution enters it once, and each stage of the
+        // pipeline runs on its workers directly (at small bandwidths waking the workers
+        // for every stage cost as much as the stages).
+        let threads = crate::workers::thread_count(options.threads)?;
+        let workers = WorkerPool::new(threads, "so3fft-match")?;
+        let s2 = S2Plan::new_on(
             b_in,
             &S2Options {
                 threads: options.threads,
@@ -81,10 +87,11 @@ impl Correlation {
                 degree_limit: Some(deg_lim + 1),
                 ..S2Options::default()
             },
+            Some(&workers),
         )?;
         // Degrees up to `deg_lim` on the grid of `b_out`: a partial plan when that is less
         // than the grid's bandwidth (the full plan otherwise).
-        let so3 = PartialPlan::new(
+        let so3 = PartialPlan::new_on(
             &Shape::new(deg_lim + 1).with_grid(b_out, 2 * b_out, 2 * b_out),
             &PartialOptions {
                 direction: Direction::Inverse,
@@ -93,6 +100,7 @@ impl Correlation {
                 real: options.real,
                 ..PartialOptions::default()
             },
+            Some(&workers),
         )?;
         Ok(Correlation {
             b_in,
@@ -122,8 +130,14 @@ impl Correlation {
         self.so3.num_samples()
     }
 
-    /// Runs `f` with the plan's coefficient buffers (new ones when they are in use).
-    fn with_buffers<R>(&self, f: impl FnOnce(&mut Buffers) -> Result<R>) -> Result<R> {
+    /// Runs `f` with the plan's coefficient buffers (new ones when they are in use), on
+    /// the plans' worker threads.
+    fn with_buffers<R: Send>(&self, f: impl FnOnce(&mut Buffers) -> Result<R> + Send) -> Result<R> {
+        self.s2.install(|| self.with_buffers_here(f))
+    }
+
+    /// [`Correlation::with_buffers`] on the calling thread.
+    fn with_buffers_here<R>(&self, f: impl FnOnce(&mut Buffers) -> Result<R>) -> Result<R> {
         let fresh = || -> Result<Buffers> {
             let vec = |n: usize| -> Result<Vec<Complex64>> {
                 let mut v = Vec::new();
@@ -418,11 +432,11 @@ impl Correlation {
 
     /// The body of the `correlate_many` functions, with the S^2 forward and SO(3) inverse
     /// of the plan's kind of samples.
-    fn many<T, G>(
+    fn many<T: Sync, G: Send>(
         &self,
         (signal, patterns, out): (&[T], &[T], &mut [G]),
-        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
-        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<()>,
+        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()> + Sync, bool),
+        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<()> + Sync,
     ) -> Result<()> {
         let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
         check_many(patterns.len(), ns, out.len(), ng)?;

@@ -312,7 +312,7 @@ impl<X: Exchange> DistributedPlan<X> {
             max_workspace_bytes: Some(usize::MAX / 4),
             ..options.clone()
         };
-        let mut general = General::new(shape, pairs, (isa, bits, threads), &opts)?;
+        let mut general = General::new(shape, pairs, (isa, bits, threads), &opts, None)?;
         let p = comm.size();
         let clusters = &general.dwt.clusters;
         let cost: Vec<usize> = clusters

@@ -127,6 +127,16 @@ enum Data {
 impl PartialPlan {
     /// A plan for `shape` with `options`.
     pub fn new(shape: &Shape, options: &PartialOptions) -> Result<PartialPlan> {
+        PartialPlan::new_on(shape, options, None)
+    }
+
+    /// [`PartialPlan::new`] on the workers of `shared` if given (with the plan's thread
+    /// count).
+    pub(crate) fn new_on(
+        shape: &Shape,
+        options: &PartialOptions,
+        shared: Option<&WorkerPool>,
+    ) -> Result<PartialPlan> {
         shape.validate()?;
         let restricted = options.betas != Betas::All;
         let direction = if restricted {
@@ -163,13 +173,14 @@ impl PartialPlan {
                 real: options.real,
                 ..PlanOptions::default()
             };
-            Engine::Full(Box::new(Plan::new(shape.degree_limit, &po)?))
+            Engine::Full(Box::new(Plan::new_on(shape.degree_limit, &po, shared)?))
         } else {
             Engine::General(Box::new(General::new(
                 shape,
                 pairs,
                 (isa, bits, threads),
                 options,
+                shared,
             )?))
         };
         Ok(PartialPlan {
@@ -434,6 +445,7 @@ impl General {
         pairs: LanePairs,
         (isa, bits, threads): (Isa, u32, usize),
         options: &PartialOptions,
+        shared: Option<&WorkerPool>,
     ) -> Result<General> {
         let layout = CoefLayout::new(shape);
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
@@ -490,7 +502,7 @@ impl General {
             budget,
             lanes_w: w,
             layout_n: shape.order_limit_gamma,
-            workers: WorkerPool::new(threads, "so3fft-partial")?,
+            workers: WorkerPool::shared_or_new(shared, threads, "so3fft-partial")?,
         })
     }
 

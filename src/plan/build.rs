@@ -171,7 +171,12 @@ impl Plan {
 
     /// [`Plan::new`] without the measured choice of [`FftThreading::Auto`](crate::FftThreading::Auto) (which then
     /// means slices across workers).
-    pub(super) fn build(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+    /// On the workers of `shared` if given (which must have the plan's thread count).
+    pub(super) fn build(
+        bandwidth: usize,
+        options: &PlanOptions,
+        shared: Option<&WorkerPool>,
+    ) -> Result<Plan> {
         let b = bandwidth;
         let Checked {
             threads,
@@ -232,7 +237,7 @@ impl Plan {
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
         let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
-        let workers = WorkerPool::new(threads, "so3fft")?;
+        let workers = WorkerPool::shared_or_new(shared, threads, "so3fft")?;
         Ok(Plan {
             b,
             direction: options.direction,

@@ -90,7 +90,16 @@ impl Plan {
     /// times both ways of threading the FFT stage and keeps the faster one (see
     /// [`FftThreading::Auto`]; [`Plan::fft_threading`] tells which).
     pub fn new(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
-        let mut plan = Plan::build(bandwidth, options)?;
+        Plan::new_on(bandwidth, options, None)
+    }
+
+    /// [`Plan::new`] on the workers of `shared` if given (with the plan's thread count).
+    pub(crate) fn new_on(
+        bandwidth: usize,
+        options: &PlanOptions,
+        shared: Option<&WorkerPool>,
+    ) -> Result<Plan> {
+        let mut plan = Plan::build(bandwidth, options, shared)?;
         plan.tune_fft_threading(options);
         Ok(plan)
     }

@@ -336,3 +336,44 @@ fn plan_is_send_sync() {
     fn is<T: Send + Sync>() {}
     is::<super::Plan>();
 }
+
+/// Plans on one shared pool: the threads run until the last plan on them is dropped (and
+/// that drop waits for them); a plan on a pool of another thread count is refused; a plan
+/// executed from inside the pool (as a correlation runs its stages) gives the same
+/// samples as one on its own workers, bit for bit.
+#[test]
+fn plans_share_a_pool() {
+    use crate::workers::WorkerPool;
+    use num_complex::Complex64;
+    let options = super::PlanOptions {
+        threads: 2,
+        ..Default::default()
+    };
+    let pool = WorkerPool::new(2, "so3fft-test").unwrap();
+    let live = pool.live_count();
+    let a = super::Plan::new_on(6, &options, Some(&pool)).unwrap();
+    let b = super::Plan::new_on(6, &options, Some(&pool)).unwrap();
+    let three = super::PlanOptions {
+        threads: 3,
+        ..Default::default()
+    };
+    assert!(super::Plan::new_on(6, &three, Some(&pool)).is_err());
+    let own = super::Plan::new(6, &options).unwrap();
+    let coeffs: Vec<Complex64> = (0..own.num_coeffs())
+        .map(|i| Complex64::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos()))
+        .collect();
+    let mut want = vec![Complex64::default(); own.num_samples()];
+    own.inverse(&coeffs, &mut want).unwrap();
+    let mut got = want.clone();
+    pool.pool()
+        .install(|| a.inverse(&coeffs, &mut got))
+        .unwrap();
+    assert!(got.iter().zip(&want).all(|(x, y)| x == y));
+    drop(pool);
+    drop(a);
+    assert_eq!(*live.0.lock().unwrap(), 2, "b still holds the threads");
+    b.inverse(&coeffs, &mut got).unwrap();
+    assert!(got.iter().zip(&want).all(|(x, y)| x == y));
+    drop(b);
+    assert_eq!(*live.0.lock().unwrap(), 0);
+}

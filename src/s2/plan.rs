@@ -64,6 +64,15 @@ pub struct S2Plan {
 impl S2Plan {
     /// A plan for bandwidth `bandwidth` (`1 ..= S2_MAX_BANDWIDTH`).
     pub fn new(bandwidth: usize, options: &S2Options) -> Result<S2Plan> {
+        S2Plan::new_on(bandwidth, options, None)
+    }
+
+    /// [`S2Plan::new`] on the workers of `shared` if given (with the plan's thread count).
+    pub(crate) fn new_on(
+        bandwidth: usize,
+        options: &S2Options,
+        shared: Option<&WorkerPool>,
+    ) -> Result<S2Plan> {
         let b = bandwidth;
         if b == 0 || b > S2_MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -92,7 +101,7 @@ impl S2Plan {
         let starts = (-(b as isize - 1)..b as isize)
             .map(|m| order_start(b, m))
             .collect();
-        let workers = WorkerPool::new(threads, "so3fft-s2")?;
+        let workers = WorkerPool::shared_or_new(shared, threads, "so3fft-s2")?;
         Ok(S2Plan {
             b,
             threads,
