@@ -55,14 +55,18 @@ unsafe fn two_passes<S: Simd, const P: usize>(
     acc: &mut [S::V; P],
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller; the
-    // buffer index `i - i0` is below `PASS_BLOCK` (`i0 <= i < i1 <= i0 + PASS_BLOCK`).
+    // buffer index `i - i0` is below `PASS_BLOCK` (`i0 <= i < i1 <= i0 + PASS_BLOCK`), and
+    // the second pass reads only entries the first wrote in the same block: the run calls
+    // back at every degree from the first accumulated one (`first`) on.
     unsafe {
         const H: usize = 8;
         // Each half's sums are kept in memory between its loops and in locals during them
         // (the opaque use of their address makes the reload real): left alone, LLVM keeps
         // both halves in registers throughout and spills sums inside the loops instead.
         let (mut lo_mem, mut hi_mem) = ([S::zero(); H], [S::zero(); H]);
-        let mut d = [S::zero(); PASS_BLOCK];
+        // Written by the first pass before the second reads it (from the first degree
+        // accumulated on, the run calls back at every degree); not cleared per vector.
+        let mut d = [const { MaybeUninit::<S::V>::uninit() }; PASS_BLOCK];
         // First degree accumulated: the run calls back from there on, in every block.
         let mut first = n;
         let mut i0 = s.i;
@@ -71,7 +75,7 @@ unsafe fn two_passes<S: Simd, const P: usize>(
             let mut lo = lo_mem;
             let mut add = |v: S::V, i: usize| {
                 acc_row::<S, H>(&mut lo, v, fin.add(i * P));
-                *d.get_unchecked_mut(i - i0) = v;
+                d.get_unchecked_mut(i - i0).write(v);
                 first = first.min(i);
             };
             s.run_slow(i1, &mut add);
@@ -80,7 +84,8 @@ unsafe fn two_passes<S: Simd, const P: usize>(
             std::hint::black_box(&mut lo_mem);
             let mut hi = hi_mem;
             for i in first.max(i0)..i1 {
-                acc_row::<S, H>(&mut hi, *d.get_unchecked(i - i0), fin.add(i * P + H));
+                let v = d.get_unchecked(i - i0).assume_init();
+                acc_row::<S, H>(&mut hi, v, fin.add(i * P + H));
             }
             hi_mem = hi;
             std::hint::black_box(&mut hi_mem);
