@@ -43,6 +43,8 @@ mod correlate;
 mod index;
 mod matching;
 mod real;
+#[cfg(test)]
+mod real_paths_tests;
 mod rotate;
 mod s2;
 mod so3;
