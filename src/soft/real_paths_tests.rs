@@ -454,9 +454,9 @@ fn combine_formula(
 
 /// Every output entry written (no NaN left), equal as numbers to the formula: real
 /// inputs (half computed, partners by the symmetry), complex ones, one input off the
-/// symmetry by one ulp (complex), degree limits below both bandwidths, and on the workers
-/// of a cached plan (large enough outputs). With real inputs the output is exactly
-/// symmetric.
+/// symmetry by one ulp (complex), degree limits below both bandwidths, on the workers of a
+/// cached plan (large enough outputs) and with non-temporal stores (outputs over 8 MiB).
+/// With real inputs the output is exactly symmetric.
 #[test]
 fn combine_writes_the_formula_once() {
     let mut rng = Rng(5);
@@ -470,6 +470,9 @@ fn combine_writes_the_formula_once() {
         (4, 4, -1),
         (24, 24, 23),
         (24, 24, 12),
+        // Outputs over 8 MiB: non-temporal stores.
+        (12, 80, 11),
+        (80, 80, 79),
     ] {
         for (real_sig, real_pat, ulp) in [
             (true, true, false),
