@@ -84,8 +84,10 @@ pub unsafe extern "C" fn seanindex2(m: c_int, l: c_int, bw: c_int, loc: *mut c_i
 /// both of bandwidth `bwIn` in `seanindex` order, into the SO(3) coefficients of their
 /// correlation at bandwidth `bwOut`:
 /// `so3Coef[so3CoefLoc(m1,m2,l,bwOut)] = 2pi sqrt(2/(2l+1)) (-1)^(m1+m2) f(l,-m1) conj(h(l,-m2))`
-/// for `l <= degLim`, 0 for all other coefficients (all `(4bwOut^3-bwOut)/3` are written).
-/// Requires `degLim < min(bwIn, bwOut)` (a negative `degLim` gives all zeros).
+/// for `l <= degLim`, 0 for all other coefficients (all `(4bwOut^3-bwOut)/3` are written,
+/// each once). Requires `degLim < min(bwIn, bwOut)` (a negative `degLim` gives all zeros).
+/// Inputs with the exact S^2 real symmetry (those of real signals) compute half of the
+/// order pairs and fill the others by the SO(3) symmetry: the same numbers.
 ///
 /// cbindgen:ignore
 #[no_mangle]

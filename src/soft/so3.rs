@@ -152,6 +152,8 @@ unsafe fn inverse_core(
 /// `weights[k]/w_B(k)` in a private copy); NULL means the standard weights.
 /// `flag != 0`: real data; the output is the transform of the real part of `data` and is
 /// exactly symmetric, `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`, `fhat(l,0,0)` real.
+/// `flag = 0` on samples whose imaginary parts are all exactly 0 (and real parts finite)
+/// takes the same real path: the complex transform's result within rounding.
 /// The workspaces and the plan `p1` are accepted and not used; `data` is not modified.
 ///
 /// cbindgen:ignore
@@ -178,8 +180,10 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw(
 /// `flag != 0`: real data; only the blocks `(0,0)`, `(0,M')` for `M' > 0`, `(M,M')` for
 /// `M > 0, M' != -M` and `(-m,m)` for `m > 0` of `coeffs` are read (the others are rebuilt by
 /// the real symmetry in a private array; they may hold anything) and the imaginary parts of
-/// `data` are exactly 0. The workspaces and the plan `p1` are accepted and not used;
-/// `coeffs` is not modified.
+/// `data` are exactly 0. `flag = 0` on coefficients with the exact real symmetry (every
+/// pair, `fhat(l,0,0)` real, all finite) takes the real path too and writes `(x, 0)`: the
+/// complex transform's result within rounding. The workspaces and the plan `p1` are
+/// accepted and not used; `coeffs` is not modified.
 ///
 /// cbindgen:ignore
 #[no_mangle]
