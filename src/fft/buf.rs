@@ -176,6 +176,37 @@ pub(crate) unsafe fn copy_rows(
     }
 }
 
+/// Write the `n` reals at `src` as `n` complex values `(x, 0)` at `dst` (`2n` doubles); with
+/// `stream`, by non-temporal stores where `dst` is 16-byte aligned (output too large to stay
+/// in the cache: ordinary stores would first read every line), else by plain stores.
+///
+/// # Safety
+/// `src` is valid for reading `n` doubles and `dst` for writing `2n`; they do not overlap.
+pub(crate) unsafe fn spread_reals(src: *const f64, dst: *mut f64, n: usize, stream: bool) {
+    #[cfg(target_arch = "x86_64")]
+    if stream && (dst as usize).is_multiple_of(16) {
+        use std::arch::x86_64::{_mm_load_sd, _mm_sfence, _mm_stream_pd};
+        for i in 0..n {
+            // SAFETY: `src + i` and the 16-byte aligned pair `dst + 2i` are in bounds (this
+            // function's contract); `_mm_load_sd` puts the real in the low lane and 0 in the
+            // high one, which is (x, 0); SSE2 is part of x86_64.
+            unsafe { _mm_stream_pd(dst.add(2 * i), _mm_load_sd(src.add(i))) };
+        }
+        // SAFETY: a store fence (SSE, part of x86_64) orders the streaming stores before
+        // any later access.
+        unsafe { _mm_sfence() };
+        return;
+    }
+    let _ = stream;
+    for i in 0..n {
+        // SAFETY: in bounds by this function's contract.
+        unsafe {
+            *dst.add(2 * i) = *src.add(i);
+            *dst.add(2 * i + 1) = 0.0;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::AlignedBuf;

@@ -14,6 +14,13 @@ use std::f64::consts::PI;
 /// `Chat(l, m1, m2) = 2 pi sqrt(2/(2l+1)) (-1)^(m1+m2) fhat(l,-m1) conj(hhat(l,-m2))` for
 /// `l <= deg_lim`, zero for every other coefficient (SOFT's `so3CombineCoef_fftw`).
 /// `deg_lim < min(b_in, b_out)`.
+///
+/// Every entry of `out` is written once (no zeroing pass). When both inputs have the real
+/// symmetry `fhat(l,-m) = (-1)^m conj(fhat(l,m))` exactly up to degree `deg_lim` (all
+/// finite, `fhat(l,0)` real), only the order pairs `(m1 >= 0, ...)` are computed and their
+/// partners written as `(-1)^(m1-m2) conj(Chat(l,m1,m2))`, which is then the same number as
+/// the formula gives. Called on a rayon worker (inside `ThreadPool::install`), the orders
+/// are spread over the pool's threads.
 pub fn combine(
     (sig, pat): (&[Complex64], &[Complex64]),
     b_in: usize,
@@ -22,16 +29,151 @@ pub fn combine(
     out: &mut [Complex64],
 ) -> Result<()> {
     check(sig.len(), pat.len(), (b_in, deg_lim, b_out), out.len())?;
-    out.fill(Complex64::default());
-    add_combined(
-        (sig, pat),
-        b_in,
-        (0, deg_lim),
-        b_out,
-        (1.0, out),
-        (false, Combine::Add),
-    );
+    let real = s2_real_symmetric(sig, b_in, deg_lim) && s2_real_symmetric(pat, b_in, deg_lim);
+    write_combined((sig, pat), b_in, deg_lim, b_out, out, real);
     Ok(())
+}
+
+/// Whether the S^2 coefficients `c` (bandwidth `b`) of degrees up to `deg_lim` are finite and
+/// have the real symmetry exactly: `c(l,0)` real, `c(l,-m) = (-1)^m conj(c(l,m))` (as
+/// numbers: `+0` and `-0` are equal).
+pub(crate) fn s2_real_symmetric(c: &[Complex64], b: usize, deg_lim: usize) -> bool {
+    let zero = order_start(b, 0);
+    let m0 = c[zero..=zero + deg_lim]
+        .iter()
+        .all(|z| z.im == 0.0 && z.re.is_finite());
+    m0 && (1..=deg_lim).all(|m| {
+        let (p, q) = (order_start(b, m as isize), order_start(b, -(m as isize)));
+        let n = deg_lim + 1 - m;
+        let s = if m % 2 == 0 { 1.0 } else { -1.0 };
+        c[p..p + n].iter().zip(&c[q..q + n]).all(|(a, z)| {
+            a.re.is_finite() && a.im.is_finite() && z.re == s * a.re && z.im == -s * a.im
+        })
+    })
+}
+
+/// [`combine`]'s writing: each row `m1` of `out` (contiguous in the layout) written once,
+/// the combination in degrees `max(|m1|,|m2|)..=deg_lim` of each block, zeros elsewhere;
+/// with `real`, rows `m1 >= 0` computed and rows `m1 < 0` filled by the SO(3) real
+/// symmetry (row 0: blocks `m2 >= 0` computed, `m2 < 0` filled).
+fn write_combined(
+    (sig, pat): (&[Complex64], &[Complex64]),
+    b_in: usize,
+    deg_lim: usize,
+    b_out: usize,
+    out: &mut [Complex64],
+    real: bool,
+) {
+    let norms: Vec<f64> = (0..=deg_lim)
+        .map(|l| 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt())
+        .collect();
+    let bo = b_out as isize;
+    let len = out.len();
+    let dst = SendPtr(out.as_mut_ptr());
+    // An output too large for the cache is written by non-temporal stores (ordinary ones
+    // would first read every line).
+    let stream = 16 * len > STREAM_BYTES && (dst.get() as usize).is_multiple_of(16);
+    // Block (m1, m2): the entries of degrees first..b_out, as a raw range of `out`.
+    let block = |m1: isize, m2: isize| {
+        let first = m1.unsigned_abs().max(m2.unsigned_abs());
+        let start = block_start(b_out, m1, m2);
+        assert!(start + (b_out - first) <= len);
+        (first, dst.get().wrapping_add(start))
+    };
+    // Writes block (m1, m2) and, with `mirror`, its partner (-m1, -m2) by the symmetry.
+    let one_block = |m1: isize, m2: isize, mirror: bool| {
+        let (first, at) = block(m1, m2);
+        let partner = mirror.then(|| block(-m1, -m2).1);
+        let sign = if (m1 + m2).rem_euclid(2) == 0 {
+            1.0
+        } else {
+            -1.0
+        };
+        let computed = if first <= deg_lim {
+            let f_row = &sig[order_start(b_in, -m1)..];
+            let h_row = &pat[order_start(b_in, -m2)..];
+            let (a1, a2) = (m1.unsigned_abs(), m2.unsigned_abs());
+            for l in first..=deg_lim {
+                let v = f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+                // SAFETY: entry `l - first < b_out - first` of the block (asserted in
+                // `block`), which is this task's alone (see the loop over rows below).
+                unsafe {
+                    put(at.add(l - first), v, stream);
+                    if let Some(p) = partner {
+                        // (-1)^(m1-m2) = (-1)^(m1+m2) = sign.
+                        put(p.add(l - first), v.conj() * sign, stream);
+                    }
+                }
+            }
+            deg_lim + 1 - first
+        } else {
+            0
+        };
+        for i in computed..b_out - first {
+            // SAFETY: as above.
+            unsafe {
+                put(at.add(i), Complex64::default(), stream);
+                if let Some(p) = partner {
+                    put(p.add(i), Complex64::default(), stream);
+                }
+            }
+        }
+    };
+    // Row m1 (and, with `real`, row -m1): the tasks write disjoint rows.
+    let row = |m1: isize| {
+        if real {
+            if m1 < 0 {
+                return;
+            }
+            let lowest = if m1 == 0 { 0 } else { -(bo - 1) };
+            for m2 in lowest..bo {
+                one_block(m1, m2, !(m1 == 0 && m2 == 0));
+            }
+        } else {
+            for m2 in -(bo - 1)..bo {
+                one_block(m1, m2, false);
+            }
+        }
+        if stream {
+            store_fence();
+        }
+    };
+    if rayon::current_thread_index().is_some() {
+        (-(bo - 1)..bo).into_par_iter().for_each(row);
+    } else {
+        (-(bo - 1)..bo).for_each(row);
+    }
+}
+
+/// Bytes of output from which [`combine`] writes with non-temporal stores: a quarter of a
+/// 32 MiB last-level cache.
+const STREAM_BYTES: usize = 8 << 20;
+
+/// Write `v` at `p`; with `stream`, by a non-temporal store (`p` 16-byte aligned).
+///
+/// # Safety
+/// `p` is valid for writing one value and, with `stream`, 16-byte aligned.
+#[inline(always)]
+unsafe fn put(p: *mut Complex64, v: Complex64, stream: bool) {
+    #[cfg(target_arch = "x86_64")]
+    if stream {
+        use std::arch::x86_64::{_mm_set_pd, _mm_stream_pd};
+        // SAFETY: the caller's contract; SSE2 is part of x86_64.
+        unsafe { _mm_stream_pd(p as *mut f64, _mm_set_pd(v.im, v.re)) };
+        return;
+    }
+    let _ = stream;
+    // SAFETY: the caller's contract.
+    unsafe { *p = v };
+}
+
+/// Orders the non-temporal stores of [`put`] before any later access.
+fn store_fence() {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86_64.
+    unsafe {
+        std::arch::x86_64::_mm_sfence()
+    };
 }
 
 /// An error unless the lengths fit the bandwidths and `deg_lim < min(b_in, b_out)`.

@@ -55,6 +55,28 @@ pub(super) enum RealInput {
     RealParts(SendConstPtr<Complex64>),
 }
 
+/// Where the real samples of an inverse transform go.
+#[derive(Clone, Copy)]
+pub(super) enum RealOutput {
+    /// `(2B)^3` doubles.
+    Real(SendPtr<f64>),
+    /// The real parts of `(2B)^3` complex values, whose imaginary parts are set to 0 in the
+    /// same pass; with `stream`, by non-temporal stores (an output too large for the cache).
+    RealParts {
+        samples: SendPtr<Complex64>,
+        stream: bool,
+    },
+}
+
+/// The direction of a real transform's FFT stage, with its samples.
+#[derive(Clone, Copy)]
+pub(super) enum RealSamples {
+    /// Forward: the samples are read.
+    Forward(RealInput),
+    /// Inverse: the samples are written.
+    Inverse(RealOutput),
+}
+
 /// A slice FFT and how it runs: which direction, and whether on FFTW's threads (groups
 /// one after another, block copies spread over the workers) or one slice per worker.
 #[derive(Clone, Copy)]
@@ -334,15 +356,14 @@ impl FftStage {
     }
 
     /// FFT stage of one chunk for real data (see `real.rs`) with the real layout `blocks`,
-    /// one mirrored pair of slices at a time: forward from `input` into the blocks (r2c,
-    /// then the conjugated half spectra, weighted), or (with `input = None`) inverse from
-    /// the blocks into the real sample array `grid` (c2r).
+    /// one mirrored pair of slices at a time: forward from the samples into the blocks
+    /// (r2c, then the conjugated half spectra, weighted), or inverse from the blocks into
+    /// the samples (c2r).
     pub(super) fn chunk_real(
         &self,
         blocks: &Blocks,
         ch: &Chunk,
-        input: Option<RealInput>,
-        grid: SendPtr<f64>,
+        samples: RealSamples,
         buf: ChunkBuf,
     ) -> Result<()> {
         let fft = self.real_fft()?;
@@ -360,42 +381,54 @@ impl FftStage {
                     weights: &w,
                     first_pair: j,
                 };
+                // Real samples in a complex array go through n^2 packed reals in the free
+                // part of the scratch, one slice at a time.
+                let packed = sp.wrapping_add(2 * nh) as *mut f64;
                 // SAFETY: the scratch (this task's alone) holds at least two padded slices,
                 // 2n(n + 4) complex values: two half spectra (nh = n^2/2 + n each) and n^2
                 // packed reals (n^2/2 values) fit; pair `j` owns its two rows of every
-                // block and its two sample slices (n^2 reals each), which no other task
-                // touches.
+                // block and its two sample slices (n^2 reals or complex values each), which
+                // no other task touches.
                 unsafe {
-                    if let Some(input) = input {
-                        // Real parts of complex samples are first packed into the free
-                        // part of the scratch, one slice at a time.
-                        let packed = sp.add(2 * nh) as *mut f64;
-                        for (&dst, k) in s.iter().zip([k0, k1]) {
-                            let src = match input {
-                                RealInput::Real(p) => p.get().add(k * nn),
-                                RealInput::RealParts(p) => {
-                                    let slice = p.get().add(k * nn);
-                                    for i in 0..nn {
-                                        *packed.add(i) = (*slice.add(i)).re;
+                    match samples {
+                        RealSamples::Forward(input) => {
+                            for (&dst, k) in s.iter().zip([k0, k1]) {
+                                let src = match input {
+                                    RealInput::Real(p) => p.get().add(k * nn),
+                                    RealInput::RealParts(p) => {
+                                        let slice = p.get().add(k * nn);
+                                        for i in 0..nn {
+                                            *packed.add(i) = (*slice.add(i)).re;
+                                        }
+                                        packed as *const f64
                                     }
-                                    packed as *const f64
-                                }
-                            };
-                            fft.r2c(src, dst);
+                                };
+                                fft.r2c(src, dst);
+                            }
+                            // S(M,M') = conj(R[M][M']) for M' >= 0.
+                            scatter_group(blocks, &group, true, buf, 0..blocks.len());
                         }
-                        // S(M,M') = conj(R[M][M']) for M' >= 0.
-                        scatter_group(blocks, &group, true, buf, 0..blocks.len());
-                    } else {
-                        gather_group(blocks, &group, true, buf, 0..blocks.len());
-                        for (&slot, k) in s.iter().zip([k0, k1]) {
-                            // Frequency B (alpha or gamma) is outside the band limit.
-                            for i in 0..=b {
-                                *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
+                        RealSamples::Inverse(output) => {
+                            gather_group(blocks, &group, true, buf, 0..blocks.len());
+                            for (&slot, k) in s.iter().zip([k0, k1]) {
+                                // Frequency B (alpha or gamma) is outside the band limit.
+                                for i in 0..=b {
+                                    *slot.add(b * (b + 1) + i) = Complex64::new(0.0, 0.0);
+                                }
+                                for a in 0..n {
+                                    *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
+                                }
+                                match output {
+                                    RealOutput::Real(p) => fft.c2r(slot, p.get().add(k * nn)),
+                                    RealOutput::RealParts { samples, stream } => {
+                                        // c2r into the cache, then (x, 0) to the samples:
+                                        // no second pass over them.
+                                        fft.c2r(slot, packed);
+                                        let dst = samples.get().add(k * nn) as *mut f64;
+                                        fft::spread_reals(packed, dst, nn, stream);
+                                    }
+                                }
                             }
-                            for a in 0..n {
-                                *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
-                            }
-                            fft.c2r(slot, grid.get().add(k * nn));
                         }
                     }
                 }

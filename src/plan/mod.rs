@@ -118,6 +118,12 @@ impl Plan {
         self.workers.pool()
     }
 
+    /// Runs `f` on the plan's worker threads (rayon's parallel iterators inside it use
+    /// them), for work that goes with a transform, such as the SOFT layer's checks.
+    pub(crate) fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        self.pool().install(f)
+    }
+
     /// The bandwidth `B`.
     pub fn bandwidth(&self) -> usize {
         self.b

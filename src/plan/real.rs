@@ -10,14 +10,13 @@
 
 use super::blocks::Blocks;
 use super::dwt_stage::DwtLayout;
-use super::fft_stage::RealInput;
+use super::fft_stage::{RealInput, RealOutput, RealSamples};
 use super::options::StageTimes;
 use super::schedule::Spare;
 use super::shared::{SendConstPtr, SendPtr};
 use super::Plan;
 use crate::error::{Error, Result};
 use num_complex::Complex64;
-use rayon::prelude::*;
 
 impl Plan {
     /// Forward transform of a real signal: `(2B)^3` real samples (the sample layout of docs/conventions.md) to all
@@ -36,28 +35,28 @@ impl Plan {
 
     /// [`Plan::inverse_real`] into a complex sample array: real parts are the samples,
     /// imaginary parts exactly 0 (for callers whose interface is complex, such as the C API
-    /// with `SO3FFT_REAL` and SOFT's `flag = 1`). No extra memory: the reals are written to
-    /// the first half of `samples` and spread in place.
+    /// with `SO3FFT_REAL`, SOFT's `flag = 1` and SOFT's `flag = 0` on real-symmetric
+    /// coefficients). No extra memory and no extra pass: the FFT stage writes each slice's
+    /// reals as `(x, 0)` (the chunk buffers live in the complex output's free slices).
     pub(crate) fn inverse_real_to_complex(
         &self,
         coeffs: &[Complex64],
         samples: &mut [Complex64],
     ) -> Result<()> {
         self.check(false, samples.len(), coeffs.len())?;
-        let ns = samples.len();
-        // SAFETY: `samples` spans 2 ns doubles; the f64 view ends before `samples` is used.
-        let re = unsafe { std::slice::from_raw_parts_mut(samples.as_mut_ptr() as *mut f64, ns) };
-        self.inverse_real(coeffs, re)?;
-        // SAFETY: `samples` is valid for 2 ns doubles.
-        unsafe {
-            spread_real_in_place(
-                self.pool(),
-                samples.as_mut_ptr() as *mut f64,
-                ns,
-                self.threads,
-            )
-        };
-        Ok(())
+        let out = samples.as_mut_ptr();
+        // Non-temporal stores only for an output that would not stay in the cache anyway
+        // (below, ordinary stores into the cache are faster).
+        let stream = 16 * samples.len() > self.schedule.plain_store_limit;
+        self.inverse_real_impl(
+            coeffs,
+            RealOutput::RealParts {
+                samples: SendPtr(out),
+                stream,
+            },
+            Spare::over(out, self.b),
+        )
+        .map(|_| ())
     }
 
     /// Like [`Plan::forward_real`], also returning the time of each stage.
@@ -146,10 +145,7 @@ impl Plan {
             true,
             t,
             spare,
-            |ch, buf| {
-                let no_output = SendPtr(std::ptr::null_mut());
-                self.fft.chunk_real(t, ch, Some(input), no_output, buf)
-            },
+            |ch, buf| self.fft.chunk_real(t, ch, RealSamples::Forward(input), buf),
             // The chunks accumulate the representatives only (half the coefficient traffic
             // per chunk); the last one also writes their partners.
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
@@ -166,20 +162,37 @@ impl Plan {
         samples: &mut [f64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.fft.real_fft()?;
         // One raw pointer for the output slices and for the buffers in the free ones.
-        let out = SendPtr(samples.as_mut_ptr());
+        let out = samples.as_mut_ptr();
+        self.inverse_real_impl(
+            coeffs,
+            RealOutput::Real(SendPtr(out)),
+            Spare::over(out, self.b),
+        )
+    }
+
+    /// The real inverse of `coeffs` (length checked by the caller) into `output`, with
+    /// chunk buffers in the output slices not yet written (`spare`, over the same array).
+    fn inverse_real_impl(
+        &self,
+        coeffs: &[Complex64],
+        output: RealOutput,
+        spare: Spare,
+    ) -> Result<StageTimes> {
+        self.fft.real_fft()?;
         let t = self.real_blocks()?;
         let layout = DwtLayout {
             blocks: t,
             real: true,
         };
-        let spare = Spare::over(out.get(), self.b);
         self.run_chunks(
             false,
             t,
             Some(spare),
-            |ch, buf| self.fft.chunk_real(t, ch, None, out, buf),
+            |ch, buf| {
+                self.fft
+                    .chunk_real(t, ch, RealSamples::Inverse(output), buf)
+            },
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer no other task touches.
             |sc, step, pass| unsafe { self.dwt.inverse_cluster(sc, &layout, step, coeffs, pass) },
@@ -190,75 +203,5 @@ impl Plan {
         self.blocks_real.as_ref().ok_or_else(|| {
             Error::InvalidArgument("the plan was made without PlanOptions::real".into())
         })
-    }
-}
-
-/// Turn `n` reals at `base[0..n]` into `n` complex values `(x, 0)` at `base[0..2n]`, in
-/// place. Entry `i` goes to doubles `2i, 2i+1`, so going from the top down never
-/// overwrites a real still to be read. With several threads (on the plan's `pool`): the
-/// range `[ceil(n/2), n)` lands in `[2 ceil(n/2), 2n)`, clear of every real still to be
-/// read, so its pieces can be done at once; then the range below, halving down to the
-/// first few entries. One thread does it in a single pass from the top.
-///
-/// # Safety
-/// `base` is valid for `2n` doubles.
-unsafe fn spread_real_in_place(pool: &rayon::ThreadPool, base: *mut f64, n: usize, threads: usize) {
-    // Entries `lo..hi` to doubles `2 lo..2 hi`, from the top down.
-    let spread = |p: SendPtr<f64>, lo: usize, hi: usize| {
-        for i in (lo..hi).rev() {
-            // SAFETY: `i < hi <= n` and `2i + 1 < 2n`: inside the caller's `2n` doubles.
-            // Within a round the pieces write disjoint ranges `[2a, 2a + 2 per)` at or
-            // above `2 lo >= hi` and read reals below `hi` that no piece of the round
-            // writes; the last (single) pass runs alone.
-            unsafe {
-                let v = *p.get().add(i);
-                *p.get().add(2 * i + 1) = 0.0;
-                *p.get().add(2 * i) = v;
-            }
-        }
-    };
-    let mut hi = n;
-    if threads > 1 {
-        while hi > 1 << 16 {
-            // Rounded up: with `hi` odd, `hi / 2` would write double `hi - 1`, a real
-            // another piece of this round still reads.
-            let lo = hi.div_ceil(2);
-            let per = (hi - lo).div_ceil(threads);
-            let p = SendPtr(base);
-            pool.install(|| {
-                (lo..hi)
-                    .step_by(per)
-                    .par_bridge()
-                    .for_each(|a| spread(p, a, (a + per).min(hi)))
-            });
-            hi = lo;
-        }
-    }
-    spread(SendPtr(base), 0, hi);
-}
-
-#[cfg(test)]
-mod tests {
-    /// Every real ends up as `(x, 0)` at its own index, with one thread (one pass) and with
-    /// several (halving rounds, uneven pieces), for sizes around the rounds' threshold.
-    #[test]
-    fn spread_real_in_place_keeps_every_value() {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap();
-        for n in [1usize, 7, 1 << 16, (1 << 16) + 1, 300_001] {
-            for threads in [1usize, 2, 3] {
-                let mut v: Vec<f64> = (0..2 * n)
-                    .map(|i| if i < n { i as f64 + 0.5 } else { f64::NAN })
-                    .collect();
-                // SAFETY: `v` holds 2n doubles.
-                unsafe { super::spread_real_in_place(&pool, v.as_mut_ptr(), n, threads) };
-                assert!(
-                    (0..n).all(|i| v[2 * i] == i as f64 + 0.5 && v[2 * i + 1] == 0.0),
-                    "n={n} threads={threads}"
-                );
-            }
-        }
     }
 }

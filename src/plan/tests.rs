@@ -377,3 +377,67 @@ fn plans_share_a_pool() {
     drop(b);
     assert_eq!(*live.0.lock().unwrap(), 0);
 }
+
+/// The real inverse into a complex array (the FFT stage writing each slice's reals as
+/// `(x, 0)`, its chunk buffers in the complex output's free slices, a schedule of its own)
+/// gives the real inverse's samples bit for bit and imaginary parts exactly +0: one chunk,
+/// chunk groups and the chain (which fits in complex slices), either store mode, output
+/// 16-byte aligned (streamed) or not.
+#[test]
+fn real_inverse_into_complex_matches_real_samples() {
+    use num_complex::Complex64;
+    for (b, cap) in [
+        (24usize, None),
+        (36, Some(1usize)),
+        (37, Some(1usize)),
+        (20, Some(500_000)),
+        (41, None),
+    ] {
+        let opts = super::PlanOptions {
+            max_workspace_bytes: cap,
+            real: true,
+            threads: 2,
+            ..Default::default()
+        };
+        let mut plan = super::Plan::new(b, &opts).unwrap();
+        let mut x = 0.3f64;
+        // Any coefficients: the real inverse reads one block of each pair.
+        let coefs: Vec<Complex64> = (0..plan.num_coeffs())
+            .map(|_| {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-3, 1.0 - 1e-3);
+                Complex64::new(x - 0.5, 0.25 - x / 2.0)
+            })
+            .collect();
+        let ns = plan.num_samples();
+        for limit in [0usize, usize::MAX] {
+            plan.schedule.plain_store_limit = limit;
+            let mut want = vec![0.0; ns];
+            plan.inverse_real(&coefs, &mut want).unwrap();
+            for aligned in [true, false] {
+                // Doubles from `skip`: 16-byte aligned (streamed stores) or only 8.
+                let mut raw = vec![f64::NAN; 2 * ns + 1];
+                let skip = (0..2)
+                    .find(|&k| {
+                        (raw.as_ptr().wrapping_add(k) as usize).is_multiple_of(16) == aligned
+                    })
+                    .unwrap();
+                let ptr = raw[skip..].as_mut_ptr() as *mut Complex64;
+                // SAFETY: 2 ns doubles from `skip` lie in `raw`; Complex64 needs 8 bytes.
+                let out = unsafe { std::slice::from_raw_parts_mut(ptr, ns) };
+                if !aligned && limit == 0 && cap == Some(1) {
+                    let t = plan.blocks_real.as_ref().unwrap();
+                    let spare = Spare::over(out.as_mut_ptr(), b);
+                    assert!(
+                        plan.schedule.chunk_groups(t, false, Some(&spare)).chained,
+                        "B={b}: no chain in complex slices"
+                    );
+                }
+                plan.inverse_real_to_complex(&coefs, out).unwrap();
+                let ok = out.iter().zip(&want).all(|(z, w)| {
+                    z.re.to_bits() == w.to_bits() && z.im.to_bits() == 0.0f64.to_bits()
+                });
+                assert!(ok, "B={b} cap={cap:?} limit={limit} aligned={aligned}");
+            }
+        }
+    }
+}

@@ -39,6 +39,23 @@ impl<P> Cache<P> {
         }
     }
 
+    /// The plan of bandwidth `b` in this process if it has been made (and no thread is
+    /// making it right now), without making it.
+    fn made(&self, b: usize) -> Option<Arc<P>> {
+        let slot = {
+            let _guard = MAP_LOCK.lock();
+            // SAFETY: the lock is held, so no other reference to the map exists.
+            let map = unsafe { &*self.map.get() };
+            map.get(&(std::process::id(), b))?.clone()
+        };
+        let g = match slot.try_lock() {
+            Ok(g) => g,
+            Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return None,
+        };
+        g.as_ref().map(Arc::clone)
+    }
+
     /// The slot of bandwidth `b` in this process, made empty on first use.
     fn slot(&self, b: usize) -> Slot<P> {
         let _guard = MAP_LOCK.lock();
@@ -174,6 +191,13 @@ pub(super) fn cached<P>(
 /// The cached SO(3) plan of bandwidth `b`, created on first use.
 pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
     cached(&SO3_PLANS, b, || Plan::new(b, cache_options()))
+}
+
+/// The cached SO(3) plan of bandwidth `b` if it exists already (for work that can use its
+/// worker threads but should not make a plan).
+pub(super) fn made_plan(b: usize) -> Option<Arc<Plan>> {
+    register_fork_handlers();
+    SO3_PLANS.made(b)
 }
 
 /// Options of the cached S^2 plans (threads and rigour as for the SO(3) plans).

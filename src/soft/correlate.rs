@@ -1,11 +1,16 @@
 //! The correlation helpers of `so3_correlate_fftw.h` (S^2 coefficient index, combination of
 //! S^2 coefficients into SO(3) coefficients).
 
+use super::cache::made_plan;
 use super::{guarded, soft_bandwidth, to_int, FftwComplex};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::CallError;
 use crate::{num_coeffs, Complex64};
 use std::ffi::{c_double, c_int};
+
+/// Outputs of [`so3CombineCoef_fftw`] shorter than this are written on the calling thread
+/// (waking the workers costs more than the work).
+const PARALLEL_MIN_COEFFS: usize = 1 << 14;
 
 /// Index of the spherical-harmonic coefficient of degree `l` and order `m` at bandwidth `b`
 /// in SOFT's/S2kit's layout (docs/conventions.md, spherical harmonics): `m >= 0`: `m b - m(m-1)/2 + (l-m)`;
@@ -79,8 +84,10 @@ pub unsafe extern "C" fn seanindex2(m: c_int, l: c_int, bw: c_int, loc: *mut c_i
 /// both of bandwidth `bwIn` in `seanindex` order, into the SO(3) coefficients of their
 /// correlation at bandwidth `bwOut`:
 /// `so3Coef[so3CoefLoc(m1,m2,l,bwOut)] = 2pi sqrt(2/(2l+1)) (-1)^(m1+m2) f(l,-m1) conj(h(l,-m2))`
-/// for `l <= degLim`, 0 for all other coefficients (all `(4bwOut^3-bwOut)/3` are written).
-/// Requires `degLim < min(bwIn, bwOut)` (a negative `degLim` gives all zeros).
+/// for `l <= degLim`, 0 for all other coefficients (all `(4bwOut^3-bwOut)/3` are written,
+/// each once). Requires `degLim < min(bwIn, bwOut)` (a negative `degLim` gives all zeros).
+/// Inputs with the exact S^2 real symmetry (those of real signals) compute half of the
+/// order pairs and fill the others by the SO(3) symmetry: the same numbers.
 ///
 /// cbindgen:ignore
 #[no_mangle]
@@ -119,8 +126,8 @@ pub unsafe extern "C" fn so3CombineCoef_fftw(
         // anyone else during the call (the module's safety contract); disjoint from the
         // inputs (checked when they are read).
         let out = unsafe { std::slice::from_raw_parts_mut(so3Coef.cast::<Complex64>(), nout) };
-        out.fill(Complex64::new(0.0, 0.0));
         if degLim < 0 {
+            out.fill(Complex64::new(0.0, 0.0));
             return Ok(());
         }
         // SAFETY: each input is non-NULL, aligned and disjoint from the output (checked)
@@ -134,7 +141,16 @@ pub unsafe extern "C" fn so3CombineCoef_fftw(
         };
         let sig = join(read(sigCoefR), read(sigCoefI));
         let pat = join(read(patCoefR), read(patCoefI));
-        crate::matching::combine((&sig, &pat), bin, degLim as usize, bout, out)?;
+        // Every entry written once; real-symmetric inputs (real signals) compute half of
+        // the order pairs. On the worker threads of the cached plan of bwOut if it exists
+        // (a correlation's inverse makes it; a plan is not made here for that).
+        let run = |out: &mut [Complex64]| {
+            crate::matching::combine((&sig, &pat), bin, degLim as usize, bout, out)
+        };
+        match made_plan(bout) {
+            Some(plan) if nout >= PARALLEL_MIN_COEFFS => plan.install(|| run(out))?,
+            _ => run(out)?,
+        }
         Ok(())
     })
 }

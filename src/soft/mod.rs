@@ -34,6 +34,8 @@
 //!   threads during the call. NULL, alignment and input/output overlap are checked; the
 //!   extent cannot be, and rests on the caller (as in SOFT).
 //! - **Real data** (`flag != 0`): see [`Forward_SO3_Naive_fftw`] and [`Inverse_SO3_Naive_fftw`].
+//!   `flag = 0` calls on real data (samples with imaginary parts exactly 0, coefficients with
+//!   the exact real symmetry) take the same real paths (docs/migrating-from-soft.md).
 
 #![allow(non_snake_case)]
 #![allow(clippy::missing_safety_doc)]
@@ -43,6 +45,8 @@ mod correlate;
 mod index;
 mod matching;
 mod real;
+#[cfg(test)]
+mod real_paths_tests;
 mod rotate;
 mod s2;
 mod so3;

@@ -4,7 +4,8 @@
 use super::SoftResult;
 use crate::ffi::{CallError, ErrorKind};
 use crate::grid::block_start;
-use crate::Complex64;
+use crate::{Complex64, Plan};
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::{Mutex, PoisonError};
 
@@ -41,22 +42,87 @@ pub(super) fn parity(m: isize, mp: isize) -> f64 {
     }
 }
 
-/// Make forward coefficients exactly real-symmetric: each block pair becomes the transform
-/// of the real part of the samples, `(c(M,M') + (-1)^(M-M') conj(c(-M,-M'))) / 2`, and
-/// `fhat(l, 0, 0)` becomes real.
-pub(super) fn symmetrize(b: usize, c: &mut [Complex64]) {
-    let s00 = block_start(b, 0, 0);
-    for v in &mut c[s00..s00 + b] {
-        v.im = 0.0;
+// Which automatic real path a `flag = 0` call took, counted per calling thread for the
+// tests (`[forward, inverse]`); nothing outside the tests.
+#[cfg(test)]
+thread_local! {
+    pub(super) static REAL_PATHS: std::cell::Cell<[usize; 2]> =
+        const { std::cell::Cell::new([0, 0]) };
+}
+
+/// Count a `flag = 0` call that took the real path (`inverse`: the inverse, else the
+/// forward), in the tests only.
+pub(super) fn note_real_path(inverse: bool) {
+    #[cfg(test)]
+    REAL_PATHS.with(|c| {
+        let mut v = c.get();
+        v[usize::from(inverse)] += 1;
+        c.set(v);
+    });
+    let _ = inverse;
+}
+
+/// Values per piece of the parallel scans for real data (a piece is read at memory speed
+/// in a few microseconds; a scan of fewer values runs on the calling thread).
+const SCAN_PIECE: usize = 1 << 15;
+
+/// Whether `f` holds for every piece of `0..n` (pieces of [`SCAN_PIECE`]), on the plan's
+/// workers when there are several pieces; stops soon after a piece where it fails.
+fn all_pieces(plan: &Plan, n: usize, f: impl Fn(usize, usize) -> bool + Sync) -> bool {
+    if n <= SCAN_PIECE {
+        return f(0, n);
     }
-    for (m, mp) in real_primary_pairs(b) {
-        let (p, q) = (block_start(b, m, mp), block_start(b, -m, -mp));
-        let s = parity(m, mp);
-        for i in 0..block_len(b, m, mp) {
-            let a = (c[p + i] + c[q + i].conj() * s) * 0.5;
-            c[p + i] = a;
-            c[q + i] = a.conj() * s;
-        }
+    plan.install(|| {
+        (0..n.div_ceil(SCAN_PIECE))
+            .into_par_iter()
+            .all(|i| f(i * SCAN_PIECE, ((i + 1) * SCAN_PIECE).min(n)))
+    })
+}
+
+/// Whether complex samples are real data: every imaginary part exactly 0 (either sign) and
+/// every real part finite. A `flag = 0` forward on such samples may take the real path.
+pub(super) fn real_samples(plan: &Plan, samples: &[Complex64]) -> bool {
+    all_pieces(plan, samples.len(), |i0, i1| {
+        // No early exit inside a piece: the loop vectorises.
+        samples[i0..i1]
+            .iter()
+            .fold(true, |ok, z| ok & (z.im == 0.0) & z.re.is_finite())
+    })
+}
+
+/// Whether coefficients (bandwidth `b`) have the real symmetry exactly: all finite,
+/// `fhat(l,0,0)` real, and `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))` for every pair
+/// (compared as numbers: `+0` and `-0` are equal). A `flag = 0` inverse of such coefficients
+/// is real, and the real inverse (which reads one block of each pair) gives it.
+pub(super) fn real_symmetric(plan: &Plan, b: usize, c: &[Complex64]) -> bool {
+    let bi = b as isize;
+    // Row `m`'s blocks `(m, M' > 0)`, and `(m, 0)` for `m > 0`, against their partners
+    // `(-m, -M')`: with `(0, 0)`, every pair once.
+    let row = |m: isize| -> bool {
+        let lowest = if m > 0 { 0 } else { 1 };
+        (lowest..bi).all(|mp| {
+            let (p, q) = (block_start(b, m, mp), block_start(b, -m, -mp));
+            let n = block_len(b, m, mp);
+            let s = parity(m, mp);
+            c[p..p + n]
+                .iter()
+                .zip(&c[q..q + n])
+                .fold(true, |ok, (a, z)| {
+                    ok & a.re.is_finite()
+                        & a.im.is_finite()
+                        & (z.re == s * a.re)
+                        & (z.im == -s * a.im)
+                })
+        })
+    };
+    let s00 = block_start(b, 0, 0);
+    let zero = c[s00..s00 + b]
+        .iter()
+        .all(|z| z.im == 0.0 && z.re.is_finite());
+    zero && if c.len() <= SCAN_PIECE {
+        (-(bi - 1)..bi).all(row)
+    } else {
+        plan.install(|| (-(bi - 1)..bi).into_par_iter().all(row))
     }
 }
 

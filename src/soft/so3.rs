@@ -2,7 +2,9 @@
 //! `wrap_fftw.h`: eight entry points on two shared bodies.
 
 use super::cache::plan_for;
-use super::real::{expand_real, release_real_buf, symmetrize, try_zeroed};
+use super::real::{
+    expand_real, note_real_path, real_samples, real_symmetric, release_real_buf, try_zeroed,
+};
 use super::{guarded, FftwComplex, SoftResult};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::CallError;
@@ -59,17 +61,24 @@ unsafe fn forward_core(
             std::slice::from_raw_parts_mut(coeffs.cast::<Complex64>(), nc),
         )
     };
-    match (ratios, flag != 0) {
-        // Real data, standard weights: the real-signal path (half the work) reads the real
-        // parts and writes exactly symmetric coefficients.
-        (None, true) => {
-            return plan
-                .forward_real_parts(samples, out)
-                .map(|_| ())
-                .map_err(CallError::from)
+    // Real data: flag = 1 (the transform of the real parts), or flag = 0 on samples whose
+    // imaginary parts are all exactly 0 (and real parts finite), where the real-signal path
+    // (half the work) computes the same transform. It reads the real parts and writes
+    // exactly symmetric coefficients.
+    let real = flag != 0 || real_samples(&plan, samples);
+    if flag == 0 && real {
+        note_real_path(false);
+    }
+    let run = |samples: &[Complex64], out: &mut [Complex64]| {
+        if real {
+            plan.forward_real_parts(samples, out).map(|_| ())
+        } else {
+            plan.forward(samples, out)
         }
-        (None, false) => plan.forward(samples, out),
-        (Some(r), _) => {
+    };
+    match ratios {
+        None => run(samples, out),
+        Some(r) => {
             // Custom weights: the forward is linear in each beta slice, so scaling slice k
             // by weights[k] / w_B(k) gives exactly SOFT's sum with the caller's weights.
             let mut scaled = try_zeroed(ns)?;
@@ -83,14 +92,10 @@ unsafe fn forward_core(
                     *d = *s * r[k];
                 }
             }
-            plan.forward(&scaled, out)
+            run(&scaled, out)
         }
     }
-    .map_err(CallError::from)?;
-    if flag != 0 {
-        symmetrize(b, out);
-    }
-    Ok(())
+    .map_err(CallError::from)
 }
 
 /// Inverse transform of the coefficients at `coeffs` into the samples at `data`.
@@ -119,6 +124,15 @@ unsafe fn inverse_core(
         )
     };
     if flag == 0 {
+        // Coefficients with the exact real symmetry (a real signal's, e.g. a correlation's
+        // of real functions) have a real inverse: the real-signal path (half the work)
+        // writes it as (x, 0). Anything else, even one pair off by an ulp, stays complex.
+        if real_symmetric(&plan, b, input) {
+            note_real_path(true);
+            return plan
+                .inverse_real_to_complex(input, out)
+                .map_err(CallError::from);
+        }
         return plan.inverse(input, out).map_err(CallError::from);
     }
     let expanded = expand_real(b, input)?;
@@ -138,6 +152,8 @@ unsafe fn inverse_core(
 /// `weights[k]/w_B(k)` in a private copy); NULL means the standard weights.
 /// `flag != 0`: real data; the output is the transform of the real part of `data` and is
 /// exactly symmetric, `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`, `fhat(l,0,0)` real.
+/// `flag = 0` on samples whose imaginary parts are all exactly 0 (and real parts finite)
+/// takes the same real path: the complex transform's result within rounding.
 /// The workspaces and the plan `p1` are accepted and not used; `data` is not modified.
 ///
 /// cbindgen:ignore
@@ -164,8 +180,10 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw(
 /// `flag != 0`: real data; only the blocks `(0,0)`, `(0,M')` for `M' > 0`, `(M,M')` for
 /// `M > 0, M' != -M` and `(-m,m)` for `m > 0` of `coeffs` are read (the others are rebuilt by
 /// the real symmetry in a private array; they may hold anything) and the imaginary parts of
-/// `data` are exactly 0. The workspaces and the plan `p1` are accepted and not used;
-/// `coeffs` is not modified.
+/// `data` are exactly 0. `flag = 0` on coefficients with the exact real symmetry (every
+/// pair, `fhat(l,0,0)` real, all finite) takes the real path too and writes `(x, 0)`: the
+/// complex transform's result within rounding. The workspaces and the plan `p1` are
+/// accepted and not used; `coeffs` is not modified.
 ///
 /// cbindgen:ignore
 #[no_mangle]
