@@ -29,14 +29,33 @@ int main(int argc, char **argv) {
         pat = c.is_real ? real_parts(c.pat, 4 * c.bw * c.bw) : c.pat;
         if (c.is_real) {
             double *grid = (double *)malloc((size_t)n * sizeof(double));
+            double *fused = (double *)malloc((size_t)n * sizeof(double));
+            double fused_angles[3];
             CHECK(grid && so3fft_correlate_real(p, sig, pat, grid) == SO3FFT_OK);
             at = so3fft_grid_argmax_real(c.bw, grid, angles);
+            /* the argmax found while the grid is computed: the same point and grid */
+            CHECK(fused && so3fft_correlate_real_argmax(p, sig, pat, fused, fused_angles) == at);
+            CHECK(fused && memcmp(fused, grid, (size_t)n * sizeof(double)) == 0);
+            CHECK(memcmp(fused_angles, angles, sizeof angles) == 0);
+            CHECK(so3fft_correlate_real_argmax(p, sig, pat, fused, NULL) == at);
+            CHECK(so3fft_correlate_real_argmax(NULL, sig, pat, fused, NULL) == -1);
+            CHECK_ERR(SO3FFT_ENULL);
+            free(fused);
             free(grid);
         } else {
-            so3fft_complex *grid = alloc_cx((size_t)n);
+            so3fft_complex *grid = alloc_cx((size_t)n), *fused = alloc_cx((size_t)n);
+            double fused_angles[3];
             CHECK(so3fft_correlate(p, (so3fft_complex *)sig, (so3fft_complex *)pat, grid) ==
                   SO3FFT_OK);
             at = so3fft_grid_argmax(c.bw, grid, angles);
+            CHECK(so3fft_correlate_argmax(p, (so3fft_complex *)sig, (so3fft_complex *)pat, fused,
+                                          fused_angles) == at);
+            CHECK(memcmp(fused, grid, (size_t)n * sizeof(so3fft_complex)) == 0);
+            CHECK(memcmp(fused_angles, angles, sizeof angles) == 0);
+            /* a complex plan refuses real inputs */
+            CHECK(so3fft_correlate_real_argmax(p, sig, pat, (double *)fused, NULL) == -1);
+            CHECK_ERR(SO3FFT_EINVAL);
+            free(fused);
             free(grid);
         }
         CHECK(at == (ptrdiff_t)(c.ii * 4 * c.bw * c.bw + c.jj * 2 * c.bw + c.kk));

@@ -390,6 +390,15 @@ int so3fft_correlate(so3fft_correlation p, so3fft_complex *signal, so3fft_comple
 // `SO3FFT_REAL`).
 int so3fft_correlate_real(so3fft_correlation p, const double *signal, const double *pattern, double *out);
 
+// [`so3fft_correlate`] and the index of the grid's largest `|C|^2` (the point
+// [`so3fft_grid_argmax`] gives), found while the grid is computed; its Euler angles into
+// `angles` (3 doubles, or NULL). -1 on error.
+ptrdiff_t so3fft_correlate_argmax(so3fft_correlation p, so3fft_complex *signal, so3fft_complex *pattern, so3fft_complex *out, double *angles);
+
+// [`so3fft_correlate_real`] and the index of the grid's largest `C^2`, as
+// [`so3fft_correlate_argmax`].
+ptrdiff_t so3fft_correlate_real_argmax(so3fft_correlation p, const double *signal, const double *pattern, double *out, double *angles);
+
 // Index of the largest `|C|^2` of a complex grid of bandwidth `B` (ties: the lowest index;
 // SOFT's rule), its Euler angles `(alpha, beta, gamma)` into `angles` (3 doubles, or NULL);
 // -1 on error.

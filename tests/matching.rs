@@ -731,3 +731,85 @@ fn rotations_near_the_poles_refined() {
         );
     }
 }
+
+/// The argmax found while the inverse computes the grid (`correlate_argmax`,
+/// `correlate_real_argmax`) is the scan's (`grid_argmax`) exactly, index and value, and
+/// the grid is the plain correlation's bit for bit: on the full transform (slices watched)
+/// and on a finer grid (the general engine, scanned after), with one and two threads,
+/// including an all-zero grid and exact ties.
+#[test]
+fn fused_argmax_equals_the_scan() {
+    for name in [
+        "cor_B8_complex.txt",
+        "cor_B8_real.txt",
+        "cor_B16_complex.txt",
+        "cor_B16_real.txt",
+        "cor_B8_zero_signal.txt",
+        "cor_B8_axisymmetric_tie.txt",
+    ] {
+        let c = case(name);
+        for (b_out, threads) in [(None, 1), (None, 2), (Some(2 * c.b), 2)] {
+            let plan = Correlation::new(
+                c.b,
+                &CorrelationOptions {
+                    real: c.real,
+                    threads,
+                    b_out,
+                    ..Default::default()
+                },
+            )
+            .unwrap();
+            let b_out = plan.b_out();
+            let what = format!("{name} b_out={b_out} threads={threads}");
+            let (fused, scanned) = if c.real {
+                let re = |v: &[Complex64]| v.iter().map(|z| z.re).collect::<Vec<f64>>();
+                let (s, p) = (re(&c.signal), re(&c.pattern));
+                let mut plain = vec![0.0; plan.num_grid()];
+                plan.correlate_real(&s, &p, &mut plain).unwrap();
+                let mut out = vec![f64::NAN; plan.num_grid()];
+                let fused = plan.correlate_real_argmax(&s, &p, &mut out).unwrap();
+                let same = out
+                    .iter()
+                    .zip(&plain)
+                    .all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "{what}: grid");
+                (fused, grid_argmax_real(b_out, &plain))
+            } else {
+                let mut plain = vec![Complex64::default(); plan.num_grid()];
+                plan.correlate(&c.signal, &c.pattern, &mut plain).unwrap();
+                let mut out = vec![Complex64::new(f64::NAN, 0.0); plan.num_grid()];
+                let fused = plan
+                    .correlate_argmax(&c.signal, &c.pattern, &mut out)
+                    .unwrap();
+                assert!(out == plain, "{what}: grid");
+                (fused, grid_argmax(b_out, &plain))
+            };
+            assert_eq!(fused.index, scanned.index, "{what}");
+            assert_eq!(fused.value.to_bits(), scanned.value.to_bits(), "{what}");
+            if b_out == c.b && !name.contains("tie") {
+                assert_eq!(fused.index, c.maxloc, "{what}: reference");
+            }
+        }
+        // A plan for the other kind of input refuses.
+        let plan = Correlation::new(
+            c.b,
+            &CorrelationOptions {
+                real: !c.real,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let n = plan.num_grid();
+        if c.real {
+            let s = vec![0.0; 4 * c.b * c.b];
+            assert!(plan
+                .correlate_real_argmax(&s, &s, &mut vec![0.0; n])
+                .is_err());
+        } else {
+            let mut out = vec![Complex64::default(); n];
+            assert!(plan
+                .correlate_argmax(&c.signal, &c.pattern, &mut out)
+                .is_err());
+        }
+    }
+}

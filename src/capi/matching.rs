@@ -177,6 +177,59 @@ pub unsafe extern "C" fn so3fft_correlate_real(
     })
 }
 
+/// [`so3fft_correlate`] and the index of the grid's largest `|C|^2` (the point
+/// [`so3fft_grid_argmax`] gives), found while the grid is computed; its Euler angles into
+/// `angles` (3 doubles, or NULL). -1 on error.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlate_argmax(
+    p: so3fft_correlation,
+    signal: *mut so3fft_complex,
+    pattern: *mut so3fft_complex,
+    out: *mut so3fft_complex,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: `p` NULL or live; arrays of the documented sizes, `angles` NULL or 3
+        // doubles (the API's contract).
+        unsafe {
+            let plan = plan_ref(p)?;
+            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
+            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 16, "out");
+            let (s, h) = inputs(
+                signal.cast_const().cast::<Complex64>(),
+                pattern.cast_const().cast(),
+                ns,
+                Some(&grid),
+            )?;
+            let out = std::slice::from_raw_parts_mut(out.cast::<Complex64>(), ng);
+            Ok(put_angles(plan.correlate_argmax(s, h, out)?, angles))
+        }
+    })
+}
+
+/// [`so3fft_correlate_real`] and the index of the grid's largest `C^2`, as
+/// [`so3fft_correlate_argmax`].
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlate_real_argmax(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    out: *mut c_double,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: as in `so3fft_correlate_argmax`.
+        unsafe {
+            let plan = plan_ref(p)?;
+            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
+            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 8, "out");
+            let (s, h) = inputs(signal, pattern, ns, Some(&grid))?;
+            let out = std::slice::from_raw_parts_mut(out, ng);
+            Ok(put_angles(plan.correlate_real_argmax(s, h, out)?, angles))
+        }
+    })
+}
+
 /// Writes a peak's angles and returns its index.
 ///
 /// # Safety

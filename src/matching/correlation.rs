@@ -3,10 +3,12 @@
 //! inverse SO(3) transform.
 
 use super::combine::{add_combined, Combine};
+use super::peaks::{grid_argmax, grid_argmax_real, Peak, SliceArgmax};
 use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::partial::{PartialOptions, PartialPlan, Shape};
+use crate::plan::SliceRef;
 use crate::s2::{S2Options, S2Plan};
 use crate::workers::WorkerPool;
 use crate::{Direction, Rigor};
@@ -399,6 +401,53 @@ impl Correlation {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
             self.combine_shells(shells, (fwd, true), buf)?;
             self.so3.inverse_real(&buf.so3, out)
+        })
+    }
+
+    /// [`Correlation::correlate`] and the grid's largest `|C|^2` ([`grid_argmax`]: the
+    /// same point, value and tie rule), found while the inverse computes each slice of the
+    /// grid instead of in a second pass over it (when the grid's plan is the full
+    /// transform, `b_out` the input bandwidth and every degree combined; else by a scan
+    /// after the inverse).
+    pub fn correlate_argmax(
+        &self,
+        signal: &[Complex64],
+        pattern: &[Complex64],
+        out: &mut [Complex64],
+    ) -> Result<Peak> {
+        self.need(false)?;
+        self.with_buffers(|buf| {
+            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
+            let seen = SliceArgmax::new(self.b_out);
+            let watch = |k: usize, s: SliceRef| seen.watch(k, s);
+            Ok(if self.so3.inverse_watched(&buf.so3, out, &watch)? {
+                seen.peak()
+            } else {
+                grid_argmax(self.b_out, out)
+            })
+        })
+    }
+
+    /// [`Correlation::correlate_real`] and the grid's largest `C^2`
+    /// ([`grid_argmax_real`]), as [`Correlation::correlate_argmax`].
+    pub fn correlate_real_argmax(
+        &self,
+        signal: &[f64],
+        pattern: &[f64],
+        out: &mut [f64],
+    ) -> Result<Peak> {
+        self.need(true)?;
+        self.with_buffers(|buf| {
+            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, true), buf)?;
+            let seen = SliceArgmax::new(self.b_out);
+            let watch = |k: usize, s: SliceRef| seen.watch(k, s);
+            Ok(if self.so3.inverse_real_watched(&buf.so3, out, &watch)? {
+                seen.peak()
+            } else {
+                grid_argmax_real(self.b_out, out)
+            })
         })
     }
 

@@ -17,6 +17,7 @@ mod series;
 
 pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};
+pub(crate) use peaks::SliceArgmax;
 pub use peaks::{grid_argmax, grid_argmax_real, top_peaks, top_peaks_real, Peak};
 pub use refine::So3Series;
 pub use rotation::{rotate_s2_coeffs, rotate_s2_coeffs_to, Rotation};

@@ -52,53 +52,114 @@ pub fn grid_argmax_real(b: usize, values: &[f64]) -> Peak {
     argmax_by(b, values, |x| x * x)
 }
 
+/// The first largest `f(v)` of `values` (strictly larger replaces; NaN is never taken),
+/// with its index plus `base`; `(0.0, usize::MAX)` when no value is positive. In blocks: a
+/// block's maximum first (eight independent running maxima, which vectorise), then, only
+/// when it beats the best so far, the first index in the block that reaches it.
+fn first_largest_in<T: Copy>(values: &[T], base: usize, f: &impl Fn(T) -> f64) -> (f64, usize) {
+    const BLOCK: usize = 1024;
+    let (mut best, mut at) = (0.0, usize::MAX);
+    for (k, block) in values.chunks(BLOCK).enumerate() {
+        let mut lanes = [0.0f64; 8];
+        let mut groups = block.chunks_exact(8);
+        for g in &mut groups {
+            for (m, &v) in lanes.iter_mut().zip(g) {
+                let x = f(v);
+                // NaN compares false and is never taken.
+                *m = if x > *m { x } else { *m };
+            }
+        }
+        let top = groups
+            .remainder()
+            .iter()
+            .map(|&v| f(v))
+            .chain(lanes)
+            .fold(0.0, |m, x| if x > m { x } else { m });
+        if top > best {
+            let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
+            (best, at) = (top, base + k * BLOCK + i);
+        }
+    }
+    (best, at)
+}
+
+/// Of two `(value, index)` candidates, the larger value, or at equal values the lower
+/// index: the candidate a scan in flat order keeps.
+fn first_largest(x: (f64, usize), y: (f64, usize)) -> (f64, usize) {
+    if y.0 > x.0 || (y.0 == x.0 && y.1 < x.1) {
+        y
+    } else {
+        x
+    }
+}
+
+/// The peak of the candidate `best` of a grid of bandwidth `b`: index 0 when no value
+/// was positive.
+fn peak_of(b: usize, (best, at): (f64, usize)) -> Peak {
+    Peak::at(b, if at == usize::MAX { 0 } else { at }, best)
+}
+
 /// The scan of [`grid_argmax`], in parts spread over rayon's current pool (each part's first
-/// largest value; the parts' results combined by value, then by the lower index) and, within
-/// a part, in blocks: a block's maximum first (eight independent running maxima, which
-/// vectorise), then, only when it beats the best so far, the first index in the block that
-/// reaches it. The same index as a one-by-one scan.
+/// largest value; the parts' results combined by value, then by the lower index): the same
+/// index as a one-by-one scan.
 fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync) -> Peak {
     const PART: usize = 1 << 16;
-    const BLOCK: usize = 1024;
-    let part_best = |(p, part): (usize, &[T])| -> (f64, usize) {
-        let (mut best, mut at) = (0.0, usize::MAX);
-        for (k, block) in part.chunks(BLOCK).enumerate() {
-            let mut lanes = [0.0f64; 8];
-            let mut groups = block.chunks_exact(8);
-            for g in &mut groups {
-                for (m, &v) in lanes.iter_mut().zip(g) {
-                    let x = f(v);
-                    // NaN compares false and is never taken.
-                    *m = if x > *m { x } else { *m };
-                }
-            }
-            let top = groups
-                .remainder()
-                .iter()
-                .map(|&v| f(v))
-                .chain(lanes)
-                .fold(0.0, |m, x| if x > m { x } else { m });
-            if top > best {
-                let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
-                (best, at) = (top, p * PART + k * BLOCK + i);
-            }
-        }
-        (best, at)
-    };
-    let first_largest = |x: (f64, usize), y: (f64, usize)| {
-        if y.0 > x.0 || (y.0 == x.0 && y.1 < x.1) {
-            y
-        } else {
-            x
-        }
-    };
-    let (best, at) = values
+    let best = values
         .par_chunks(PART)
         .enumerate()
-        .map(part_best)
+        .map(|(p, part)| first_largest_in(part, p * PART, &f))
         .reduce(|| (0.0, usize::MAX), first_largest);
-    // No positive value: index 0.
-    Peak::at(b, if at == usize::MAX { 0 } else { at }, best)
+    peak_of(b, best)
+}
+
+/// [`grid_argmax`] gathered slice by slice while an inverse computes the grid (each slice
+/// scanned while in the cache, see `SliceWatch`): [`SliceArgmax::watch`] takes the slices
+/// in any order, [`SliceArgmax::peak`] gives the same peak as a scan of the whole grid.
+pub(crate) struct SliceArgmax {
+    b: usize,
+    /// The best candidate of each beta slice seen.
+    best: std::sync::Mutex<Vec<(f64, usize)>>,
+}
+
+impl SliceArgmax {
+    /// For a grid of bandwidth `b`.
+    pub(crate) fn new(b: usize) -> SliceArgmax {
+        SliceArgmax {
+            b,
+            best: std::sync::Mutex::new(vec![(0.0, usize::MAX); 2 * b]),
+        }
+    }
+
+    /// Scans beta slice `k` (`|C|^2`: `|z|^2` of complex values, `x^2` of real ones).
+    pub(crate) fn watch(&self, k: usize, slice: crate::plan::SliceRef) {
+        use crate::plan::SliceRef;
+        let n = 2 * self.b;
+        let base = k * n * n;
+        let found = match slice {
+            SliceRef::Real(v) => first_largest_in(&v[..n * n], base, &|x: f64| x * x),
+            SliceRef::Complex {
+                values,
+                row,
+                stride,
+            } => (0..row).fold((0.0, usize::MAX), |acc, r| {
+                let cells = &values[r * stride..][..row];
+                first_largest(
+                    acc,
+                    first_largest_in(cells, base + r * row, &|z: Complex64| z.norm_sqr()),
+                )
+            }),
+        };
+        self.best.lock().unwrap_or_else(|e| e.into_inner())[k] = found;
+    }
+
+    /// The grid's first largest value over the slices seen.
+    pub(crate) fn peak(&self) -> Peak {
+        let best = self.best.lock().unwrap_or_else(|e| e.into_inner());
+        peak_of(
+            self.b,
+            best.iter().copied().fold((0.0, usize::MAX), first_largest),
+        )
+    }
 }
 
 /// Up to `k` peaks of `|C|^2` on the grid `values` (bandwidth `b`), largest first: grid

@@ -9,7 +9,7 @@ use super::shape::{CoefLayout, Shape};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::{Error, Result};
 use crate::fft::{AlignedBuf, Rigor};
-use crate::plan::{Direction, Plan, PlanOptions, StageTimes};
+use crate::plan::{Direction, Plan, PlanOptions, SliceWatch, StageTimes};
 use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
@@ -255,6 +255,38 @@ impl PartialPlan {
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
         self.inverse_real_many(one(coeffs.len(), samples.len()), coeffs, samples)
             .map(|_| ())
+    }
+
+    /// [`PartialPlan::inverse`] that shows every output slice to `watch` as it is
+    /// computed, where the plan runs on [`Plan`] (the full shape); `Ok(false)` (and
+    /// `watch` never called) on the general engine.
+    pub(crate) fn inverse_watched(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        watch: SliceWatch,
+    ) -> Result<bool> {
+        match &self.engine {
+            Engine::Full(p) if self.direction != Direction::Forward => {
+                p.inverse_watched(coeffs, samples, watch).map(|()| true)
+            }
+            _ => self.inverse(coeffs, samples).map(|()| false),
+        }
+    }
+
+    /// [`PartialPlan::inverse_real`] with a watch, as [`PartialPlan::inverse_watched`].
+    pub(crate) fn inverse_real_watched(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        watch: SliceWatch,
+    ) -> Result<bool> {
+        match &self.engine {
+            Engine::Full(p) if self.real && self.direction != Direction::Forward => p
+                .inverse_real_watched(coeffs, samples, watch)
+                .map(|()| true),
+            _ => self.inverse_real(coeffs, samples).map(|()| false),
+        }
     }
 
     /// `batch.count` forwards; the time of each stage.

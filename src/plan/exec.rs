@@ -3,6 +3,7 @@
 
 use super::blocks::{Blocks, BufLayout, ChunkBuf};
 use super::dwt_stage::{DwtLayout, Scratch};
+use super::fft_stage::SliceWatch;
 use super::options::StageTimes;
 use super::schedule::{Chunk, ChunkGroups, ClusterStep, Pass, PlacedChunk, Spare};
 use super::shared::SendPtr;
@@ -59,7 +60,7 @@ impl Plan {
             true,
             &self.blocks,
             spare,
-            |ch, buf| self.fft.chunk(&self.blocks, ch, true, input, buf),
+            |ch, buf| self.fft.chunk(&self.blocks, ch, (true, None), input, buf),
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer and coefficient rows no other task touches; the buffer holds the
             // chunk's blocks (filled by the FFT stage before); `coeffs` has
@@ -74,6 +75,7 @@ impl Plan {
         &self,
         coeffs: &[Complex64],
         samples: &mut [Complex64],
+        watch: Option<SliceWatch>,
     ) -> Result<StageTimes> {
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SendPtr(samples.as_mut_ptr());
@@ -86,7 +88,7 @@ impl Plan {
             false,
             &self.blocks,
             Some(spare),
-            |ch, buf| self.fft.chunk(&self.blocks, ch, false, out, buf),
+            |ch, buf| self.fft.chunk(&self.blocks, ch, (false, watch), out, buf),
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer no other task touches; the buffer is the chunk's.
             |sc, step, pass| unsafe { self.dwt.inverse_cluster(sc, &layout, step, coeffs, pass) },

@@ -68,13 +68,32 @@ pub(super) enum RealOutput {
     },
 }
 
+/// One output slice of an inverse, handed to a [`SliceWatch`] right after it is
+/// computed (while in the cache): the real slice as written, or a complex slice in the
+/// scratch, `row` values per row and rows `stride` values apart.
+pub(crate) enum SliceRef<'a> {
+    /// The `(2B)^2` reals of the slice.
+    Real(&'a [f64]),
+    /// The `2B` rows of the slice.
+    Complex {
+        values: &'a [Complex64],
+        row: usize,
+        stride: usize,
+    },
+}
+
+/// What an inverse calls with the beta index and the values of each output slice, once
+/// per slice, from whichever worker computed it (for scans fused into the transform, such
+/// as a grid's argmax).
+pub(crate) type SliceWatch<'a> = &'a (dyn Fn(usize, SliceRef) + Sync);
+
 /// The direction of a real transform's FFT stage, with its samples.
 #[derive(Clone, Copy)]
-pub(super) enum RealSamples {
+pub(super) enum RealSamples<'a> {
     /// Forward: the samples are read.
     Forward(RealInput),
-    /// Inverse: the samples are written.
-    Inverse(RealOutput),
+    /// Inverse: the samples are written (each slice shown to the watch if given).
+    Inverse(RealOutput, Option<SliceWatch<'a>>),
 }
 
 /// A slice FFT and how it runs: which direction, and whether on FFTW's threads (groups
@@ -87,6 +106,8 @@ pub(super) struct SliceRun<'a> {
     pub forward: bool,
     /// Whether `fft` runs on FFTW's threads.
     pub fftw_threaded: bool,
+    /// Inverse: shown each output slice.
+    pub watch: Option<SliceWatch<'a>>,
 }
 
 /// The FFT stage of a plan: its slice FFTs, weights and per-worker scratch.
@@ -200,7 +221,7 @@ impl FftStage {
         &self,
         blocks: &Blocks,
         ch: &Chunk,
-        forward: bool,
+        (forward, watch): (bool, Option<SliceWatch>),
         grid: SendPtr<Complex64>,
         buf: ChunkBuf,
     ) -> Result<()> {
@@ -216,6 +237,7 @@ impl FftStage {
             fft,
             forward,
             fftw_threaded: self.fftw_threaded,
+            watch,
         };
         self.pairs(blocks, ch, run, &slices, buf)
     }
@@ -237,15 +259,18 @@ impl FftStage {
             let j0 = gi * g;
             let gn = g.min(npairs - j0);
             let mut grid = [std::ptr::null_mut(); 2 * MAX_GROUP];
+            let mut betas = [0; 2 * MAX_GROUP];
             let mut w = [0.0; 2 * MAX_GROUP];
             for jj in 0..gn {
                 let (k0, k1) = ch.pair_betas(self.b, j0 + jj);
                 (grid[2 * jj], grid[2 * jj + 1]) = (slice(k0).get(), slice(k1).get());
+                (betas[2 * jj], betas[2 * jj + 1]) = (k0, k1);
                 (w[2 * jj], w[2 * jj + 1]) = (self.weights[k0], self.weights[k1]);
             }
             self.with_scratch(|scratch| {
                 let group = GroupSlices {
                     grid: &grid[..2 * gn],
+                    betas: &betas[..2 * gn],
                     weights: &w[..2 * gn],
                     first_pair: j0,
                 };
@@ -337,7 +362,7 @@ impl FftStage {
                 // belongs to one cluster's slot).
                 unsafe { gather_group(blocks, &slices, false, buf, c0..c1) }
             });
-            for (src, &dst) in s.iter().zip(group.grid) {
+            for ((src, &dst), &k) in s.iter().zip(group.grid).zip(group.betas) {
                 let src = src.get();
                 // SAFETY: row `b` and column `b` of a padded `n x rs` slice of the scratch.
                 unsafe {
@@ -349,6 +374,18 @@ impl FftStage {
                     // In place in the cache, then streamed to the samples: FFTW's own
                     // stores would first read every line of `dst` from memory.
                     fft.in_place(src);
+                }
+                if let Some(watch) = run.watch {
+                    // SAFETY: the padded slice, this task's alone, holds `n` rows of `rs`.
+                    let values = unsafe { std::slice::from_raw_parts(src, (n - 1) * rs + n) };
+                    watch(
+                        k,
+                        SliceRef::Complex {
+                            values,
+                            row: n,
+                            stride: rs,
+                        },
+                    );
                 }
                 copy(src, dst);
             }
@@ -363,7 +400,7 @@ impl FftStage {
         &self,
         blocks: &Blocks,
         ch: &Chunk,
-        samples: RealSamples,
+        samples: RealSamples<'_>,
         buf: ChunkBuf,
     ) -> Result<()> {
         let fft = self.real_fft()?;
@@ -408,7 +445,7 @@ impl FftStage {
                             // S(M,M') = conj(R[M][M']) for M' >= 0.
                             scatter_group(blocks, &group, true, buf, 0..blocks.len());
                         }
-                        RealSamples::Inverse(output) => {
+                        RealSamples::Inverse(output, watch) => {
                             gather_group(blocks, &group, true, buf, 0..blocks.len());
                             for (&slot, k) in s.iter().zip([k0, k1]) {
                                 // Frequency B (alpha or gamma) is outside the band limit.
@@ -418,15 +455,27 @@ impl FftStage {
                                 for a in 0..n {
                                     *slot.add(a * (b + 1) + b) = Complex64::new(0.0, 0.0);
                                 }
-                                match output {
-                                    RealOutput::Real(p) => fft.c2r(slot, p.get().add(k * nn)),
+                                let written = match output {
+                                    RealOutput::Real(p) => {
+                                        let dst = p.get().add(k * nn);
+                                        fft.c2r(slot, dst);
+                                        dst as *const f64
+                                    }
                                     RealOutput::RealParts { samples, stream } => {
                                         // c2r into the cache, then (x, 0) to the samples:
                                         // no second pass over them.
                                         fft.c2r(slot, packed);
                                         let dst = samples.get().add(k * nn) as *mut f64;
                                         fft::spread_reals(packed, dst, nn, stream);
+                                        packed as *const f64
                                     }
+                                };
+                                if let Some(watch) = watch {
+                                    // The slice's reals, just written (this task's).
+                                    watch(
+                                        k,
+                                        SliceRef::Real(std::slice::from_raw_parts(written, nn)),
+                                    );
                                 }
                             }
                         }
@@ -455,6 +504,8 @@ impl FftStage {
 /// weights and the group's first pair.
 struct GroupSlices<'a> {
     grid: &'a [*mut Complex64],
+    /// The beta index of each slice of `grid`.
+    betas: &'a [usize],
     weights: &'a [f64],
     first_pair: usize,
 }

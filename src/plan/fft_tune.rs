@@ -148,6 +148,7 @@ impl Plan {
                                     fft,
                                     forward,
                                     fftw_threaded: threaded,
+                                    watch: None,
                                 };
                                 let buf = ChunkBuf {
                                     base: SendPtr(bp),

@@ -42,6 +42,7 @@ pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDT
 
 #[cfg(feature = "internals")]
 pub use fft_stage::BlockCopies;
+pub(crate) use fft_stage::{SliceRef, SliceWatch};
 
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
@@ -254,7 +255,18 @@ impl Plan {
         samples: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.inverse_impl(coeffs, samples)
+        self.inverse_impl(coeffs, samples, None)
+    }
+
+    /// [`Plan::inverse`] that shows every output slice to `watch` as it is computed.
+    pub(crate) fn inverse_watched(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        watch: SliceWatch,
+    ) -> Result<()> {
+        self.check(false, samples.len(), coeffs.len())?;
+        self.inverse_impl(coeffs, samples, Some(watch)).map(|_| ())
     }
 
     /// [`Plan::forward`] that may overwrite `samples` (like FFTW's `FFTW_DESTROY_INPUT`):
@@ -312,7 +324,8 @@ pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Re
                 layout,
             };
             for ch in plan.schedule.chunks(&plan.blocks) {
-                plan.fft.chunk(&plan.blocks, &ch, forward, grid, buf)?;
+                plan.fft
+                    .chunk(&plan.blocks, &ch, (forward, None), grid, buf)?;
             }
             Ok(())
         })

@@ -10,7 +10,7 @@
 
 use super::blocks::Blocks;
 use super::dwt_stage::DwtLayout;
-use super::fft_stage::{RealInput, RealOutput, RealSamples};
+use super::fft_stage::{RealInput, RealOutput, RealSamples, SliceWatch};
 use super::options::StageTimes;
 use super::schedule::Spare;
 use super::shared::{SendConstPtr, SendPtr};
@@ -50,10 +50,13 @@ impl Plan {
         let stream = 16 * samples.len() > self.schedule.plain_store_limit;
         self.inverse_real_impl(
             coeffs,
-            RealOutput::RealParts {
-                samples: SendPtr(out),
-                stream,
-            },
+            (
+                RealOutput::RealParts {
+                    samples: SendPtr(out),
+                    stream,
+                },
+                None,
+            ),
             Spare::over(out, self.b),
         )
         .map(|_| ())
@@ -166,9 +169,26 @@ impl Plan {
         let out = samples.as_mut_ptr();
         self.inverse_real_impl(
             coeffs,
-            RealOutput::Real(SendPtr(out)),
+            (RealOutput::Real(SendPtr(out)), None),
             Spare::over(out, self.b),
         )
+    }
+
+    /// [`Plan::inverse_real`] that shows every output slice to `watch` as it is computed.
+    pub(crate) fn inverse_real_watched(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        watch: SliceWatch,
+    ) -> Result<()> {
+        self.check(false, samples.len(), coeffs.len())?;
+        let out = samples.as_mut_ptr();
+        self.inverse_real_impl(
+            coeffs,
+            (RealOutput::Real(SendPtr(out)), Some(watch)),
+            Spare::over(out, self.b),
+        )
+        .map(|_| ())
     }
 
     /// The real inverse of `coeffs` (length checked by the caller) into `output`, with
@@ -176,7 +196,7 @@ impl Plan {
     fn inverse_real_impl(
         &self,
         coeffs: &[Complex64],
-        output: RealOutput,
+        (output, watch): (RealOutput, Option<SliceWatch>),
         spare: Spare,
     ) -> Result<StageTimes> {
         self.fft.real_fft()?;
@@ -191,7 +211,7 @@ impl Plan {
             Some(spare),
             |ch, buf| {
                 self.fft
-                    .chunk_real(t, ch, RealSamples::Inverse(output), buf)
+                    .chunk_real(t, ch, RealSamples::Inverse(output, watch), buf)
             },
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer no other task touches.

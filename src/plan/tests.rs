@@ -441,3 +441,73 @@ fn real_inverse_into_complex_matches_real_samples() {
         }
     }
 }
+
+/// An inverse with a watch shows it every beta slice exactly once, with the values the
+/// slice holds in the output (complex: rows of the scratch, padded; real: the output
+/// slice), complex and real, with one chunk and with several.
+#[test]
+fn watched_inverse_shows_every_slice_once() {
+    use super::fft_stage::SliceRef;
+    use num_complex::Complex64;
+    use std::sync::Mutex;
+    for (b, cap) in [(12usize, None), (36, Some(1usize))] {
+        let opts = super::PlanOptions {
+            threads: 2,
+            real: true,
+            max_workspace_bytes: cap,
+            ..Default::default()
+        };
+        let plan = super::Plan::new(b, &opts).unwrap();
+        let n = 2 * b;
+        let coeffs: Vec<Complex64> = (0..plan.num_coeffs())
+            .map(|i| Complex64::new((i as f64 * 0.37).sin(), (i as f64 * 0.71).cos()))
+            .collect();
+        // Complex: each slice's rows as seen.
+        let seen: Mutex<Vec<Option<Vec<Complex64>>>> = Mutex::new(vec![None; n]);
+        let watch = |k: usize, s: SliceRef| {
+            let SliceRef::Complex {
+                values,
+                row,
+                stride,
+            } = s
+            else {
+                panic!("real slice from the complex inverse")
+            };
+            assert_eq!(row, n);
+            let rows: Vec<Complex64> = (0..n)
+                .flat_map(|r| values[r * stride..][..n].iter().copied())
+                .collect();
+            let old = seen.lock().unwrap()[k].replace(rows);
+            assert!(old.is_none(), "B={b}: slice {k} twice");
+        };
+        let mut out = vec![Complex64::default(); plan.num_samples()];
+        plan.inverse_watched(&coeffs, &mut out, &watch).unwrap();
+        for (k, s) in seen.into_inner().unwrap().into_iter().enumerate() {
+            let s = s.unwrap_or_else(|| panic!("B={b}: slice {k} not shown"));
+            assert!(
+                s == out[k * n * n..][..n * n],
+                "B={b} cap={cap:?}: slice {k}"
+            );
+        }
+        // Real.
+        let seen: Mutex<Vec<Option<Vec<f64>>>> = Mutex::new(vec![None; n]);
+        let watch = |k: usize, s: SliceRef| {
+            let SliceRef::Real(v) = s else {
+                panic!("complex slice from the real inverse")
+            };
+            let old = seen.lock().unwrap()[k].replace(v.to_vec());
+            assert!(old.is_none(), "B={b}: real slice {k} twice");
+        };
+        let mut out = vec![0.0; plan.num_samples()];
+        plan.inverse_real_watched(&coeffs, &mut out, &watch)
+            .unwrap();
+        for (k, s) in seen.into_inner().unwrap().into_iter().enumerate() {
+            let s = s.unwrap_or_else(|| panic!("B={b}: real slice {k} not shown"));
+            let same = s
+                .iter()
+                .zip(&out[k * n * n..][..n * n])
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(same, "B={b} cap={cap:?}: real slice {k}");
+        }
+    }
+}

@@ -5,7 +5,7 @@ use super::guarded;
 use super::s2::s2_plan_for;
 use crate::ffi::checks::{self, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::matching::{combine, grid_argmax, grid_argmax_real};
+use crate::matching::{combine, SliceArgmax};
 use crate::Complex64;
 use std::ffi::{c_double, c_int};
 
@@ -61,8 +61,10 @@ pub unsafe extern "C" fn softFFTWCor2(
             s2.forward_real(p, &mut pat_hat)?;
             combine((&sig_hat, &pat_hat), b, b - 1, b, &mut so3_hat)?;
             let mut out = vec![0.0; so3.num_samples()];
-            so3.inverse_real(&so3_hat, &mut out)?;
-            grid_argmax_real(b, &out)
+            // The argmax taken slice by slice while the inverse computes them.
+            let seen = SliceArgmax::new(b);
+            so3.inverse_real_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
+            seen.peak()
         } else {
             // SAFETY: as above, 2 (2bw)^2 doubles each, read as (2bw)^2 complex values
             // (Complex64 is #[repr(C)] {re, im}); only read.
@@ -76,8 +78,9 @@ pub unsafe extern "C" fn softFFTWCor2(
             s2.forward(p, &mut pat_hat)?;
             combine((&sig_hat, &pat_hat), b, b - 1, b, &mut so3_hat)?;
             let mut out = vec![Complex64::default(); so3.num_samples()];
-            so3.inverse(&so3_hat, &mut out)?;
-            grid_argmax(b, &out)
+            let seen = SliceArgmax::new(b);
+            so3.inverse_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
+            seen.peak()
         };
         // SAFETY: non-NULL (checked); single doubles the caller owns.
         unsafe {
