@@ -28,28 +28,62 @@ pub struct ClusterInputs {
 /// Recurrence coefficients of base pair `(m, mp)` at bandwidth `b` and lane inputs for
 /// `nbs` points spread evenly over the grid (lower half first, as in a chunk).
 pub fn cluster_setup(b: usize, m: usize, mp: usize, nbs: usize) -> ClusterInputs {
-    let ks: Vec<usize> = (0..nbs).map(|s| s * (2 * b) / nbs).collect();
-    cluster_setup_at(b, m, mp, &ks)
+    ClusterTables::new(b).setup(m, mp, nbs)
+}
+
+/// `nbs` grid betas of bandwidth `b` spread evenly over the grid.
+fn spread(b: usize, nbs: usize) -> Vec<usize> {
+    (0..nbs).map(|s| s * (2 * b) / nbs).collect()
 }
 
 /// As [`cluster_setup`], for the grid betas `ks`.
+#[cfg(test)]
 pub fn cluster_setup_at(b: usize, m: usize, mp: usize, ks: &[usize]) -> ClusterInputs {
-    let nbs = ks.len();
-    let bt = BetaTables::grid(b);
-    let norm = start_norm(m, mp);
-    let mut rc = RecCoeffs::new(b - m);
-    RecTables::new(b).coeffs(m, mp, &mut rc);
-    let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
-    let base = BaseStart::new(m, mp, norm, test_skip_bits());
-    for (s, &k) in ks.iter().enumerate() {
-        tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
-        (p[s], sc[s]) = bt.start(k, &base, 1.0);
+    ClusterTables::new(b).setup_at(m, mp, ks)
+}
+
+/// The bandwidth-wide tables of [`cluster_setup`] (grid betas, recurrence tables), built
+/// once for the setup of many clusters.
+pub struct ClusterTables {
+    b: usize,
+    bt: BetaTables,
+    rt: RecTables,
+}
+
+impl ClusterTables {
+    /// The tables of bandwidth `b`.
+    pub fn new(b: usize) -> ClusterTables {
+        ClusterTables {
+            b,
+            bt: BetaTables::grid(b),
+            rt: RecTables::new(b),
+        }
     }
-    ClusterInputs {
-        coeffs: rc,
-        tau,
-        p,
-        sc,
+
+    /// [`cluster_setup`] of base pair `(m, mp)` at `nbs` points, with these tables.
+    pub fn setup(&self, m: usize, mp: usize, nbs: usize) -> ClusterInputs {
+        self.setup_at(m, mp, &spread(self.b, nbs))
+    }
+
+    /// As [`ClusterTables::setup`], for the grid betas `ks`.
+    pub fn setup_at(&self, m: usize, mp: usize, ks: &[usize]) -> ClusterInputs {
+        let (b, bt) = (self.b, &self.bt);
+        let nbs = ks.len();
+        let norm = start_norm(m, mp);
+        let mut rc = RecCoeffs::new(b - m);
+        self.rt.coeffs(m, mp, &mut rc);
+        let (mut tau, mut p, mut sc) = (vec![0.0; nbs], vec![0.0; nbs], vec![0.0; nbs]);
+        let base = BaseStart::new(m, mp, norm, test_skip_bits());
+        for (s, &k) in ks.iter().enumerate() {
+            tau[s] = if k < b { bt.tau_lo[k] } else { bt.tau_hi[k] };
+            (p[s], sc[s]) = bt.start(k, &base, 1.0);
+        }
+        ClusterInputs {
+            coeffs: rc,
+            tau,
+            p,
+            sc,
+        }
     }
 }
 

@@ -38,8 +38,10 @@ TOOL (default: the full benchmark described below):
                       GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
   match (or --match)  rotational matching: a rotated random function recovered; pipeline
                       medians (complex, real), one refinement and ten peaks refined
-                      together, grid and refined angle errors; eight patterns against one
-                      signal (per pattern) and four shells against one correlation
+                      together, grid and refined angle errors; the pipeline against its
+                      floor (FFTW alone on the grid's slices + the DWT at its in-cache kernel
+                      rate; the DWT part needs --features internals); eight patterns against
+                      one signal (per pattern) and four shells against one correlation
   mpi-model (or --mpi-model)  distributed plans at B = 1024, 2048 on 8..256 nodes: memory
                       per rank, bytes exchanged, expected time, from one-core rates measured here
   partial (or --partial)  partial plans against the transforms they replace: degree-limited

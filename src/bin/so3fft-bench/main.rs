@@ -21,6 +21,7 @@
 
 mod big;
 mod cli;
+mod floor;
 mod matching;
 mod memory;
 mod mpi_model;
