@@ -1,7 +1,7 @@
 //! Making a plan: validation of the options, the memory layout, and construction.
 
 use super::blocks::Blocks;
-use super::dwt_stage::{self, DwtStage};
+use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
 use super::options::{FftThreading, PlanOptions, MAX_BANDWIDTH};
 use super::schedule::Schedule;
@@ -92,18 +92,11 @@ impl Layout {
         }
         let block_lanes = Blocks::lanes_for(chunk.max(chunk_real.unwrap_or(0)));
         let clusters = crate::symmetry::num_generic(b) + 2 * b;
-        // Recurrence tables (2 double-double tables of (B+1)(B+2) entries; every cluster's
-        // coefficients at small B, see `DwtStage`), starting-value
+        // Recurrence tables (2 double-double tables of (B+1)(B+2) entries), starting-value
         // norms (B(B+1)/2 Ext), power tables (2 * 2B * (64 + 2B/64 + 1) Ext), cluster list
         // and slot tables (8 + 8 * 9 bytes per cluster, twice with the real layout),
         // per-worker DWT scratch.
-        let rec_cache = dwt_stage::rec_cache_bytes(b);
         let table_bytes = 32 * (b + 1) * (b + 2)
-            + if rec_cache <= dwt_stage::REC_CACHE_BYTES {
-                rec_cache
-            } else {
-                0
-            }
             + 8 * b * (b + 1)
             + 64 * b * (66 + b / 32)
             + 2 * 80 * clusters

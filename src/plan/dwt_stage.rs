@@ -12,7 +12,7 @@ use crate::grid::block_start;
 use crate::numeric::Ext;
 use crate::simd::Isa;
 use crate::symmetry::{Cluster, Member};
-use crate::wigner::{big, start_norms, BetaTables, RecCoeffs, RecTables, REC_PAD};
+use crate::wigner::{big, start_norms, BetaTables, RecCoeffs, RecTables};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -106,16 +106,6 @@ struct CoeffSource<'a> {
     vscale: &'a [f64],
 }
 
-/// Largest size of a plan's cache of every cluster's recurrence coefficients
-/// ([`rec_cache_bytes`]): up to B = 128.
-pub(super) const REC_CACHE_BYTES: usize = 17 << 20;
-
-/// Bytes of every cluster's recurrence coefficients at bandwidth `b` (five arrays of
-/// `B - m` degrees plus padding per base pair `(m, m')`).
-pub(super) fn rec_cache_bytes(b: usize) -> usize {
-    (0..b).map(|m| (m + 1) * (b - m + REC_PAD) * 5 * 8).sum()
-}
-
 /// The DWT stage of a plan: the cluster order, the Wigner-d tables and per-worker scratch.
 pub(super) struct DwtStage {
     b: usize,
@@ -129,10 +119,6 @@ pub(super) struct DwtStage {
     start_norms: Vec<Ext>,
     /// Three-term recurrence coefficients.
     recurrence: RecTables,
-    /// Every cluster's recurrence coefficients, in cluster order, where they take at most
-    /// [`REC_CACHE_BYTES`] (small bandwidths, where working them out per cluster and
-    /// execution is a noticeable share of the stage); else empty.
-    rec_cache: Vec<RecCoeffs>,
     /// Per-worker scratch.
     scratch: Vec<Mutex<Scratch>>,
     /// Lanes of the largest block (for a private scratch when all are busy).
@@ -153,27 +139,13 @@ impl DwtStage {
         (threads, lanes): (usize, usize),
         (skip_bits, skip): (u32, bool),
     ) -> DwtStage {
-        let recurrence = RecTables::new(b);
-        let rec_cache = if rec_cache_bytes(b) <= REC_CACHE_BYTES {
-            clusters
-                .iter()
-                .map(|&(m, mp)| {
-                    let mut r = RecCoeffs::new(b - m as usize);
-                    recurrence.coeffs(m as usize, mp as usize, &mut r);
-                    r
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
         DwtStage {
             b,
             isa,
             clusters,
             beta_tables: BetaTables::grid(b),
             start_norms: start_norms(b),
-            recurrence,
-            rec_cache,
+            recurrence: RecTables::new(b),
             scratch: (0..threads)
                 .map(|_| Mutex::new(Scratch::new(b, lanes)))
                 .collect(),
@@ -231,12 +203,6 @@ impl DwtStage {
         });
     }
 
-    /// The recurrence coefficients of cluster `index` after [`DwtStage::setup`]: cached,
-    /// or worked out into the scratch.
-    fn rec<'a>(&'a self, sc: &'a Scratch, index: usize) -> &'a RecCoeffs {
-        self.rec_cache.get(index).unwrap_or(&sc.rec)
-    }
-
     /// Lane inputs of the kernels after [`DwtStage::setup`].
     fn lanes<'a>(&self, sc: &'a Scratch, ch: &Chunk) -> Lanes<'a> {
         let nl = ch.lanes();
@@ -262,7 +228,7 @@ impl DwtStage {
     /// same cluster in another chunk).
     fn setup(&self, sc: &mut Scratch, cl: &Cluster, ch: &Chunk, rec: bool) -> usize {
         let n = self.b - cl.l0();
-        if rec && self.rec_cache.is_empty() {
+        if rec {
             sc.rec.resize(n);
             self.recurrence.coeffs(cl.m, cl.mp, &mut sc.rec);
         }
@@ -371,7 +337,7 @@ impl DwtStage {
     unsafe fn run_forward(
         &self,
         sc: &mut Scratch,
-        (ch, index): (&Chunk, usize),
+        ch: &Chunk,
         rows: BlockRows,
         n: usize,
         next: Prefetch,
@@ -379,7 +345,7 @@ impl DwtStage {
         let p = rows.width;
         let mut out = Scratch::take(&mut sc.out, (n + 8) * p, (self.b + 8) * 16);
         let f = &mut out[..(n + 8) * p];
-        let rec = Rec::new(self.rec(sc, index), n);
+        let rec = Rec::new(&sc.rec, n);
         let mut lanes = self.lanes(sc, ch);
         lanes.prefetch = next;
         (lanes.pair_stride, lanes.row_gap) = (rows.pair_stride, rows.row_gap);
@@ -466,7 +432,7 @@ impl DwtStage {
             }
         };
         // SAFETY: the block is the caller's.
-        let lo = unsafe { self.run_forward(sc, (ch, c), rows, n, next) }.min(n);
+        let lo = unsafe { self.run_forward(sc, ch, rows, n, next) }.min(n);
         sc.from_l = cl.l0() + lo;
         let (sums, lo) = if pass.position == 0 && pass.last_in_group {
             (&sc.out, lo)
@@ -520,7 +486,7 @@ impl DwtStage {
                 // Degree `l0 + lo` has the parity of `cl.m + lo`.
                 let sg = [mem.sign_at(cl.m + lo), mem.sign_at(cl.m + lo + 1)];
                 let src = sums.as_ptr().add(lo * p + 2 * q);
-                let s = &self.rec(sc, c).s[lo..n];
+                let s = &sc.rec.s[lo..n];
                 let add = !pass.first_group;
                 let factors = DegreeFactors {
                     signs: sg,
@@ -556,7 +522,7 @@ impl DwtStage {
         let p = rows.width;
         let (mem, nm) = layout.members(cl);
         let mut data = Scratch::take(&mut sc.data, n * p, self.b * 16);
-        let rec = Rec::new(self.rec(sc, c), n);
+        let rec = Rec::new(&sc.rec, n);
         let mut lanes = self.lanes(sc, ch);
         // Blocks too large for the cache are half-major, written with non-temporal
         // stores (see `plan/blocks.rs`).
@@ -576,7 +542,7 @@ impl DwtStage {
             cluster: cl,
             members: &mem[..nm],
             coef,
-            vscale: &self.rec(sc, c).s[..n],
+            vscale: &sc.rec.s[..n],
         };
         let mut fill = |fin: &mut [f64], from: usize, to: usize| {
             if from < have {
