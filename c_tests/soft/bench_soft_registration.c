@@ -11,8 +11,8 @@
  * correlation two FST_semi_memo (dataformat 0), so3CombineCoef_fftw (degLim bw - 1),
  * Inverse_SO3_Naive_fftw with flag 0 (complex) and the client's own copy of the real parts
  * of the SO(3) grid into its array, followed by an argmax there. The native half is
- * so3fft_correlate_real on the same real samples (plan made once with SO3FFT_REAL |
- * SO3FFT_MEASURE) followed by so3fft_grid_argmax_real.
+ * so3fft_correlate_real_argmax on the same real samples (plan made once with SO3FFT_REAL |
+ * SO3FFT_MEASURE): the grid and its argmax, taken while the grid is computed.
  *
  * Each repetition runs both, alternating which goes first; a first call of each is made and
  * discarded before timing (the SOFT layer plans on it). Printed per bandwidth: medians of
@@ -314,12 +314,14 @@ static long client_correlate(client *c) {
 /* One correlation through the native real pipeline; returns the grid index of the maximum. */
 static long native_correlate(so3fft_correlation p, int bw, const double *sig, const double *pat,
                              double *out) {
-    if (so3fft_correlate_real(p, sig, pat, out) != SO3FFT_OK) {
-        fprintf(stderr, "bench_soft_registration: so3fft_correlate_real: %s\n",
+    ptrdiff_t at = so3fft_correlate_real_argmax(p, sig, pat, out, NULL);
+    (void)bw;
+    if (at < 0) {
+        fprintf(stderr, "bench_soft_registration: so3fft_correlate_real_argmax: %s\n",
                 so3fft_last_error());
         exit(EXIT_FAILURE);
     }
-    return (long)so3fft_grid_argmax_real(bw, out, NULL);
+    return (long)at;
 }
 #endif
 

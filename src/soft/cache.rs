@@ -6,6 +6,7 @@ use super::SoftResult;
 use crate::ffi::CallError;
 use crate::s2::S2Options;
 use crate::system::ForkLock;
+use crate::workers::{thread_count, WorkerPool};
 use crate::{wisdom, Direction, FftThreading, Plan, PlanOptions, Rigor};
 use std::cell::UnsafeCell;
 use std::collections::BTreeMap;
@@ -188,9 +189,35 @@ pub(super) fn cached<P>(
     Ok(p)
 }
 
+/// The worker threads of every cached plan of this process: one pool, so that a client's
+/// calls one after another (two S^2 transforms, the combine, the SO(3) inverse) reach the
+/// same workers, which are often still awake from the call before, instead of waking those
+/// of each plan in turn. Made on first use, anew in a child made by `fork()`.
+pub(super) fn layer_workers() -> crate::Result<WorkerPool> {
+    struct PoolSlot(UnsafeCell<Option<WorkerPool>>);
+    // SAFETY: the cell is only accessed while `MAP_LOCK` is held (below).
+    unsafe impl Sync for PoolSlot {}
+    static POOL: PoolSlot = PoolSlot(UnsafeCell::new(None));
+    register_fork_handlers();
+    let _guard = MAP_LOCK.lock();
+    // SAFETY: the lock is held, so no other reference to the cell exists.
+    let slot = unsafe { &mut *POOL.0.get() };
+    match slot {
+        Some(w) if w.in_own_process() => Ok(w.clone()),
+        _ => {
+            let w = WorkerPool::new(thread_count(env_threads())?, "so3fft-soft")?;
+            // A parent's pool is left to the orphan list by its drop (no waiting).
+            *slot = Some(w.clone());
+            Ok(w)
+        }
+    }
+}
+
 /// The cached SO(3) plan of bandwidth `b`, created on first use.
 pub(super) fn plan_for(b: usize) -> SoftResult<Arc<Plan>> {
-    cached(&SO3_PLANS, b, || Plan::new(b, cache_options()))
+    cached(&SO3_PLANS, b, || {
+        Plan::new_on(b, cache_options(), Some(&layer_workers()?))
+    })
 }
 
 /// The cached SO(3) plan of bandwidth `b` if it exists already (for work that can use its

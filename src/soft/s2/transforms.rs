@@ -1,7 +1,7 @@
 //! `FST_semi_memo`, `InvFST_semi_memo`, `FST_semi_fly`, `InvFST_semi_fly`: SOFT's split-array
 //! spherical-harmonic transforms on one cached [`S2Plan`] per bandwidth.
 
-use super::super::cache::{cached, s2_options, Cache};
+use super::super::cache::{cached, layer_workers, s2_options, Cache};
 use super::super::real::try_zeroed;
 use super::super::{guarded, SoftResult};
 use crate::ffi::checks::{self, input_output, Array};
@@ -61,7 +61,7 @@ impl S2Entry {
     /// The plan of bandwidth `b` with `options`.
     fn new(b: usize, options: &S2Options) -> crate::Result<S2Entry> {
         Ok(S2Entry {
-            plan: S2Plan::new(b, options)?,
+            plan: S2Plan::new_on(b, options, Some(&layer_workers()?))?,
             buffers: Mutex::new(None),
         })
     }
