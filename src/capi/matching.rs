@@ -128,6 +128,30 @@ unsafe fn inputs<'a, T>(
     })
 }
 
+/// The plan and arrays of a correlation call, checked: samples of `T`, a grid of `G`.
+type CallArgs<'a, T, G> = (&'a Correlation, (&'a [T], &'a [T]), &'a mut [G]);
+
+/// [`CallArgs`] of a call on `p` with `signal`, `pattern` (`(2L)^2` values each) and the
+/// grid `out` (`(2 B_out)^3` values).
+///
+/// # Safety
+/// `p` is NULL or a live plan; the arrays are NULL or hold those sizes (the API's
+/// contract).
+unsafe fn call_args<'a, T, G>(
+    p: so3fft_correlation,
+    (signal, pattern): (*const T, *const T),
+    out: *mut G,
+) -> Result<CallArgs<'a, T, G>, CallError> {
+    // SAFETY: this function's contract.
+    unsafe {
+        let plan = plan_ref(p)?;
+        let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
+        let grid = Array::new(out.cast_const().cast::<u8>(), ng * size_of::<G>(), "out");
+        let inputs = inputs(signal, pattern, ns, Some(&grid))?;
+        Ok((plan, inputs, std::slice::from_raw_parts_mut(out, ng)))
+    }
+}
+
 /// The correlation of complex S^2 samples (`(2L)^2` each) into the grid `out`
 /// (`(2 B_out)^3` values, SO(3) sample order). `SO3FFT_OK` or an error code.
 #[no_mangle]
@@ -138,20 +162,12 @@ pub unsafe extern "C" fn so3fft_correlate(
     out: *mut so3fft_complex,
 ) -> c_int {
     guarded_code(|| {
-        // SAFETY: `p` NULL or live; arrays of the documented sizes (the API's contract).
-        unsafe {
-            let plan = plan_ref(p)?;
-            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
-            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 16, "out");
-            let (s, h) = inputs(
-                signal.cast_const().cast::<Complex64>(),
-                pattern.cast_const().cast(),
-                ns,
-                Some(&grid),
-            )?;
-            let out = std::slice::from_raw_parts_mut(out.cast::<Complex64>(), ng);
-            Ok(plan.correlate(s, h, out)?)
-        }
+        // SAFETY: `p` NULL or live; arrays of the documented sizes (the API's contract);
+        // `so3fft_complex` is layout-identical to `Complex64`.
+        let (plan, (s, h), out) = unsafe {
+            call_args::<Complex64, Complex64>(p, (signal.cast(), pattern.cast()), out.cast())
+        }?;
+        Ok(plan.correlate(s, h, out)?)
     })
 }
 
@@ -166,14 +182,8 @@ pub unsafe extern "C" fn so3fft_correlate_real(
 ) -> c_int {
     guarded_code(|| {
         // SAFETY: as in `so3fft_correlate`.
-        unsafe {
-            let plan = plan_ref(p)?;
-            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
-            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 8, "out");
-            let (s, h) = inputs(signal, pattern, ns, Some(&grid))?;
-            let out = std::slice::from_raw_parts_mut(out, ng);
-            Ok(plan.correlate_real(s, h, out)?)
-        }
+        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
+        Ok(plan.correlate_real(s, h, out)?)
     })
 }
 
@@ -189,21 +199,13 @@ pub unsafe extern "C" fn so3fft_correlate_argmax(
     angles: *mut c_double,
 ) -> isize {
     guarded(-1, || {
-        // SAFETY: `p` NULL or live; arrays of the documented sizes, `angles` NULL or 3
-        // doubles (the API's contract).
-        unsafe {
-            let plan = plan_ref(p)?;
-            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
-            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 16, "out");
-            let (s, h) = inputs(
-                signal.cast_const().cast::<Complex64>(),
-                pattern.cast_const().cast(),
-                ns,
-                Some(&grid),
-            )?;
-            let out = std::slice::from_raw_parts_mut(out.cast::<Complex64>(), ng);
-            Ok(put_angles(plan.correlate_argmax(s, h, out)?, angles))
-        }
+        // SAFETY: as in `so3fft_correlate`.
+        let (plan, (s, h), out) = unsafe {
+            call_args::<Complex64, Complex64>(p, (signal.cast(), pattern.cast()), out.cast())
+        }?;
+        let peak = plan.correlate_argmax(s, h, out)?;
+        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
+        Ok(unsafe { put_angles(peak, angles) })
     })
 }
 
@@ -218,15 +220,11 @@ pub unsafe extern "C" fn so3fft_correlate_real_argmax(
     angles: *mut c_double,
 ) -> isize {
     guarded(-1, || {
-        // SAFETY: as in `so3fft_correlate_argmax`.
-        unsafe {
-            let plan = plan_ref(p)?;
-            let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
-            let grid = Array::new(out.cast_const().cast::<u8>(), ng * 8, "out");
-            let (s, h) = inputs(signal, pattern, ns, Some(&grid))?;
-            let out = std::slice::from_raw_parts_mut(out, ng);
-            Ok(put_angles(plan.correlate_real_argmax(s, h, out)?, angles))
-        }
+        // SAFETY: as in `so3fft_correlate`.
+        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
+        let peak = plan.correlate_real_argmax(s, h, out)?;
+        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
+        Ok(unsafe { put_angles(peak, angles) })
     })
 }
 
