@@ -56,33 +56,31 @@ pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &m
     unsafe { forward_raw(isa, p, rec, lanes, xin.as_ptr(), ft) }
 }
 
-/// The inverse kernel of the `m' = 0` recurrences run two degrees per step (the S^2
-/// Legendre stage, see `wigner::two_step`): `y[col nb + s] = sum_j v_j(beta_s)
-/// fin[j 2c + col]` for `col < 2c`, `c` = 2 or 4 (the even columns, then the odd ones),
-/// `nb = lanes.tau.len()` lanes, all in the lower half and not interleaved, `v_j` the
-/// values of step `j < rec.len()`. Rows `0..rec.len()` of `2c` values of `fin` are read.
+/// The inverse kernel of the `m' = 0` recurrences, whose degrees alternate parity (the
+/// S^2 Legendre stage): `y[(par c + q) nb + s] = sum_{i % 2 = par} dt_{l0+i}(beta_s)
+/// fin[i c + q]` for `c` = 2 or 4 columns, `nb = lanes.tau.len()` lanes, all in the lower
+/// half and not interleaved. Rows `0..rec.len()` of `fin` are read.
 pub fn inverse_parity(isa: Isa, c: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
     check_shared(isa, c, rec, lanes);
     let nb = lanes.tau.len();
     assert!(c == 2 || c == 4);
     assert!(!lanes.interleaved && lanes.upper_from >= nb);
-    assert!(fin.len() >= rec.len() * 2 * c && y.len() >= 2 * c * nb);
+    assert!(fin.len() >= rec.len() * c && y.len() >= 2 * c * nb);
     // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
     unsafe { parity::run(isa, c, rec, lanes, fin.as_ptr(), y.as_mut_ptr()) }
 }
 
-/// Values of the forward parity kernel's partial sums for `n` steps, `c` columns and
+/// Values of the forward parity kernel's partial sums for `n` degrees, `c` columns and
 /// vectors of `w` lanes (see [`forward_parity`]).
 pub fn parity_partial_len(n: usize, c: usize, w: usize) -> usize {
-    (2 * n * c).next_multiple_of(w) * w
+    (n * c).next_multiple_of(w) * w
 }
 
-/// The forward kernel of the `m' = 0` recurrences run two degrees per step (the S^2
-/// analysis): `ft[j 2c + col] = sum_s v_j(beta_s) x[col][s]` for `col < 2c`, with `x` in
-/// `2 c` columns of `nb = lanes.tau.len()` values (the even data, then the odd), lanes as
-/// for [`inverse_parity`]. `part` is scratch of [`parity_partial_len`] values; `ft` holds
-/// at least `(2 n c).next_multiple_of(isa.lanes())` values (`n = rec.len()` steps), rows
-/// from `n` on are scratch.
+/// The forward kernel of the `m' = 0` recurrences (the S^2 analysis):
+/// `ft[i c + q] = sum_s dt_{l0+i}(beta_s) x[(i % 2) c + q][s]`, with `x` in `2 c` columns of
+/// `nb = lanes.tau.len()` values (the even combinations, then the odd ones), lanes as for
+/// [`inverse_parity`]. `part` is scratch of [`parity_partial_len`] values; `ft` holds at
+/// least `(n c).next_multiple_of(isa.lanes())` values, rows from `n` on are scratch.
 pub fn forward_parity(
     isa: Isa,
     c: usize,
@@ -96,7 +94,7 @@ pub fn forward_parity(
     assert!(c == 2 || c == 4);
     assert!(!lanes.interleaved && lanes.upper_from >= nb);
     assert!(x.len() >= 2 * c * nb && part.len() >= parity_partial_len(n, c, w));
-    assert!(ft.len() >= (2 * n * c).next_multiple_of(w));
+    assert!(ft.len() >= (n * c).next_multiple_of(w));
     // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
     unsafe {
         parity::run_forward(

@@ -1,12 +1,15 @@
-//! The kernels of the `m' = 0` recurrences (the Legendre stage of the S^2 transforms), run
-//! two degrees per step (`wigner::two_step`): each step's values `v_j` serve an even degree
-//! and, times `x = cos beta`, an odd one, so each feeds `2 C` columns:
-//! - inverse: `y[col nb + s] = sum_j v_j(beta_s) fin[j 2C + col]`, `col < 2 C`
-//!   (`col = par C + q`: the even columns, then the odd ones),
-//! - forward: `ft[j 2C + col] = sum_s v_j(beta_s) x[col][s]`.
+//! The kernels of the `m' = 0` recurrences (the Legendre stage of the S^2 transforms),
+//! whose degrees alternate between two sets of columns:
+//! - inverse: `y[(par C + q) nb + s] = sum over i with i % 2 = par of dt_{l0+i}(beta_s) fin[i C + q]`,
+//! - forward: `ft[i C + q] = sum_s dt_{l0+i}(beta_s) x[(par(i) C + q) nb + s]`, `par(i) = i % 2`.
 //!
-//! Per vector of betas and step: `2 C` multiply-adds and the recurrence step. With so
-//! little work per step, `K` vectors run together so that their recurrence chains overlap.
+//! For `m' = 0` the value at the mirror ring, `dt^l_{m,0}(pi - beta)`, is
+//! `(-1)^(l+m) dt^l_{m,0}(beta)`, so a ring and its mirror need only the even and the odd
+//! degree sums of one ring. The general inverse kernel holds both sums in columns of a row
+//! and multiplies the zeros of the other parity; this one keeps `C` columns per degree and
+//! sends each degree to the sums of its parity: per vector of betas and degree, `C`
+//! multiply-adds and the recurrence step. With so little work per step, `K` vectors run
+//! together so that their recurrence chains overlap.
 
 use super::lanes::{Lanes, Rec};
 use super::state::{prefix_states, State};
@@ -16,20 +19,20 @@ use std::mem::MaybeUninit;
 /// Vectors of betas whose states are set up together (through their negligible prefixes).
 const VECTORS: usize = 16;
 
-/// What a group of `K` chains does with the recurrence values of a step: the inverse
-/// accumulates them against the step's coefficients, the forward adds their products
-/// with the chains' data into the step's partial sums.
+/// What a group of `K` chains does with the recurrence values of a degree: the inverse
+/// accumulates them against the degree's coefficients, the forward adds their products
+/// with the chains' data into the degree's partial sums.
 trait Sink<S: Simd, const K: usize>: Copy {
-    /// Chain `c` alone (while it catches up with the others): the values `v` of step `j`.
+    /// Chain `c` alone (while it catches up with the others): the values `v` of degree `i`.
     ///
     /// # Safety
-    /// The CPU supports `S`'s instruction set; step `j` is one of the kernel's.
-    unsafe fn one(&mut self, c: usize, v: S::V, j: usize);
-    /// All chains: the values `v` of step `j`.
+    /// The CPU supports `S`'s instruction set; degree `i` is one of the kernel's.
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize);
+    /// All chains: the values `v` of degree `i`, whose parity is `PAR`.
     ///
     /// # Safety
     /// As for [`Sink::one`].
-    unsafe fn all(&mut self, v: &[S::V; K], j: usize);
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize);
 }
 
 /// The vectors of lanes in groups of `K` chains, each state past its negligible prefix:
@@ -67,9 +70,9 @@ unsafe fn chain_groups<'r, S: Simd, const W: usize, const K: usize>(
     }
 }
 
-/// Runs the chains `st` to step `n`: each alone until all its lanes are active, then up
-/// to the step the furthest one reached, then all together, the recurrence step first in
-/// each round (see `State::run_fast`).
+/// Runs the chains `st` to degree `n`: each alone until all its lanes are active, then up
+/// to the degree the furthest one reached, then all together, two degrees (one of each
+/// parity) per round with the recurrence step first (see `State::run_fast`).
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; every lane is in the lower half.
@@ -83,14 +86,14 @@ unsafe fn run_chains<S: Simd, const K: usize>(
     unsafe {
         let n = rec.len();
         for (c, s) in st.iter_mut().enumerate() {
-            s.run_slow(n, &mut |v, j| sink.one(c, v, j));
+            s.run_slow(n, &mut |v, i| sink.one(c, v, i));
         }
-        let j0 = st.iter().map(|s| s.i).max().unwrap_or(n);
+        let i0 = st.iter().map(|s| s.i).max().unwrap_or(n);
         for (c, s) in st.iter_mut().enumerate() {
-            s.run_fast(j0, &mut |v, j| sink.one(c, v, j));
+            s.run_fast(i0, &mut |v, i| sink.one(c, v, i));
         }
         // A fresh copy indexed only by constants in the joint phase, so that its sums live
-        // in registers (the phases above index them by chain at run time).
+        // in registers (the phases above index them by parity at run time).
         let mut joint = *sink;
         let (slope, offset) = (rec.neg_a.as_ptr(), rec.a_plus_c.as_ptr());
         let mut p0 = [S::zero(); K];
@@ -100,31 +103,47 @@ unsafe fn run_chains<S: Simd, const K: usize>(
         for c in 0..K {
             (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
         }
-        for j in j0..n {
-            let (a, b) = (S::splat(*slope.add(j)), S::splat(*offset.add(j)));
-            let v = p1;
-            for c in 0..K {
-                // With AVX2's 16 registers the arguments are read from memory at each
-                // step (a volatile read, which LLVM keeps in the loop): held in registers
-                // they push a sum onto the stack, where the store-to-load latency lands on
-                // its chain.
-                let tc = if narrow {
-                    std::ptr::read_volatile(&tau[c])
-                } else {
-                    tau[c]
-                };
-                let t = S::fma(a, tc, b);
-                let p2 = S::fence(S::fms(t, p1[c], p0[c]));
-                (p0[c], p1[c]) = (p1[c], p2);
-            }
-            joint.all(&v, j);
+        macro_rules! degree {
+            ($i:expr, $par:literal) => {{
+                let i = $i;
+                let (a, b) = (S::splat(*slope.add(i)), S::splat(*offset.add(i)));
+                let v = p1;
+                for c in 0..K {
+                    // With AVX2's 16 registers the arguments are read from memory at each
+                    // step (a volatile read, which LLVM keeps in the loop): held in
+                    // registers they push a sum onto the stack, where the store-to-load
+                    // latency lands on its chain.
+                    let tc = if narrow {
+                        std::ptr::read_volatile(&tau[c])
+                    } else {
+                        tau[c]
+                    };
+                    let t = S::fma(a, tc, b);
+                    let p2 = S::fence(S::fms(t, p1[c], p0[c]));
+                    (p0[c], p1[c]) = (p1[c], p2);
+                }
+                joint.all::<$par>(&v, i);
+            }};
+        }
+        let mut i = i0;
+        if i < n && i % 2 == 1 {
+            degree!(i, 1);
+            i += 1;
+        }
+        while i + 1 < n {
+            degree!(i, 0);
+            degree!(i + 1, 1);
+            i += 2;
+        }
+        if i < n {
+            degree!(i, 0);
         }
         *sink = joint;
     }
 }
 
-/// The inverse's sink: per chain, the sums of each column (`2 C` of 8: the even
-/// columns, then the odd ones), against the coefficient rows `fin` (`2 C` values per step).
+/// The inverse's sink: per chain, the sums of each parity and column (`2 C` of 8), against
+/// the coefficient rows `fin` (`C` values per degree).
 #[derive(Clone, Copy)]
 struct InverseSums<S: Simd, const C: usize, const K: usize> {
     sums: [[S::V; 8]; K],
@@ -133,25 +152,26 @@ struct InverseSums<S: Simd, const C: usize, const K: usize> {
 
 impl<S: Simd, const C: usize, const K: usize> Sink<S, K> for InverseSums<S, C, K> {
     #[inline(always)]
-    unsafe fn one(&mut self, c: usize, v: S::V, j: usize) {
-        // SAFETY: row `j` of `fin` holds `2 C` values (the kernel's contract).
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize) {
+        // SAFETY: row `i` of `fin` holds `C` values (the kernel's contract).
         unsafe {
-            let row = self.fin.add(j * 2 * C);
-            for (q, a) in self.sums[c][..2 * C].iter_mut().enumerate() {
+            let row = self.fin.add(i * C);
+            let sums = &mut self.sums[c][(i % 2) * C..][..C];
+            for (q, a) in sums.iter_mut().enumerate() {
                 *a = S::fma(v, S::splat(*row.add(q)), *a);
             }
         }
     }
 
     #[inline(always)]
-    unsafe fn all(&mut self, v: &[S::V; K], j: usize) {
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize) {
         // SAFETY: as in `one`.
         unsafe {
-            let row = self.fin.add(j * 2 * C);
-            for q in 0..2 * C {
+            let row = self.fin.add(i * C);
+            for q in 0..C {
                 let x = S::splat(*row.add(q));
                 for (c, vc) in v.iter().enumerate() {
-                    self.sums[c][q] = S::fma(*vc, x, self.sums[c][q]);
+                    self.sums[c][PAR * C + q] = S::fma(*vc, x, self.sums[c][PAR * C + q]);
                 }
             }
         }
@@ -159,7 +179,7 @@ impl<S: Simd, const C: usize, const K: usize> Sink<S, K> for InverseSums<S, C, K
 }
 
 /// # Safety
-/// The CPU supports `S`'s instruction set; `fin` holds `rec.len()` rows of `2 C` values;
+/// The CPU supports `S`'s instruction set; `fin` holds `rec.len()` rows of `C` values;
 /// `y` is valid for writes of `2 C` columns of `lanes.tau.len()` values; every lane is in
 /// the lower half (`lanes.upper_from >= lanes.tau.len()`).
 #[inline(always)]
@@ -189,7 +209,7 @@ unsafe fn body<S: Simd, const W: usize, const C: usize, const K: usize>(
 }
 
 /// The forward's sink: per chain its data (`2 C` columns of 8, zero for the chains that
-/// repeat another), added into the partial sums `part` (`W` lanes per step and column).
+/// repeat another), added into the partial sums `part` (`W` lanes per degree and column).
 #[derive(Clone, Copy)]
 struct ForwardSums<S: Simd, const W: usize, const C: usize, const K: usize> {
     data: [[S::V; 8]; K],
@@ -197,19 +217,24 @@ struct ForwardSums<S: Simd, const W: usize, const C: usize, const K: usize> {
 }
 
 impl<S: Simd, const W: usize, const C: usize, const K: usize> ForwardSums<S, W, C, K> {
-    /// `part[(j 2C + col) W ..][..W] += sum over chains of v * data[col]`.
+    /// `part[(i C + q) W ..][..W] += sum over chains of v * data[par C + q]`.
     ///
     /// # Safety
-    /// The CPU supports `S`'s instruction set; the rows of step `j` are inside `part`.
+    /// The CPU supports `S`'s instruction set; the rows of degree `i` are inside `part`.
     #[inline(always)]
-    unsafe fn add(&mut self, chains: impl Iterator<Item = (usize, S::V)> + Clone, j: usize) {
+    unsafe fn add(
+        &mut self,
+        chains: impl Iterator<Item = (usize, S::V)> + Clone,
+        i: usize,
+        par: usize,
+    ) {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
         unsafe {
-            for col in 0..2 * C {
-                let p = self.part.add((j * 2 * C + col) * W);
+            for q in 0..C {
+                let p = self.part.add((i * C + q) * W);
                 let mut f = S::load(p);
                 for (c, v) in chains.clone() {
-                    f = S::fma(v, self.data[c][col], f);
+                    f = S::fma(v, self.data[c][par * C + q], f);
                 }
                 S::store(p, f);
             }
@@ -221,27 +246,27 @@ impl<S: Simd, const W: usize, const C: usize, const K: usize> Sink<S, K>
     for ForwardSums<S, W, C, K>
 {
     #[inline(always)]
-    unsafe fn one(&mut self, c: usize, v: S::V, j: usize) {
-        // SAFETY: step `j`'s rows are inside `part` (the kernel's contract).
-        unsafe { self.add(std::iter::once((c, v)), j) }
+    unsafe fn one(&mut self, c: usize, v: S::V, i: usize) {
+        // SAFETY: degree `i`'s rows are inside `part` (the kernel's contract).
+        unsafe { self.add(std::iter::once((c, v)), i, i % 2) }
     }
 
     #[inline(always)]
-    unsafe fn all(&mut self, v: &[S::V; K], j: usize) {
+    unsafe fn all<const PAR: usize>(&mut self, v: &[S::V; K], i: usize) {
         // SAFETY: as in `one`.
-        unsafe { self.add(v.iter().copied().enumerate(), j) }
+        unsafe { self.add(v.iter().copied().enumerate(), i, PAR) }
     }
 }
 
 /// The forward kernel (see the module doc): the chains of `K` vectors of betas run over the
-/// steps as in [`body`], each step adding `v * x` of every chain into a vector of
+/// degrees as in [`body`], each degree adding `v * x` of every chain into a vector of
 /// partial sums per column (`part`, lanes = betas, in L1 or L2), whose lanes are summed at
 /// the end (transposed `W` rows at a time).
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; `x` holds `2 C` columns of `lanes.tau.len()`
-/// values; `part` is valid for writes of `(rec.len() 2C).next_multiple_of(W) W` values and
-/// `ft` for `(rec.len() 2C).next_multiple_of(W)` values; every lane is in the lower half.
+/// values; `part` is valid for writes of `(rec.len() C).next_multiple_of(W) W` values and
+/// `ft` for `(rec.len() C).next_multiple_of(W)` values; every lane is in the lower half.
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
     rec: &Rec,
@@ -254,7 +279,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
     unsafe {
         let n = rec.len();
         let nb = lanes.tau.len();
-        let rows = (2 * n * C).next_multiple_of(W);
+        let rows = (n * C).next_multiple_of(W);
         std::ptr::write_bytes(part, 0, rows * W);
         chain_groups::<S, W, K>(rec, lanes, |st, s0, k| {
             let mut sink = ForwardSums::<S, W, C, K> {

@@ -13,7 +13,6 @@
 use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
 use crate::simd::Isa;
-use crate::wigner::two_step::{even_to_odd, odd_to_even, two_step_coeffs};
 use crate::wigner::{big, start_norm, BetaTables, RecCoeffs, RecTables, DEFAULT_SKIP_BITS};
 use num_complex::Complex64;
 use std::sync::Mutex;
@@ -101,9 +100,6 @@ impl Group {
 
 /// Per-worker scratch.
 pub(super) struct Scratch {
-    /// The order's degree-wise recurrence coefficients (`S_i`, `A'_i`).
-    base: RecCoeffs,
-    /// The kernels' two-degree steps (`wigner::two_step`; `T_j` in `s`).
     rec: RecCoeffs,
     tau: Vec<f64>,
     start: Vec<f64>,
@@ -119,8 +115,7 @@ pub(super) struct Scratch {
 impl Scratch {
     fn new(b: usize, lanes: usize, width: usize) -> Scratch {
         Scratch {
-            base: RecCoeffs::new(b + 1),
-            rec: RecCoeffs::new(b.div_ceil(2)),
+            rec: RecCoeffs::new(b),
             tau: vec![0.0; lanes],
             start: vec![0.0; lanes],
             scale: vec![0.0; lanes],
@@ -145,10 +140,6 @@ pub(super) struct LegendreStage {
     norms: Vec<Ext>,
     /// Quadrature weights of the northern rings (the southern ones are the same).
     weights: Vec<f64>,
-    /// `cos theta_k` and `sin^2 theta_k` of the northern rings (`sin2` padded with zeros to
-    /// the lanes): the factor of the odd degrees, the kernels' argument.
-    cos: Vec<f64>,
-    sin2: Vec<f64>,
     scratch: Vec<Mutex<Scratch>>,
 }
 
@@ -157,23 +148,15 @@ impl LegendreStage {
     pub(super) fn new(b: usize, lend: usize, isa: Isa, workers: usize) -> LegendreStage {
         assert!(0 < lend && lend <= b);
         let lanes = b.next_multiple_of(isa.lanes());
-        let beta_tables = BetaTables::grid(b);
-        // From `tau = 1 - cos theta`, exact near the pole: `sin^2 = tau (2 - tau)`.
-        let tau = &beta_tables.tau_lo[..b];
-        let cos = tau.iter().map(|t| 1.0 - t).collect();
-        let mut sin2: Vec<f64> = tau.iter().map(|t| t * (2.0 - t)).collect();
-        sin2.resize(lanes, 0.0);
         LegendreStage {
             b,
             lend,
             isa,
             lanes,
             recurrence: RecTables::new(b),
-            beta_tables,
+            beta_tables: BetaTables::grid(b),
             norms: (0..b).map(|m| start_norm(m, 0)).collect(),
             weights: crate::grid::weights(b)[..b].to_vec(),
-            cos,
-            sin2,
             scratch: (0..workers)
                 .map(|_| Mutex::new(Scratch::new(b, lanes, isa.lanes())))
                 .collect(),
@@ -203,15 +186,11 @@ impl LegendreStage {
         f(&mut Scratch::new(self.b, self.lanes, self.isa.lanes()))
     }
 
-    /// Recurrence coefficients and lane inputs of order `m`; the numbers of degrees and of
-    /// two-degree steps.
-    fn setup(&self, sc: &mut Scratch, m: usize) -> (usize, usize) {
+    /// Recurrence coefficients and lane inputs of order `m`; the number of degrees.
+    fn setup(&self, sc: &mut Scratch, m: usize) -> usize {
         let n = self.lend - m;
-        let steps = n.div_ceil(2);
-        // `2 steps <= n + 1` degrees: within the tables, as `lend <= b`.
-        sc.base.resize(2 * steps);
-        self.recurrence.coeffs(m, 0, &mut sc.base);
-        two_step_coeffs(&sc.base, steps, &mut sc.rec);
+        sc.rec.resize(n);
+        self.recurrence.coeffs(m, 0, &mut sc.rec);
         let b = self.b;
         self.beta_tables.starts(
             self.isa,
@@ -223,11 +202,11 @@ impl LegendreStage {
             &mut sc.start[..b],
             &mut sc.scale[..b],
         );
-        sc.tau.copy_from_slice(&self.sin2);
-        for v in [&mut sc.start, &mut sc.scale] {
+        sc.tau[..b].copy_from_slice(&self.beta_tables.tau_lo[..b]);
+        for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
             v[b..].fill(0.0);
         }
-        (n, steps)
+        n
     }
 
     fn lanes<'a>(&self, sc: &'a Scratch) -> Lanes<'a> {
@@ -257,9 +236,9 @@ impl LegendreStage {
         assert!(!groups.is_empty() && groups.len() <= 2);
         let b = self.b;
         self.with_scratch(|sc| {
-            let (n, steps) = self.setup(sc, m);
+            let n = self.setup(sc, m);
             // Kernel input: the even combinations of each group's spectra (re, im), then the
-            // odd ones times cos(theta), weighted, one column of `nb` rings each.
+            // odd ones, weighted, one column of `nb` rings each.
             let c = 2 * groups.len();
             let nb = self.lanes;
             let mut x = std::mem::take(&mut sc.rows);
@@ -274,31 +253,36 @@ impl LegendreStage {
                     // SAFETY: rings k and mirror < 2B hold the group's order; read only.
                     let (u, v) =
                         unsafe { (*g.spectra.at(k, g.order), *g.spectra.at(mirror, g.order)) };
-                    let (e, o) = ((u + v) * w, (u - v) * (w * self.cos[k]));
+                    let (e, o) = ((u + v) * w, (u - v) * w);
                     x[(2 * q) * nb + k] = e.re;
                     x[(2 * q + 1) * nb + k] = e.im;
                     x[(c + 2 * q) * nb + k] = o.re;
                     x[(c + 2 * q + 1) * nb + k] = o.im;
                 }
             }
-            let rec = Rec::new(&sc.rec, steps);
+            let rec = Rec::new(&sc.rec, n);
             let mut sums = std::mem::take(&mut sc.sums);
             let mut part = std::mem::take(&mut sc.part);
             let lanes = self.lanes(sc);
             dwt::forward_parity(self.isa, c, &rec, &lanes, &x, (&mut part, &mut sums));
-            let (base, t) = (&sc.base, &sc.rec.s);
-            // Step j's sums of column `col` of group `q`, times `T_j`: sums of `e_{2j}`.
-            let step_sum = |j: usize, col: usize| {
-                let z = &sums[j * 2 * c + col..][..2];
-                Complex64::new(z[0], z[1]) * t[j]
-            };
             for (q, g) in groups.iter().enumerate() {
                 let f = g.sign(m) * factor;
                 // SAFETY: |order| < b; the block has b - m >= n entries, this task's alone
                 // (caller's contract), as has the partner block written below.
                 let (own, partner) = unsafe { (g.coef.block(g.order), g.coef.block(-g.order)) };
-                let write = |i: usize, v: Complex64| {
-                    // SAFETY: entry i < b - m of the blocks (above).
+                for i in n..b - m {
+                    // SAFETY: entry i < b - m of the blocks: degrees beyond the limit are 0.
+                    unsafe {
+                        *own.add(i) = Complex64::default();
+                        if g.partner && m > 0 {
+                            *partner.add(i) = Complex64::default();
+                        }
+                    }
+                }
+                for i in 0..n {
+                    let z = &sums[i * c + 2 * q..][..2];
+                    let v = Complex64::new(z[0], z[1]) * (sc.rec.s[i] * f);
+                    // SAFETY: entry i < n of the blocks (above).
                     unsafe {
                         *own.add(i) = v;
                         if g.partner && m > 0 {
@@ -309,20 +293,7 @@ impl LegendreStage {
                             };
                         }
                     }
-                };
-                // Degrees beyond the limit are 0.
-                for i in n..b - m {
-                    write(i, Complex64::default());
                 }
-                for j in 0..steps {
-                    write(2 * j, step_sum(j, 2 * q) * (base.s[2 * j] * f));
-                }
-                let odd = |j: usize| step_sum(j, c + 2 * q);
-                even_to_odd(base, steps, odd, |j, v| {
-                    if 2 * j + 1 < n {
-                        write(2 * j + 1, v * (base.s[2 * j + 1] * f));
-                    }
-                });
             }
             sc.sums = sums;
             sc.part = part;
@@ -371,47 +342,26 @@ impl LegendreStage {
         assert!(!groups.is_empty() && groups.len() <= 2);
         let b = self.b;
         self.with_scratch(|sc| {
-            let (n, steps) = self.setup(sc, m);
-            // Kernel input: per step `j`, the scaled coefficients of each group (re, im) of
-            // degree `2j`, then those of the odd degrees carried by `e_{2j}`.
+            let n = self.setup(sc, m);
+            // Kernel input: per degree, the scaled coefficients of each group (re, im).
             let c = 2 * groups.len();
             let mut fin = std::mem::take(&mut sc.sums);
-            let (base, t) = (&sc.base, &sc.rec.s);
             for (q, g) in groups.iter().enumerate() {
                 // SAFETY: |order| < b; the block has at least n entries, only read here.
                 let block = unsafe { g.coef.block(g.order) }.cast_const();
                 let f = g.sign(m) * factor;
-                // The coefficient of `e_i`, 0 from degree `n` on.
-                let coef = |i: usize| {
-                    if i < n {
-                        // SAFETY: entry i < n of the block (above).
-                        unsafe { *block.add(i) * (base.s[i] * f) }
-                    } else {
-                        Complex64::default()
-                    }
-                };
-                for j in 0..steps {
-                    let v = coef(2 * j) * t[j];
-                    fin[j * 2 * c + 2 * q] = v.re;
-                    fin[j * 2 * c + 2 * q + 1] = v.im;
+                for (i, &s) in sc.rec.s[..n].iter().enumerate() {
+                    // SAFETY: entry i < n of the block (above).
+                    let v = unsafe { *block.add(i) } * (s * f);
+                    fin[i * c + 2 * q] = v.re;
+                    fin[i * c + 2 * q + 1] = v.im;
                 }
-                odd_to_even(
-                    base,
-                    steps,
-                    |j| coef(2 * j + 1),
-                    |j, v| {
-                        let v = v * t[j];
-                        fin[j * 2 * c + c + 2 * q] = v.re;
-                        fin[j * 2 * c + c + 2 * q + 1] = v.im;
-                    },
-                );
             }
-            let rec = Rec::new(&sc.rec, steps);
+            let rec = Rec::new(&sc.rec, n);
             let mut rows = std::mem::take(&mut sc.rows);
             let lanes = self.lanes(sc);
-            dwt::inverse_parity(self.isa, c, &rec, &lanes, &fin[..steps * 2 * c], &mut rows);
-            // Columns of the output: even sums, then odd sums (to be multiplied by
-            // cos(theta)), `nb` lanes each.
+            dwt::inverse_parity(self.isa, c, &rec, &lanes, &fin[..n * c], &mut rows);
+            // Columns of the output: even sums, then odd sums, `nb` lanes each.
             let nb = self.lanes;
             let column =
                 |par: usize, q: usize, part: usize| &rows[(par * c + 2 * q + part) * nb..][..b];
@@ -419,8 +369,7 @@ impl LegendreStage {
                 let (er, ei) = (column(0, q, 0), column(0, q, 1));
                 let (or, oi) = (column(1, q, 0), column(1, q, 1));
                 for k in 0..b {
-                    let e = Complex64::new(er[k], ei[k]);
-                    let o = Complex64::new(or[k], oi[k]) * self.cos[k];
+                    let (e, o) = (Complex64::new(er[k], ei[k]), Complex64::new(or[k], oi[k]));
                     let mirror = 2 * b - 1 - k;
                     // SAFETY: rings k and mirror, the group's order's column: this task's.
                     unsafe {

@@ -11,7 +11,6 @@
 pub(crate) mod column;
 pub(crate) mod recurrence;
 pub(crate) mod starts;
-pub(crate) mod two_step;
 
 use crate::numeric::{sin_cos_dd, Dd};
 use crate::simd::Isa;
