@@ -53,12 +53,17 @@ pub fn grid_argmax_real(b: usize, values: &[f64]) -> Peak {
 }
 
 /// The first largest `f(v)` of `values` (strictly larger replaces; NaN is never taken),
-/// with its index plus `base`; `(0.0, usize::MAX)` when no value is positive. In blocks: a
+/// with its index plus `base`, against the candidate of the values before them (`start`;
+/// `(0.0, usize::MAX)`: none, which stays when no value is positive). In blocks: a
 /// block's maximum first (eight independent running maxima, which vectorise), then, only
 /// when it beats the best so far, the first index in the block that reaches it.
-fn first_largest_in<T: Copy>(values: &[T], base: usize, f: &impl Fn(T) -> f64) -> (f64, usize) {
+fn first_largest_in<T: Copy>(
+    values: &[T],
+    base: usize,
+    f: &impl Fn(T) -> f64,
+    (mut best, mut at): (f64, usize),
+) -> (f64, usize) {
     const BLOCK: usize = 1024;
-    let (mut best, mut at) = (0.0, usize::MAX);
     for (k, block) in values.chunks(BLOCK).enumerate() {
         let mut lanes = [0.0f64; 8];
         let mut groups = block.chunks_exact(8);
@@ -75,6 +80,7 @@ fn first_largest_in<T: Copy>(values: &[T], base: usize, f: &impl Fn(T) -> f64) -
             .map(|&v| f(v))
             .chain(lanes)
             .fold(0.0, |m, x| if x > m { x } else { m });
+        // Only a block that beats the values before it is searched again.
         if top > best {
             let i = block.iter().position(|&v| f(v) == top).unwrap_or(0);
             (best, at) = (top, base + k * BLOCK + i);
@@ -107,7 +113,7 @@ fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync
     let best = values
         .par_chunks(PART)
         .enumerate()
-        .map(|(p, part)| first_largest_in(part, p * PART, &f))
+        .map(|(p, part)| first_largest_in(part, p * PART, &f, (0.0, usize::MAX)))
         .reduce(|| (0.0, usize::MAX), first_largest);
     peak_of(b, best)
 }
@@ -136,17 +142,17 @@ impl SliceArgmax {
         let n = 2 * self.b;
         let base = k * n * n;
         let found = match slice {
-            SliceRef::Real(v) => first_largest_in(&v[..n * n], base, &|x: f64| x * x),
+            SliceRef::Real(v) => {
+                first_largest_in(&v[..n * n], base, &|x: f64| x * x, (0.0, usize::MAX))
+            }
             SliceRef::Complex {
                 values,
                 row,
                 stride,
             } => (0..row).fold((0.0, usize::MAX), |acc, r| {
+                // Rows in flat order, each with the largest value before it.
                 let cells = &values[r * stride..][..row];
-                first_largest(
-                    acc,
-                    first_largest_in(cells, base + r * row, &|z: Complex64| z.norm_sqr()),
-                )
+                first_largest_in(cells, base + r * row, &|z: Complex64| z.norm_sqr(), acc)
             }),
         };
         self.best.lock().unwrap_or_else(|e| e.into_inner())[k] = found;
@@ -418,6 +424,56 @@ mod tests {
             let z: Vec<Complex64> = g.iter().map(|&x| Complex64::new(0.0, x)).collect();
             let q = grid_argmax(b, &z);
             assert_eq!((q.index, q.value), (at, best));
+        }
+    }
+
+    /// Slices shown in any order, complex ones row by row in padded rows, give the rule's
+    /// point: ties within a row, across rows and across slices go to the lowest index.
+    #[test]
+    fn slice_watch_takes_the_first_largest_value() {
+        use crate::plan::SliceRef;
+        let b = 6;
+        let (n, stride) = (2 * b, 2 * b + 3);
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
+            ((state >> 40) % 9) as f64 - 4.0
+        };
+        let mut v: Vec<f64> = (0..n * n * n).map(|_| next()).collect();
+        v[5] = f64::NAN;
+        let mut grids = vec![v.clone()];
+        // The largest value in a late row of slice 3, then again in an earlier row of
+        // slice 3 and in slice 9: the earlier row of slice 3 wins.
+        v[3 * n * n + 7 * n + 2] = 50.0;
+        grids.push(v.clone());
+        v[3 * n * n + 2 * n + 5] = -50.0;
+        v[9 * n * n] = 50.0;
+        grids.push(v);
+        for g in &grids {
+            let (at, best) = plain(g);
+            let (real, complex) = (SliceArgmax::new(b), SliceArgmax::new(b));
+            for k in (0..n).rev() {
+                let slice = &g[k * n * n..][..n * n];
+                real.watch(k, SliceRef::Real(slice));
+                let mut padded = vec![Complex64::new(f64::NAN, 0.0); n * stride];
+                for r in 0..n {
+                    for c in 0..n {
+                        padded[r * stride + c] = Complex64::new(slice[r * n + c], 0.0);
+                    }
+                }
+                let values = &padded[..(n - 1) * stride + n];
+                complex.watch(
+                    k,
+                    SliceRef::Complex {
+                        values,
+                        row: n,
+                        stride,
+                    },
+                );
+            }
+            for p in [real.peak(), complex.peak()] {
+                assert_eq!((p.index, p.value), (at, best));
+            }
         }
     }
 }
