@@ -201,7 +201,8 @@ so3fft_plan so3fft_plan_both(int B, unsigned int flags);
 // count (0 = all cores). NULL on error.
 so3fft_plan so3fft_plan_general(int B, int direction, so3fft_complex *in, so3fft_complex *out, unsigned int flags, int nthreads);
 
-// Destroys a plan (after its worker threads have finished); NULL is a no-op.
+// Destroys a plan (after the worker threads it was the last to use have finished); NULL
+// is a no-op.
 void so3fft_destroy_plan(so3fft_plan p);
 
 // Executes a plan on the arrays given at planning. Returns `SO3FFT_OK` or an error code.
@@ -325,7 +326,8 @@ so3fft_s2_plan so3fft_plan_s2(int B, unsigned int flags, int nthreads);
 // does not read them. NULL on error.
 so3fft_s2_plan so3fft_plan_s2_limited(int B, int L, int Mmax, unsigned int flags, int nthreads);
 
-// Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
+// Destroys an S^2 plan (after the worker threads it was the last to use have finished);
+// NULL is a no-op.
 void so3fft_destroy_s2_plan(so3fft_s2_plan p);
 
 // The bandwidth of an S^2 plan (`SO3FFT_ENULL` for NULL).

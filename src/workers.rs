@@ -1,9 +1,10 @@
-//! The worker threads of a plan: a rayon pool that a plan's `Drop` waits for, and that a
-//! child made by `fork()` never waits for (its threads are the parent's); and [`SendPtr`],
-//! the address the tasks of one execution share.
+//! The worker threads of plans: a rayon pool shared by the plans of a process with the same
+//! worker count, which the last of them waits for when dropped, and which a child made by
+//! `fork()` never waits for (its threads are the parent's); and [`SendPtr`], the address the
+//! tasks of one execution share.
 
 use crate::error::{Error, Result};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex, Weak};
 
 /// Largest worker count a plan accepts.
 pub(crate) const MAX_THREADS: usize = 1024;
@@ -30,6 +31,11 @@ pub(crate) const WORKER_STACK_BYTES: usize = 2 << 20;
 /// Pools of plans dropped in a child made by `fork()`: kept reachable until the process
 /// ends, since dropping them would wait for threads that do not exist there.
 static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
+
+/// The process's pools by worker count, held weakly: a pool lives while a plan holds it, so
+/// a program that makes many plans runs one set of workers per thread count, and one that
+/// drops all its plans has no threads left.
+static PROCESS_POOLS: Mutex<Vec<(usize, Weak<Workers>)>> = Mutex::new(Vec::new());
 
 /// A plan's worker threads. Clones share the threads (plans run one after another by one
 /// caller, such as a correlation's transforms, share a pool: a task already on its
@@ -72,19 +78,35 @@ impl WorkerPool {
         })))
     }
 
-    /// `shared` if given (an error unless it has `threads` workers), else new workers.
-    pub(crate) fn shared_or_new(
-        shared: Option<&WorkerPool>,
-        threads: usize,
-        name: &'static str,
-    ) -> Result<WorkerPool> {
+    /// The process's pool of `threads` workers (named `so3fft-<i>`), started if no plan
+    /// of this process holds one; [`Error::Resources`] if the system refuses the threads.
+    pub(crate) fn process(threads: usize) -> Result<WorkerPool> {
+        let mut pools = PROCESS_POOLS.lock().unwrap_or_else(|e| e.into_inner());
+        pools.retain(|(_, w)| w.strong_count() > 0);
+        let found = pools
+            .iter()
+            .filter(|(n, _)| *n == threads)
+            .find_map(|(_, w)| w.upgrade())
+            // A parent's pool in a child made by `fork()` has no threads here.
+            .filter(|w| w.in_own_process());
+        if let Some(w) = found {
+            return Ok(WorkerPool(w));
+        }
+        let pool = WorkerPool::new(threads, "so3fft")?;
+        pools.push((threads, Arc::downgrade(&pool.0)));
+        Ok(pool)
+    }
+
+    /// `shared` if given (an error unless it has `threads` workers), else the process's
+    /// pool of `threads` workers ([`WorkerPool::process`]).
+    pub(crate) fn shared_or_new(shared: Option<&WorkerPool>, threads: usize) -> Result<WorkerPool> {
         match shared {
             Some(w) if w.pool().current_num_threads() == threads => Ok(w.clone()),
             Some(w) => Err(Error::InvalidArgument(format!(
                 "a plan of {threads} threads on a pool of {}",
                 w.pool().current_num_threads()
             ))),
-            None => WorkerPool::new(threads, name),
+            None => WorkerPool::process(threads),
         }
     }
 
@@ -97,6 +119,12 @@ impl WorkerPool {
     /// `fork()` after the pool was started.
     pub(crate) fn in_own_process(&self) -> bool {
         self.0.in_own_process()
+    }
+
+    /// Whether `self` and `other` are the same workers (for tests).
+    #[cfg(test)]
+    pub(crate) fn same_as(&self, other: &WorkerPool) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
     }
 
     /// Number of worker threads still running (for tests).

@@ -229,7 +229,8 @@ pub extern "C" fn so3fft_plan_general(
     make_plan(B, direction, r#in, out, flags, nthreads)
 }
 
-/// Destroys a plan (after its worker threads have finished); NULL is a no-op.
+/// Destroys a plan (after the worker threads it was the last to use have finished); NULL
+/// is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_destroy_plan(p: so3fft_plan) {
     guarded((), || {

@@ -80,7 +80,8 @@ pub extern "C" fn so3fft_plan_s2_limited(
     })
 }
 
-/// Destroys an S^2 plan (after its worker threads have finished); NULL is a no-op.
+/// Destroys an S^2 plan (after the worker threads it was the last to use have finished);
+/// NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_destroy_s2_plan(p: so3fft_s2_plan) {
     guarded((), || {

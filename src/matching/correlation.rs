@@ -79,7 +79,7 @@ impl Correlation {
         // pipeline runs on its workers directly (at small bandwidths waking the workers
         // for every stage cost as much as the stages).
         let threads = crate::workers::thread_count(options.threads)?;
-        let workers = WorkerPool::new(threads, "so3fft-match")?;
+        let workers = WorkerPool::process(threads)?;
         let s2 = S2Plan::new_on(
             b_in,
             &S2Options {

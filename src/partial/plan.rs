@@ -534,7 +534,7 @@ impl General {
             budget,
             lanes_w: w,
             layout_n: shape.order_limit_gamma,
-            workers: WorkerPool::shared_or_new(shared, threads, "so3fft-partial")?,
+            workers: WorkerPool::shared_or_new(shared, threads)?,
         })
     }
 

@@ -237,7 +237,7 @@ impl Plan {
         let buf = AlignedBuf::new(layout.chunk_bytes.div_ceil(16))?;
         let dwt = DwtStage::new(b, isa, clusters, (threads, lanes), (skip_bits, skip));
         // The pool comes last: nothing after it can fail, so a failed plan leaves no threads.
-        let workers = WorkerPool::shared_or_new(shared, threads, "so3fft")?;
+        let workers = WorkerPool::shared_or_new(shared, threads)?;
         Ok(Plan {
             b,
             direction: options.direction,

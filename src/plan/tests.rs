@@ -337,6 +337,53 @@ fn plan_is_send_sync() {
     is::<super::Plan>();
 }
 
+/// Plans made without a pool share the process's pool of their thread count: many plans,
+/// one set of workers; another thread count, other workers; the plans on one pool give
+/// the same samples as a plan alone.
+#[test]
+fn plans_of_a_thread_count_share_the_process_pool() {
+    use crate::workers::WorkerPool;
+    let options = |threads| super::PlanOptions {
+        threads,
+        ..Default::default()
+    };
+    let plans: Vec<super::Plan> = (0..12)
+        .map(|i| super::Plan::new(4 + i % 3, &options(2)).unwrap())
+        .collect();
+    let pool = WorkerPool::process(2).unwrap();
+    assert!(plans.iter().all(|p| p.workers.same_as(&pool)));
+    let three = super::Plan::new(4, &options(3)).unwrap();
+    assert!(!three.workers.same_as(&pool));
+    assert!(three.workers.same_as(&WorkerPool::process(3).unwrap()));
+    let s2 = crate::s2::S2Plan::new(
+        8,
+        &crate::s2::S2Options {
+            threads: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(s2.workers().same_as(&pool));
+    // Executions on the shared workers, one after another and from two threads at once.
+    let coeffs: Vec<num_complex::Complex64> = (0..plans[0].num_coeffs())
+        .map(|i| num_complex::Complex64::new((i as f64).sin(), (2.0 * i as f64).cos()))
+        .collect();
+    let mut want = vec![num_complex::Complex64::default(); plans[0].num_samples()];
+    three.inverse(&coeffs, &mut want).unwrap();
+    std::thread::scope(|s| {
+        for p in [&plans[0], &plans[3]] {
+            let (coeffs, want) = (&coeffs, &want);
+            s.spawn(move || {
+                let mut got = vec![num_complex::Complex64::default(); p.num_samples()];
+                for _ in 0..5 {
+                    p.inverse(coeffs, &mut got).unwrap();
+                    assert!(got == *want);
+                }
+            });
+        }
+    });
+}
+
 /// Plans on one shared pool: the threads run until the last plan on them is dropped (and
 /// that drop waits for them); a plan on a pool of another thread count is refused; a plan
 /// executed from inside the pool (as a correlation runs its stages) gives the same

@@ -101,7 +101,7 @@ impl S2Plan {
         let starts = (-(b as isize - 1)..b as isize)
             .map(|m| order_start(b, m))
             .collect();
-        let workers = WorkerPool::shared_or_new(shared, threads, "so3fft-s2")?;
+        let workers = WorkerPool::shared_or_new(shared, threads)?;
         Ok(S2Plan {
             b,
             threads,
@@ -120,6 +120,12 @@ impl S2Plan {
     /// ring scratch of the same size, made on their first use and kept with the plan.
     pub fn memory_needed(b: usize, threads: usize) -> usize {
         16 * scratch_len(b) + LegendreStage::bytes(b, threads) + 8 * 2 * b
+    }
+
+    /// The plan's worker threads (for tests).
+    #[cfg(test)]
+    pub(crate) fn workers(&self) -> &WorkerPool {
+        &self.workers
     }
 
     /// Runs `f` on the plan's worker threads (rayon parallel iterators in `f` use them).
