@@ -24,8 +24,10 @@
 
 use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
-use super::plan::{General, LaneRows, PartialOptions};
+use super::general::General;
+use super::options::PartialOptions;
 use super::shape::Shape;
+use super::slots::LaneRows;
 use crate::dwt::Prefetch;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
