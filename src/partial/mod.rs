@@ -11,11 +11,14 @@
 //! - `general`: the general engine (every shape but the full one with all betas): the
 //!   chunk loop;
 //! - `slots`: where a slice's values are in the lane rows (`LaneRows`, `SlotTable`);
-//! - `distributed`: [`DistributedPlan`], the transforms spread over ranks ([`Exchange`]).
+//! - `distributed`: [`DistributedPlan`], the transforms spread over ranks;
+//! - `exchange`: [`Exchange`], what they need of their group, and [`ThreadExchange`];
+//! - `mpi`: `MpiExchange`, the exchange over MPI (feature `mpi`).
 
 mod betas;
 mod distributed;
 mod dwt_stage;
+mod exchange;
 mod fft_stage;
 mod general;
 #[cfg(feature = "mpi")]
@@ -28,7 +31,8 @@ mod slots;
 mod tests;
 
 pub use betas::Betas;
-pub use distributed::{DistributedPlan, DistributedTimes, Exchange, ThreadExchange};
+pub use distributed::{DistributedPlan, DistributedTimes};
+pub use exchange::{Exchange, ThreadExchange};
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
 pub use options::{Batch, PartialOptions};
