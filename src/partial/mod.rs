@@ -6,23 +6,35 @@
 //! - `betas`: [`Betas`] and the kernels' lane pairs of a beta and its mirror;
 //! - `dwt_stage`: the clusters of a shape and their kernel calls;
 //! - `fft_stage`: pruned slice DFTs;
-//! - `plan`: [`PartialPlan`], construction and the chunk loop;
-//! - `distributed`: [`DistributedPlan`], the transforms spread over ranks ([`Exchange`]).
+//! - `options`: [`PartialOptions`] and [`Batch`];
+//! - `plan`: [`PartialPlan`], its construction, argument checks and transforms;
+//! - `general`: the general engine (every shape but the full one with all betas): the
+//!   chunk loop;
+//! - `slots`: where a slice's values are in the lane rows (`LaneRows`, `SlotTable`);
+//! - `distributed`: [`DistributedPlan`], the transforms spread over ranks;
+//! - `exchange`: [`Exchange`], what they need of their group, and [`ThreadExchange`];
+//! - `mpi`: `MpiExchange`, the exchange over MPI (feature `mpi`).
 
 mod betas;
 mod distributed;
 mod dwt_stage;
+mod exchange;
 mod fft_stage;
+mod general;
 #[cfg(feature = "mpi")]
 mod mpi;
+mod options;
 mod plan;
 mod shape;
+mod slots;
 #[cfg(test)]
 mod tests;
 
 pub use betas::Betas;
-pub use distributed::{DistributedPlan, DistributedTimes, Exchange, ThreadExchange};
+pub use distributed::{DistributedPlan, DistributedTimes};
+pub use exchange::{Exchange, ThreadExchange};
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
-pub use plan::{Batch, PartialOptions, PartialPlan};
+pub use options::{Batch, PartialOptions};
+pub use plan::PartialPlan;
 pub use shape::{Shape, MAX_GRID_SIDE};

@@ -2,7 +2,7 @@
 //! (feature `mpi`; the few MPI calls are in `mpi_shim.c`, compiled against the MPI
 //! installation's header).
 
-use super::distributed::Exchange;
+use super::exchange::Exchange;
 use crate::error::{Error, Result};
 use std::ffi::c_int;
 

@@ -1,0 +1,627 @@
+//! The general engine of a [`PartialPlan`](super::PartialPlan) (every shape but the full
+//! one with all betas): its construction, and its transforms one chunk of lane pairs at a
+//! time (the DWT stage over all clusters, then the FFT stage over the chunk's slices).
+
+use super::betas::{Betas, LanePairs};
+use super::dwt_stage::{ChunkLanes, DwtStage, KERNEL_BATCH};
+use super::fft_stage::{FftStage, Work};
+use super::options::{Batch, PartialOptions};
+use super::shape::{CoefLayout, Shape};
+use super::slots::{LaneRows, SlotTable};
+use crate::dwt::{BatchRows, Prefetch};
+use crate::error::Result;
+use crate::fft::AlignedBuf;
+use crate::plan::StageTimes;
+use crate::simd::Isa;
+use crate::system::check_headroom;
+use crate::wigner::SKIP_BITS_RANGE;
+use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
+use num_complex::Complex64;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// A plan of the general engine.
+pub(super) struct General {
+    pub(super) layout: CoefLayout,
+    pub(super) pairs: LanePairs,
+    /// Its clusters are never changed after `new`: `slots` is made from them.
+    pub(super) dwt: DwtStage,
+    pub(super) fft: FftStage,
+    /// The slots of a lane row, flat (for the scatters and gathers, complex and real).
+    slots: SlotTable,
+    /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
+    pub(super) pair_weight: Vec<f64>,
+    /// Per-worker FFT buffers (made on first use).
+    work: Vec<Mutex<Work>>,
+    /// The chunk buffer (taken by one execution at a time).
+    buf: Mutex<Option<AlignedBuf>>,
+    budget: usize,
+    pub(super) lanes_w: usize,
+    /// The order limit `N` of `M'`.
+    layout_n: usize,
+    pub(super) workers: WorkerPool,
+}
+
+/// Pointers of one execution (all arrays of a batch).
+#[derive(Clone, Copy)]
+pub(super) enum Data {
+    Complex(SendPtr<Complex64>),
+    Real(SendPtr<f64>),
+}
+
+impl General {
+    pub(super) fn new(
+        shape: &Shape,
+        pairs: LanePairs,
+        (isa, bits, threads): (Isa, u32, usize),
+        options: &PartialOptions,
+        shared: Option<&WorkerPool>,
+    ) -> Result<General> {
+        let layout = CoefLayout::new(shape);
+        let (na, ng) = (shape.n_alpha, shape.n_gamma);
+        let arrays = 16 * (shape.num_samples() + shape.num_coeffs());
+        let budget = options
+            .max_workspace_bytes
+            .unwrap_or_else(|| (512usize << 20).max(arrays / 20));
+        let w = isa.lanes();
+        let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
+        let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
+        let tables = 64 * 2 * pairs.pairs * (2 * shape.degree_limit + 66);
+        check_headroom(
+            DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
+                .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
+                .saturating_add(tables)
+                .saturating_add(crate::fft::planning_bytes(4 * na * ng, 1)),
+        )?;
+        // No skipping: the scaled starting values still need a threshold (the widest).
+        let skip = if bits == 0 {
+            (*SKIP_BITS_RANGE.end(), false)
+        } else {
+            (bits, true)
+        };
+        let fft = FftStage::new(
+            (na, ng),
+            shape.order_limit_gamma,
+            options.real,
+            options.rigor,
+        )?;
+        let dwt = DwtStage::new(
+            &layout,
+            (na, ng, fft.strides().0),
+            isa,
+            skip,
+            (threads, max_lanes),
+        );
+        let pair_weight = if options.betas == Betas::All {
+            let wts = crate::grid::weights(shape.grid_bandwidth);
+            let f = 2.0 * PI / (na * ng) as f64;
+            wts[..pairs.pairs].iter().map(|x| x * f).collect()
+        } else {
+            Vec::new()
+        };
+        let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
+        Ok(General {
+            layout,
+            pairs,
+            slots,
+            dwt,
+            fft,
+            pair_weight,
+            work: (0..threads).map(|_| Mutex::new(Work::default())).collect(),
+            buf: Mutex::new(None),
+            budget,
+            lanes_w: w,
+            layout_n: shape.order_limit_gamma,
+            workers: WorkerPool::shared_or_new(shared, threads)?,
+        })
+    }
+
+    /// Bytes of one transform's blocks per lane pair.
+    fn pair_bytes(&self) -> usize {
+        (self.dwt.row_total * 2 * 8).max(1)
+    }
+
+    /// Lane pairs per chunk: what the workspace cap holds for one transform (at least
+    /// one), the pairs spread evenly over the fewest chunks, a multiple of the vector
+    /// width when that is at least one vector. It does not depend on the batch, so a batch
+    /// sums in the order of single executes.
+    fn chunk_pairs(&self) -> usize {
+        let pairs = self.pairs.pairs;
+        let most = (self.budget / self.pair_bytes()).clamp(1, pairs);
+        let h = pairs.div_ceil(pairs.div_ceil(most));
+        let w = self.lanes_w;
+        if h >= w && h.next_multiple_of(w) <= most {
+            h.next_multiple_of(w)
+        } else {
+            h
+        }
+    }
+
+    /// Transforms of a batch run together (sharing each cluster's recurrence coefficients,
+    /// starting values and d values, see `dwt/batch.rs`): as many as the workspace cap holds
+    /// at the chunk size (at least one).
+    fn group_size(&self) -> usize {
+        let hp = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        (self.budget / (hp * self.pair_bytes())).max(1)
+    }
+
+    /// Runs `run(first, sub_batch)` on the groups of `batch` (see [`General::group_size`]),
+    /// summing the stage times.
+    fn by_groups(
+        &self,
+        batch: Batch,
+        mut run: impl FnMut(usize, Batch) -> Result<StageTimes>,
+    ) -> Result<StageTimes> {
+        let g = self.group_size();
+        let mut sum = StageTimes::default();
+        let mut t0 = 0;
+        while t0 < batch.count {
+            let count = g.min(batch.count - t0);
+            let s = run(t0, Batch { count, ..batch })?;
+            sum.fft += s.fft;
+            sum.dwt += s.dwt;
+            sum.total += s.total;
+            t0 += count;
+        }
+        Ok(sum)
+    }
+
+    /// Inverse of a batch, group by group.
+    pub(super) fn inverse(
+        &self,
+        batch: Batch,
+        coef: SendConstPtr<Complex64>,
+        out: Data,
+    ) -> Result<StageTimes> {
+        self.by_groups(batch, |t0, b| {
+            let c = SendConstPtr(coef.get().wrapping_add(t0 * batch.in_dist));
+            let o = match out {
+                Data::Complex(p) => {
+                    Data::Complex(SendPtr(p.get().wrapping_add(t0 * batch.out_dist)))
+                }
+                Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(t0 * batch.out_dist))),
+            };
+            self.inverse_group(b, c, o)
+        })
+    }
+
+    /// Forward of a batch, group by group (`inp` complex values, or reals with `real`).
+    pub(super) fn forward(
+        &self,
+        batch: Batch,
+        inp: SendConstPtr<f64>,
+        coef: SendPtr<Complex64>,
+        real: bool,
+    ) -> Result<StageTimes> {
+        let per_value = if real { 1 } else { 2 };
+        self.by_groups(batch, |t0, b| {
+            let i = SendConstPtr(inp.get().wrapping_add(t0 * batch.in_dist * per_value));
+            let c = SendPtr(coef.get().wrapping_add(t0 * batch.out_dist));
+            self.forward_group(b, i, c, real)
+        })
+    }
+
+    /// Runs `f` with the chunk buffer of at least `len` doubles (the plan's, else a new one).
+    fn with_buf<R>(&self, len: usize, f: impl FnOnce(*mut f64) -> Result<R>) -> Result<R> {
+        let mut guard = self.buf.try_lock().ok();
+        let mut own = None;
+        let slot: &mut Option<AlignedBuf> = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => &mut own,
+        };
+        let complex = len.div_ceil(2);
+        if slot.as_ref().is_none_or(|b| b.len() < complex) {
+            *slot = None;
+            check_headroom(complex * 16)?;
+            *slot = Some(AlignedBuf::new(complex)?);
+        }
+        let p = slot.as_ref().expect("just made").as_mut_ptr().cast::<f64>();
+        f(p)
+    }
+
+    /// Runs `f` with a worker's FFT buffers (a private set when all are busy).
+    pub(super) fn with_work<R>(&self, f: impl FnOnce(&mut Work) -> Result<R>) -> Result<R> {
+        match lock_free(&self.work) {
+            Some(mut g) => f(&mut g),
+            None => f(&mut Work::default()),
+        }
+    }
+
+    /// The chunks of lane pairs for `count` transforms.
+    fn chunks(&self) -> impl Iterator<Item = ChunkLanes> + '_ {
+        let h = self.chunk_pairs();
+        let w = self.lanes_w;
+        (0..self.pairs.pairs).step_by(h).map(move |j0| {
+            let h = h.min(self.pairs.pairs - j0);
+            let hp = h.next_multiple_of(w);
+            // The chunk's share of a split: pairs past its last one write nothing.
+            let first_upper_pair = self.pairs.first_upper_pair.and_then(|k| {
+                let k = if k >= j0 + h {
+                    hp
+                } else {
+                    k.saturating_sub(j0)
+                };
+                k.is_multiple_of(w).then_some(k)
+            });
+            ChunkLanes {
+                j0,
+                h,
+                hp,
+                row_len: self.dwt.row_total,
+                first_upper_pair,
+            }
+        })
+    }
+
+    /// Inverse of a group of transforms, chunk by chunk.
+    fn inverse_group(
+        &self,
+        batch: Batch,
+        coef: SendConstPtr<Complex64>,
+        out: Data,
+    ) -> Result<StageTimes> {
+        let start = Instant::now();
+        let mut times = StageTimes::default();
+        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let slice_len = self.fft.slice_len();
+        let real = matches!(out, Data::Real(_));
+        // Rows far larger than the caches go out with non-temporal stores.
+        let stream = batch.count * per_t_max * 8 > 8 << 20;
+        self.with_buf(batch.count * per_t_max, |buf| {
+            let buf = SendPtr(buf);
+            self.workers.pool().install(|| {
+                for ch in self.chunks() {
+                    // Chunks of padding pairs only (selections) write nothing.
+                    let tasks = self.slice_tasks(ch, batch.count);
+                    if tasks.is_empty() {
+                        continue;
+                    }
+                    let lanes = ch.lanes();
+                    let per_t = self.dwt.row_total * lanes;
+                    let t0 = Instant::now();
+                    let clusters = &self.dwt.clusters;
+                    clusters
+                        .par_iter()
+                        .enumerate()
+                        .with_min_len(4)
+                        .for_each(|(i, cl)| {
+                            self.dwt.with_scratch(|sc| {
+                                let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                    let count = KERNEL_BATCH.min(batch.count - t0);
+                                    // What the next kernel call will gather: this cluster
+                                    // for the next transforms, else the next cluster (likely
+                                    // this task's next one) for the first ones.
+                                    let next = if t0 + count < batch.count {
+                                        Some((cl, t0 + count))
+                                    } else {
+                                        clusters.get(i + 1).map(|c| (c, 0))
+                                    };
+                                    let next = next.map(|(c, u)| {
+                                        let rows = BatchRows {
+                                            base: coef.get().wrapping_add(u * batch.in_dist),
+                                            dist: batch.in_dist,
+                                            count: KERNEL_BATCH.min(batch.count - u),
+                                        };
+                                        (c, rows)
+                                    });
+                                    let c = BatchRows {
+                                        base: coef.get().wrapping_add(t0 * batch.in_dist),
+                                        dist: batch.in_dist,
+                                        count,
+                                    };
+                                    let b = BatchRows {
+                                        base: buf.get().wrapping_add(t0 * per_t + cl.offset),
+                                        dist: per_t,
+                                        count,
+                                    };
+                                    // SAFETY: coefficient arrays `t0..t0 + count` of the
+                                    // batch (checked lengths), read only; this cluster's
+                                    // `cl.p` doubles of the lane rows of those transforms,
+                                    // inside the chunk buffer, written by this task only.
+                                    unsafe {
+                                        if count == 1 {
+                                            let hints = next.map_or(Prefetch::none(), |(c, r)| {
+                                                self.dwt.coefficient_hints(c, r.base, real)
+                                            });
+                                            self.dwt.inverse(
+                                                sc,
+                                                cl,
+                                                ch,
+                                                n,
+                                                c.base,
+                                                (real, stream, hints),
+                                                b.base,
+                                            )
+                                        } else {
+                                            self.dwt.inverse_many(
+                                                sc,
+                                                cl,
+                                                ch,
+                                                n,
+                                                c,
+                                                (real, stream, next),
+                                                b,
+                                            )
+                                        }
+                                    }
+                                }
+                            })
+                        });
+                    let t1 = Instant::now();
+                    times.dwt += (t1 - t0).as_secs_f64();
+                    tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        self.with_work(|work| {
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                            let at = t * batch.out_dist + s * slice_len;
+                            match out {
+                                Data::Complex(o) => {
+                                    let w = self.fft.inv_buf(work)?;
+                                    // SAFETY: the lane rows were written by the DWT stage
+                                    // above (finished); slice `s` of output `t` is inside
+                                    // the checked output and this task's alone.
+                                    unsafe {
+                                        self.scatter(w, &[rows]);
+                                        self.fft.inverse(w, o.get().add(at));
+                                    }
+                                }
+                                Data::Real(o) => {
+                                    let w = self.fft.half_buf(work)?;
+                                    // SAFETY: as above, for the real output.
+                                    unsafe {
+                                        self.scatter_real(w, &[rows]);
+                                        self.fft.inverse_real(w, o.get().add(at));
+                                    }
+                                }
+                            }
+                            Ok(())
+                        })
+                    })?;
+                    times.fft += t1.elapsed().as_secs_f64();
+                }
+                Ok(())
+            })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// Forward of a group of transforms, chunk by chunk.
+    fn forward_group(
+        &self,
+        batch: Batch,
+        inp: SendConstPtr<f64>,
+        coef: SendPtr<Complex64>,
+        real: bool,
+    ) -> Result<StageTimes> {
+        let start = Instant::now();
+        let mut times = StageTimes::default();
+        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let slice_len = self.fft.slice_len();
+        self.with_buf(batch.count * per_t_max, |buf| {
+            let buf = SendPtr(buf);
+            self.workers.pool().install(|| {
+                for ch in self.chunks() {
+                    let lanes = ch.lanes();
+                    let per_t = self.dwt.row_total * lanes;
+                    let t0 = Instant::now();
+                    let tasks = self.slice_tasks(ch, batch.count);
+                    tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        self.with_work(|work| {
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                            let weight = self.pair_weight[ch.j0 + jj];
+                            // SAFETY: slice `s` of input `t` is inside the checked input
+                            // (complex values, or reals for the real forward); the values
+                            // written are this slice's slots of two lane rows: no other
+                            // task writes them (its mirror writes the other slots of the
+                            // same rows).
+                            unsafe {
+                                if real {
+                                    let w = self.fft.half_buf(work)?;
+                                    let at = t * batch.in_dist + s * slice_len;
+                                    self.fft.forward_real(w, inp.get().add(at));
+                                    self.gather_real(w, &[rows], weight);
+                                } else {
+                                    let w = self.fft.fwd_buf(work)?;
+                                    let at = 2 * (t * batch.in_dist + s * slice_len);
+                                    self.fft.forward(w, inp.get().add(at).cast());
+                                    self.gather(w, &[rows], weight);
+                                }
+                            }
+                            Ok(())
+                        })
+                    })?;
+                    let t1 = Instant::now();
+                    times.fft += (t1 - t0).as_secs_f64();
+                    let first = ch.j0 == 0;
+                    for t in 0..batch.count {
+                        // SAFETY: the padding lane rows of transform `t` in the chunk
+                        // buffer, written by nobody (the FFT stage is finished).
+                        unsafe { self.zero_padding(buf.get().add(t * per_t), ch) };
+                    }
+                    self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
+                        self.dwt.with_scratch(|sc| {
+                            let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                            for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                let count = KERNEL_BATCH.min(batch.count - t0);
+                                let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
+                                let c = coef.get().wrapping_add(t0 * batch.out_dist);
+                                // SAFETY: this cluster's slots of the lane rows of
+                                // transforms `t0..t0 + count` (written by the FFT stage or
+                                // zeroed above, finished); their coefficient arrays are
+                                // inside the checked output, and this cluster's slots'
+                                // blocks are this task's.
+                                unsafe {
+                                    if count == 1 {
+                                        self.dwt.forward(sc, cl, ch, n, block, c, first)
+                                    } else {
+                                        self.dwt.forward_many(
+                                            sc,
+                                            cl,
+                                            ch,
+                                            n,
+                                            BatchRows {
+                                                base: block.cast_const(),
+                                                dist: per_t,
+                                                count,
+                                            },
+                                            BatchRows {
+                                                base: c,
+                                                dist: batch.out_dist,
+                                                count,
+                                            },
+                                            first,
+                                        )
+                                    }
+                                }
+                            }
+                        })
+                    });
+                    times.dwt += t1.elapsed().as_secs_f64();
+                }
+                Ok(())
+            })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
+    }
+
+    /// The FFT stage's tasks of a chunk: `(transform, pair in chunk, upper, slice)` for
+    /// every slice the chunk's pairs write.
+    fn slice_tasks(&self, ch: ChunkLanes, count: usize) -> Vec<(usize, usize, bool, usize)> {
+        let mut v = Vec::new();
+        for t in 0..count {
+            for jj in 0..ch.h {
+                for (u, &s) in self.pairs.outputs[ch.j0 + jj].iter().enumerate() {
+                    if s != usize::MAX {
+                        v.push((t, jj, u == 1, s));
+                    }
+                }
+            }
+        }
+        v
+    }
+
+    /// The lane rows of a slice (its own, and its mirror's, where its reversed members
+    /// are) in the chunk buffer at `buf`, transform offset `at`.
+    pub(super) fn lane_rows(
+        &self,
+        buf: *mut f64,
+        at: usize,
+        ch: ChunkLanes,
+        (jj, upper): (usize, bool),
+    ) -> LaneRows {
+        let rt = self.dwt.row_total;
+        let (r, rm) = if upper {
+            (ch.hp + jj, jj)
+        } else {
+            (jj, ch.hp + jj)
+        };
+        LaneRows {
+            own: buf.wrapping_add(at + r * rt),
+            mirror: buf.wrapping_add(at + rm * rt),
+            clusters: (0, self.dwt.clusters.len()),
+        }
+    }
+
+    /// Complex inverse: a slice's values from its lane rows into the inverse's work buffer
+    /// (whose columns `|M'| <= N` are cleared first; the others stay zero).
+    ///
+    /// # Safety
+    /// Each part's lane rows hold its clusters' slots, written by the DWT stage.
+    pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: &[LaneRows]) {
+        let (na, ng) = self.fft.dims();
+        let (rs, _) = self.fft.strides();
+        let n = self.layout_n;
+        for row in w.chunks_exact_mut(rs).take(na) {
+            row[..=n].fill(Complex64::default());
+            row[ng - n..ng].fill(Complex64::default());
+        }
+        for part in rows {
+            for &(at, work) in self.slots.of(part.clusters) {
+                let x = part.at(at);
+                // SAFETY: the slot's two doubles are inside the part's lane row (the table
+                // holds the offsets of `dwt.clusters`' slots).
+                w[work as usize] = unsafe { Complex64::new(*x, *x.add(1)) };
+            }
+        }
+    }
+
+    /// Real inverse: `conj` of a slice's values with `M' >= 0` into the half buffer.
+    ///
+    /// # Safety
+    /// As for [`General::scatter`].
+    pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: &[LaneRows]) {
+        w.fill(Complex64::default());
+        for part in rows {
+            for &(at, idx) in self.slots.real_of(part.clusters) {
+                if idx & SlotTable::CONJ != 0 {
+                    continue;
+                }
+                let x = part.at(at);
+                // SAFETY: as in `scatter`.
+                w[idx as usize] = unsafe { Complex64::new(*x, -*x.add(1)) };
+            }
+        }
+    }
+
+    /// Forward: a slice's values (the forward's work buffer), times its weight, into
+    /// its slots of the lane rows.
+    ///
+    /// # Safety
+    /// As for [`General::scatter`], for writes; no other task writes these slots.
+    pub(super) unsafe fn gather(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
+        for part in rows {
+            for &(at, work) in self.slots.of(part.clusters) {
+                let v = w[work as usize] * weight;
+                let x = part.at(at);
+                // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
+                unsafe {
+                    *x = v.re;
+                    *x.add(1) = v.im;
+                }
+            }
+        }
+    }
+
+    /// Real forward: as [`General::gather`], from the half spectrum `C` (see the FFT
+    /// stage): `F(M, M') = conj(C[M][M'])` for `M' >= 0`, `C[-M][-M']` below.
+    ///
+    /// # Safety
+    /// As for [`General::gather`].
+    pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
+        for part in rows {
+            for &(at, idx) in self.slots.real_of(part.clusters) {
+                let v = if idx & SlotTable::CONJ != 0 {
+                    w[(idx & !SlotTable::CONJ) as usize]
+                } else {
+                    w[idx as usize].conj()
+                } * weight;
+                let x = part.at(at);
+                // SAFETY: as in `gather`.
+                unsafe {
+                    *x = v.re;
+                    *x.add(1) = v.im;
+                }
+            }
+        }
+    }
+
+    /// Zero the padding lane rows (`h..hp` of each half) of one transform's chunk rows at
+    /// `rows`, which the forward kernel multiplies by exact zeros.
+    ///
+    /// # Safety
+    /// The chunk's `2 hp` lane rows at `rows` are the caller's.
+    pub(super) unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
+        let rt = self.dwt.row_total;
+        for half in 0..2 {
+            let from = half * ch.hp + ch.h;
+            // SAFETY: lane rows `from..(half + 1) hp`, inside the chunk's rows.
+            unsafe { std::ptr::write_bytes(rows.add(from * rt), 0, (ch.hp - ch.h) * rt) };
+        }
+    }
+}

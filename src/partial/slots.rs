@@ -1,0 +1,109 @@
+//! Where a slice's values are in the chunk buffer: [`LaneRows`], a slice's lane rows, and
+//! [`SlotTable`], the flat table of every slot of a lane row that the FFT stage's scatters
+//! and gathers read.
+
+use super::dwt_stage::DwtStage;
+use crate::error::{Error, Result};
+
+/// A slice's lane rows: its own and its mirror's, for the clusters `clusters.0 ..
+/// clusters.1`; cluster `c`'s slots start `offset(c)` doubles after the pointers (which may
+/// point before the rows when they hold only a later part of the clusters).
+#[derive(Clone, Copy)]
+pub(super) struct LaneRows {
+    pub(super) own: *mut f64,
+    pub(super) mirror: *mut f64,
+    pub(super) clusters: (usize, usize),
+}
+
+impl LaneRows {
+    /// Rows that hold the clusters `clusters` only, the first of which at offset `first`
+    /// of the full lane row: their slots at `own` and `mirror` onwards.
+    pub(super) fn part(
+        (own, mirror): (*mut f64, *mut f64),
+        clusters: (usize, usize),
+        first: usize,
+    ) -> LaneRows {
+        LaneRows {
+            own: own.wrapping_sub(first),
+            mirror: mirror.wrapping_sub(first),
+            clusters,
+        }
+    }
+
+    /// Where a slot of a [`SlotTable`] entry is.
+    #[inline(always)]
+    pub(super) fn at(&self, at: u32) -> *mut f64 {
+        let row = if at & SlotTable::MIRROR != 0 {
+            self.mirror
+        } else {
+            self.own
+        };
+        row.wrapping_add((at & !SlotTable::MIRROR) as usize)
+    }
+}
+
+/// Every slot of a lane row in cluster order, flat: the FFT stage's scatters and gathers
+/// read 8 bytes a slot here (one table for the complex layout, one for the real) instead of
+/// each cluster's list of slots (a heap allocation per cluster, 64 bytes a slot: at
+/// B = 128 about 4 MB read per slice).
+pub(super) struct SlotTable {
+    /// `(offset in the lane row, or'ed with MIRROR for a reversed member, whose value is in
+    /// the mirror's row; index in the FFT stage's work buffer)`.
+    entries: Vec<(u32, u32)>,
+    /// First entry of each cluster, then the total.
+    start: Vec<usize>,
+    /// The same for the real layout's half buffer (`n_alpha` rows `hs` apart, `M' >= 0`):
+    /// the index of `(M, M')` if `M' >= 0`, else of `(-M, -M')` or'ed with `CONJ` (the real
+    /// forward reads the value there unconjugated; the real inverse skips it).
+    real: Vec<(u32, u32)>,
+}
+
+impl SlotTable {
+    const MIRROR: u32 = 1 << 31;
+    pub(super) const CONJ: u32 = 1 << 31;
+
+    /// The table of `dwt`'s clusters; the real entries for a half buffer of `na` rows `hs`
+    /// apart.
+    pub(super) fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
+        let too_large =
+            || Error::InvalidArgument("shape too large for the general engine's slot table".into());
+        let fits = |x: usize| u32::try_from(x).ok().filter(|a| a & (1 << 31) == 0);
+        let half = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
+        let mut entries = Vec::new();
+        let mut real = Vec::new();
+        let mut start = Vec::with_capacity(dwt.clusters.len() + 1);
+        for cl in &dwt.clusters {
+            start.push(entries.len());
+            for (q, s) in cl.slots.iter().enumerate() {
+                let mem = &s.member;
+                let (Some(at), Ok(work)) = (fits(cl.offset + 2 * q), u32::try_from(s.work)) else {
+                    return Err(too_large());
+                };
+                let at = at | if mem.reversed { Self::MIRROR } else { 0 };
+                entries.push((at, work));
+                let idx = if mem.mp >= 0 {
+                    fits(half(mem.m, mem.mp))
+                } else {
+                    fits(half(-mem.m, -mem.mp)).map(|i| i | Self::CONJ)
+                };
+                real.push((at, idx.ok_or_else(too_large)?));
+            }
+        }
+        start.push(entries.len());
+        Ok(SlotTable {
+            entries,
+            start,
+            real,
+        })
+    }
+
+    /// The entries of clusters `a..b`.
+    pub(super) fn of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+        &self.entries[self.start[a]..self.start[b]]
+    }
+
+    /// The real entries of clusters `a..b`.
+    pub(super) fn real_of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+        &self.real[self.start[a]..self.start[b]]
+    }
+}
