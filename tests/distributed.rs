@@ -198,6 +198,24 @@ fn collective_errors() {
             });
         }
     });
+    // A skip threshold outside the accepted range is refused on every rank, as by a
+    // partial plan.
+    for bits in [5u32, 1000] {
+        let bad = PartialOptions {
+            skip_bits: Some(bits),
+            ..opts(false)
+        };
+        assert!(PartialPlan::new(&Shape::new(6), &bad).is_err());
+        let group = ThreadExchange::group(2);
+        std::thread::scope(|scope| {
+            for comm in &group {
+                let bad = &bad;
+                scope.spawn(move || {
+                    assert!(DistributedPlan::new(comm, &Shape::new(6), bad).is_err());
+                });
+            }
+        });
+    }
     // One rank refuses (bad arguments of its own): the others fail too.
     let group = ThreadExchange::group(3);
     std::thread::scope(|scope| {

@@ -26,7 +26,7 @@ use super::betas::{Betas, LanePairs};
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
 use super::exchange::Exchange;
 use super::general::General;
-use super::options::PartialOptions;
+use super::options::{skip_bits, PartialOptions};
 use super::shape::Shape;
 use super::slots::LaneRows;
 use crate::dwt::Prefetch;
@@ -274,10 +274,7 @@ impl<X: Exchange> DistributedPlan<X> {
         }
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
-        let bits = match options.skip_bits {
-            None => crate::wigner::DEFAULT_SKIP_BITS,
-            Some(b) => b,
-        };
+        let bits = skip_bits(options.skip_bits)?;
         let pairs = LanePairs::new(shape, &Betas::All, None)?;
         let np = pairs.pairs;
         // One chunk of every beta: a cluster's kernel call covers all lanes.

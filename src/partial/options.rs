@@ -2,9 +2,11 @@
 //! transforms ([`Batch`]): the public arguments of its construction and execution.
 
 use super::betas::Betas;
+use crate::error::{Error, Result};
 use crate::fft::Rigor;
 use crate::plan::Direction;
 use crate::simd::Isa;
+use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 
 /// Options of a [`PartialPlan`](super::PartialPlan).
 #[derive(Clone, Debug, Default)]
@@ -28,12 +30,27 @@ pub struct PartialOptions {
     /// `Some(0)`: nothing skipped; else 24..=560). Thresholds above the default save nothing
     /// measurable (`docs/partial-plans.md`).
     pub skip_bits: Option<u32>,
-    /// Cap on the chunk buffer in bytes (`None`: 256 MiB).
+    /// Cap on the chunk buffer in bytes (`None`: the larger of 512 MiB and a twentieth of
+    /// the plan's sample and coefficient arrays; for a distributed plan, of the rank's
+    /// share of them).
     pub max_workspace_bytes: Option<usize>,
     /// Run the full shape on the general engine too (normally the full shape runs on
     /// [`Plan`](crate::plan::Plan), which is faster): for tests and benchmarks.
     #[doc(hidden)]
     pub general_engine: bool,
+}
+
+/// The skip threshold's exponent of a `skip_bits` option (0: no skipping); an error
+/// outside 0 and [`SKIP_BITS_RANGE`].
+pub(super) fn skip_bits(option: Option<u32>) -> Result<u32> {
+    match option {
+        None => Ok(DEFAULT_SKIP_BITS),
+        Some(0) => Ok(0),
+        Some(b) if SKIP_BITS_RANGE.contains(&b) => Ok(b),
+        Some(b) => Err(Error::InvalidArgument(format!(
+            "skip_bits {b} outside {SKIP_BITS_RANGE:?}"
+        ))),
+    }
 }
 
 /// Several transforms in one call, FFTW `plan_many` style: `count` inputs `in_dist` values

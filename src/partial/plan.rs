@@ -4,26 +4,13 @@
 
 use super::betas::{Betas, LanePairs};
 use super::general::{Data, General};
-use super::options::{Batch, PartialOptions};
+use super::options::{skip_bits, Batch, PartialOptions};
 use super::shape::Shape;
 use crate::error::{Error, Result};
 use crate::plan::{Direction, Plan, PlanOptions, SliceWatch, StageTimes};
 use crate::simd::Isa;
-use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool};
 use num_complex::Complex64;
-
-/// The skip threshold's exponent of a `skip_bits` option (0: no skipping).
-fn skip_bits(option: Option<u32>) -> Result<u32> {
-    match option {
-        None => Ok(DEFAULT_SKIP_BITS),
-        Some(0) => Ok(0),
-        Some(b) if SKIP_BITS_RANGE.contains(&b) => Ok(b),
-        Some(b) => Err(Error::InvalidArgument(format!(
-            "skip_bits {b} outside {SKIP_BITS_RANGE:?}"
-        ))),
-    }
-}
 
 enum Engine {
     Full(Box<Plan>),
