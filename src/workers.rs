@@ -4,7 +4,9 @@
 //! tasks of one execution share.
 
 use crate::error::{Error, Result};
-use std::sync::{Arc, Condvar, Mutex, Weak};
+use crate::system::ForkLock;
+use std::cell::UnsafeCell;
+use std::sync::{Arc, Condvar, Mutex, Once, Weak};
 
 /// Largest worker count a plan accepts.
 pub(crate) const MAX_THREADS: usize = 1024;
@@ -34,8 +36,16 @@ static ORPHAN_POOLS: Mutex<Vec<rayon::ThreadPool>> = Mutex::new(Vec::new());
 
 /// The process's pools by worker count, held weakly: a pool lives while a plan holds it, so
 /// a program that makes many plans runs one set of workers per thread count, and one that
-/// drops all its plans has no threads left.
-static PROCESS_POOLS: Mutex<Vec<(usize, Weak<Workers>)>> = Mutex::new(Vec::new());
+/// drops all its plans has no threads left. Accessed only under [`REGISTRY_LOCK`].
+struct PoolRegistry(UnsafeCell<Vec<(usize, Weak<Workers>)>>);
+
+// SAFETY: the vector is only accessed while `REGISTRY_LOCK` is held (`WorkerPool::process`).
+unsafe impl Sync for PoolRegistry {}
+
+static PROCESS_POOLS: PoolRegistry = PoolRegistry(UnsafeCell::new(Vec::new()));
+
+/// Guards [`PROCESS_POOLS`]; a child made by `fork()` never inherits it locked.
+static REGISTRY_LOCK: ForkLock = ForkLock::new();
 
 /// A plan's worker threads. Clones share the threads (plans run one after another by one
 /// caller, such as a correlation's transforms, share a pool: a task already on its
@@ -81,7 +91,22 @@ impl WorkerPool {
     /// The process's pool of `threads` workers (named `so3fft-<i>`), started if no plan
     /// of this process holds one; [`Error::Resources`] if the system refuses the threads.
     pub(crate) fn process(threads: usize) -> Result<WorkerPool> {
-        let mut pools = PROCESS_POOLS.lock().unwrap_or_else(|e| e.into_inner());
+        static HANDLERS: Once = Once::new();
+        HANDLERS.call_once(|| {
+            extern "C" fn prepare() {
+                REGISTRY_LOCK.before_fork();
+            }
+            extern "C" fn release() {
+                REGISTRY_LOCK.after_fork();
+            }
+            // SAFETY: the handlers are plain functions that live as long as the process. If
+            // registration fails (ENOMEM), a fork during a plan's construction may leave
+            // the registry locked in the child, as without it.
+            unsafe { libc::pthread_atfork(Some(prepare), Some(release), Some(release)) };
+        });
+        let _guard = REGISTRY_LOCK.lock();
+        // SAFETY: the lock is held, so no other reference to the vector exists.
+        let pools = unsafe { &mut *PROCESS_POOLS.0.get() };
         pools.retain(|(_, w)| w.strong_count() > 0);
         let found = pools
             .iter()
@@ -125,6 +150,20 @@ impl WorkerPool {
     #[cfg(test)]
     pub(crate) fn same_as(&self, other: &WorkerPool) -> bool {
         Arc::ptr_eq(&self.0, &other.0)
+    }
+
+    /// An error unless the workers exist in this process: a plan made before `fork()`,
+    /// used in the child, has none there.
+    pub(crate) fn check_process(&self) -> Result<()> {
+        if self.in_own_process() {
+            Ok(())
+        } else {
+            Err(Error::InvalidArgument(
+                "plan made in another process (before fork()): its worker threads do not \
+                 exist here; make a new plan in this process"
+                    .into(),
+            ))
+        }
     }
 
     /// Number of worker threads still running (for tests).

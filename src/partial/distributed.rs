@@ -467,6 +467,7 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     fn check(&self, forward: bool, real: bool, samples: usize, coeffs: usize) -> Result<()> {
+        self.parts.general.workers.check_process()?;
         self.parts.direction.check_runs(forward)?;
         if real && !self.parts.real {
             return Err(Error::InvalidArgument(

@@ -44,7 +44,7 @@ pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDT
 pub use fft_stage::BlockCopies;
 pub(crate) use fft_stage::{SliceRef, SliceWatch};
 
-use crate::error::{Error, Result};
+use crate::error::{check_length, Result};
 use crate::fft::AlignedBuf;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
@@ -196,36 +196,11 @@ impl Plan {
         self.schedule.buf_bytes
     }
 
-    /// Whether the plan's worker threads exist in this process: `false` in a child made by
-    /// `fork()` after the plan was made.
-    pub(crate) fn in_own_process(&self) -> bool {
-        self.workers.in_own_process()
-    }
-
     fn check(&self, fwd: bool, samples: usize, coeffs: usize) -> Result<()> {
-        if !self.in_own_process() {
-            return Err(Error::InvalidArgument(
-                "plan made in another process (before fork()): its worker threads do not \
-                 exist here; make a new plan in this process"
-                    .into(),
-            ));
-        }
+        self.workers.check_process()?;
         self.direction.check_runs(fwd)?;
-        if samples != self.num_samples() {
-            return Err(Error::LengthMismatch {
-                what: "samples",
-                expected: self.num_samples(),
-                got: samples,
-            });
-        }
-        if coeffs != self.num_coeffs() {
-            return Err(Error::LengthMismatch {
-                what: "coefficients",
-                expected: self.num_coeffs(),
-                got: coeffs,
-            });
-        }
-        Ok(())
+        check_length("samples", self.num_samples(), samples)?;
+        check_length("coefficients", self.num_coeffs(), coeffs)
     }
 
     /// Forward transform: samples (`(2B)^3`, the sample layout of docs/conventions.md) to coefficients (`(4B^3-B)/3`).

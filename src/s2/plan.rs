@@ -155,11 +155,7 @@ impl S2Plan {
 
     /// An error unless the arrays hold `howmany` fields of samples and coefficients.
     fn check(&self, samples: usize, coeffs: usize, howmany: usize) -> Result<()> {
-        if !self.workers.in_own_process() {
-            return Err(Error::InvalidArgument(
-                "S^2 plan made in another process (before fork()): make a new plan here".into(),
-            ));
-        }
+        self.workers.check_process()?;
         if howmany == 0 {
             return Err(Error::InvalidArgument("howmany is 0".into()));
         }
