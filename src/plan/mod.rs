@@ -279,13 +279,7 @@ impl Plan {
 /// `benches/` (feature `internals`).
 #[cfg(feature = "internals")]
 pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Result<()> {
-    if grid.len() != plan.num_samples() {
-        return Err(Error::LengthMismatch {
-            what: "samples",
-            expected: plan.num_samples(),
-            got: grid.len(),
-        });
-    }
+    check_length("samples", plan.num_samples(), grid.len())?;
     let grid = shared::SendPtr(grid.as_mut_ptr());
     plan.with_buf(|buf| {
         plan.pool().install(|| {
