@@ -17,6 +17,7 @@ pub(crate) mod starts;
 use crate::numeric::{sin_cos_dd, Dd};
 use crate::simd::Isa;
 use column::column;
+pub use derivatives::wigner_d_derivatives;
 pub(crate) use recurrence::{RecCoeffs, RecTables, REC_PAD};
 pub(crate) use starts::{
     big, start_norm, start_norms, BetaTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
