@@ -4,18 +4,19 @@
 //! `C(alpha, beta, gamma) = sum_{M,M'} e^{-iM alpha} S_{M,M'}(beta) e^{-iM' gamma}` with the
 //! beta sums `S_{M,M'}(beta) = sum_l fhat(l,M,M') (1/2pi) dt^l_{M,M'}(beta)`. The alpha and
 //! gamma derivatives multiply by `-iM` and `-iM'`; the beta derivatives come from the
-//! differentiated recurrence ([`column_derivatives`](crate::wigner::derivatives)). One pass
-//! over the coefficients serves every rotation of the batch: the rotations sit in the
-//! vector lanes, as the betas do in the DWT kernels, and each coefficient, loaded once per
-//! cluster, feeds every lane.
+//! differentiated recurrence of the Wigner module ([`columns`]). One pass over the
+//! coefficients serves every rotation of the batch: the rotations sit in the vector lanes,
+//! as the betas do in the DWT kernels, and each coefficient, loaded once per cluster, feeds
+//! every lane.
 
 use crate::grid::block_start;
-use crate::numeric::{sin_cos_dd, Dd, Ext};
+use crate::numeric::{Dd, Ext};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{avx2::Avx2, avx512::Avx512};
 use crate::simd::{scalar::Scalar, Isa, Simd};
 use crate::symmetry::Cluster;
-use crate::wigner::{big, start_norms, BetaTables, RecCoeffs, RecTables, SKIP_BITS_RANGE};
+use crate::wigner::derivatives::{columns, half_angles, Points};
+use crate::wigner::{start_norms, RecCoeffs, RecTables};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -275,9 +276,13 @@ impl SeriesTables {
         let mut scratch = vec![0.0; 2 * size];
         for (mp, table) in self.clusters[m * (m + 1) / 2..][..m + 1].iter().enumerate() {
             let [g0, g1] = &table.groups;
+            let base = (m, mp, table.norm);
             for chunk in 0..lanes.chunks {
-                let at = GroupAt { m, mp, chunk };
                 let (s0, s1) = scratch.split_at_mut(size);
+                // Group `k` reads the points `k padded + chunk w ..` (beta, then pi - beta),
+                // the reversed one with the sign `(-1)^(l-m)`.
+                let first = |k: usize| k * lanes.padded + chunk * lanes.w;
+                let (isa, points, rec) = (lanes.isa, &lanes.points, &table.rec);
                 // SAFETY: `S` is the instruction set this function was compiled for (the
                 // callers' contract) and has `lanes.w` lanes (asserted); the scratch areas
                 // hold `3 n w` doubles, the other lengths are checked inside.
@@ -286,31 +291,35 @@ impl SeriesTables {
                     // the other (side by side they spill); each lane's values are the same.
                     match (g0.len > 0, g1.len > 0) {
                         (true, true) if lanes.w == 4 => {
-                            column_lanes::<S, 1>(lanes, table, at, [0], [s0]);
-                            column_lanes::<S, 1>(lanes, table, at, [1], [s1]);
+                            columns::<S, 1>(isa, points, base, rec, [first(0)], [false], [s0]);
+                            columns::<S, 1>(isa, points, base, rec, [first(1)], [true], [s1]);
                         }
-                        (true, true) => column_lanes::<S, 2>(lanes, table, at, [0, 1], [s0, s1]),
-                        (true, false) => column_lanes::<S, 1>(lanes, table, at, [0], [s0]),
-                        (false, true) => column_lanes::<S, 1>(lanes, table, at, [1], [s1]),
+                        (true, true) => columns::<S, 2>(
+                            isa,
+                            points,
+                            base,
+                            rec,
+                            [first(0), first(1)],
+                            [false, true],
+                            [s0, s1],
+                        ),
+                        (true, false) => {
+                            columns::<S, 1>(isa, points, base, rec, [first(0)], [false], [s0])
+                        }
+                        (false, true) => {
+                            columns::<S, 1>(isa, points, base, rec, [first(1)], [true], [s1])
+                        }
                         (false, false) => {}
                     }
                     for (k, (group, s)) in [(g0, &*s0), (g1, &*s1)].into_iter().enumerate() {
                         if group.len > 0 {
-                            group_terms::<S>(lanes, table, group, (at, k), coeffs, s, acc);
+                            group_terms::<S>(lanes, table, group, (chunk, k), coeffs, s, acc);
                         }
                     }
                 }
             }
         }
     }
-}
-
-/// Where a cluster's terms go: base pair and chunk of lanes.
-#[derive(Clone, Copy)]
-struct GroupAt {
-    m: usize,
-    mp: usize,
-    chunk: usize,
 }
 
 /// The rotations of one evaluation in vector lanes (`w` per chunk, the last chunk padded
@@ -322,12 +331,8 @@ struct Lanes {
     /// Lanes in all (`chunks * w`).
     padded: usize,
     lmax: usize,
-    /// Half-angle powers of the `2 * padded` points: beta of every lane, then pi - beta.
-    betas: BetaTables,
-    /// Per point (index `k * padded + lane`): the recurrence argument `-tau_lo` (below
-    /// pi/2) or `tau_hi` (above), its sign (`-1`, `+1`), `-sin(theta)`, `-cos(theta)`,
-    /// `cot(theta/2)`, `tan(theta/2)`, `1/sin^2(theta/2)`, `1/cos^2(theta/2)`.
-    point: [Vec<f64>; 8],
+    /// The `2 * padded` points of the recurrence: beta of every lane, then pi - beta.
+    points: Points,
     /// `e^{-i M' gamma}` of every lane, real parts then imaginary parts, at
     /// `((M' + lmax) * 2 + part) * padded + lane`.
     gamma_phase: Vec<f64>,
@@ -339,49 +344,11 @@ impl Lanes {
         let chunks = points.len().div_ceil(w);
         let padded = chunks * w;
         let at = |lane: usize| points[lane.min(points.len() - 1)];
-        let mut half = Vec::with_capacity(2 * padded);
-        for lane in 0..padded {
-            // The derivatives of the starting values divide by sin(beta/2): keep off the
-            // pole beta = 0 (the only one a double hits exactly), by far less than any error.
-            let beta = at(lane)[1];
-            let beta = if beta.abs() < 1e-30 {
-                1e-30f64.copysign(beta)
-            } else {
-                beta
-            };
-            let (s, c) = if (0.0..=PI).contains(&beta) {
-                sin_cos_dd(Dd::new(beta / 2.0))
-            } else {
-                (Dd::new((beta / 2.0).sin()), Dd::new((beta / 2.0).cos()))
-            };
-            half.push((c, s));
-        }
+        let mut half: Vec<(Dd, Dd)> = (0..padded).map(|lane| half_angles(at(lane)[1])).collect();
         // pi - beta without rounding: the half-angle cosine and sine swapped.
         let reversed: Vec<(Dd, Dd)> = half.iter().map(|&(c, s)| (s, c)).collect();
         half.extend(reversed);
-        let betas = BetaTables::new(&half, 2 * lmax);
-        let mut point: [Vec<f64>; 8] = Default::default();
-        for (k, &(c, s)) in half.iter().enumerate() {
-            let (c, s) = (c.to_f64(), s.to_f64());
-            let upper = betas.upper(k);
-            let values = [
-                if upper {
-                    betas.tau_hi[k]
-                } else {
-                    -betas.tau_lo[k]
-                },
-                if upper { 1.0 } else { -1.0 },
-                -2.0 * s * c,
-                -(c - s) * (c + s),
-                c / s,
-                s / c,
-                1.0 / (s * s),
-                1.0 / (c * c),
-            ];
-            for (p, v) in point.iter_mut().zip(values) {
-                p.push(v);
-            }
-        }
+        let beta_points = Points::new(&half, lmax);
         let top = lmax as isize;
         let mut gamma_phase = vec![0.0; (2 * lmax + 1) * 2 * padded];
         for (i, mp) in (-top..=top).enumerate() {
@@ -397,8 +364,7 @@ impl Lanes {
             chunks,
             padded,
             lmax,
-            betas,
-            point,
+            points: beta_points,
             gamma_phase,
         }
     }
@@ -450,7 +416,7 @@ impl Lanes {
 }
 
 /// The terms of one group of cluster `table` for the lanes of one chunk: the sums of its
-/// column and the column's two derivatives (in `scratch`, from [`column_lanes`]) against
+/// column and the column's two derivatives (in `scratch`, from [`columns`]) against
 /// each member's coefficients, and those with the gamma phases into the row sums `acc`.
 ///
 /// # Safety
@@ -460,7 +426,7 @@ unsafe fn group_terms<S: Simd>(
     lanes: &Lanes,
     table: &ClusterTable,
     group: &Group,
-    (at, k): (GroupAt, usize),
+    (chunk, k): (usize, usize),
     coeffs: &[Complex64],
     scratch: &[f64],
     acc: &mut [f64],
@@ -479,7 +445,7 @@ unsafe fn group_terms<S: Simd>(
         }
     };
     let top = lanes.lmax as isize;
-    let base = at.chunk * w;
+    let base = chunk * w;
     // SAFETY: every access below is at `base + lane < padded` in a row of length `padded`
     // (the phase and accumulator layouts of `Lanes`).
     unsafe {
@@ -522,145 +488,6 @@ unsafe fn group_terms<S: Simd>(
                         None => S::add(v, old),
                     };
                     S::store(p, new);
-                }
-            }
-        }
-    }
-}
-
-/// The columns `dt^l(theta)` and their first two derivatives of `K` groups (`ks`) of one
-/// cluster at the lanes of one chunk, in one loop (independent recurrences side by side hide
-/// each other's latency): degree `i` of group `ks[q]` at `scratch[q][(3 i + d) w ..]` (`d`
-/// the order of the derivative), with `(-1)^i` for the reversed group (`k = 1`), in the
-/// arithmetic of the DWT kernels' recurrence (see `wigner::column`).
-///
-/// # Safety
-/// The CPU supports the instruction set of `S`; every scratch area holds `3 n w` doubles.
-#[inline(always)]
-unsafe fn column_lanes<S: Simd, const K: usize>(
-    lanes: &Lanes,
-    table: &ClusterTable,
-    at: GroupAt,
-    ks: [usize; K],
-    scratch: [&mut [f64]; K],
-) {
-    let w = lanes.w;
-    let rec = &table.rec;
-    let n = rec.len();
-    assert!(scratch.iter().all(|x| x.len() == 3 * n * w) && w <= 8);
-    let bits = *SKIP_BITS_RANGE.end();
-    let k0 = ks.map(|k| k * lanes.padded + at.chunk * w);
-    let mut start = [[0.0; 8]; K];
-    let mut index = [[0.0; 8]; K];
-    for q in 0..K {
-        lanes.betas.starts(
-            lanes.isa,
-            k0[q],
-            at.m,
-            at.mp,
-            table.norm,
-            bits,
-            &mut start[q][..w],
-            &mut index[q][..w],
-        );
-    }
-    let (a, b) = ((at.m + at.mp) as f64, (at.m - at.mp) as f64);
-    let (rec_a, apc, cma, s) = (
-        &rec.a[..n],
-        &rec.a_plus_c[..n],
-        &rec.c_minus_a[..n],
-        &rec.s[..n],
-    );
-    // SAFETY: the instruction set by the caller; the lane vectors are read at
-    // `k0 .. k0 + w <= 2 padded`, `start` and `index` hold 8 doubles per group, and every
-    // scratch store is at `(3 i + d) w + w <= 3 n w`.
-    unsafe {
-        let point: [[S::V; 8]; K] = std::array::from_fn(|q| {
-            lanes
-                .point
-                .each_ref()
-                .map(|v| S::load(v.as_ptr().add(k0[q])))
-        });
-        let (zero, one) = (S::zero(), S::splat(1.0));
-        let inf = S::splat(f64::INFINITY);
-        let threshold = S::splat(big(bits));
-        let tiny = S::splat(crate::wigner::starts::TINY);
-        let mut cur = [[zero; 3]; K];
-        let mut prev = [[zero; 3]; K];
-        let mut index: [S::V; K] = std::array::from_fn(|q| S::load(index[q].as_ptr()));
-        let mut weight = [zero; K];
-        let mut limit = [zero; K];
-        let mut scaled = false;
-        for q in 0..K {
-            let [_, _, _, _, cot, tan, isq, icq] = point[q];
-            let u0 = S::load(start[q].as_ptr());
-            // u'_m = r1 u_m, u''_m = r2 u_m with r1 = (b cot - a tan) / 2 and
-            // r2 = (b(b-1)/sin^2 + a(a-1)/cos^2) / 4 - m^2 (half angles; no cancellation
-            // near the poles); terms with a zero exponent are absent (the splats are 0).
-            let r1 = S::mul(
-                S::splat(0.5),
-                S::fms(S::splat(b), cot, S::mul(S::splat(a), tan)),
-            );
-            let r2 = S::fms(
-                S::splat(0.25),
-                S::fma(
-                    S::splat(b * (b - 1.0).max(0.0)),
-                    isq,
-                    S::mul(S::splat(a * (a - 1.0).max(0.0)), icq),
-                ),
-                S::splat((at.m * at.m) as f64),
-            );
-            cur[q] = [u0, S::mul(r1, u0), S::mul(r2, u0)];
-            // Lanes still below the skip threshold read 0 and are rescaled when they grow
-            // past `threshold`; the others never are (their limit is infinite).
-            weight[q] = S::blend_ge(index[q], zero, one, zero);
-            limit[q] = S::blend_ge(index[q], zero, inf, threshold);
-            scaled |= S::any_ge(S::splat(-0.5), index[q]);
-        }
-        let out = scratch.map(|x| x.as_mut_ptr());
-        for i in 0..n {
-            let ai = S::splat(rec_a[i]);
-            let (cma, apc) = (S::splat(cma[i]), S::splat(apc[i]));
-            for q in 0..K {
-                let [sigtau, sigma, nsin, ncos, ..] = point[q];
-                let sign = if ks[q] == 1 && i % 2 == 1 {
-                    -s[i]
-                } else {
-                    s[i]
-                };
-                let ws = S::mul(weight[q], S::splat(sign));
-                for (d, u) in cur[q].iter().enumerate() {
-                    S::store(out[q].add((3 * i + d) * w), S::mul(*u, ws));
-                }
-                let p = S::fma(ai, sigtau, S::blend_ge(sigma, zero, cma, apc));
-                let dp = S::mul(ai, nsin);
-                let ddp = S::mul(ai, ncos);
-                let [u0, u1, u2] = cur[q];
-                let next = [
-                    S::fms(p, u0, prev[q][0]),
-                    S::fma(p, u1, S::fms(dp, u0, prev[q][1])),
-                    S::fma(
-                        p,
-                        u2,
-                        S::fma(S::add(dp, dp), u1, S::fms(ddp, u0, prev[q][2])),
-                    ),
-                ];
-                prev[q] = cur[q];
-                cur[q] = next;
-            }
-            if scaled {
-                scaled = false;
-                for q in 0..K {
-                    let size = S::abs(cur[q][0]);
-                    if S::any_ge(size, limit[q]) {
-                        let factor = S::blend_ge(size, limit[q], tiny, one);
-                        prev[q] = prev[q].map(|v| S::mul(v, factor));
-                        cur[q] = cur[q].map(|v| S::mul(v, factor));
-                        index[q] = S::add(index[q], S::blend_ge(size, limit[q], one, zero));
-                        weight[q] = S::blend_ge(index[q], zero, one, zero);
-                        limit[q] = S::blend_ge(index[q], zero, inf, threshold);
-                    }
-                    scaled |= S::any_ge(S::splat(-0.5), index[q]);
                 }
             }
         }

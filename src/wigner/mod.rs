@@ -1,6 +1,7 @@
 //! Wigner-d functions: the public d functions on top of the recurrence coefficients
 //! (`recurrence.rs`) and the overflow/underflow-free starting values (`starts.rs`) that
-//! the DWT kernels use; `column.rs` runs the recurrence for one beta as the kernels do.
+//! the DWT kernels use; `column.rs` runs the recurrence for one beta as the kernels do,
+//! `derivatives.rs` its beta derivatives for several betas at once (peak refinement).
 //!
 //! The kernels run the three-term recurrence in `l` for the normalised
 //! `dt^l = sqrt((2l+1)/2) d^l` of a base pair `(m, m')`, `m >= m' >= 0`:
@@ -9,12 +10,14 @@
 //! `dt^{m}_{m,m'} = (-1)^(m-m') sqrt((2m+1)/2) sqrt(binom(2m, m-m')) cos(beta/2)^(m+m') sin(beta/2)^(m-m')`.
 
 pub(crate) mod column;
+pub(crate) mod derivatives;
 pub(crate) mod recurrence;
 pub(crate) mod starts;
 
 use crate::numeric::{sin_cos_dd, Dd};
 use crate::simd::Isa;
 use column::column;
+pub use derivatives::wigner_d_derivatives;
 pub(crate) use recurrence::{RecCoeffs, RecTables, REC_PAD};
 pub(crate) use starts::{
     big, start_norm, start_norms, BetaTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
