@@ -207,10 +207,77 @@ pub(crate) unsafe fn spread_reals(src: *const f64, dst: *mut f64, n: usize, stre
     }
 }
 
+/// A plan's chunk buffer, which one execution at a time uses: made at planning or on first
+/// use, grown when a batch needs more. An execution that finds it taken by another gets a
+/// private buffer while the memory it needs is available twice over; otherwise a plain
+/// thread waits for the plan's, and a worker of some rayon pool (which must not block: the
+/// holder may be further down its own stack) gets [`Error::OutOfMemory`].
+pub(crate) struct ChunkBuffer(std::sync::Mutex<Option<AlignedBuf>>);
+
+impl ChunkBuffer {
+    /// The buffer `made` at planning, or `None` to make it on first use.
+    pub(crate) fn new(made: Option<AlignedBuf>) -> ChunkBuffer {
+        ChunkBuffer(std::sync::Mutex::new(made))
+    }
+
+    /// Runs `f` with a buffer of at least `len` complex values (see [`ChunkBuffer`]).
+    pub(crate) fn with<R>(
+        &self,
+        len: usize,
+        f: impl FnOnce(&AlignedBuf) -> Result<R>,
+    ) -> Result<R> {
+        use crate::system::{check_headroom, mem_available};
+        use std::sync::TryLockError;
+        let mut guard = match self.0.try_lock() {
+            Ok(g) => g,
+            Err(TryLockError::Poisoned(e)) => e.into_inner(),
+            Err(TryLockError::WouldBlock) => {
+                let bytes = 16 * len;
+                if mem_available().is_none_or(|a| a / 2 >= bytes) {
+                    check_headroom(bytes)?;
+                    return f(&AlignedBuf::new(len)?);
+                }
+                if rayon::current_thread_index().is_some() {
+                    return Err(Error::OutOfMemory { bytes });
+                }
+                self.0.lock().unwrap_or_else(|e| e.into_inner())
+            }
+        };
+        if guard.as_ref().is_none_or(|b| b.len() < len) {
+            // The old buffer goes before the new one is mapped.
+            *guard = None;
+            check_headroom(16 * len)?;
+            *guard = Some(AlignedBuf::new(len)?);
+        }
+        f(guard.as_ref().expect("just made"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::AlignedBuf;
+    use super::{AlignedBuf, ChunkBuffer};
     use num_complex::Complex64;
+
+    /// A chunk buffer is made on first use and kept, grown when more is asked, and an
+    /// execution that finds it taken (here the same thread, one call inside another) gets
+    /// a private buffer of its own size.
+    #[test]
+    fn chunk_buffer_is_kept_grown_and_never_shared() {
+        let cb = ChunkBuffer::new(None);
+        let first = cb.with(100, |b| Ok((b.as_mut_ptr(), b.len()))).unwrap();
+        assert!(first.1 >= 100);
+        let again = cb.with(50, |b| Ok(b.as_mut_ptr())).unwrap();
+        assert_eq!(again, first.0, "kept");
+        let grown = cb.with(1 << 16, |b| Ok(b.len())).unwrap();
+        assert!(grown >= 1 << 16);
+        cb.with(10, |outer| {
+            let inner = cb.with(1000, |b| Ok((b.as_mut_ptr(), b.len())))?;
+            assert_ne!(inner.0, outer.as_mut_ptr(), "a taken buffer is not shared");
+            assert!(inner.1 >= 1000);
+            Ok(())
+        })
+        .unwrap();
+    }
 
     /// Buffers from 2 MiB on start on a 2 MiB boundary; every size is zero-filled and
     /// writable to its last value, and dropping gives the memory back (no crash when

@@ -22,7 +22,7 @@ mod planner;
 mod slices;
 pub mod wisdom;
 
-pub(crate) use buf::{copy_rows, slice_stride, spread_reals, AlignedBuf};
+pub(crate) use buf::{copy_rows, slice_stride, spread_reals, AlignedBuf, ChunkBuffer};
 pub(crate) use planner::{plan_guarded, planning_bytes, RawPlan};
 pub(crate) use slices::{SliceFft, SliceFftReal};
 

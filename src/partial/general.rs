@@ -10,7 +10,7 @@ use super::shape::{CoefLayout, Shape};
 use super::slots::{LaneRows, SlotTable};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::Result;
-use crate::fft::AlignedBuf;
+use crate::fft::ChunkBuffer;
 use crate::plan::StageTimes;
 use crate::simd::Isa;
 use crate::system::check_headroom;
@@ -36,7 +36,7 @@ pub(super) struct General {
     /// Per-worker FFT buffers (made on first use).
     work: Vec<Mutex<Work>>,
     /// The chunk buffer (taken by one execution at a time).
-    buf: Mutex<Option<AlignedBuf>>,
+    buf: ChunkBuffer,
     budget: usize,
     pub(super) lanes_w: usize,
     /// The order limit `N` of `M'`.
@@ -110,7 +110,7 @@ impl General {
             fft,
             pair_weight,
             work: (0..threads).map(|_| Mutex::new(Work::default())).collect(),
-            buf: Mutex::new(None),
+            buf: ChunkBuffer::new(None),
             budget,
             lanes_w: w,
             layout_n: shape.order_limit_gamma,
@@ -203,22 +203,10 @@ impl General {
         })
     }
 
-    /// Runs `f` with the chunk buffer of at least `len` doubles (the plan's, else a new one).
+    /// Runs `f` with a chunk buffer of at least `len` doubles (see [`ChunkBuffer`]).
     fn with_buf<R>(&self, len: usize, f: impl FnOnce(*mut f64) -> Result<R>) -> Result<R> {
-        let mut guard = self.buf.try_lock().ok();
-        let mut own = None;
-        let slot: &mut Option<AlignedBuf> = match guard.as_deref_mut() {
-            Some(s) => s,
-            None => &mut own,
-        };
-        let complex = len.div_ceil(2);
-        if slot.as_ref().is_none_or(|b| b.len() < complex) {
-            *slot = None;
-            check_headroom(complex * 16)?;
-            *slot = Some(AlignedBuf::new(complex)?);
-        }
-        let p = slot.as_ref().expect("just made").as_mut_ptr().cast::<f64>();
-        f(p)
+        self.buf
+            .with(len.div_ceil(2), |b| f(b.as_mut_ptr().cast::<f64>()))
     }
 
     /// Runs `f` with a worker's FFT buffers (a private set when all are busy).

@@ -7,14 +7,13 @@ use super::options::{FftThreading, PlanOptions, MAX_BANDWIDTH};
 use super::schedule::Schedule;
 use super::Plan;
 use crate::error::{Error, Result};
-use crate::fft::{planning_bytes, AlignedBuf};
+use crate::fft::{planning_bytes, AlignedBuf, ChunkBuffer};
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
 use crate::system::{check_headroom, mem_available, mem_total};
 use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 use crate::workers::{WorkerPool, WORKER_STACK_BYTES};
-use std::sync::Mutex;
 
 /// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.7%` of the
 /// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
@@ -254,7 +253,7 @@ impl Plan {
                 buf_bytes: layout.chunk_bytes,
                 plain_store_limit: plain_store_limit(),
             },
-            buf: Mutex::new(Some(buf)),
+            buf: ChunkBuffer::new(Some(buf)),
         })
     }
 }

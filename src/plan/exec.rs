@@ -10,34 +10,13 @@ use super::shared::SendPtr;
 use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
-use crate::system::mem_available;
 use num_complex::Complex64;
 use std::time::Instant;
 
 impl Plan {
-    /// Run `f` with a chunk buffer: the plan's own if free, else a temporary one.
-    ///
-    /// A concurrent execution gets a private chunk buffer only while the memory it needs is
-    /// available (twice over); otherwise a plain thread waits for the plan's buffer, and a
-    /// worker of some rayon pool (which must not block: the holder may be further down its
-    /// own stack) gets `Error::OutOfMemory`.
+    /// Run `f` with a chunk buffer of the plan's workspace size (see [`ChunkBuffer`]).
     pub(super) fn with_buf<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
-        let g = match self.buf.try_lock() {
-            Ok(g) => g,
-            Err(std::sync::TryLockError::Poisoned(e)) => e.into_inner(),
-            Err(std::sync::TryLockError::WouldBlock) => {
-                let bytes = self.workspace_bytes();
-                if mem_available().is_none_or(|a| a / 2 >= bytes) {
-                    let tmp = AlignedBuf::new(bytes.div_ceil(16))?;
-                    return f(&tmp);
-                }
-                if rayon::current_thread_index().is_some() {
-                    return Err(Error::OutOfMemory { bytes });
-                }
-                self.buf.lock().unwrap_or_else(|e| e.into_inner())
-            }
-        };
-        f(g.as_ref().expect("plan buffer present"))
+        self.buf.with(self.workspace_bytes().div_ceil(16), f)
     }
 
     /// The forward of complex samples at `samples` into `coeffs`, with chunk buffers in

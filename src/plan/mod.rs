@@ -45,7 +45,7 @@ pub use fft_stage::BlockCopies;
 pub(crate) use fft_stage::{SliceRef, SliceWatch};
 
 use crate::error::{check_length, Result};
-use crate::fft::AlignedBuf;
+use crate::fft::ChunkBuffer;
 use crate::grid::{num_coeffs, num_samples};
 use crate::simd::Isa;
 use crate::workers::WorkerPool;
@@ -54,7 +54,6 @@ use dwt_stage::DwtStage;
 use fft_stage::FftStage;
 use num_complex::Complex64;
 use schedule::{Schedule, Spare};
-use std::sync::Mutex;
 
 /// A precomputed SO(3) FFT of one bandwidth: weights, Wigner starting-value tables,
 /// cluster schedule, FFTW plans, worker pool and chunk buffer.
@@ -79,7 +78,7 @@ pub struct Plan {
     /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
     blocks_real: Option<Blocks>,
     /// The chunk buffer (taken by one execution at a time, see `Plan::with_buf`).
-    buf: Mutex<Option<AlignedBuf>>,
+    buf: ChunkBuffer,
     /// How executions go through the chunks (and the chunk buffer's size).
     schedule: Schedule,
 }
