@@ -25,7 +25,8 @@ pub struct CorrelationOptions {
     pub deg_lim: Option<usize>,
     /// Real inputs: a real correlation through the real-signal inverse (about half the work).
     pub real: bool,
-    /// Worker threads (0 = all cores).
+    /// Worker threads (0 = all cores), shared with the process's other plans of the same
+    /// count (see [`PlanOptions::threads`](crate::plan::PlanOptions::threads)).
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,

@@ -13,7 +13,8 @@ use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 pub struct PartialOptions {
     /// Which transforms the plan runs (default both).
     pub direction: Direction,
-    /// Worker threads (0 = all cores).
+    /// Worker threads (0 = all cores), shared with the process's other plans of the same
+    /// count (see [`PlanOptions::threads`](crate::plan::PlanOptions::threads)).
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,

@@ -173,7 +173,7 @@ impl Plan {
     /// plus `O(B^2)` tables. A transform needs the
     /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
     /// large. [`Plan::memory_needed`] gives the same number before planning.
-    /// [`Plan::new`] fails with [`Error::OutOfMemory`] when this exceeds the available memory.
+    /// [`Plan::new`] fails with [`Error::OutOfMemory`](crate::Error::OutOfMemory) when this exceeds the available memory.
     pub fn memory_bytes(&self) -> usize {
         self.memory
     }

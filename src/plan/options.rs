@@ -39,7 +39,8 @@ impl Direction {
 pub struct PlanOptions {
     /// Which transforms the plan runs (default both).
     pub direction: Direction,
-    /// Worker threads; 0 means all available cores.
+    /// Worker threads; 0 means all available cores. The plans of a process with the same
+    /// count share one pool of workers, which the last of them stops when dropped.
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,

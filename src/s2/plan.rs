@@ -19,7 +19,8 @@ pub const S2_MAX_BANDWIDTH: usize = 4096;
 /// Options of an [`S2Plan`].
 #[derive(Clone, Debug, Default)]
 pub struct S2Options {
-    /// Worker threads (0 = all cores).
+    /// Worker threads (0 = all cores), shared with the process's other plans of the same
+    /// count (see [`PlanOptions::threads`](crate::plan::PlanOptions::threads)).
     pub threads: usize,
     /// FFTW planner rigour of the ring DFTs.
     pub rigor: Rigor,
