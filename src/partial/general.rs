@@ -159,10 +159,7 @@ impl General {
         let mut t0 = 0;
         while t0 < batch.count {
             let count = g.min(batch.count - t0);
-            let s = run(t0, Batch { count, ..batch })?;
-            sum.fft += s.fft;
-            sum.dwt += s.dwt;
-            sum.total += s.total;
+            sum += run(t0, Batch { count, ..batch })?;
             t0 += count;
         }
         Ok(sum)

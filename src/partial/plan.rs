@@ -368,10 +368,7 @@ fn full_many(
 ) -> Result<StageTimes> {
     let mut sum = StageTimes::default();
     for t in 0..b.count {
-        let s = run(t * b.in_dist, (ilen, t * b.out_dist, olen))?;
-        sum.fft += s.fft;
-        sum.dwt += s.dwt;
-        sum.total += s.total;
+        sum += run(t * b.in_dist, (ilen, t * b.out_dist, olen))?;
     }
     Ok(sum)
 }

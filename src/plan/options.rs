@@ -113,3 +113,12 @@ pub struct StageTimes {
     /// Whole call.
     pub total: f64,
 }
+
+impl std::ops::AddAssign for StageTimes {
+    /// Stage by stage (the times of several executions, as a batch reports them).
+    fn add_assign(&mut self, other: StageTimes) {
+        self.fft += other.fft;
+        self.dwt += other.dwt;
+        self.total += other.total;
+    }
+}
