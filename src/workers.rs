@@ -108,12 +108,12 @@ impl WorkerPool {
         // SAFETY: the lock is held, so no other reference to the vector exists.
         let pools = unsafe { &mut *PROCESS_POOLS.0.get() };
         pools.retain(|(_, w)| w.strong_count() > 0);
+        // A parent's pool in a child made by `fork()` has no threads here: it is passed over
+        // (and stays listed while the parent's plans live in the child's memory).
         let found = pools
             .iter()
             .filter(|(n, _)| *n == threads)
-            .find_map(|(_, w)| w.upgrade())
-            // A parent's pool in a child made by `fork()` has no threads here.
-            .filter(|w| w.in_own_process());
+            .find_map(|(_, w)| w.upgrade().filter(|w| w.in_own_process()));
         if let Some(w) = found {
             return Ok(WorkerPool(w));
         }
@@ -254,4 +254,41 @@ pub(crate) fn lock_free<T>(pool: &[Mutex<T>]) -> Option<std::sync::MutexGuard<'_
         Err(std::sync::TryLockError::Poisoned(e)) => Some(e.into_inner()),
         Err(std::sync::TryLockError::WouldBlock) => None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WorkerPool;
+
+    /// In a child made by `fork()`, the parent's pool (still listed, its plans still in
+    /// the child's memory) is passed over, and the child's plans share one pool of their own.
+    #[test]
+    fn a_forked_child_shares_a_pool_of_its_own() {
+        // A thread count no other test uses, so that this pool is the parent's own.
+        let parent = WorkerPool::process(3).unwrap();
+        // SAFETY: the child makes and compares pools, then leaves by `_exit` without
+        // running anything of the test harness; the registry's lock is free in the child
+        // (its fork handlers).
+        let pid = unsafe { libc::fork() };
+        assert!(pid >= 0, "fork failed");
+        if pid == 0 {
+            let ok = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let a = WorkerPool::process(3).unwrap();
+                let b = WorkerPool::process(3).unwrap();
+                a.same_as(&b) && !a.same_as(&parent)
+            }))
+            .unwrap_or(false);
+            // SAFETY: ends the child at once (no destructors, no atexit handlers).
+            unsafe { libc::_exit(if ok { 0 } else { 1 }) };
+        }
+        let mut status = 0;
+        // SAFETY: waits for the child made above; `status` is a valid out-pointer.
+        let waited = unsafe { libc::waitpid(pid, &mut status, 0) };
+        assert_eq!(waited, pid);
+        assert!(
+            libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
+            "the child's plans did not share one pool of its own (status {status})"
+        );
+        assert!(parent.same_as(&WorkerPool::process(3).unwrap()));
+    }
 }

@@ -205,13 +205,31 @@ fn collective_errors() {
             skip_bits: Some(bits),
             ..opts(false)
         };
-        assert!(PartialPlan::new(&Shape::new(6), &bad).is_err());
+        let refused = |r: so3fft::Result<()>| matches!(r, Err(so3fft::Error::InvalidArgument(m)) if m.contains("skip_bits"));
+        assert!(refused(PartialPlan::new(&Shape::new(6), &bad).map(|_| ())));
         let group = ThreadExchange::group(2);
         std::thread::scope(|scope| {
             for comm in &group {
                 let bad = &bad;
                 scope.spawn(move || {
-                    assert!(DistributedPlan::new(comm, &Shape::new(6), bad).is_err());
+                    let r = DistributedPlan::new(comm, &Shape::new(6), bad).map(|_| ());
+                    assert!(refused(r), "rank {}", comm.rank());
+                });
+            }
+        });
+    }
+    // The ends of the range, and 0 (no skipping), are accepted.
+    for bits in [0u32, 24, 560] {
+        let good = PartialOptions {
+            skip_bits: Some(bits),
+            ..opts(false)
+        };
+        let group = ThreadExchange::group(2);
+        std::thread::scope(|scope| {
+            for comm in &group {
+                let good = &good;
+                scope.spawn(move || {
+                    assert!(DistributedPlan::new(comm, &Shape::new(6), good).is_ok());
                 });
             }
         });

@@ -3,7 +3,12 @@
 
 use so3fft::{Complex64, Error, Isa, Plan, PlanOptions, ISA_VARIABLE};
 
-fn inverse(b: usize, isa: Option<Isa>, coeffs: &[Complex64]) -> so3fft::Result<Vec<Complex64>> {
+/// The inverse of a plan made with `isa`, and the instruction set the plan took.
+fn inverse(
+    b: usize,
+    isa: Option<Isa>,
+    coeffs: &[Complex64],
+) -> so3fft::Result<(Vec<Complex64>, Isa)> {
     let plan = Plan::new(
         b,
         &PlanOptions {
@@ -14,7 +19,7 @@ fn inverse(b: usize, isa: Option<Isa>, coeffs: &[Complex64]) -> so3fft::Result<V
     )?;
     let mut out = vec![Complex64::default(); plan.num_samples()];
     plan.inverse(coeffs, &mut out)?;
-    Ok(out)
+    Ok((out, plan.isa()))
 }
 
 #[test]
@@ -25,7 +30,7 @@ fn isa_variable_selects_the_kernels() {
         .collect();
     std::env::remove_var(ISA_VARIABLE);
     assert_eq!(Isa::selected().unwrap(), Isa::detect());
-    let want = inverse(b, None, &coeffs).unwrap();
+    let (want, _) = inverse(b, None, &coeffs).unwrap();
     for name in ["avx512", "AVX2", " scalar "] {
         std::env::set_var(ISA_VARIABLE, name);
         let isa = match name.trim().to_ascii_lowercase().as_str() {
@@ -41,16 +46,18 @@ fn isa_variable_selects_the_kernels() {
         }
         assert_eq!(Isa::selected().unwrap(), isa, "{name}");
         // The kernels of that set: the same transform to rounding.
-        let got = inverse(b, None, &coeffs).unwrap();
+        let (got, taken) = inverse(b, None, &coeffs).unwrap();
+        assert_eq!(taken, isa, "{name}: the plan's kernels");
         let scale = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
-        let err = got
+        // Every value within rounding (a NaN fails the comparison).
+        let close = got
             .iter()
             .zip(&want)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
-        assert!(err < 1e-13 * scale, "{name}: {err:e}");
+            .all(|(a, b)| (a - b).norm() < 1e-13 * scale);
+        assert!(close, "{name}: not the transform to rounding");
         // An explicit option wins over the variable.
-        let explicit = inverse(b, Some(Isa::detect()), &coeffs).unwrap();
+        let (explicit, taken) = inverse(b, Some(Isa::detect()), &coeffs).unwrap();
+        assert_eq!(taken, Isa::detect(), "{name}: explicit option");
         assert!(explicit == want, "{name}: explicit option");
     }
     // Not an instruction set: an error, not a guess.

@@ -233,8 +233,7 @@ impl ChunkBuffer {
             Err(TryLockError::Poisoned(e)) => e.into_inner(),
             Err(TryLockError::WouldBlock) => {
                 let bytes = 16 * len;
-                if mem_available().is_none_or(|a| a / 2 >= bytes) {
-                    check_headroom(bytes)?;
+                if mem_available().is_none_or(|a| a / 2 >= bytes) && check_headroom(bytes).is_ok() {
                     return f(&AlignedBuf::new(len)?);
                 }
                 if rayon::current_thread_index().is_some() {

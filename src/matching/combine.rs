@@ -135,7 +135,7 @@ fn write_combined(
             }
         }
         if stream {
-            store_fence();
+            crate::simd::sfence();
         }
     };
     if rayon::current_thread_index().is_some() {
@@ -165,15 +165,6 @@ unsafe fn put(p: *mut Complex64, v: Complex64, stream: bool) {
     let _ = stream;
     // SAFETY: the caller's contract.
     unsafe { *p = v };
-}
-
-/// Orders the non-temporal stores of [`put`] before any later access.
-fn store_fence() {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE is part of x86_64.
-    unsafe {
-        std::arch::x86_64::_mm_sfence()
-    };
 }
 
 /// An error unless the lengths fit the bandwidths and `deg_lim < min(b_in, b_out)`.
@@ -285,5 +276,47 @@ pub(super) fn add_combined(
         (-top..=top).into_par_iter().for_each(row);
     } else {
         (-top..=top).for_each(row);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::s2_real_symmetric;
+    use crate::s2::s2_coef_index;
+    use num_complex::Complex64;
+
+    /// The exact real symmetry is recognised, `-0` counting as `0`, and one broken value
+    /// (one ulp, a NaN, an imaginary part at `m = 0`) up to the degree limit is enough to
+    /// refuse it; values above the limit are not looked at.
+    #[test]
+    fn real_symmetry_is_recognised_exactly() {
+        let (b, lim) = (9, 6);
+        let mut c = vec![Complex64::default(); b * b];
+        for l in 0..b {
+            c[s2_coef_index(b, l, 0)] = Complex64::new(0.3 * l as f64 - 1.0, -0.0);
+            for m in 1..=l as isize {
+                let v = Complex64::new((l as f64 + 0.5 * m as f64).sin(), (m as f64).cos());
+                let s = if m % 2 == 0 { 1.0 } else { -1.0 };
+                c[s2_coef_index(b, l, m)] = v;
+                c[s2_coef_index(b, l, -m)] = v.conj() * s;
+            }
+        }
+        assert!(s2_real_symmetric(&c, b, lim));
+        let broken = |f: &dyn Fn(&mut [Complex64])| {
+            let mut d = c.clone();
+            f(&mut d);
+            s2_real_symmetric(&d, b, lim)
+        };
+        let at = |l, m| s2_coef_index(b, l, m);
+        let ulp = |x: f64| f64::from_bits(x.to_bits() + 1);
+        assert!(!broken(&|d| d[at(4, -3)].re = ulp(d[at(4, -3)].re)));
+        assert!(!broken(&|d| d[at(6, 2)].im = ulp(d[at(6, 2)].im)));
+        assert!(!broken(&|d| d[at(2, 0)].im = 1e-300));
+        assert!(!broken(&|d| {
+            d[at(5, 1)] = Complex64::new(f64::NAN, 0.0);
+            d[at(5, -1)] = Complex64::new(f64::NAN, 0.0);
+        }));
+        // Above the degree limit: not part of the check.
+        assert!(broken(&|d| d[at(8, -3)].re += 1.0));
     }
 }

@@ -123,8 +123,9 @@ fn argmax_by<T: Copy + Sync>(b: usize, values: &[T], f: impl Fn(T) -> f64 + Sync
 /// in any order, [`SliceArgmax::peak`] gives the same peak as a scan of the whole grid.
 pub(crate) struct SliceArgmax {
     b: usize,
-    /// The best candidate of each beta slice seen.
-    best: std::sync::Mutex<Vec<(f64, usize)>>,
+    /// The best candidate of the slices seen so far (merged in any order by
+    /// [`first_largest`], which prefers the larger value, then the lower index).
+    best: std::sync::Mutex<(f64, usize)>,
 }
 
 impl SliceArgmax {
@@ -132,7 +133,7 @@ impl SliceArgmax {
     pub(crate) fn new(b: usize) -> SliceArgmax {
         SliceArgmax {
             b,
-            best: std::sync::Mutex::new(vec![(0.0, usize::MAX); 2 * b]),
+            best: std::sync::Mutex::new((0.0, usize::MAX)),
         }
     }
 
@@ -155,16 +156,13 @@ impl SliceArgmax {
                 first_largest_in(cells, base + r * row, &|z: Complex64| z.norm_sqr(), acc)
             }),
         };
-        self.best.lock().unwrap_or_else(|e| e.into_inner())[k] = found;
+        let mut best = self.best.lock().unwrap_or_else(|e| e.into_inner());
+        *best = first_largest(*best, found);
     }
 
     /// The grid's first largest value over the slices seen.
     pub(crate) fn peak(&self) -> Peak {
-        let best = self.best.lock().unwrap_or_else(|e| e.into_inner());
-        peak_of(
-            self.b,
-            best.iter().copied().fold((0.0, usize::MAX), first_largest),
-        )
+        peak_of(self.b, *self.best.lock().unwrap_or_else(|e| e.into_inner()))
     }
 }
 

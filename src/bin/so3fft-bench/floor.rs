@@ -192,9 +192,8 @@ pub fn plan_slices(bandwidths: &[usize], rigor: Rigor) -> so3fft::Result<Vec<Sli
             c2r_aligned,
         });
     }
-    // SAFETY: no library plan exists yet and no other thread runs FFTW (module
-    // documentation); forgetting wisdom leaves existing plans valid.
-    unsafe { fftw::fftw_forget_wisdom() };
+    // The library's call, under its planner lock; existing plans stay valid.
+    so3fft::wisdom::forget();
     Ok(plans)
 }
 
