@@ -11,7 +11,7 @@
 //! With no argument all three run.
 
 use so3fft::internals::{fft_stage_alone, BlockCopies};
-use so3fft::{Complex64, FftThreading, Plan, PlanOptions, Rigor};
+use so3fft::{Complex64, FftThreading, Options, Plan, Rigor};
 use std::time::Instant;
 
 fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
@@ -116,12 +116,10 @@ fn timing() {
             let t = Instant::now();
             let p = Plan::new(
                 b,
-                &PlanOptions {
-                    threads,
-                    rigor: Rigor::Measure,
-                    fft_threading,
-                    ..Default::default()
-                },
+                &Options::default()
+                    .with_threads(threads)
+                    .with_rigor(Rigor::Measure)
+                    .with_fft_threading(fft_threading),
             )
             .unwrap();
             (p, t.elapsed().as_secs_f64())
@@ -165,12 +163,10 @@ fn stage_loop() {
     let fwd = std::env::var("SO3FFT_FWD").is_ok();
     let plan = Plan::new(
         b,
-        &PlanOptions {
-            threads,
-            rigor: Rigor::Measure,
-            fft_threading: FftThreading::SlicesAcrossWorkers,
-            ..Default::default()
-        },
+        &Options::default()
+            .with_threads(threads)
+            .with_rigor(Rigor::Measure)
+            .with_fft_threading(FftThreading::SlicesAcrossWorkers),
     )
     .unwrap();
     let n = 2 * b;

@@ -4,7 +4,7 @@
 //!
 //! `cargo bench --bench tune_count -- [B] [PLANS]` (defaults 128 and 20).
 
-use so3fft::{FftThreading, Plan, PlanOptions, Rigor};
+use so3fft::{FftThreading, Options, Plan, Rigor};
 
 fn main() {
     // `cargo bench` adds flags such as `--bench`: only the plain arguments count.
@@ -22,11 +22,9 @@ fn main() {
         }
     };
     let (b, n) = (arg(0, 128), arg(1, 20));
-    let options = PlanOptions {
-        threads: 2,
-        rigor: Rigor::Measure,
-        ..Default::default()
-    };
+    let options = Options::default()
+        .with_threads(2)
+        .with_rigor(Rigor::Measure);
     let mut fftw = 0;
     let t = std::time::Instant::now();
     for _ in 0..n {

@@ -8,8 +8,8 @@
 
 use so3fft::matching::Rotation;
 use so3fft::matching::{grid_argmax_real, rotate_s2_coeffs, Correlation, CorrelationOptions};
-use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
-use so3fft::{Complex64, Plan, PlanOptions};
+use so3fft::s2::{s2_coef_index, S2Plan};
+use so3fft::{Complex64, Options, Plan};
 use std::time::Instant;
 
 fn random_coeffs(n: usize, seed: u64) -> Vec<Complex64> {
@@ -31,26 +31,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect::<Result<_, _>>()?,
         None => vec![8, 16, 32, 64, 128],
     };
-    let opts = PlanOptions {
-        rigor: so3fft::Rigor::Measure,
-        threads: std::env::var("SO3FFT_THREADS")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(0),
-        max_workspace_bytes: std::env::var("SO3FFT_WORKSPACE_MB")
-            .ok()
-            .and_then(|s| s.parse::<usize>().ok())
-            .map(|mb| mb << 20),
-        skip_bits: std::env::var("SO3FFT_SKIP_BITS")
-            .ok()
-            .and_then(|s| s.parse().ok()),
-        fft_threading: match std::env::var("SO3FFT_FFT_THREADING").as_deref() {
+    let opts = Options::default()
+        .with_rigor(so3fft::Rigor::Measure)
+        .with_threads(
+            std::env::var("SO3FFT_THREADS")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0),
+        )
+        .with_max_workspace_bytes(
+            std::env::var("SO3FFT_WORKSPACE_MB")
+                .ok()
+                .and_then(|s| s.parse::<usize>().ok())
+                .map(|mb| mb << 20),
+        )
+        .with_skip_bits(
+            std::env::var("SO3FFT_SKIP_BITS")
+                .ok()
+                .and_then(|s| s.parse().ok()),
+        )
+        .with_fft_threading(match std::env::var("SO3FFT_FFT_THREADING").as_deref() {
             Ok("workers") => so3fft::FftThreading::SlicesAcrossWorkers,
             Ok("fftw") => so3fft::FftThreading::FftwThreads,
             _ => so3fft::FftThreading::Auto,
-        },
-        ..Default::default()
-    };
+        });
     println!("so3fft demo: random coefficients -> inverse -> forward, all cores");
     println!(
         "{:>5} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>11} {:>11}",
@@ -73,8 +77,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let coeffs = random_coeffs(plan.num_coeffs(), 0x5eed + b as u64);
         let mut samples = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
         let mut back = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
-        let ti = plan.inverse_timed(&coeffs, &mut samples)?;
-        let tf = plan.forward_timed(&samples, &mut back)?;
+        let ti = plan.inverse(&coeffs, &mut samples)?;
+        let tf = plan.forward(&samples, &mut back)?;
         let (mut emax, mut num, mut den) = (0.0f64, 0.0, 0.0);
         for (a, c) in back.iter().zip(&coeffs) {
             emax = emax.max((a - c).norm());
@@ -120,13 +124,7 @@ fn matching(l: usize, threads: usize) -> Result<(), Box<dyn std::error::Error>> 
         }
     }
     let truth = Rotation::new(1.234567, 0.987654, 4.321098);
-    let s2 = S2Plan::new(
-        l,
-        &S2Options {
-            threads,
-            ..Default::default()
-        },
-    )?;
+    let s2 = S2Plan::new(l, &Options::default().with_threads(threads))?;
     let (mut sig, mut pat) = (vec![0.0; s2.num_samples()], vec![0.0; s2.num_samples()]);
     s2.inverse_real(&rotate_s2_coeffs(l, &hat, &truth)?, &mut sig)?;
     s2.inverse_real(&hat, &mut pat)?;

@@ -7,7 +7,7 @@
 //! `mpirun --bind-to none -np 2 target/release/examples/mpi_bench B THREADS RUNS`
 
 use so3fft::partial::{mpi_finalize, mpi_init, MpiExchange};
-use so3fft::{Complex64, DistributedPlan, Exchange, PartialOptions, Shape};
+use so3fft::{Complex64, DistributedPlan, Exchange, Options, Shape};
 
 fn rnd(state: &mut u64) -> f64 {
     *state = state
@@ -35,11 +35,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn bench(comm: &MpiExchange, b: usize, threads: usize, runs: usize) -> so3fft::Result<()> {
     let s = Shape::new(b);
-    let o = PartialOptions {
-        threads,
-        rigor: so3fft::Rigor::Measure,
-        ..PartialOptions::default()
-    };
+    let o = Options::default()
+        .with_threads(threads)
+        .with_rigor(so3fft::Rigor::Measure);
     let plan = DistributedPlan::new(comm, &s, &o)?;
     // What the planner says this rank will hold, before anything large is allocated.
     let arrays = 16 * (plan.local_num_samples() + plan.local_num_coeffs());

@@ -3,12 +3,12 @@
 //!
 //! `cargo run --release --example partial`
 
-use so3fft::{Complex64, PartialOptions, PartialPlan, Shape};
+use so3fft::{Complex64, Options, PartialPlan, Shape};
 
 fn main() -> so3fft::Result<()> {
     // |M|, |M'| <= 8 at B = 1024: a 2048 x 17 x 17 grid instead of 2048^3 samples.
     let shape = Shape::new(1024).with_orders(8, 8);
-    let plan = PartialPlan::new(&shape, &PartialOptions::default())?;
+    let plan = PartialPlan::new(&shape, &Options::default())?;
     let mut coeffs = vec![Complex64::default(); plan.num_coeffs()];
     let at = shape.coef_index(1000, -3, 8).expect("held by the shape");
     coeffs[at] = Complex64::new(1.0, -0.5);
@@ -31,10 +31,7 @@ fn main() -> so3fft::Result<()> {
     let fine = Shape::new(32).with_grid(64, 128, 128);
     let plan = PartialPlan::new(
         &fine,
-        &PartialOptions {
-            direction: so3fft::Direction::Inverse,
-            ..PartialOptions::default()
-        },
+        &Options::default().with_direction(so3fft::Direction::Inverse),
     )?;
     let coeffs = vec![Complex64::new(1e-3, 0.0); plan.num_coeffs()];
     let mut samples = vec![Complex64::default(); plan.num_samples()];

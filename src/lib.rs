@@ -7,9 +7,9 @@
 //! `k (2B)^2 + j1 (2B) + j2`, coefficients in `so3CoefLoc` order.
 //!
 //! ```
-//! use so3fft::{Plan, PlanOptions, Complex64};
+//! use so3fft::{Complex64, Options, Plan};
 //! let b = 8;
-//! let plan = Plan::new(b, &PlanOptions::default()).unwrap();
+//! let plan = Plan::new(b, &Options::default()).unwrap();
 //! let mut coeffs = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
 //! coeffs[so3fft::coef_index(b, 3, -1, 2)] = Complex64::new(1.0, 0.5);
 //! let mut samples = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
@@ -34,6 +34,7 @@ mod grid;
 pub mod internals;
 pub mod matching;
 mod numeric;
+mod options;
 pub mod partial;
 mod plan;
 pub mod s2;
@@ -41,6 +42,7 @@ mod simd;
 pub mod soft;
 mod symmetry;
 mod system;
+mod transform;
 pub mod wigner;
 mod workers;
 
@@ -50,8 +52,8 @@ pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
 pub use num_complex::Complex64;
-pub use partial::{
-    Batch, Betas, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
-};
-pub use plan::{Direction, FftThreading, Plan, PlanOptions, StageTimes, MAX_BANDWIDTH};
+pub use options::{Betas, Direction, FftThreading, Options};
+pub use partial::{Batch, DistributedPlan, Exchange, PartialPlan, Shape, ThreadExchange};
+pub use plan::{Plan, StageTimes, MAX_BANDWIDTH};
 pub use simd::{Isa, ISA_VARIABLE};
+pub use transform::{Scratch, Transform};

@@ -5,7 +5,7 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Isa, Plan, PlanOptions};
+use so3fft::{Complex64, Isa, Options, Plan};
 
 /// Doubles per beta of the complex chunk layout (see `Plan::workspace_bytes`).
 fn lane_doubles(b: usize) -> usize {
@@ -14,13 +14,11 @@ fn lane_doubles(b: usize) -> usize {
 
 /// Plan options whose chunk buffer holds chunks of `h` low betas (a multiple of 8; smaller
 /// caps give 8).
-fn opts(b: usize, h: usize, isa: Isa, real: bool) -> PlanOptions {
-    PlanOptions {
-        max_workspace_bytes: Some(2 * h.next_multiple_of(8) * lane_doubles(b) * 8),
-        isa: Some(isa),
-        real,
-        ..Default::default()
-    }
+fn opts(b: usize, h: usize, isa: Isa, real: bool) -> Options {
+    Options::default()
+        .with_max_workspace_bytes(Some(2 * h.next_multiple_of(8) * lane_doubles(b) * 8))
+        .with_isa(Some(isa))
+        .with_real(real)
 }
 
 fn isas() -> Vec<Isa> {

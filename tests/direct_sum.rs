@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Plan, PlanOptions};
+use so3fft::{Complex64, Options, Plan};
 use std::f64::consts::{PI, SQRT_2};
 
 const TOL: f64 = 1e-12;
@@ -124,7 +124,7 @@ fn inverse_vs_direct_sum() {
         let coefs = rng.complex_vec(n_coeffs(b));
         let want = direct_inverse(b, &coefs);
         let tdirect = t0.elapsed().as_secs_f64();
-        let plan = Plan::new(b, &PlanOptions::default()).expect("Plan::new");
+        let plan = Plan::new(b, &Options::default()).expect("Plan::new");
         let mut got = vec![Complex64::new(0.0, 0.0); n_samples(b)];
         plan.inverse(&coefs, &mut got).expect("inverse");
         let (e, i) = max_abs_diff(&got, &want);
@@ -149,7 +149,7 @@ fn forward_vs_direct_quadrature() {
         let samples = rng.complex_vec(n_samples(b));
         let want = direct_forward(b, &samples);
         let tdirect = t0.elapsed().as_secs_f64();
-        let plan = Plan::new(b, &PlanOptions::default()).expect("Plan::new");
+        let plan = Plan::new(b, &Options::default()).expect("Plan::new");
         let mut got = vec![Complex64::new(0.0, 0.0); n_coeffs(b)];
         plan.forward(&samples, &mut got).expect("forward");
         let (e, i) = max_abs_diff(&got, &want);

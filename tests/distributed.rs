@@ -5,17 +5,13 @@
 
 mod common;
 
-use so3fft::{
-    Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape, ThreadExchange,
-};
+use so3fft::{Complex64, DistributedPlan, Exchange, Options, PartialPlan, Shape, ThreadExchange};
 
-fn opts(real: bool) -> PartialOptions {
-    PartialOptions {
-        threads: 1,
-        real,
-        general_engine: true,
-        ..PartialOptions::default()
-    }
+fn opts(real: bool) -> Options {
+    Options::default()
+        .with_threads(1)
+        .with_real(real)
+        .with_general_engine(true)
 }
 
 /// Every `(l, m, mp)` the shape holds, with its global index.
@@ -53,10 +49,7 @@ fn check_grouped(s: Shape, ranks: usize, real: bool, cap: Option<usize>) {
         x.iter().zip(y).all(|(a, b)| (a - b).abs() <= tol * big)
     };
     let flat = |z: &[Complex64]| -> Vec<f64> { z.iter().flat_map(|v| [v.re, v.im]).collect() };
-    let dist_opts = PartialOptions {
-        max_workspace_bytes: cap,
-        ..opts(real)
-    };
+    let dist_opts = opts(real).with_max_workspace_bytes(cap);
     let single = PartialPlan::new(&s, &opts(real)).unwrap();
     let (nc, ns, sl) = (s.num_coeffs(), s.num_samples(), s.slice_len());
     let mut st = 5u64;
@@ -201,10 +194,7 @@ fn collective_errors() {
     // A skip threshold outside the accepted range is refused on every rank, as by a
     // partial plan.
     for bits in [5u32, 1000] {
-        let bad = PartialOptions {
-            skip_bits: Some(bits),
-            ..opts(false)
-        };
+        let bad = opts(false).with_skip_bits(Some(bits));
         let refused = |r: so3fft::Result<()>| matches!(r, Err(so3fft::Error::InvalidArgument(m)) if m.contains("skip_bits"));
         assert!(refused(PartialPlan::new(&Shape::new(6), &bad).map(|_| ())));
         let group = ThreadExchange::group(2);
@@ -220,10 +210,7 @@ fn collective_errors() {
     }
     // The ends of the range, and 0 (no skipping), are accepted.
     for bits in [0u32, 24, 560] {
-        let good = PartialOptions {
-            skip_bits: Some(bits),
-            ..opts(false)
-        };
+        let good = opts(false).with_skip_bits(Some(bits));
         let group = ThreadExchange::group(2);
         std::thread::scope(|scope| {
             for comm in &group {

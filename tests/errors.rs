@@ -3,10 +3,10 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Direction, Error, Plan, PlanOptions, MAX_BANDWIDTH};
+use so3fft::{Complex64, Direction, Error, Options, Plan, MAX_BANDWIDTH};
 
-fn opts() -> PlanOptions {
-    PlanOptions::default()
+fn opts() -> Options {
+    Options::default()
 }
 
 #[test]
@@ -41,7 +41,8 @@ fn length_mismatch_leaves_output_untouched() {
     let sentinel = Complex64::new(12345.0, -678.0);
     let good_s = vec![Complex64::new(0.5, 0.25); ns];
     let good_c = vec![Complex64::new(0.5, 0.25); nc];
-    let is_mismatch = |r: so3fft::Result<()>| matches!(r, Err(Error::LengthMismatch { .. }));
+    let is_mismatch =
+        |r: so3fft::Result<so3fft::StageTimes>| matches!(r, Err(Error::LengthMismatch { .. }));
     // forward: wrong input length (short and long), wrong output length
     for (sl, cl) in [
         (ns - 1, nc),
@@ -95,20 +96,20 @@ fn length_mismatch_leaves_output_untouched() {
     // timed variants check as well
     let mut s = vec![sentinel; ns + 2];
     assert!(matches!(
-        p.inverse_timed(&good_c, &mut s),
+        p.inverse(&good_c, &mut s),
         Err(Error::LengthMismatch { .. })
     ));
     assert!(s.iter().all(|&x| x == sentinel));
     let mut c = vec![sentinel; nc + 2];
     assert!(matches!(
-        p.forward_timed(&good_s, &mut c),
+        p.forward(&good_s, &mut c),
         Err(Error::LengthMismatch { .. })
     ));
     assert!(c.iter().all(|&x| x == sentinel));
     // and a correct call still works after the errors
     let mut c = vec![sentinel; nc];
     p.forward(&good_s, &mut c).unwrap();
-    let t = p.forward_timed(&good_s, &mut c).unwrap();
+    let t = p.forward(&good_s, &mut c).unwrap();
     assert!(t.total >= 0.0 && t.fft >= 0.0 && t.dwt >= 0.0);
 }
 
@@ -117,14 +118,7 @@ fn wrong_direction() {
     let b = 4;
     let (ns, nc) = (n_samples(b), n_coeffs(b));
     let sentinel = Complex64::new(-3.0, 7.0);
-    let pi = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Inverse,
-            ..opts()
-        },
-    )
-    .unwrap();
+    let pi = Plan::new(b, &opts().with_direction(Direction::Inverse)).unwrap();
     let s = vec![Complex64::new(1.0, 0.0); ns];
     let mut c = vec![sentinel; nc];
     let r = pi.forward(&s, &mut c);
@@ -133,22 +127,12 @@ fn wrong_direction() {
         c.iter().all(|&x| x == sentinel),
         "forward on an Inverse plan modified the output"
     );
-    assert!(matches!(
-        pi.forward_timed(&s, &mut c),
-        Err(Error::WrongDirection)
-    ));
+    assert!(matches!(pi.forward(&s, &mut c), Err(Error::WrongDirection)));
     // inverse on the inverse plan works
     pi.inverse(&c, &mut vec![Complex64::new(0.0, 0.0); ns])
         .unwrap();
 
-    let pf = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Forward,
-            ..opts()
-        },
-    )
-    .unwrap();
+    let pf = Plan::new(b, &opts().with_direction(Direction::Forward)).unwrap();
     let c = vec![Complex64::new(1.0, 0.0); nc];
     let mut s = vec![sentinel; ns];
     let r = pf.inverse(&c, &mut s);
@@ -157,10 +141,7 @@ fn wrong_direction() {
         s.iter().all(|&x| x == sentinel),
         "inverse on a Forward plan modified the output"
     );
-    assert!(matches!(
-        pf.inverse_timed(&c, &mut s),
-        Err(Error::WrongDirection)
-    ));
+    assert!(matches!(pf.inverse(&c, &mut s), Err(Error::WrongDirection)));
     pf.forward(&s, &mut vec![Complex64::new(0.0, 0.0); nc])
         .unwrap();
 }
@@ -257,7 +238,7 @@ fn child_max_bandwidth_plan() {
     }
     let t0 = std::time::Instant::now();
     let r = std::panic::catch_unwind(|| {
-        Plan::new(MAX_BANDWIDTH, &PlanOptions::default())
+        Plan::new(MAX_BANDWIDTH, &Options::default())
             .map(|p| (p.bandwidth(), p.num_samples(), p.num_coeffs()))
     });
     match r {
@@ -282,13 +263,7 @@ fn child_max_bandwidth_plan() {
 #[test]
 fn tiny_workspace_cap() {
     let b = 16;
-    match Plan::new(
-        b,
-        &PlanOptions {
-            max_workspace_bytes: Some(4096),
-            ..PlanOptions::default()
-        },
-    ) {
+    match Plan::new(b, &Options::default().with_max_workspace_bytes(Some(4096))) {
         Ok(p) => {
             let mut rng = Rng::new(5);
             let c = rng.complex_vec(n_coeffs(b));
@@ -397,13 +372,7 @@ fn sample_index_and_grid_helpers() {
 #[test]
 fn invalid_skip_bits() {
     for bits in [1u32, 23, 561, 10_000] {
-        let r = Plan::new(
-            4,
-            &PlanOptions {
-                skip_bits: Some(bits),
-                ..Default::default()
-            },
-        );
+        let r = Plan::new(4, &Options::default().with_skip_bits(Some(bits)));
         assert!(
             matches!(r, Err(Error::InvalidArgument(_))),
             "skip_bits {bits}"
@@ -417,10 +386,7 @@ fn invalid_skip_bits() {
 #[test]
 fn default_plan_memory_within_five_percent_at_512() {
     let b = 512;
-    let options = PlanOptions {
-        direction: Direction::Forward,
-        ..Default::default()
-    };
+    let options = Options::default().with_direction(Direction::Forward);
     let estimate = Plan::memory_needed(b, &options).unwrap();
     match Plan::new(b, &options) {
         Ok(plan) => {
@@ -461,12 +427,10 @@ fn memory_estimate_matches_plans() {
     for b in [1usize, 7, 24, 64] {
         for real in [false, true] {
             for cap in [None, Some(1usize << 20), Some(64 << 20)] {
-                let options = PlanOptions {
-                    real,
-                    threads: 2,
-                    max_workspace_bytes: cap,
-                    ..Default::default()
-                };
+                let options = Options::default()
+                    .with_real(real)
+                    .with_threads(2)
+                    .with_max_workspace_bytes(cap);
                 let estimate = Plan::memory_needed(b, &options).unwrap();
                 let plan = Plan::new(b, &options).unwrap();
                 assert_eq!(
@@ -493,15 +457,8 @@ fn memory_estimate_matches_plans() {
         }
     }
     assert!(matches!(
-        Plan::memory_needed(0, &PlanOptions::default()),
+        Plan::memory_needed(0, &Options::default()),
         Err(Error::InvalidBandwidth { .. })
     ));
-    assert!(Plan::memory_needed(
-        8,
-        &PlanOptions {
-            skip_bits: Some(7),
-            ..Default::default()
-        }
-    )
-    .is_err());
+    assert!(Plan::memory_needed(8, &Options::default().with_skip_bits(Some(7))).is_err());
 }

@@ -1,4 +1,4 @@
-//! The two ways of threading the FFT stage (PlanOptions::fft_threading) and the plan-time
+//! The two ways of threading the FFT stage (Options::fft_threading) and the plan-time
 //! choice between them (FftThreading::Auto).
 //!
 //! Truth is independent of the library: direct summation of the defining formulas
@@ -9,20 +9,18 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, FftThreading, Plan, PlanOptions, Rigor};
+use so3fft::{Complex64, FftThreading, Options, Plan, Rigor};
 
 const Z: Complex64 = Complex64::new(0.0, 0.0);
 
 fn make(b: usize, threads: usize, fft: FftThreading, rigor: Rigor, ws: Option<usize>) -> Plan {
     Plan::new(
         b,
-        &PlanOptions {
-            threads,
-            fft_threading: fft,
-            rigor,
-            max_workspace_bytes: ws,
-            ..Default::default()
-        },
+        &Options::default()
+            .with_threads(threads)
+            .with_fft_threading(fft)
+            .with_rigor(rigor)
+            .with_max_workspace_bytes(ws),
     )
     .expect("Plan::new")
 }
@@ -158,12 +156,10 @@ fn auto_resolves_to_a_concrete_variant() {
     for direction in [so3fft::Direction::Forward, so3fft::Direction::Inverse] {
         let p = Plan::new(
             b,
-            &PlanOptions {
-                threads: 2,
-                rigor: Rigor::Measure,
-                direction,
-                ..Default::default()
-            },
+            &Options::default()
+                .with_threads(2)
+                .with_rigor(Rigor::Measure)
+                .with_direction(direction),
         )
         .unwrap();
         assert!(VARIANTS.contains(&p.fft_threading()));

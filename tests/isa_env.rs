@@ -1,7 +1,7 @@
 //! `SO3FFT_ISA`: the instruction set of plans whose options name none. One test in its own
 //! binary (its own process), since it sets the environment variable.
 
-use so3fft::{Complex64, Error, Isa, Plan, PlanOptions, ISA_VARIABLE};
+use so3fft::{Complex64, Error, Isa, Options, Plan, ISA_VARIABLE};
 
 /// The inverse of a plan made with `isa`, and the instruction set the plan took.
 fn inverse(
@@ -9,14 +9,7 @@ fn inverse(
     isa: Option<Isa>,
     coeffs: &[Complex64],
 ) -> so3fft::Result<(Vec<Complex64>, Isa)> {
-    let plan = Plan::new(
-        b,
-        &PlanOptions {
-            isa,
-            threads: 1,
-            ..Default::default()
-        },
-    )?;
+    let plan = Plan::new(b, &Options::default().with_isa(isa).with_threads(1))?;
     let mut out = vec![Complex64::default(); plan.num_samples()];
     plan.inverse(coeffs, &mut out)?;
     Ok((out, plan.isa()))
@@ -40,7 +33,7 @@ fn isa_variable_selects_the_kernels() {
         };
         if !isa.is_supported() {
             // A set this CPU lacks: planning refuses, naming the variable.
-            let err = Plan::new(b, &PlanOptions::default()).err().unwrap();
+            let err = Plan::new(b, &Options::default()).err().unwrap();
             assert!(matches!(&err, Error::InvalidArgument(m) if m.contains(ISA_VARIABLE)));
             continue;
         }
@@ -63,7 +56,7 @@ fn isa_variable_selects_the_kernels() {
     // Not an instruction set: an error, not a guess.
     std::env::set_var(ISA_VARIABLE, "sse9");
     assert!(matches!(Isa::selected(), Err(Error::InvalidArgument(_))));
-    let err = Plan::new(b, &PlanOptions::default()).err().unwrap();
+    let err = Plan::new(b, &Options::default()).err().unwrap();
     assert!(matches!(&err, Error::InvalidArgument(m) if m.contains("sse9")));
     // Empty: as if unset.
     std::env::set_var(ISA_VARIABLE, "");

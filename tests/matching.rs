@@ -146,17 +146,11 @@ fn bad_arguments_are_errors() {
 }
 
 use so3fft::matching::{rotate_s2_coeffs, Rotation, So3Series};
-use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, S2Plan};
+use so3fft::Options;
 
 fn s2_plan(b: usize) -> S2Plan {
-    S2Plan::new(
-        b,
-        &S2Options {
-            threads: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    S2Plan::new(b, &Options::default().with_threads(2)).unwrap()
 }
 
 /// Rotation of S^2 functions against the reference (`f(g^-1 x)` evaluated directly with
@@ -571,7 +565,7 @@ fn correlation_grid_matches_direct_integration() {
 /// plan: their grids equal the full plan's inverse of the correlation's coefficients.
 #[test]
 fn padded_and_degree_limited_grids_match_the_full_inverse() {
-    use so3fft::{Plan, PlanOptions};
+    use so3fft::Plan;
     for (b_in, b_out, deg_lim, real) in [
         (8, 16, None, false),
         (8, 16, Some(4), true),
@@ -592,14 +586,7 @@ fn padded_and_degree_limited_grids_match_the_full_inverse() {
             state = state.wrapping_mul(6364136223846793005).wrapping_add(1);
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
-        let full = Plan::new(
-            b_out,
-            &PlanOptions {
-                real,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let full = Plan::new(b_out, &Options::default().with_real(real)).unwrap();
         let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(b_out)];
         let mut want = vec![Complex64::default(); plan.num_grid()];
         if real {

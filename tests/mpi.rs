@@ -12,20 +12,18 @@
 mod common;
 
 use so3fft::partial::{mpi_finalize, mpi_init, MpiExchange};
-use so3fft::{Complex64, DistributedPlan, Exchange, PartialOptions, PartialPlan, Shape};
+use so3fft::{Complex64, DistributedPlan, Exchange, Options, PartialPlan, Shape};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
 
 /// Longest a run on N ranks may take.
 const TIMEOUT: Duration = Duration::from_secs(600);
 
-fn opts(real: bool) -> PartialOptions {
-    PartialOptions {
-        threads: 1,
-        real,
-        general_engine: true,
-        ..PartialOptions::default()
-    }
+fn opts(real: bool) -> Options {
+    Options::default()
+        .with_threads(1)
+        .with_real(real)
+        .with_general_engine(true)
 }
 
 /// Local coefficients of `plan` taken from the global array `c`.
@@ -76,10 +74,7 @@ fn agreement(
     cap: Option<usize>,
 ) -> so3fft::Result<usize> {
     let single = PartialPlan::new(&s, &opts(real))?;
-    let options = PartialOptions {
-        max_workspace_bytes: cap,
-        ..opts(real)
-    };
+    let options = opts(real).with_max_workspace_bytes(cap);
     let plan = DistributedPlan::new(comm, &s, &options)?;
     let tol = if cap.is_some() { 1e-14 } else { 0.0 };
     let mut bad = usize::from((plan.groups() > 1) != cap.is_some());
@@ -134,7 +129,7 @@ fn run(comm: &MpiExchange) -> so3fft::Result<usize> {
     }
     // Order-limited B = 1024 over the ranks: a round trip.
     let s = Shape::new(1024).with_orders(8, 8);
-    let plan = DistributedPlan::new(comm, &s, &PartialOptions::default())?;
+    let plan = DistributedPlan::new(comm, &s, &Options::default())?;
     let mut st = 11u64 + comm.rank() as u64;
     let c: Vec<Complex64> = (0..plan.local_num_coeffs())
         .map(|_| Complex64::new(common::rnd(&mut st), common::rnd(&mut st)))

@@ -6,8 +6,8 @@ mod common;
 
 use so3fft::wigner::wigner_d_column;
 use so3fft::{
-    coef_index, num_coeffs, Batch, Betas, Complex64, Direction, Isa, PartialOptions, PartialPlan,
-    Plan, PlanOptions, Shape,
+    coef_index, num_coeffs, Batch, Betas, Complex64, Direction, Isa, Options, PartialPlan, Plan,
+    Shape,
 };
 use std::f64::consts::PI;
 
@@ -88,11 +88,8 @@ fn max_diff(a: &[Complex64], b: &[Complex64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn opts() -> PartialOptions {
-    PartialOptions {
-        threads: 2,
-        ..PartialOptions::default()
-    }
+fn opts() -> Options {
+    Options::default().with_threads(2)
 }
 
 fn zeros(n: usize) -> Vec<Complex64> {
@@ -140,13 +137,10 @@ fn limited_layout_is_dense_and_ordered() {
 fn general_engine_matches_full_plan() {
     for b in [1, 2, 5, 8, 16] {
         let s = Shape::new(b);
-        let o = PartialOptions {
-            general_engine: true,
-            ..opts()
-        };
+        let o = opts().with_general_engine(true);
         let pp = PartialPlan::new(&s, &o).unwrap();
         assert!(!pp.uses_full_plan());
-        let full = Plan::new(b, &PlanOptions::default()).unwrap();
+        let full = Plan::new(b, &Options::default()).unwrap();
         let c = random_coeffs(&s, 7 + b as u64);
         let (mut x, mut y) = (zeros(s.num_samples()), zeros(s.num_samples()));
         pp.inverse(&c, &mut x).unwrap();
@@ -167,7 +161,7 @@ fn general_engine_matches_full_plan() {
 #[test]
 fn limited_shapes_match_full_plan() {
     let b = 12;
-    let full = Plan::new(b, &PlanOptions::default()).unwrap();
+    let full = Plan::new(b, &Options::default()).unwrap();
     let shapes = [
         Shape::new(b).with_orders(4, 2).with_grid(b, 2 * b, 2 * b),
         Shape::new(b).with_orders(1, 7).with_grid(b, 2 * b, 2 * b),
@@ -253,11 +247,7 @@ fn batches_equal_single_executes() {
 
 fn batch_case(cap: Option<usize>) {
     let s = Shape::new(9).with_orders(5, 3).with_grid(10, 12, 9);
-    let o = PartialOptions {
-        real: true,
-        max_workspace_bytes: cap,
-        ..opts()
-    };
+    let o = opts().with_real(true).with_max_workspace_bytes(cap);
     let pp = PartialPlan::new(&s, &o).unwrap();
     let (nc, ns) = (s.num_coeffs(), s.num_samples());
     // More than one batched kernel call (8 transforms each), the last one odd.
@@ -326,10 +316,7 @@ fn selected_betas() {
     let mut x = zeros(s.num_samples());
     all.inverse(&c, &mut x).unwrap();
     let ks = vec![23, 0, 5, 18, 6, 11, 12];
-    let o = PartialOptions {
-        betas: Betas::Indices(ks.clone()),
-        ..opts()
-    };
+    let o = opts().with_betas(Betas::Indices(ks.clone()));
     let sel = PartialPlan::new(&s, &o).unwrap();
     assert_eq!(sel.direction(), Direction::Inverse);
     assert_eq!(sel.num_slices(), ks.len());
@@ -341,10 +328,7 @@ fn selected_betas() {
         assert!(e < 1e-13, "slice {k}: {e:e}");
     }
     let vals = vec![0.0, 0.3, PI / 2.0, 2.9, PI, 1.0];
-    let o = PartialOptions {
-        betas: Betas::Values(vals.clone()),
-        ..opts()
-    };
+    let o = opts().with_betas(Betas::Values(vals.clone()));
     let sel = PartialPlan::new(&s, &o).unwrap();
     let mut y = zeros(sel.num_samples());
     sel.inverse(&c, &mut y).unwrap();
@@ -400,12 +384,10 @@ fn selections_without_mirrors() {
             for ks in selections {
                 // Chunks of the whole selection, of one pair, of a few, of about a vector.
                 for cap in [None, Some(1), Some(30_000), Some(80_000), Some(150_000)] {
-                    let o = PartialOptions {
-                        betas: Betas::Indices(ks.to_vec()),
-                        isa: Some(isa),
-                        max_workspace_bytes: cap,
-                        ..opts()
-                    };
+                    let o = opts()
+                        .with_betas(Betas::Indices(ks.to_vec()))
+                        .with_isa(Some(isa))
+                        .with_max_workspace_bytes(cap);
                     let what = format!("{s:?} {isa:?} {ks:?} {cap:?}");
                     let sel = PartialPlan::new(&s, &o).unwrap();
                     let mut y = zeros(sel.num_samples());
@@ -419,14 +401,9 @@ fn selections_without_mirrors() {
                     if !ks.contains(&(nb - 1 - ks[0])) {
                         with_mirror.push(nb - 1 - ks[0]);
                     }
-                    let unsplit = PartialPlan::new(
-                        &s,
-                        &PartialOptions {
-                            betas: Betas::Indices(with_mirror),
-                            ..o.clone()
-                        },
-                    )
-                    .unwrap();
+                    let unsplit =
+                        PartialPlan::new(&s, &o.clone().with_betas(Betas::Indices(with_mirror)))
+                            .unwrap();
                     let mut z = zeros(unsplit.num_samples());
                     unsplit.inverse(&c, &mut z).unwrap();
                     assert!(
@@ -435,28 +412,14 @@ fn selections_without_mirrors() {
                     );
                     // The same betas as values.
                     let vals = Betas::Values(ks.iter().map(|&k| s.beta(k)).collect());
-                    let by_value = PartialPlan::new(
-                        &s,
-                        &PartialOptions {
-                            betas: vals,
-                            ..o.clone()
-                        },
-                    )
-                    .unwrap();
+                    let by_value = PartialPlan::new(&s, &o.clone().with_betas(vals)).unwrap();
                     let mut v = zeros(by_value.num_samples());
                     by_value.inverse(&c, &mut v).unwrap();
                     let e = max_diff(&v, &y);
                     assert!(e < 1e-13, "{what}: values against indices {e:e}");
                     // Real plans: the real part of the complex inverse of Hermitian data,
                     // one at a time and as a batch of two.
-                    let r = PartialPlan::new(
-                        &s,
-                        &PartialOptions {
-                            real: true,
-                            ..o.clone()
-                        },
-                    )
-                    .unwrap();
+                    let r = PartialPlan::new(&s, &o.clone().with_real(true)).unwrap();
                     let mut yr = vec![0.0; r.num_samples()];
                     r.inverse_real(&hc, &mut yr).unwrap();
                     for (i, &k) in ks.iter().enumerate() {
@@ -519,11 +482,7 @@ fn real_against_complex() {
     ];
     for s in shapes {
         for general in [false, true] {
-            let o = PartialOptions {
-                real: true,
-                general_engine: general,
-                ..opts()
-            };
+            let o = opts().with_real(true).with_general_engine(general);
             let pp = PartialPlan::new(&s, &o).unwrap();
             let mut c = random_coeffs(&s, 17);
             common::make_hermitian(&s, &mut c);
@@ -581,10 +540,7 @@ fn invalid_shapes_and_calls_are_rejected() {
     }
     // Undersampled beta grid: fine for the inverse.
     let s = Shape::new(8).with_grid(4, 16, 16);
-    let o = PartialOptions {
-        direction: Direction::Inverse,
-        ..opts()
-    };
+    let o = opts().with_direction(Direction::Inverse);
     assert!(PartialPlan::new(&s, &o).is_ok());
     let s = Shape::new(6).with_orders(2, 2);
     for (betas, what) in [
@@ -594,21 +550,16 @@ fn invalid_shapes_and_calls_are_rejected() {
         (Betas::Values(vec![f64::NAN]), "outside [0, pi]"),
         (Betas::Indices(vec![]), "no betas"),
     ] {
-        let o = PartialOptions { betas, ..opts() };
+        let o = opts().with_betas(betas);
         let err = PartialPlan::new(&s, &o).err().expect("rejected");
         assert!(err.to_string().contains(what), "'{err}' lacks '{what}'");
     }
-    let o = PartialOptions {
-        betas: Betas::Indices(vec![1]),
-        direction: Direction::Forward,
-        ..opts()
-    };
+    let o = opts()
+        .with_betas(Betas::Indices(vec![1]))
+        .with_direction(Direction::Forward);
     assert!(PartialPlan::new(&s, &o).is_err());
     for bits in [1, 23, 561] {
-        let o = PartialOptions {
-            skip_bits: Some(bits),
-            ..opts()
-        };
+        let o = opts().with_skip_bits(Some(bits));
         assert!(PartialPlan::new(&s, &o).is_err());
     }
     let pp = PartialPlan::new(&s, &opts()).unwrap();
@@ -634,22 +585,13 @@ fn invalid_shapes_and_calls_are_rejected() {
 }
 
 /// The skip threshold: a looser one stays within its bound (docs/conventions.md,
-/// `PlanOptions::skip_bits`: an inverse value moves by less than `L 2^-bits max|c|` per order
+/// `Options::skip_bits`: an inverse value moves by less than `L 2^-bits max|c|` per order
 /// pair of the slice DFT).
 #[test]
 fn skip_threshold_bounds_the_error() {
     let s = Shape::new(48).with_orders(20, 20).with_grid(48, 41, 41);
     let c = random_coeffs(&s, 21);
-    let plan = |bits| {
-        PartialPlan::new(
-            &s,
-            &PartialOptions {
-                skip_bits: Some(bits),
-                ..opts()
-            },
-        )
-        .unwrap()
-    };
+    let plan = |bits| PartialPlan::new(&s, &opts().with_skip_bits(Some(bits))).unwrap();
     let mut x0 = zeros(s.num_samples());
     plan(0).inverse(&c, &mut x0).unwrap();
     let scale = max_abs(&c);

@@ -4,17 +4,10 @@
 mod common;
 
 use common::*;
-use so3fft::{coef_index, sample_index, Complex64, Plan, PlanOptions};
+use so3fft::{coef_index, sample_index, Complex64, Options, Plan};
 
 fn real_plan(b: usize) -> Plan {
-    Plan::new(
-        b,
-        &PlanOptions {
-            real: true,
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    Plan::new(b, &Options::default().with_real(true)).unwrap()
 }
 
 fn zeros(n: usize) -> Vec<Complex64> {
@@ -113,7 +106,7 @@ fn real_inverse_reads_only_representatives() {
 /// A plan made without `real` refuses the real transforms.
 #[test]
 fn real_needs_the_option() {
-    let plan = Plan::new(4, &PlanOptions::default()).unwrap();
+    let plan = Plan::new(4, &Options::default()).unwrap();
     let f = vec![0.0; n_samples(4)];
     let mut c = zeros(n_coeffs(4));
     assert!(plan.forward_real(&f, &mut c).is_err());

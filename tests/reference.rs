@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Direction, Plan, PlanOptions};
+use so3fft::{Complex64, Direction, Options, Plan};
 
 const TRANSFORM_TOL: f64 = 1e-13;
 
@@ -39,7 +39,7 @@ fn check_transform_file(name: &str) {
         "{name}: sample array not fully covered"
     );
 
-    let plan = Plan::new(b, &PlanOptions::default()).expect("Plan::new");
+    let plan = Plan::new(b, &Options::default()).expect("Plan::new");
     let mut got_c = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
     plan.forward(&samples, &mut got_c).expect("forward");
     let (ef, ifw) = max_abs_diff(&got_c, &coefs);
@@ -65,14 +65,8 @@ fn check_transform_file(name: &str) {
         ));
     }
     // Also the direction-restricted plans must give the same numbers.
-    let pf = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Forward,
-            ..PlanOptions::default()
-        },
-    )
-    .expect("forward-only plan");
+    let pf = Plan::new(b, &Options::default().with_direction(Direction::Forward))
+        .expect("forward-only plan");
     let mut c2 = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
     pf.forward(&samples, &mut c2)
         .expect("forward (Forward plan)");
@@ -80,14 +74,8 @@ fn check_transform_file(name: &str) {
     if e2.is_nan() || e2 > TRANSFORM_TOL {
         fails.push(format!("forward (Direction::Forward plan) error {e2:.3e}"));
     }
-    let pi = Plan::new(
-        b,
-        &PlanOptions {
-            direction: Direction::Inverse,
-            ..PlanOptions::default()
-        },
-    )
-    .expect("inverse-only plan");
+    let pi = Plan::new(b, &Options::default().with_direction(Direction::Inverse))
+        .expect("inverse-only plan");
     let mut s2 = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
     pi.inverse(&coefs, &mut s2).expect("inverse (Inverse plan)");
     let (e3, _) = max_abs_diff(&s2, &samples);

@@ -3,7 +3,7 @@
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Plan, PlanOptions};
+use so3fft::{Complex64, Options, Plan};
 use std::f64::consts::PI;
 
 const TOL: f64 = 1e-13;
@@ -13,7 +13,7 @@ fn zeros(n: usize) -> Vec<Complex64> {
 }
 
 fn plan(b: usize) -> Plan {
-    Plan::new(b, &PlanOptions::default()).unwrap_or_else(|e| panic!("Plan::new({b}) failed: {e:?}"))
+    Plan::new(b, &Options::default()).unwrap_or_else(|e| panic!("Plan::new({b}) failed: {e:?}"))
 }
 
 /// forward(inverse(c)) == c for random band-limited coefficients (exact quadrature => identity).
@@ -221,16 +221,7 @@ fn gamma_and_alpha_shift() {
 #[test]
 fn skip_threshold_leaves_results_unchanged() {
     let b = 96;
-    let make = |bits| {
-        Plan::new(
-            b,
-            &PlanOptions {
-                skip_bits: Some(bits),
-                ..Default::default()
-            },
-        )
-        .unwrap()
-    };
+    let make = |bits| Plan::new(b, &Options::default().with_skip_bits(Some(bits))).unwrap();
     let (loose, strict) = (make(64), make(560));
     let mut rng = Rng::new(4242);
     let f = rng.complex_vec(n_samples(b));

@@ -6,7 +6,8 @@ mod common;
 
 use common::Rng;
 use num_complex::Complex64;
-use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, S2Limits, S2Plan};
+use so3fft::Options;
 use std::f64::consts::PI;
 
 /// Samples (`j k re im`) and coefficients (`index l m re im`) of a reference file.
@@ -38,14 +39,7 @@ fn max_diff(a: &[Complex64], b: &[Complex64]) -> f64 {
 }
 
 fn plan(b: usize, threads: usize) -> S2Plan {
-    S2Plan::new(
-        b,
-        &S2Options {
-            threads,
-            ..Default::default()
-        },
-    )
-    .unwrap()
+    S2Plan::new(b, &Options::default().with_threads(threads)).unwrap()
 }
 
 #[test]
@@ -203,8 +197,8 @@ fn sampled_harmonics_are_orthonormal() {
 
 #[test]
 fn bad_arguments_are_errors() {
-    assert!(S2Plan::new(0, &S2Options::default()).is_err());
-    assert!(S2Plan::new(1 << 20, &S2Options::default()).is_err());
+    assert!(S2Plan::new(0, &Options::default()).is_err());
+    assert!(S2Plan::new(1 << 20, &Options::default()).is_err());
     let p = plan(4, 1);
     let mut c = vec![Complex64::default(); 16];
     assert!(p.forward(&[Complex64::default(); 63], &mut c).is_err());
@@ -300,14 +294,13 @@ fn degree_and_order_limits_equal_zeroed_full_transforms() {
     let mut rng = Rng::new(44);
     for (b, lim, mmax) in [(16usize, 9usize, 16usize), (16, 16, 3), (21, 12, 5)] {
         let full = plan(b, 2);
-        let limited = S2Plan::new(
+        let limited = S2Plan::with_limits(
             b,
-            &S2Options {
-                threads: 2,
+            S2Limits {
                 degree_limit: Some(lim),
                 order_limit: Some(mmax),
-                ..Default::default()
             },
+            &Options::default().with_threads(2),
         )
         .unwrap();
         let keep = |l: usize, m: isize| l < lim && m.unsigned_abs() <= mmax;
@@ -360,13 +353,13 @@ fn degree_and_order_limits_equal_zeroed_full_transforms() {
         );
     }
     let bad = |d, o| {
-        S2Plan::new(
+        S2Plan::with_limits(
             8,
-            &S2Options {
+            S2Limits {
                 degree_limit: d,
                 order_limit: o,
-                ..Default::default()
             },
+            &Options::default(),
         )
     };
     assert!(bad(Some(0), None).is_err());
@@ -456,15 +449,8 @@ fn instruction_sets_agree() {
             if !isa.is_supported() {
                 continue;
             }
-            let p = S2Plan::new(
-                b,
-                &S2Options {
-                    threads: 2,
-                    isa: Some(isa),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
+            let p =
+                S2Plan::new(b, &Options::default().with_threads(2).with_isa(Some(isa))).unwrap();
             let mut fwd = vec![Complex64::default(); nc];
             p.forward(&samples, &mut fwd).unwrap();
             let mut inv = vec![Complex64::default(); ns];

@@ -1,9 +1,9 @@
-//! Results must not depend on the number of threads (PlanOptions.threads = 1 vs 2).
+//! Results must not depend on the number of threads (Options::threads = 1 vs 2).
 
 mod common;
 
 use common::*;
-use so3fft::{Complex64, Plan, PlanOptions};
+use so3fft::{Complex64, Options, Plan};
 
 const TOL: f64 = 1e-15;
 
@@ -11,22 +11,8 @@ const TOL: f64 = 1e-15;
 fn threads_1_vs_2() {
     let mut fails = Vec::new();
     for b in [16usize, 48] {
-        let p1 = Plan::new(
-            b,
-            &PlanOptions {
-                threads: 1,
-                ..PlanOptions::default()
-            },
-        )
-        .expect("plan threads=1");
-        let p2 = Plan::new(
-            b,
-            &PlanOptions {
-                threads: 2,
-                ..PlanOptions::default()
-            },
-        )
-        .expect("plan threads=2");
+        let p1 = Plan::new(b, &Options::default().with_threads(1)).expect("plan threads=1");
+        let p2 = Plan::new(b, &Options::default().with_threads(2)).expect("plan threads=2");
         assert_eq!(p1.threads(), 1, "Plan::threads() for threads=1");
         assert_eq!(p2.threads(), 2, "Plan::threads() for threads=2");
         let mut rng = Rng::new(900 + b as u64);
@@ -68,14 +54,7 @@ fn threads_1_vs_2() {
 #[test]
 fn concurrent_execution_on_shared_plan() {
     let b = 12;
-    let plan = Plan::new(
-        b,
-        &PlanOptions {
-            threads: 1,
-            ..PlanOptions::default()
-        },
-    )
-    .unwrap();
+    let plan = Plan::new(b, &Options::default().with_threads(1)).unwrap();
     let inputs: Vec<Vec<Complex64>> = (0..4)
         .map(|i| Rng::new(70 + i).complex_vec(n_samples(b)))
         .collect();

@@ -41,10 +41,10 @@ unsafe fn run_forward(
         let samples = unsafe { std::slice::from_raw_parts_mut(samples.cast::<Complex64>(), ns) };
         return if state.real {
             plan.forward_real_parts_destroying_input(samples, coeffs)
-                .map(|_| ())
         } else {
             plan.forward_destroying_input(samples, coeffs)
         }
+        .map(|_| ())
         .map_err(CallError::from);
     }
     // SAFETY: as above, `ns` values, only read.
@@ -56,7 +56,9 @@ unsafe fn run_forward(
             .map(|_| ())
             .map_err(CallError::from);
     }
-    plan.forward(samples, coeffs).map_err(CallError::from)
+    plan.forward(samples, coeffs)
+        .map(|_| ())
+        .map_err(CallError::from)
 }
 
 /// Inverse transform of the plan `state` from the coefficients at `coeffs` to the samples
@@ -94,7 +96,9 @@ unsafe fn run_inverse(
             .inverse_real_to_complex(coeffs, samples)
             .map_err(CallError::from);
     }
-    plan.inverse(coeffs, samples).map_err(CallError::from)
+    plan.inverse(coeffs, samples)
+        .map(|_| ())
+        .map_err(CallError::from)
 }
 
 /// Executes a plan on the arrays given at planning. Returns `SO3FFT_OK` or an error code.

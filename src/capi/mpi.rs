@@ -7,7 +7,8 @@
 use super::partial::{checked_shape, options_of, so3fft_partial_options, so3fft_shape};
 use super::{guarded, guarded_code, guarded_count, so3fft_complex};
 use crate::ffi::{CallError, ErrorKind};
-use crate::partial::{Betas, DistributedPlan, MpiExchange};
+use crate::options::Betas;
+use crate::partial::{DistributedPlan, MpiExchange};
 use crate::Complex64;
 use std::ffi::{c_int, c_uint};
 

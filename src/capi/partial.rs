@@ -4,8 +4,8 @@ use super::{direction_of, guarded, guarded_code, guarded_count, rigor_of, thread
 use super::{so3fft_complex, SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
 use crate::ffi::checks::{input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::partial::{Batch, Betas, PartialOptions, PartialPlan, Shape};
-use crate::plan::Direction;
+use crate::options::{Betas, Direction, Options};
+use crate::partial::{Batch, PartialPlan, Shape};
 use crate::Complex64;
 use std::ffi::{c_int, c_uint};
 
@@ -193,16 +193,16 @@ fn vec_for<T>(n: usize) -> Result<Vec<T>, CallError> {
 pub(super) unsafe fn options_of(
     o: *const so3fft_partial_options,
     flags: c_uint,
-) -> Result<PartialOptions, CallError> {
+) -> Result<Options, CallError> {
     if flags & SO3FFT_DESTROY_INPUT != 0 {
         return Err(CallError::invalid(
             "SO3FFT_DESTROY_INPUT: a partial plan never overwrites its input".to_string(),
         ));
     }
-    let mut opts = PartialOptions {
+    let mut opts = Options {
         rigor: rigor_of(flags & !SO3FFT_REAL)?,
         real: flags & SO3FFT_REAL != 0,
-        ..PartialOptions::default()
+        ..Options::default()
     };
     // SAFETY: the API's contract.
     let Some(o) = (unsafe { o.as_ref() }) else {

@@ -8,7 +8,7 @@ use super::{
 };
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{last_error, CallError, ErrorKind};
-use crate::{Direction, FftThreading, Plan, PlanOptions};
+use crate::{Direction, FftThreading, Options, Plan};
 use std::ffi::{c_int, c_uint};
 use std::sync::atomic::{AtomicI32, AtomicUsize, Ordering};
 
@@ -145,14 +145,14 @@ fn make_plan(
             }
         }
         let real = flags & SO3FFT_REAL != 0;
-        let options = PlanOptions {
+        let options = Options {
             direction,
             threads,
             rigor,
             real,
             max_workspace_bytes: planner_workspace_cap(),
             fft_threading: fft_threading_of(PLANNER_FFT_THREADING.load(Ordering::Relaxed))?,
-            ..PlanOptions::default()
+            ..Options::default()
         };
         let plan = Plan::new(b, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_plan_s {

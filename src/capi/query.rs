@@ -7,7 +7,7 @@ use super::{
     SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_REAL,
 };
 use crate::ffi::checks;
-use crate::{FftThreading, Plan, PlanOptions};
+use crate::{FftThreading, Options, Plan};
 use std::ffi::{c_int, c_uint};
 
 /// The bandwidth of a plan (`SO3FFT_ENULL` for NULL).
@@ -45,12 +45,12 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
         let b = checks::bandwidth(B)?;
         let rigor = rigor_of(flags)?;
         let threads = threads_of(nthreads)?;
-        let options = PlanOptions {
+        let options = Options {
             threads,
             rigor,
             real: flags & SO3FFT_REAL != 0,
             max_workspace_bytes: planner_workspace_cap(),
-            ..PlanOptions::default()
+            ..Options::default()
         };
         Ok(Plan::memory_needed(b, &options)? as isize)
     })

@@ -4,7 +4,8 @@ use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_
 use super::{SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::s2::{s2_num_coeffs, s2_num_samples, s2_try_coef_index, S2Options, S2Plan};
+use crate::options::Options;
+use crate::s2::{s2_num_coeffs, s2_num_samples, s2_try_coef_index, S2Limits, S2Plan};
 use crate::Complex64;
 use std::ffi::{c_int, c_uint};
 
@@ -37,10 +38,10 @@ pub extern "C" fn so3fft_plan_s2(B: c_int, flags: c_uint, nthreads: c_int) -> so
                 "flags 0x{flags:x}: an S^2 plan takes only a planner rigour (real samples have their own execute functions)"
             )));
         }
-        let options = S2Options {
+        let options = Options {
             threads: threads_of(nthreads)?,
             rigor: rigor_of(flags)?,
-            ..S2Options::default()
+            ..Options::default()
         };
         let plan = S2Plan::new(b, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_s2_plan_s { plan })))
@@ -68,14 +69,16 @@ pub extern "C" fn so3fft_plan_s2_limited(
                 "flags 0x{flags:x}: an S^2 plan takes only a planner rigour"
             )));
         }
-        let options = S2Options {
+        let options = Options {
             threads: threads_of(nthreads)?,
             rigor: rigor_of(flags)?,
+            ..Options::default()
+        };
+        let limits = S2Limits {
             degree_limit: Some(limit(L, "degree limit L")?),
             order_limit: Some(limit(Mmax, "order limit Mmax")?),
-            ..S2Options::default()
         };
-        let plan = S2Plan::new(b, &options)?;
+        let plan = S2Plan::with_limits(b, limits, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_s2_plan_s { plan })))
     })
 }

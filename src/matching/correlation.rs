@@ -7,11 +7,12 @@ use super::peaks::{grid_argmax, grid_argmax_real, Peak, SliceArgmax};
 use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
-use crate::partial::{PartialOptions, PartialPlan, Shape};
+use crate::options::{Direction, Options};
+use crate::partial::{PartialPlan, Shape};
 use crate::plan::SliceRef;
-use crate::s2::{S2Options, S2Plan};
+use crate::s2::{S2Limits, S2Plan};
 use crate::workers::WorkerPool;
-use crate::{Direction, Rigor};
+use crate::Rigor;
 use num_complex::Complex64;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -26,7 +27,7 @@ pub struct CorrelationOptions {
     /// Real inputs: a real correlation through the real-signal inverse (about half the work).
     pub real: bool,
     /// Worker threads (0 = all cores), shared with the process's other plans of the same
-    /// count (see [`PlanOptions::threads`](crate::plan::PlanOptions::threads)).
+    /// count (see [`Options::threads`]).
     pub threads: usize,
     /// FFTW planner rigour.
     pub rigor: Rigor,
@@ -83,12 +84,15 @@ impl Correlation {
         let workers = WorkerPool::process(threads)?;
         let s2 = S2Plan::new_on(
             b_in,
-            &S2Options {
+            // Only the combined degrees are needed.
+            S2Limits {
+                degree_limit: Some(deg_lim + 1),
+                order_limit: None,
+            },
+            &Options {
                 threads: options.threads,
                 rigor: options.rigor,
-                // Only the combined degrees are needed.
-                degree_limit: Some(deg_lim + 1),
-                ..S2Options::default()
+                ..Options::default()
             },
             Some(&workers),
         )?;
@@ -96,12 +100,12 @@ impl Correlation {
         // than the grid's bandwidth (the full plan otherwise).
         let so3 = PartialPlan::new_on(
             &Shape::new(deg_lim + 1).with_grid(b_out, 2 * b_out, 2 * b_out),
-            &PartialOptions {
+            &Options {
                 direction: Direction::Inverse,
                 threads: options.threads,
                 rigor: options.rigor,
                 real: options.real,
-                ..PartialOptions::default()
+                ..Options::default()
             },
             Some(&workers),
         )?;
@@ -387,7 +391,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
             self.combine_shells(shells, (fwd, false), buf)?;
-            self.so3.inverse(&buf.so3, out)
+            self.so3.inverse(&buf.so3, out).map(|_| ())
         })
     }
 
@@ -401,7 +405,7 @@ impl Correlation {
         self.with_buffers(|buf| {
             let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
             self.combine_shells(shells, (fwd, true), buf)?;
-            self.so3.inverse_real(&buf.so3, out)
+            self.so3.inverse_real(&buf.so3, out).map(|_| ())
         })
     }
 
@@ -463,7 +467,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(false)?;
         let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
+        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g).map(|_| ());
         self.many((signal, patterns, out), (forward, false), inverse)
     }
 
@@ -476,7 +480,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(true)?;
         let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
+        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g).map(|_| ());
         self.many((signal, patterns, out), (forward, true), inverse)
     }
 

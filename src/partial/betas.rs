@@ -5,21 +5,9 @@
 use super::shape::Shape;
 use crate::error::{Error, Result};
 use crate::numeric::{sin_cos_dd, Dd, PI_DD};
+use crate::options::Betas;
 use crate::wigner::BetaTables;
 use std::f64::consts::PI;
-
-/// The betas an inverse evaluates.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub enum Betas {
-    /// Every beta of the grid (`2 B_grid` slices).
-    #[default]
-    All,
-    /// The grid betas of these indices (each `< 2 B_grid`), in this order: output slice
-    /// `i` is `beta_{k_i}`.
-    Indices(Vec<usize>),
-    /// These beta values in `[0, pi]` (not necessarily on the grid), in this order.
-    Values(Vec<f64>),
-}
 
 /// Kernel lanes in pairs: point `j` (`j < pairs`) is a beta `<= pi/2` and point
 /// `pairs + j` its mirror. Each output slice is one point of a pair.

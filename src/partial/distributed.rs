@@ -22,17 +22,16 @@
 //!   [`PartialPlan`](super::PartialPlan) whose chunk holds every beta: the results are
 //!   bitwise equal. With several groups the forward adds the same terms in another order.
 
-use super::betas::{Betas, LanePairs};
+use super::betas::LanePairs;
 use super::dwt_stage::{ChunkLanes, ClusterPlan};
 use super::exchange::Exchange;
 use super::general::General;
-use super::options::{skip_bits, PartialOptions};
 use super::shape::Shape;
 use super::slots::LaneRows;
 use crate::dwt::Prefetch;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
-use crate::plan::Direction;
+use crate::options::{Betas, Direction, Options};
 use crate::simd::Isa;
 use crate::workers::{SendConstPtr, SendPtr};
 use num_complex::Complex64;
@@ -216,7 +215,7 @@ struct Parts {
 impl<X: Exchange> DistributedPlan<X> {
     /// A plan for `shape` over the ranks of `comm` (collective; every rank passes the same
     /// shape and options). `options.betas` must be [`Betas::All`]; batches are not offered.
-    pub fn new(comm: X, shape: &Shape, options: &PartialOptions) -> Result<Self> {
+    pub fn new(comm: X, shape: &Shape, options: &Options) -> Result<Self> {
         // The ranks first agree on the shape and options (a rank with others would exchange
         // other lengths), then each builds its part; a failure anywhere fails every rank.
         let key = [
@@ -262,7 +261,7 @@ impl<X: Exchange> DistributedPlan<X> {
         Ok(())
     }
 
-    fn build(comm: &X, shape: &Shape, options: &PartialOptions) -> Result<Parts> {
+    fn build(comm: &X, shape: &Shape, options: &Options) -> Result<Parts> {
         shape.validate()?;
         if options.betas != Betas::All {
             return Err(Error::InvalidArgument(
@@ -274,15 +273,16 @@ impl<X: Exchange> DistributedPlan<X> {
         }
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
-        let bits = skip_bits(options.skip_bits)?;
+        let skip = options.skip()?;
+        options.check_workspace()?;
         let pairs = LanePairs::new(shape, &Betas::All, None)?;
         let np = pairs.pairs;
         // One chunk of every beta: a cluster's kernel call covers all lanes.
-        let opts = PartialOptions {
+        let opts = Options {
             max_workspace_bytes: Some(usize::MAX / 4),
             ..options.clone()
         };
-        let mut general = General::new(shape, pairs, (isa, bits, threads), &opts, None)?;
+        let mut general = General::new(shape, pairs, (isa, skip, threads), &opts, None)?;
         let p = comm.size();
         let clusters = &general.dwt.clusters;
         let cost: Vec<usize> = clusters
@@ -362,7 +362,7 @@ impl<X: Exchange> DistributedPlan<X> {
             options.max_workspace_bytes.unwrap_or_else(|| {
                 let h = share.pairs.1 - share.pairs.0;
                 let arrays = sample_bytes * 2 * h * shape.slice_len() + 16 * coeffs_of(share);
-                (512usize << 20).max(arrays / 20)
+                Options::default_workspace(arrays)
             })
         };
         let most = shares
@@ -531,8 +531,8 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     /// Number of groups of pairs a transform runs in: the fewest whose buffers fit every
-    /// rank's workspace cap (`PartialOptions::max_workspace_bytes`, by default the larger of
-    /// 512 MiB and a twentieth of the rank's arrays). With one group the results are bitwise
+    /// rank's workspace cap (`Options::max_workspace_bytes`, by default
+    /// [`Options::default_workspace`] of the rank's arrays). With one group the results are bitwise
     /// those of a single-process plan; with more, the forward sums each cluster over the
     /// groups in turn (a different order of the same sum, equal to rounding).
     pub fn groups(&self) -> usize {

@@ -2,19 +2,20 @@
 //! one with all betas): its construction, and its transforms one chunk of lane pairs at a
 //! time (the DWT stage over all clusters, then the FFT stage over the chunk's slices).
 
-use super::betas::{Betas, LanePairs};
+use super::betas::LanePairs;
 use super::dwt_stage::{ChunkLanes, DwtStage, KERNEL_BATCH};
 use super::fft_stage::{FftStage, Work};
-use super::options::{Batch, PartialOptions};
+use super::options::Batch;
 use super::shape::{CoefLayout, Shape};
 use super::slots::{LaneRows, SlotTable};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::Result;
 use crate::fft::ChunkBuffer;
+use crate::options::{Betas, Options};
 use crate::plan::StageTimes;
 use crate::simd::Isa;
 use crate::system::check_headroom;
-use crate::wigner::SKIP_BITS_RANGE;
+use crate::transform::Scratch;
 use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -55,32 +56,27 @@ impl General {
     pub(super) fn new(
         shape: &Shape,
         pairs: LanePairs,
-        (isa, bits, threads): (Isa, u32, usize),
-        options: &PartialOptions,
+        (isa, skip, threads): (Isa, (u32, bool), usize),
+        options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<General> {
         let layout = CoefLayout::new(shape);
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
-        let arrays = 16 * (shape.num_samples() + shape.num_coeffs());
-        let budget = options
-            .max_workspace_bytes
-            .unwrap_or_else(|| (512usize << 20).max(arrays / 20));
         let w = isa.lanes();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
         let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
         let tables = 64 * 2 * pairs.pairs * (2 * shape.degree_limit + 66);
-        check_headroom(
-            DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
-                .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
-                .saturating_add(tables)
-                .saturating_add(crate::fft::planning_bytes(4 * na * ng, 1)),
-        )?;
-        // No skipping: the scaled starting values still need a threshold (the widest).
-        let skip = if bits == 0 {
-            (*SKIP_BITS_RANGE.end(), false)
-        } else {
-            (bits, true)
-        };
+        // Everything but the chunk buffer.
+        let rest = DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
+            .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
+            .saturating_add(tables);
+        check_headroom(rest.saturating_add(crate::fft::planning_bytes(4 * na * ng, 1)))?;
+        // The library's one rule (see `Options::default_workspace`).
+        let sample_bytes = if options.real { 8 } else { 16 };
+        let arrays = sample_bytes * shape.num_samples() + 16 * shape.num_coeffs();
+        let budget = options
+            .max_workspace_bytes
+            .unwrap_or_else(|| Options::default_workspace_here(arrays).saturating_sub(rest));
         let fft = FftStage::new(
             (na, ng),
             shape.order_limit_gamma,
@@ -165,12 +161,13 @@ impl General {
         Ok(sum)
     }
 
-    /// Inverse of a batch, group by group.
+    /// Inverse of a batch, group by group (chunk buffer: the caller's `scratch` if given).
     pub(super) fn inverse(
         &self,
         batch: Batch,
         coef: SendConstPtr<Complex64>,
         out: Data,
+        scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.by_groups(batch, |t0, b| {
             let c = SendConstPtr(coef.get().wrapping_add(t0 * batch.in_dist));
@@ -180,30 +177,46 @@ impl General {
                 }
                 Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(t0 * batch.out_dist))),
             };
-            self.inverse_group(b, c, o)
+            self.inverse_group(b, c, o, scratch)
         })
     }
 
-    /// Forward of a batch, group by group (`inp` complex values, or reals with `real`).
+    /// Forward of a batch, group by group (`inp` complex values, or reals with `real`;
+    /// chunk buffer: the caller's `scratch` if given).
     pub(super) fn forward(
         &self,
         batch: Batch,
         inp: SendConstPtr<f64>,
         coef: SendPtr<Complex64>,
-        real: bool,
+        (real, scratch): (bool, Option<&Scratch>),
     ) -> Result<StageTimes> {
         let per_value = if real { 1 } else { 2 };
         self.by_groups(batch, |t0, b| {
             let i = SendConstPtr(inp.get().wrapping_add(t0 * batch.in_dist * per_value));
             let c = SendPtr(coef.get().wrapping_add(t0 * batch.out_dist));
-            self.forward_group(b, i, c, real)
+            self.forward_group(b, i, c, (real, scratch))
         })
     }
 
-    /// Runs `f` with a chunk buffer of at least `len` doubles (see [`ChunkBuffer`]).
-    fn with_buf<R>(&self, len: usize, f: impl FnOnce(*mut f64) -> Result<R>) -> Result<R> {
-        self.buf
-            .with(len.div_ceil(2), |b| f(b.as_mut_ptr().cast::<f64>()))
+    /// Runs `f` with a chunk buffer of at least `len` doubles: the caller's `scratch` if
+    /// given (checked to hold them), else the plan's (see [`ChunkBuffer`]).
+    fn with_buf<R>(
+        &self,
+        (len, scratch): (usize, Option<&Scratch>),
+        f: impl FnOnce(*mut f64) -> Result<R>,
+    ) -> Result<R> {
+        match scratch {
+            Some(s) => f(s.holding(8 * len)?.as_mut_ptr().cast::<f64>()),
+            None => self
+                .buf
+                .with(len.div_ceil(2), |b| f(b.as_mut_ptr().cast::<f64>())),
+        }
+    }
+
+    /// Bytes of the chunk buffer of one transform (the scratch a single call needs).
+    pub(super) fn scratch_bytes(&self) -> usize {
+        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
+        8 * self.dwt.row_total * 2 * hp_max
     }
 
     /// Runs `f` with a worker's FFT buffers (a private set when all are busy).
@@ -246,6 +259,7 @@ impl General {
         batch: Batch,
         coef: SendConstPtr<Complex64>,
         out: Data,
+        scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
@@ -255,7 +269,7 @@ impl General {
         let real = matches!(out, Data::Real(_));
         // Rows far larger than the caches go out with non-temporal stores.
         let stream = batch.count * per_t_max * 8 > 8 << 20;
-        self.with_buf(batch.count * per_t_max, |buf| {
+        self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
                 for ch in self.chunks() {
@@ -380,14 +394,14 @@ impl General {
         batch: Batch,
         inp: SendConstPtr<f64>,
         coef: SendPtr<Complex64>,
-        real: bool,
+        (real, scratch): (bool, Option<&Scratch>),
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
         let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
         let per_t_max = self.dwt.row_total * 2 * hp_max;
         let slice_len = self.fft.slice_len();
-        self.with_buf(batch.count * per_t_max, |buf| {
+        self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
                 for ch in self.chunks() {

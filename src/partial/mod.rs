@@ -6,7 +6,7 @@
 //! - `betas`: [`Betas`] and the kernels' lane pairs of a beta and its mirror;
 //! - `dwt_stage`: the clusters of a shape and their kernel calls;
 //! - `fft_stage`: pruned slice DFTs;
-//! - `options`: [`PartialOptions`] and [`Batch`];
+//! - `options`: [`Batch`];
 //! - `plan`: [`PartialPlan`], its construction, argument checks and transforms;
 //! - `general`: the general engine (every shape but the full one with all betas): the
 //!   chunk loop;
@@ -30,11 +30,10 @@ mod slots;
 #[cfg(test)]
 mod tests;
 
-pub use betas::Betas;
 pub use distributed::{DistributedPlan, DistributedTimes};
 pub use exchange::{Exchange, ThreadExchange};
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
-pub use options::{Batch, PartialOptions};
+pub use options::Batch;
 pub use plan::PartialPlan;
 pub use shape::{Shape, MAX_GRID_SIDE};

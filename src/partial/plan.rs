@@ -2,13 +2,15 @@
 //! [`Plan`] for the full shape and the general engine, `general.rs`), the argument checks
 //! and the transforms, single and batched.
 
-use super::betas::{Betas, LanePairs};
+use super::betas::LanePairs;
 use super::general::{Data, General};
-use super::options::{skip_bits, Batch, PartialOptions};
+use super::options::Batch;
 use super::shape::Shape;
 use crate::error::{Error, Result};
-use crate::plan::{Direction, Plan, PlanOptions, SliceWatch, StageTimes};
+use crate::options::{Betas, Direction, Options};
+use crate::plan::{Plan, SliceWatch, StageTimes};
 use crate::simd::Isa;
+use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool};
 use num_complex::Complex64;
 
@@ -36,7 +38,7 @@ pub struct PartialPlan {
 
 impl PartialPlan {
     /// A plan for `shape` with `options`.
-    pub fn new(shape: &Shape, options: &PartialOptions) -> Result<PartialPlan> {
+    pub fn new(shape: &Shape, options: &Options) -> Result<PartialPlan> {
         PartialPlan::new_on(shape, options, None)
     }
 
@@ -44,7 +46,7 @@ impl PartialPlan {
     /// count).
     pub(crate) fn new_on(
         shape: &Shape,
-        options: &PartialOptions,
+        options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<PartialPlan> {
         shape.validate()?;
@@ -66,29 +68,23 @@ impl PartialPlan {
         }
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
-        let bits = skip_bits(options.skip_bits)?;
-        if let Some(0) = options.max_workspace_bytes {
-            return Err(Error::InvalidArgument("max_workspace_bytes is 0".into()));
-        }
+        let skip = options.skip()?;
+        options.check_workspace()?;
         let pairs = LanePairs::new(shape, &options.betas, Some(isa.lanes()))?;
         let n_slices = pairs.n_slices;
         let engine = if shape.is_full() && !restricted && !options.general_engine {
-            let po = PlanOptions {
+            let po = Options {
                 direction,
                 threads,
-                rigor: options.rigor,
-                max_workspace_bytes: options.max_workspace_bytes,
                 isa: Some(isa),
-                skip_bits: Some(bits),
-                real: options.real,
-                ..PlanOptions::default()
+                ..options.clone()
             };
             Engine::Full(Box::new(Plan::new_on(shape.degree_limit, &po, shared)?))
         } else {
             Engine::General(Box::new(General::new(
                 shape,
                 pairs,
-                (isa, bits, threads),
+                (isa, skip, threads),
                 options,
                 shared,
             )?))
@@ -142,29 +138,33 @@ impl PartialPlan {
         self.n_slices
     }
 
-    /// Forward: samples to coefficients.
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_many(one(samples.len(), coeffs.len()), samples, coeffs)
-            .map(|_| ())
+    /// Forward: samples to coefficients; the time of each stage.
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        self.forward_in(one(samples.len(), coeffs.len()), samples, coeffs, None)
     }
 
-    /// Inverse: coefficients to samples.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
-        self.inverse_many(one(coeffs.len(), samples.len()), coeffs, samples)
-            .map(|_| ())
+    /// Inverse: coefficients to samples; the time of each stage.
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+        self.inverse_in(one(coeffs.len(), samples.len()), coeffs, samples, None)
     }
 
     /// Forward of a real signal (`num_samples` doubles): every coefficient block written.
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_real_many(one(samples.len(), coeffs.len()), samples, coeffs)
-            .map(|_| ())
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        self.forward_real_in(one(samples.len(), coeffs.len()), samples, coeffs, None)
     }
 
     /// Inverse to a real signal: reads only the blocks `M' > 0`, or `M' = 0` and `M >= 0`,
     /// and takes the others as `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
-        self.inverse_real_many(one(coeffs.len(), samples.len()), coeffs, samples)
-            .map(|_| ())
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        self.inverse_real_in(one(coeffs.len(), samples.len()), coeffs, samples, None)
+    }
+
+    /// Bytes of [`Scratch`] a single transform with scratch needs.
+    pub fn scratch_bytes(&self) -> usize {
+        match &self.engine {
+            Engine::Full(p) => p.workspace_bytes(),
+            Engine::General(g) => g.scratch_bytes(),
+        }
     }
 
     /// [`PartialPlan::inverse`] that shows every output slice to `watch` as it is
@@ -180,7 +180,7 @@ impl PartialPlan {
             Engine::Full(p) if self.direction != Direction::Forward => {
                 p.inverse_watched(coeffs, samples, watch).map(|()| true)
             }
-            _ => self.inverse(coeffs, samples).map(|()| false),
+            _ => self.inverse(coeffs, samples).map(|_| false),
         }
     }
 
@@ -195,7 +195,7 @@ impl PartialPlan {
             Engine::Full(p) if self.real && self.direction != Direction::Forward => p
                 .inverse_real_watched(coeffs, samples, watch)
                 .map(|()| true),
-            _ => self.inverse_real(coeffs, samples).map(|()| false),
+            _ => self.inverse_real(coeffs, samples).map(|_| false),
         }
     }
 
@@ -206,18 +206,7 @@ impl PartialPlan {
         samples: &[Complex64],
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
-        self.check(true, false, batch, samples.len(), coeffs.len())?;
-        match &self.engine {
-            Engine::Full(p) => full_many(batch, self.sizes(true), |i, o| {
-                p.forward_timed(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
-            }),
-            Engine::General(g) => g.forward(
-                batch,
-                SendConstPtr(samples.as_ptr().cast()),
-                SendPtr(coeffs.as_mut_ptr()),
-                false,
-            ),
-        }
+        self.forward_in(batch, samples, coeffs, None)
     }
 
     /// `batch.count` inverses; the time of each stage.
@@ -227,17 +216,7 @@ impl PartialPlan {
         coeffs: &[Complex64],
         samples: &mut [Complex64],
     ) -> Result<StageTimes> {
-        self.check(false, false, batch, coeffs.len(), samples.len())?;
-        match &self.engine {
-            Engine::Full(p) => full_many(batch, self.sizes(false), |i, o| {
-                p.inverse_timed(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
-            }),
-            Engine::General(g) => g.inverse(
-                batch,
-                SendConstPtr(coeffs.as_ptr()),
-                Data::Complex(SendPtr(samples.as_mut_ptr())),
-            ),
-        }
+        self.inverse_in(batch, coeffs, samples, None)
     }
 
     /// `batch.count` real forwards; the time of each stage.
@@ -247,18 +226,7 @@ impl PartialPlan {
         samples: &[f64],
         coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
-        self.check(true, true, batch, samples.len(), coeffs.len())?;
-        match &self.engine {
-            Engine::Full(p) => full_many(batch, self.sizes(true), |i, o| {
-                p.forward_real_timed(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
-            }),
-            Engine::General(g) => g.forward(
-                batch,
-                SendConstPtr(samples.as_ptr().cast()),
-                SendPtr(coeffs.as_mut_ptr()),
-                true,
-            ),
-        }
+        self.forward_real_in(batch, samples, coeffs, None)
     }
 
     /// `batch.count` real inverses; the time of each stage.
@@ -268,15 +236,99 @@ impl PartialPlan {
         coeffs: &[Complex64],
         samples: &mut [f64],
     ) -> Result<StageTimes> {
-        self.check(false, true, batch, coeffs.len(), samples.len())?;
-        match &self.engine {
-            Engine::Full(p) => full_many(batch, self.sizes(false), |i, o| {
-                p.inverse_real_timed(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
+        self.inverse_real_in(batch, coeffs, samples, None)
+    }
+
+    /// [`PartialPlan::forward_many`] in the caller's `scratch` if given (one transform).
+    fn forward_in(
+        &self,
+        batch: Batch,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        scratch: Option<&mut Scratch>,
+    ) -> Result<StageTimes> {
+        self.check(true, false, batch, samples.len(), coeffs.len())?;
+        match (&self.engine, scratch) {
+            (Engine::Full(p), Some(s)) => p.forward_with_scratch(samples, coeffs, s),
+            (Engine::Full(p), None) => full_many(batch, self.sizes(true), |i, o| {
+                p.forward(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
             }),
-            Engine::General(g) => g.inverse(
+            (Engine::General(g), s) => g.forward(
+                batch,
+                SendConstPtr(samples.as_ptr().cast()),
+                SendPtr(coeffs.as_mut_ptr()),
+                (false, s.as_deref()),
+            ),
+        }
+    }
+
+    /// [`PartialPlan::inverse_many`] in the caller's `scratch` if given (one transform).
+    fn inverse_in(
+        &self,
+        batch: Batch,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        scratch: Option<&mut Scratch>,
+    ) -> Result<StageTimes> {
+        self.check(false, false, batch, coeffs.len(), samples.len())?;
+        match (&self.engine, scratch) {
+            (Engine::Full(p), Some(s)) => p.inverse_with_scratch(coeffs, samples, s),
+            (Engine::Full(p), None) => full_many(batch, self.sizes(false), |i, o| {
+                p.inverse(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
+            }),
+            (Engine::General(g), s) => g.inverse(
+                batch,
+                SendConstPtr(coeffs.as_ptr()),
+                Data::Complex(SendPtr(samples.as_mut_ptr())),
+                s.as_deref(),
+            ),
+        }
+    }
+
+    /// [`PartialPlan::forward_real_many`] in the caller's `scratch` if given (one
+    /// transform).
+    fn forward_real_in(
+        &self,
+        batch: Batch,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        scratch: Option<&mut Scratch>,
+    ) -> Result<StageTimes> {
+        self.check(true, true, batch, samples.len(), coeffs.len())?;
+        match (&self.engine, scratch) {
+            (Engine::Full(p), Some(s)) => p.forward_real_with_scratch(samples, coeffs, s),
+            (Engine::Full(p), None) => full_many(batch, self.sizes(true), |i, o| {
+                p.forward_real(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
+            }),
+            (Engine::General(g), s) => g.forward(
+                batch,
+                SendConstPtr(samples.as_ptr().cast()),
+                SendPtr(coeffs.as_mut_ptr()),
+                (true, s.as_deref()),
+            ),
+        }
+    }
+
+    /// [`PartialPlan::inverse_real_many`] in the caller's `scratch` if given (one
+    /// transform).
+    fn inverse_real_in(
+        &self,
+        batch: Batch,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        scratch: Option<&mut Scratch>,
+    ) -> Result<StageTimes> {
+        self.check(false, true, batch, coeffs.len(), samples.len())?;
+        match (&self.engine, scratch) {
+            (Engine::Full(p), Some(s)) => p.inverse_real_with_scratch(coeffs, samples, s),
+            (Engine::Full(p), None) => full_many(batch, self.sizes(false), |i, o| {
+                p.inverse_real(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
+            }),
+            (Engine::General(g), s) => g.inverse(
                 batch,
                 SendConstPtr(coeffs.as_ptr()),
                 Data::Real(SendPtr(samples.as_mut_ptr())),
+                s.as_deref(),
             ),
         }
     }
@@ -371,4 +423,74 @@ fn full_many(
         sum += run(t * b.in_dist, (ilen, t * b.out_dist, olen))?;
     }
     Ok(sum)
+}
+
+impl Transform for PartialPlan {
+    fn num_samples(&self) -> usize {
+        PartialPlan::num_samples(self)
+    }
+
+    fn num_coeffs(&self) -> usize {
+        PartialPlan::num_coeffs(self)
+    }
+
+    fn scratch_bytes(&self) -> usize {
+        PartialPlan::scratch_bytes(self)
+    }
+
+    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        PartialPlan::forward(self, samples, coeffs)
+    }
+
+    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+        PartialPlan::inverse(self, coeffs, samples)
+    }
+
+    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        PartialPlan::forward_real(self, samples, coeffs)
+    }
+
+    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        PartialPlan::inverse_real(self, coeffs, samples)
+    }
+
+    fn forward_with_scratch(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        let b = one(samples.len(), coeffs.len());
+        self.forward_in(b, samples, coeffs, Some(scratch))
+    }
+
+    fn inverse_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        let b = one(coeffs.len(), samples.len());
+        self.inverse_in(b, coeffs, samples, Some(scratch))
+    }
+
+    fn forward_real_with_scratch(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        let b = one(samples.len(), coeffs.len());
+        self.forward_real_in(b, samples, coeffs, Some(scratch))
+    }
+
+    fn inverse_real_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        let b = one(coeffs.len(), samples.len());
+        self.inverse_real_in(b, coeffs, samples, Some(scratch))
+    }
 }

@@ -3,32 +3,24 @@
 use super::blocks::Blocks;
 use super::dwt_stage::DwtStage;
 use super::fft_stage::{self, FftStage};
-use super::options::{FftThreading, PlanOptions, MAX_BANDWIDTH};
+use super::options::MAX_BANDWIDTH;
 use super::schedule::Schedule;
 use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::{planning_bytes, AlignedBuf, ChunkBuffer};
 use crate::grid::{num_coeffs, num_samples};
+use crate::options::{FftThreading, Options};
 use crate::simd::Isa;
 use crate::symmetry::cluster_pairs;
 use crate::system::{check_headroom, mem_available, mem_total};
-use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
 use crate::workers::{WorkerPool, WORKER_STACK_BYTES};
 
-/// Default cap on the plan's memory ([`Plan::memory_bytes`]): `max(512 MiB, 4.7%` of the
-/// sample plus coefficient arrays`)` (real samples for a real plan), and at most half the
-/// available memory. The chunk buffer gets what the FFT buffers and tables leave of it (at
-/// least one slice pair).
+/// Default cap on the plan's memory ([`Plan::memory_bytes`]): the library's one rule
+/// ([`Options::default_workspace`]) for its sample and coefficient arrays (real samples
+/// for a real plan).
 pub(super) fn default_workspace(b: usize, real: bool) -> usize {
-    // Real plans: real samples (8 bytes each). A margin of 0.3% is left for the rest of
-    // the process.
     let sample_bytes = if real { 8 } else { 16 };
-    let grid_bytes = num_samples(b) * sample_bytes + num_coeffs(b) * 16;
-    let d = (512usize << 20).max(grid_bytes / 1000 * 47);
-    match mem_available() {
-        Some(avail) => d.min(avail / 2),
-        None => d,
-    }
+    Options::default_workspace_here(num_samples(b) * sample_bytes + num_coeffs(b) * 16)
 }
 
 /// Most bytes of blocks an inverse group writes with ordinary stores into cluster-major
@@ -67,7 +59,7 @@ pub(super) fn plain_store_limit() -> usize {
 pub(super) struct Layout {
     /// Low betas per chunk of the complex layout.
     pub(super) chunk: usize,
-    /// Low betas per chunk of the real layout (plans with `PlanOptions::real`).
+    /// Low betas per chunk of the real layout (plans with `Options::real`).
     pub(super) chunk_real: Option<usize>,
     pub(super) chunk_bytes: usize,
     pub(super) fft_scratch_bytes: usize,
@@ -124,7 +116,7 @@ pub(super) struct Checked {
 
 impl Plan {
     /// The options checked against the bandwidth and this machine.
-    pub(super) fn validate(bandwidth: usize, options: &PlanOptions) -> Result<Checked> {
+    pub(super) fn validate(bandwidth: usize, options: &Options) -> Result<Checked> {
         let b = bandwidth;
         if b == 0 || b > MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -133,16 +125,7 @@ impl Plan {
             });
         }
         let threads = crate::workers::thread_count(options.threads)?;
-        let skip_bits = match options.skip_bits {
-            None => DEFAULT_SKIP_BITS,
-            Some(0) => *SKIP_BITS_RANGE.end(),
-            Some(bits) => bits,
-        };
-        if !SKIP_BITS_RANGE.contains(&skip_bits) {
-            return Err(Error::InvalidArgument(format!(
-                "skip_bits {skip_bits} outside {SKIP_BITS_RANGE:?}"
-            )));
-        }
+        let (skip_bits, _) = options.skip()?;
         let isa = Isa::resolve(options.isa)?;
         Ok(Checked {
             threads,
@@ -152,7 +135,7 @@ impl Plan {
     }
 
     /// How a plan's memory splits up (see [`Plan::workspace_bytes`]).
-    pub(super) fn layout(b: usize, threads: usize, options: &PlanOptions) -> Layout {
+    pub(super) fn layout(b: usize, threads: usize, options: &Options) -> Layout {
         match options.max_workspace_bytes {
             Some(cap) => Layout::new(b, threads, cap, options.real),
             None => {
@@ -173,7 +156,7 @@ impl Plan {
     /// On the workers of `shared` if given (which must have the plan's thread count).
     pub(super) fn build(
         bandwidth: usize,
-        options: &PlanOptions,
+        options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<Plan> {
         let b = bandwidth;

@@ -125,7 +125,7 @@ pub(super) struct DwtStage {
     scratch_lanes: usize,
     /// Skip threshold `2^-skip_bits` for negligible Wigner-d values.
     skip_bits: u32,
-    /// Whether degrees below the threshold are skipped (`PlanOptions::skip_bits` not `Some(0)`).
+    /// Whether degrees below the threshold are skipped (`Options::skip_bits` not `Some(0)`).
     skip: bool,
 }
 

@@ -2,7 +2,7 @@
 //! the clusters of the DWT stage.
 
 use super::blocks::{Blocks, BufLayout, ChunkBuf};
-use super::dwt_stage::{DwtLayout, Scratch};
+use super::dwt_stage::{DwtLayout, Scratch as DwtScratch};
 use super::fft_stage::SliceWatch;
 use super::options::StageTimes;
 use super::schedule::{Chunk, ChunkGroups, ClusterStep, Pass, PlacedChunk, Spare};
@@ -10,22 +10,31 @@ use super::shared::SendPtr;
 use super::Plan;
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
+use crate::transform::Scratch;
 use num_complex::Complex64;
 use std::time::Instant;
 
 impl Plan {
-    /// Run `f` with a chunk buffer of the plan's workspace size (see [`ChunkBuffer`]).
-    pub(super) fn with_buf<R>(&self, f: impl FnOnce(&AlignedBuf) -> Result<R>) -> Result<R> {
-        self.buf.with(self.workspace_bytes().div_ceil(16), f)
+    /// Run `f` with a chunk buffer of the plan's workspace size: the caller's `scratch`
+    /// if given (checked to hold it), else the plan's own (see [`ChunkBuffer`]).
+    pub(super) fn with_buf<R>(
+        &self,
+        scratch: Option<&Scratch>,
+        f: impl FnOnce(&AlignedBuf) -> Result<R>,
+    ) -> Result<R> {
+        match scratch {
+            Some(s) => f(s.holding(self.workspace_bytes())?),
+            None => self.buf.with(self.workspace_bytes().div_ceil(16), f),
+        }
     }
 
     /// The forward of complex samples at `samples` into `coeffs`, with chunk buffers in
-    /// the read input slices when `spare` is given.
+    /// the read input slices when `spare` is given, in the caller's `scratch` if given.
     pub(super) fn forward_impl(
         &self,
         samples: *const Complex64,
         coeffs: &mut [Complex64],
-        spare: Option<Spare>,
+        (spare, scratch): (Option<Spare>, Option<&Scratch>),
     ) -> Result<StageTimes> {
         let coef = SendPtr(coeffs.as_mut_ptr());
         // The forward only reads the samples (a forward that may overwrite them puts
@@ -38,7 +47,7 @@ impl Plan {
         self.run_chunks(
             true,
             &self.blocks,
-            spare,
+            (spare, scratch),
             |ch, buf| self.fft.chunk(&self.blocks, ch, (true, None), input, buf),
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer and coefficient rows no other task touches; the buffer holds the
@@ -49,12 +58,13 @@ impl Plan {
     }
 
     /// The inverse of `coeffs` into the complex samples `samples` (lengths checked by the
-    /// caller), with chunk buffers in the output slices not yet written.
+    /// caller), with chunk buffers in the output slices not yet written, in the caller's
+    /// `scratch` if given.
     pub(super) fn inverse_impl(
         &self,
         coeffs: &[Complex64],
         samples: &mut [Complex64],
-        watch: Option<SliceWatch>,
+        (watch, scratch): (Option<SliceWatch>, Option<&Scratch>),
     ) -> Result<StageTimes> {
         // One raw pointer for the output slices and for the buffers in the free ones.
         let out = SendPtr(samples.as_mut_ptr());
@@ -66,7 +76,7 @@ impl Plan {
         self.run_chunks(
             false,
             &self.blocks,
-            Some(spare),
+            (Some(spare), scratch),
             |ch, buf| self.fft.chunk(&self.blocks, ch, (false, watch), out, buf),
             // SAFETY: `run_chunks` hands each task distinct clusters, whose blocks of the
             // chunk buffer no other task touches; the buffer is the chunk's.
@@ -77,20 +87,21 @@ impl Plan {
     /// The chunk loop shared by every transform: for each group of chunks (see
     /// `Schedule::chunk_groups`), the FFT stage of each chunk and the DWT of every cluster of
     /// layout `t` over the group's chunks, in the order of the direction (forward: FFT
-    /// then DWT), timed. The cluster stage learns where the chunk stands ([`Pass`]).
+    /// then DWT), timed. The cluster stage learns where the chunk stands ([`Pass`]). The
+    /// first chunk's buffer is the caller's `scratch` if given, else the plan's.
     pub(super) fn run_chunks(
         &self,
         forward: bool,
         t: &Blocks,
-        spare: Option<Spare>,
+        (spare, scratch): (Option<Spare>, Option<&Scratch>),
         fft: impl Fn(&Chunk, ChunkBuf) -> Result<()> + Sync,
-        cluster: impl Fn(&mut Scratch, &ClusterStep, &Pass) + Sync,
+        cluster: impl Fn(&mut DwtScratch, &ClusterStep, &Pass) + Sync,
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let mut times = StageTimes::default();
         let ChunkGroups { groups, chained } =
             self.schedule.chunk_groups(t, forward, spare.as_ref());
-        self.with_buf(|buf| {
+        self.with_buf(scratch, |buf| {
             let own = SendPtr(buf.as_mut_ptr() as *mut f64);
             let whole = t.total() / 2;
             let groups: Vec<Vec<PlacedChunk>> = groups

@@ -20,12 +20,12 @@ use super::block_copies::{gather_group, scatter_group, SliceGroup, MAX_GROUP};
 #[cfg(feature = "internals")]
 use super::blocks::BufLayout;
 use super::blocks::{Blocks, ChunkBuf};
-use super::options::{Direction, FftThreading, PlanOptions};
 use super::schedule::Chunk;
 use super::shared::{lock_free, SendConstPtr, SendPtr};
 use crate::error::{Error, Result};
 use crate::fft::{self, AlignedBuf, SliceFft, SliceFftReal, SIGN_MINUS, SIGN_PLUS};
 use crate::grid::weights;
+use crate::options::{Direction, FftThreading, Options};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -118,7 +118,7 @@ pub(super) struct FftStage {
     fwd: Option<SliceFft>,
     /// Inverse slice FFT (plans that run the inverse).
     inv: Option<SliceFft>,
-    /// Real-data slice FFTs (with `PlanOptions::real`).
+    /// Real-data slice FFTs (with `Options::real`).
     real: Option<SliceFftReal>,
     /// `w_B(k) * pi / (2 B^2)`: forward quadrature weight of beta `k` with the
     /// normalisation folded in.
@@ -135,7 +135,7 @@ pub(super) struct FftStage {
 impl FftStage {
     /// The slice FFTs the options ask for (the complex ones on FFTW's threads only with
     /// [`FftThreading::FftwThreads`]), weights and `threads` scratch buffers.
-    pub(super) fn new(b: usize, threads: usize, options: &PlanOptions) -> Result<FftStage> {
+    pub(super) fn new(b: usize, threads: usize, options: &Options) -> Result<FftStage> {
         let n = 2 * b;
         let fftw_threaded = threads > 1
             && match options.fft_threading {
@@ -199,9 +199,9 @@ impl FftStage {
 
     /// The real-data slice FFTs, or an error for a plan made without them.
     pub(super) fn real_fft(&self) -> Result<&SliceFftReal> {
-        self.real.as_ref().ok_or_else(|| {
-            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
+        self.real
+            .as_ref()
+            .ok_or_else(|| Error::InvalidArgument("the plan was made without Options::real".into()))
     }
 
     /// Run `f` with a per-worker FFT scratch buffer (`2 pairs_per_group` padded slices). A

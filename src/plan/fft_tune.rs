@@ -14,12 +14,12 @@
 
 use super::blocks::{BufLayout, ChunkBuf};
 use super::fft_stage::SliceRun;
-use super::options::{FftThreading, PlanOptions};
 use super::schedule::Chunk;
 use super::shared::SendPtr;
 use super::Plan;
 use crate::error::Result;
 use crate::fft::{self, AlignedBuf, Rigor, SliceFft, SIGN_MINUS, SIGN_PLUS};
+use crate::options::{FftThreading, Options};
 use crate::system::mem_available;
 use std::time::Instant;
 
@@ -48,7 +48,7 @@ impl Plan {
     /// nothing unless the options ask for `Auto` with a measuring rigour and more than one
     /// thread. Never fails: if the other variant cannot be planned, or the scratch array
     /// does not fit comfortably in memory, the plan keeps slices across workers.
-    pub(super) fn tune_fft_threading(&mut self, options: &PlanOptions) {
+    pub(super) fn tune_fft_threading(&mut self, options: &Options) {
         if options.fft_threading != FftThreading::Auto
             || options.rigor == Rigor::Estimate
             || self.threads < 2
@@ -122,7 +122,7 @@ impl Plan {
         let variants: [(Option<&SliceFft>, Option<&SliceFft>, bool); 2] =
             [(own_fwd, own_inv, false), (fwd, inv, true)];
         let mut best = [f64::INFINITY; 2];
-        self.with_buf(|buf| {
+        self.with_buf(None, |buf| {
             self.pool().install(|| {
                 // Start FFTW's threads (created on a plan's first execution) untimed.
                 if let Some(fft) = fwd.or(inv) {

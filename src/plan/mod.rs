@@ -10,7 +10,7 @@
 //! Modules, lowest first (none imports one above it; the `impl Plan` blocks of `build`,
 //! `exec`, `real` and `fft_tune` import only the `Plan` type from here):
 //! - `shared`: pointer wrappers sent across rayon tasks, per-worker scratch pools;
-//! - `options`: [`PlanOptions`] and the other option and report types;
+//! - `options`: the largest bandwidth and [`StageTimes`];
 //! - `members`, `coeffs`: which order pairs a layout holds; copies of coefficient rows;
 //! - `blocks`: the chunk buffer's layouts (slot tables, block offsets);
 //! - `schedule`: chunks, groups of chunks and where their buffers live;
@@ -37,8 +37,9 @@ mod schedule;
 mod shared;
 #[cfg(test)]
 mod tests;
+mod transform;
 
-pub use options::{Direction, FftThreading, PlanOptions, StageTimes, MAX_BANDWIDTH};
+pub use options::{StageTimes, MAX_BANDWIDTH};
 
 #[cfg(feature = "internals")]
 pub use fft_stage::BlockCopies;
@@ -47,6 +48,7 @@ pub(crate) use fft_stage::{SliceRef, SliceWatch};
 use crate::error::{check_length, Result};
 use crate::fft::ChunkBuffer;
 use crate::grid::{num_coeffs, num_samples};
+use crate::options::{Direction, FftThreading, Options};
 use crate::simd::Isa;
 use crate::workers::WorkerPool;
 use blocks::Blocks;
@@ -75,7 +77,7 @@ pub struct Plan {
     dwt: DwtStage,
     /// Chunk-buffer layout of the complex transforms.
     blocks: Blocks,
-    /// Chunk-buffer layout of the real-signal transforms (with `PlanOptions::real`).
+    /// Chunk-buffer layout of the real-signal transforms (with `Options::real`).
     blocks_real: Option<Blocks>,
     /// The chunk buffer (taken by one execution at a time, see `Plan::with_buf`).
     buf: ChunkBuffer,
@@ -89,14 +91,14 @@ impl Plan {
     /// With [`FftThreading::Auto`], a measuring rigour and more than one thread, this also
     /// times both ways of threading the FFT stage and keeps the faster one (see
     /// [`FftThreading::Auto`]; [`Plan::fft_threading`] tells which).
-    pub fn new(bandwidth: usize, options: &PlanOptions) -> Result<Plan> {
+    pub fn new(bandwidth: usize, options: &Options) -> Result<Plan> {
         Plan::new_on(bandwidth, options, None)
     }
 
     /// [`Plan::new`] on the workers of `shared` if given (with the plan's thread count).
     pub(crate) fn new_on(
         bandwidth: usize,
-        options: &PlanOptions,
+        options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<Plan> {
         let mut plan = Plan::build(bandwidth, options, shared)?;
@@ -109,7 +111,7 @@ impl Plan {
     /// (bandwidth, threads, options) and the same formulas, nothing allocated. The default
     /// workspace depends on the memory available at the time of the call (at most half of
     /// it is used), so a plan made later may differ if that has changed.
-    pub fn memory_needed(bandwidth: usize, options: &PlanOptions) -> Result<usize> {
+    pub fn memory_needed(bandwidth: usize, options: &Options) -> Result<usize> {
         let threads = Plan::validate(bandwidth, options)?.threads;
         Ok(Plan::layout(bandwidth, threads, options).total())
     }
@@ -182,7 +184,7 @@ impl Plan {
     /// `8B^2 - 8B + 8` doubles (the `(2B-1)^2` in-band values of a transformed slice in the
     /// DWT kernels' layout: 16 doubles per 8-member cluster, 8 per other one), with `h` low
     /// betas per chunk and `h'` = `h` rounded up to a multiple of 8; the real-signal
-    /// transforms ([`PlanOptions::real`]) hold `4B^2 + 4B` doubles per beta (8 per
+    /// transforms ([`Options::real`]) hold `4B^2 + 4B` doubles per beta (8 per
     /// cluster), and so about twice the betas per chunk. For a cap `c` bytes each layout
     /// takes `h = min(B, max(8, 8 floor(c / (16 * 8 * d))))` with `d` its doubles per beta,
     /// and the buffer is the larger of the two. With `max_workspace_bytes` the cap is that
@@ -202,34 +204,18 @@ impl Plan {
         check_length("coefficients", self.num_coeffs(), coeffs)
     }
 
-    /// Forward transform: samples (`(2B)^3`, the sample layout of docs/conventions.md) to coefficients (`(4B^3-B)/3`).
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_timed(samples, coeffs).map(|_| ())
-    }
-
-    /// Inverse transform: coefficients to samples.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
-        self.inverse_timed(coeffs, samples).map(|_| ())
-    }
-
-    /// Like [`Plan::forward`], also returning the time of each stage.
-    pub fn forward_timed(
-        &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
-    ) -> Result<StageTimes> {
+    /// Forward transform: samples (`(2B)^3`, the sample layout of docs/conventions.md) to
+    /// coefficients (`(4B^3-B)/3`); the time of each stage. As [`Transform::forward`](crate::Transform::forward).
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
-        self.forward_impl(samples.as_ptr(), coeffs, None)
+        self.forward_impl(samples.as_ptr(), coeffs, (None, None))
     }
 
-    /// Like [`Plan::inverse`], also returning the time of each stage.
-    pub fn inverse_timed(
-        &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
-    ) -> Result<StageTimes> {
+    /// Inverse transform: coefficients to samples; the time of each stage. As
+    /// [`Transform::inverse`](crate::Transform::inverse).
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.inverse_impl(coeffs, samples, None)
+        self.inverse_impl(coeffs, samples, (None, None))
     }
 
     /// [`Plan::inverse`] that shows every output slice to `watch` as it is computed.
@@ -240,7 +226,8 @@ impl Plan {
         watch: SliceWatch,
     ) -> Result<()> {
         self.check(false, samples.len(), coeffs.len())?;
-        self.inverse_impl(coeffs, samples, Some(watch)).map(|_| ())
+        self.inverse_impl(coeffs, samples, (Some(watch), None))
+            .map(|_| ())
     }
 
     /// [`Plan::forward`] that may overwrite `samples` (like FFTW's `FFTW_DESTROY_INPUT`):
@@ -254,22 +241,12 @@ impl Plan {
         &self,
         samples: &mut [Complex64],
         coeffs: &mut [Complex64],
-    ) -> Result<()> {
-        self.forward_destroying_input_timed(samples, coeffs)
-            .map(|_| ())
-    }
-
-    /// Like [`Plan::forward_destroying_input`], also returning the time of each stage.
-    pub fn forward_destroying_input_timed(
-        &self,
-        samples: &mut [Complex64],
-        coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_impl(base, coeffs, Some(spare))
+        self.forward_impl(base, coeffs, (Some(spare), None))
     }
 }
 
@@ -280,7 +257,7 @@ impl Plan {
 pub fn fft_stage_alone(plan: &Plan, forward: bool, grid: &mut [Complex64]) -> Result<()> {
     check_length("samples", plan.num_samples(), grid.len())?;
     let grid = shared::SendPtr(grid.as_mut_ptr());
-    plan.with_buf(|buf| {
+    plan.with_buf(None, |buf| {
         plan.pool().install(|| {
             let layout = if !forward && plan.schedule.streams_blocks(1) {
                 blocks::BufLayout::HalfMajor(plan.blocks.total() / 2)

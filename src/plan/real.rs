@@ -16,21 +16,34 @@ use super::schedule::Spare;
 use super::shared::{SendConstPtr, SendPtr};
 use super::Plan;
 use crate::error::{Error, Result};
+use crate::transform::Scratch;
 use num_complex::Complex64;
 
 impl Plan {
     /// Forward transform of a real signal: `(2B)^3` real samples (the sample layout of docs/conventions.md) to all
     /// `(4B^3-B)/3` coefficients, which satisfy the real symmetry. About half the work of
-    /// [`Plan::forward`]. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_real_timed(samples, coeffs).map(|_| ())
+    /// [`Plan::forward`]. Needs a plan made with [`Options::real`](crate::Options::real).
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        self.check(true, samples.len(), coeffs.len())?;
+        self.forward_real_impl(
+            RealInput::Real(SendConstPtr(samples.as_ptr())),
+            coeffs,
+            (None, None),
+        )
     }
 
     /// Inverse transform to a real signal: coefficients (only one of each pair
     /// `(M,M')`, `(-M,-M')` is read: those with `M' > 0`, or `M' = 0` and `M >= 0`) to
-    /// `(2B)^3` real samples. Needs a plan made with [`PlanOptions::real`](crate::PlanOptions::real).
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
-        self.inverse_real_timed(coeffs, samples).map(|_| ())
+    /// `(2B)^3` real samples. Needs a plan made with [`Options::real`](crate::Options::real).
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        self.check(false, samples.len(), coeffs.len())?;
+        // One raw pointer for the output slices and for the buffers in the free ones.
+        let out = samples.as_mut_ptr();
+        self.inverse_real_impl(
+            coeffs,
+            (RealOutput::Real(SendPtr(out)), None),
+            (Spare::over(out, self.b), None),
+        )
     }
 
     /// [`Plan::inverse_real`] into a complex sample array: real parts are the samples,
@@ -57,23 +70,9 @@ impl Plan {
                 },
                 None,
             ),
-            Spare::over(out, self.b),
+            (Spare::over(out, self.b), None),
         )
         .map(|_| ())
-    }
-
-    /// Like [`Plan::forward_real`], also returning the time of each stage.
-    pub fn forward_real_timed(
-        &self,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
-    ) -> Result<StageTimes> {
-        self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(
-            RealInput::Real(SendConstPtr(samples.as_ptr())),
-            coeffs,
-            None,
-        )
     }
 
     /// [`Plan::forward_real`] that may overwrite `samples`, for fewer passes over the
@@ -82,22 +81,16 @@ impl Plan {
         &self,
         samples: &mut [f64],
         coeffs: &mut [Complex64],
-    ) -> Result<()> {
-        self.forward_real_destroying_input_timed(samples, coeffs)
-            .map(|_| ())
-    }
-
-    /// Like [`Plan::forward_real_destroying_input`], also returning the time of each stage.
-    pub fn forward_real_destroying_input_timed(
-        &self,
-        samples: &mut [f64],
-        coeffs: &mut [Complex64],
     ) -> Result<StageTimes> {
         self.check(true, samples.len(), coeffs.len())?;
         // One raw pointer for reading the slices and for the buffers in the read ones.
         let base = samples.as_mut_ptr();
         let spare = Spare::over(base, self.b);
-        self.forward_real_impl(RealInput::Real(SendConstPtr(base)), coeffs, Some(spare))
+        self.forward_real_impl(
+            RealInput::Real(SendConstPtr(base)),
+            coeffs,
+            (Some(spare), None),
+        )
     }
 
     /// Forward transform of the real parts of complex samples (the imaginary parts are not
@@ -111,7 +104,7 @@ impl Plan {
         self.forward_real_impl(
             RealInput::RealParts(SendConstPtr(samples.as_ptr())),
             coeffs,
-            None,
+            (None, None),
         )
     }
 
@@ -127,15 +120,18 @@ impl Plan {
         self.forward_real_impl(
             RealInput::RealParts(SendConstPtr(base)),
             coeffs,
-            Some(spare),
+            (Some(spare), None),
         )
     }
 
-    fn forward_real_impl(
+    /// The real forward of `input` into `coeffs` (lengths checked by the caller), with
+    /// chunk buffers in the read input slices when `spare` is given, in the caller's
+    /// `scratch` if given.
+    pub(super) fn forward_real_impl(
         &self,
         input: RealInput,
         coeffs: &mut [Complex64],
-        spare: Option<Spare>,
+        (spare, scratch): (Option<Spare>, Option<&Scratch>),
     ) -> Result<StageTimes> {
         self.fft.real_fft()?;
         let coef = SendPtr(coeffs.as_mut_ptr());
@@ -147,7 +143,7 @@ impl Plan {
         self.run_chunks(
             true,
             t,
-            spare,
+            (spare, scratch),
             |ch, buf| self.fft.chunk_real(t, ch, RealSamples::Forward(input), buf),
             // The chunks accumulate the representatives only (half the coefficient traffic
             // per chunk); the last one also writes their partners.
@@ -155,22 +151,6 @@ impl Plan {
             // chunk buffer and coefficient rows (representatives and their partners) no
             // other task touches; `coeffs` has `num_coeffs` entries (checked above).
             |sc, step, pass| unsafe { self.dwt.forward_cluster(sc, &layout, step, coef, pass) },
-        )
-    }
-
-    /// Like [`Plan::inverse_real`], also returning the time of each stage.
-    pub fn inverse_real_timed(
-        &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
-    ) -> Result<StageTimes> {
-        self.check(false, samples.len(), coeffs.len())?;
-        // One raw pointer for the output slices and for the buffers in the free ones.
-        let out = samples.as_mut_ptr();
-        self.inverse_real_impl(
-            coeffs,
-            (RealOutput::Real(SendPtr(out)), None),
-            Spare::over(out, self.b),
         )
     }
 
@@ -186,18 +166,19 @@ impl Plan {
         self.inverse_real_impl(
             coeffs,
             (RealOutput::Real(SendPtr(out)), Some(watch)),
-            Spare::over(out, self.b),
+            (Spare::over(out, self.b), None),
         )
         .map(|_| ())
     }
 
     /// The real inverse of `coeffs` (length checked by the caller) into `output`, with
-    /// chunk buffers in the output slices not yet written (`spare`, over the same array).
-    fn inverse_real_impl(
+    /// chunk buffers in the output slices not yet written (`spare`, over the same array),
+    /// in the caller's `scratch` if given.
+    pub(super) fn inverse_real_impl(
         &self,
         coeffs: &[Complex64],
         (output, watch): (RealOutput, Option<SliceWatch>),
-        spare: Spare,
+        (spare, scratch): (Spare, Option<&Scratch>),
     ) -> Result<StageTimes> {
         self.fft.real_fft()?;
         let t = self.real_blocks()?;
@@ -208,7 +189,7 @@ impl Plan {
         self.run_chunks(
             false,
             t,
-            Some(spare),
+            (Some(spare), scratch),
             |ch, buf| {
                 self.fft
                     .chunk_real(t, ch, RealSamples::Inverse(output, watch), buf)
@@ -220,8 +201,8 @@ impl Plan {
     }
 
     fn real_blocks(&self) -> Result<&Blocks> {
-        self.blocks_real.as_ref().ok_or_else(|| {
-            Error::InvalidArgument("the plan was made without PlanOptions::real".into())
-        })
+        self.blocks_real
+            .as_ref()
+            .ok_or_else(|| Error::InvalidArgument("the plan was made without Options::real".into()))
     }
 }

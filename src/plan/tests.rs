@@ -19,7 +19,7 @@ fn chunk_groups_keep_clear_of_written_slices() {
         // Real, two chunks, the second short enough to fit in the first's slices.
         (20, true, 500_000),
     ] {
-        let opts = super::PlanOptions {
+        let opts = super::Options {
             max_workspace_bytes: Some(cap),
             real,
             ..Default::default()
@@ -171,7 +171,7 @@ fn drop_waits_for_workers() {
     for _ in 0..5 {
         let plan = super::Plan::new(
             4,
-            &super::PlanOptions {
+            &super::Options {
                 threads: 3,
                 ..Default::default()
             },
@@ -203,7 +203,7 @@ fn block_stores_do_not_change_results() {
         (41, None, SlicesAcrossWorkers),
     ] {
         for real in [false, true] {
-            let opts = super::PlanOptions {
+            let opts = super::Options {
                 max_workspace_bytes: cap,
                 real,
                 threads: 2,
@@ -258,7 +258,7 @@ fn block_stores_do_not_change_results() {
             if cap.is_some() {
                 let whole = super::Plan::new(
                     b,
-                    &super::PlanOptions {
+                    &super::Options {
                         max_workspace_bytes: None,
                         ..opts
                     },
@@ -300,7 +300,7 @@ fn block_stores_do_not_change_results() {
 fn real_parts_forward_chains_and_matches() {
     use num_complex::Complex64;
     for (b, cap) in [(36usize, 1usize), (37, 1), (20, 500_000)] {
-        let opts = super::PlanOptions {
+        let opts = super::Options {
             max_workspace_bytes: Some(cap),
             real: true,
             threads: 2,
@@ -343,7 +343,7 @@ fn plan_is_send_sync() {
 #[test]
 fn plans_of_a_thread_count_share_the_process_pool() {
     use crate::workers::WorkerPool;
-    let options = |threads| super::PlanOptions {
+    let options = |threads| super::Options {
         threads,
         ..Default::default()
     };
@@ -357,7 +357,7 @@ fn plans_of_a_thread_count_share_the_process_pool() {
     assert!(three.workers.same_as(&WorkerPool::process(3).unwrap()));
     let s2 = crate::s2::S2Plan::new(
         8,
-        &crate::s2::S2Options {
+        &crate::options::Options {
             threads: 2,
             ..Default::default()
         },
@@ -392,7 +392,7 @@ fn plans_of_a_thread_count_share_the_process_pool() {
 fn plans_share_a_pool() {
     use crate::workers::WorkerPool;
     use num_complex::Complex64;
-    let options = super::PlanOptions {
+    let options = super::Options {
         threads: 2,
         ..Default::default()
     };
@@ -400,7 +400,7 @@ fn plans_share_a_pool() {
     let live = pool.live_count();
     let a = super::Plan::new_on(6, &options, Some(&pool)).unwrap();
     let b = super::Plan::new_on(6, &options, Some(&pool)).unwrap();
-    let three = super::PlanOptions {
+    let three = super::Options {
         threads: 3,
         ..Default::default()
     };
@@ -440,7 +440,7 @@ fn real_inverse_into_complex_matches_real_samples() {
         (20, Some(500_000)),
         (41, None),
     ] {
-        let opts = super::PlanOptions {
+        let opts = super::Options {
             max_workspace_bytes: cap,
             real: true,
             threads: 2,
@@ -498,7 +498,7 @@ fn watched_inverse_shows_every_slice_once() {
     use num_complex::Complex64;
     use std::sync::Mutex;
     for (b, cap) in [(12usize, None), (36, Some(1usize))] {
-        let opts = super::PlanOptions {
+        let opts = super::Options {
             threads: 2,
             real: true,
             max_workspace_bytes: cap,

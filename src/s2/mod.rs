@@ -13,4 +13,4 @@ mod rings;
 
 pub(crate) use layout::order_start;
 pub use layout::{s2_coef_index, s2_num_coeffs, s2_num_samples, s2_try_coef_index};
-pub use plan::{S2Options, S2Plan, S2_MAX_BANDWIDTH};
+pub use plan::{S2Limits, S2Plan, S2_MAX_BANDWIDTH};

@@ -4,7 +4,8 @@ use super::layout::{order_start, s2_num_coeffs, s2_num_samples};
 use super::legendre::{CoeffRows, Group, LegendreStage, Spectra};
 use super::rings::RingFft;
 use crate::error::{check_length, Error, Result};
-use crate::fft::{AlignedBuf, Rigor};
+use crate::fft::AlignedBuf;
+use crate::options::Options;
 use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
@@ -16,17 +17,9 @@ use std::sync::Mutex;
 /// Largest bandwidth of the S^2 transforms.
 pub const S2_MAX_BANDWIDTH: usize = 4096;
 
-/// Options of an [`S2Plan`].
-#[derive(Clone, Debug, Default)]
-pub struct S2Options {
-    /// Worker threads (0 = all cores), shared with the process's other plans of the same
-    /// count (see [`PlanOptions::threads`](crate::plan::PlanOptions::threads)).
-    pub threads: usize,
-    /// FFTW planner rigour of the ring DFTs.
-    pub rigor: Rigor,
-    /// Instruction set of the kernels (`None`: [`Isa::selected`], the best this CPU has
-    /// unless the environment variable `SO3FFT_ISA` names another).
-    pub isa: Option<Isa>,
+/// Which degrees and orders an [`S2Plan`] computes (default all).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct S2Limits {
     /// Degree limit `L <= B`: only degrees `l < L` are computed (forward: the others are
     /// written as 0; inverse: they are not read). `None`: `B`.
     pub degree_limit: Option<usize>,
@@ -63,15 +56,23 @@ pub struct S2Plan {
 }
 
 impl S2Plan {
-    /// A plan for bandwidth `bandwidth` (`1 ..= S2_MAX_BANDWIDTH`).
-    pub fn new(bandwidth: usize, options: &S2Options) -> Result<S2Plan> {
-        S2Plan::new_on(bandwidth, options, None)
+    /// A plan for bandwidth `bandwidth` (`1 ..= S2_MAX_BANDWIDTH`), all degrees and
+    /// orders. It reads the options' `threads`, `rigor` and `isa`.
+    pub fn new(bandwidth: usize, options: &Options) -> Result<S2Plan> {
+        S2Plan::new_on(bandwidth, S2Limits::default(), options, None)
     }
 
-    /// [`S2Plan::new`] on the workers of `shared` if given (with the plan's thread count).
+    /// [`S2Plan::new`] computing only the degrees and orders of `limits`.
+    pub fn with_limits(bandwidth: usize, limits: S2Limits, options: &Options) -> Result<S2Plan> {
+        S2Plan::new_on(bandwidth, limits, options, None)
+    }
+
+    /// [`S2Plan::with_limits`] on the workers of `shared` if given (with the plan's thread
+    /// count).
     pub(crate) fn new_on(
         bandwidth: usize,
-        options: &S2Options,
+        limits: S2Limits,
+        options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<S2Plan> {
         let b = bandwidth;
@@ -92,7 +93,7 @@ impl S2Plan {
         )?;
         let scratch = AlignedBuf::new(scratch_len(b))?;
         let rings = RingFft::new(n, options.rigor)?;
-        let lend = options.degree_limit.unwrap_or(b);
+        let lend = limits.degree_limit.unwrap_or(b);
         if lend == 0 || lend > b {
             return Err(Error::InvalidArgument(format!(
                 "degree limit {lend} outside 1..={b} (degrees l < L are computed)"
@@ -110,7 +111,7 @@ impl S2Plan {
             rings,
             legendre,
             starts,
-            order_limit: options.order_limit.unwrap_or(b),
+            order_limit: limits.order_limit.unwrap_or(b),
             scratch: Mutex::new(Some(scratch)),
             spare: Mutex::new(None),
         })

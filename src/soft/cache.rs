@@ -4,10 +4,9 @@
 
 use super::SoftResult;
 use crate::ffi::CallError;
-use crate::s2::S2Options;
 use crate::system::ForkLock;
 use crate::workers::{thread_count, WorkerPool};
-use crate::{wisdom, Direction, FftThreading, Plan, PlanOptions, Rigor};
+use crate::{wisdom, Direction, FftThreading, Options, Plan, Rigor};
 use std::cell::UnsafeCell;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -131,10 +130,10 @@ fn env_rigor() -> Rigor {
 }
 
 /// Plan options of the cached SO(3) plans.
-fn cache_options() -> &'static PlanOptions {
-    static OPTS: OnceLock<PlanOptions> = OnceLock::new();
+fn cache_options() -> &'static Options {
+    static OPTS: OnceLock<Options> = OnceLock::new();
     OPTS.get_or_init(|| {
-        PlanOptions {
+        Options {
             direction: Direction::Both,
             threads: env_threads(),
             rigor: env_rigor(),
@@ -147,7 +146,7 @@ fn cache_options() -> &'static PlanOptions {
             } else {
                 FftThreading::Auto
             },
-            ..PlanOptions::default()
+            ..Options::default()
         }
     })
 }
@@ -228,10 +227,10 @@ pub(super) fn made_plan(b: usize) -> Option<Arc<Plan>> {
 }
 
 /// Options of the cached S^2 plans (threads and rigour as for the SO(3) plans).
-pub(super) fn s2_options() -> S2Options {
-    S2Options {
+pub(super) fn s2_options() -> Options {
+    Options {
         threads: env_threads(),
         rigor: env_rigor(),
-        ..S2Options::default()
+        ..Options::default()
     }
 }

@@ -9,7 +9,7 @@ use super::real::{parity, real_primary_pairs, REAL_PATHS};
 use super::*;
 use crate::grid::{block_start, coef_index};
 use crate::s2::s2_coef_index;
-use crate::{num_coeffs, num_samples, Complex64, Plan, PlanOptions};
+use crate::{num_coeffs, num_samples, Complex64, Options, Plan};
 use std::f64::consts::PI;
 use std::ptr::null_mut;
 
@@ -39,7 +39,7 @@ impl Rng {
 fn native(b: usize) -> Plan {
     Plan::new(
         b,
-        &PlanOptions {
+        &Options {
             threads: 2,
             ..Default::default()
         },

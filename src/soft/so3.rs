@@ -73,7 +73,7 @@ unsafe fn forward_core(
         if real {
             plan.forward_real_parts(samples, out).map(|_| ())
         } else {
-            plan.forward(samples, out)
+            plan.forward(samples, out).map(|_| ())
         }
     };
     match ratios {
@@ -133,7 +133,10 @@ unsafe fn inverse_core(
                 .inverse_real_to_complex(input, out)
                 .map_err(CallError::from);
         }
-        return plan.inverse(input, out).map_err(CallError::from);
+        return plan
+            .inverse(input, out)
+            .map(|_| ())
+            .map_err(CallError::from);
     }
     let expanded = expand_real(b, input)?;
     let res = plan.inverse_real_to_complex(&expanded, out);

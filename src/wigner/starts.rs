@@ -13,7 +13,7 @@ use crate::simd::Isa;
 /// Exponent step of one rescaling.
 pub(crate) const SCALE_STEP: i64 = 600;
 /// Default skip threshold: lanes whose true value is below `2^-DEFAULT_SKIP_BITS` are
-/// treated as zero (see `PlanOptions::skip_bits`).
+/// treated as zero (see `Options::skip_bits`).
 pub(crate) const DEFAULT_SKIP_BITS: u32 = 64;
 /// Accepted range of skip thresholds (`2^-bits`): the scaled values stay normal doubles.
 pub(crate) const SKIP_BITS_RANGE: std::ops::RangeInclusive<u32> = 24..=560;

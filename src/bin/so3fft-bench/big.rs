@@ -29,7 +29,7 @@ use crate::seeded;
 use crate::timing::{self, Timed};
 use crate::workload::{self, RoundTripError};
 use rayon::prelude::*;
-use so3fft::{Complex64, Direction, Plan, PlanOptions, StageTimes};
+use so3fft::{Complex64, Direction, Plan, StageTimes};
 use std::time::Instant;
 
 /// Memory left over for everything else when a step is admitted.
@@ -100,15 +100,13 @@ impl Lean<'_> {
     ) -> Result<Plan, so3fft::Error> {
         Plan::new(
             self.b,
-            &PlanOptions {
-                direction: Direction::Both,
-                threads: self.threads,
-                rigor: self.opts.rigor,
-                skip_bits,
-                real,
-                max_workspace_bytes: workspace,
-                ..PlanOptions::default()
-            },
+            &so3fft::Options::default()
+                .with_direction(Direction::Both)
+                .with_threads(self.threads)
+                .with_rigor(self.opts.rigor)
+                .with_skip_bits(skip_bits)
+                .with_real(real)
+                .with_max_workspace_bytes(workspace),
         )
     }
 
@@ -175,7 +173,7 @@ impl Lean<'_> {
             // The grid still holds the inverse's samples: the forward that may overwrite
             // them, on the same plan (the grid is rewritten by the next step's inverse).
             let arrays = workload::array_bytes(b, false);
-            match timed_phase(|| plan.forward_destroying_input_timed(&mut grid, &mut coeffs)) {
+            match timed_phase(|| plan.forward_destroying_input(&mut grid, &mut coeffs)) {
                 Ok(destroying) => {
                     let error = seeded::compare_complex(self.seed(), &coeffs);
                     self.destroy_complex = Some(destroying.timed.wall);
@@ -235,8 +233,8 @@ impl Lean<'_> {
             variant.name(),
             t.elapsed().as_secs_f64()
         );
-        let inverse = timed_phase(|| plan.inverse_timed(coeffs, grid))?;
-        let forward = timed_phase(|| plan.forward_timed(grid, coeffs))?;
+        let inverse = timed_phase(|| plan.inverse(coeffs, grid))?;
+        let forward = timed_phase(|| plan.forward(grid, coeffs))?;
         let t = Instant::now();
         let error = seeded::compare_complex(self.seed(), coeffs);
         let row = self.row(variant, plan, RoundTrip { inverse, forward }, error);
@@ -287,9 +285,8 @@ impl Lean<'_> {
         match self.real_round_trip(&plan, &mut coeffs, &mut grid) {
             Ok(row) => {
                 let arrays = workload::array_bytes(b, true);
-                let destroying = timed_phase(|| {
-                    plan.forward_real_destroying_input_timed(&mut grid, &mut coeffs)
-                });
+                let destroying =
+                    timed_phase(|| plan.forward_real_destroying_input(&mut grid, &mut coeffs));
                 match destroying {
                     Ok(destroying) => {
                         let error = seeded::compare_real(self.real_seed(), b, &coeffs);
@@ -318,8 +315,8 @@ impl Lean<'_> {
     ) -> Result<Row, so3fft::Error> {
         let b = self.b;
         seeded::fill_real(self.real_seed(), b, coeffs);
-        let inverse = timed_phase(|| plan.inverse_real_timed(coeffs, grid))?;
-        let forward = timed_phase(|| plan.forward_real_timed(grid, coeffs))?;
+        let inverse = timed_phase(|| plan.inverse_real(coeffs, grid))?;
+        let forward = timed_phase(|| plan.forward_real(grid, coeffs))?;
         let error = seeded::compare_real(self.real_seed(), b, coeffs);
         let arrays = workload::array_bytes(b, true);
         let mut row = self.row(Variant::Real, plan, RoundTrip { inverse, forward }, error);

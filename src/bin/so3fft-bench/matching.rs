@@ -10,7 +10,7 @@ use crate::cli::{rigor_name, Options};
 use crate::floor::{self, SliceFloor};
 use crate::workload::{dwt_flops_exact, dwt_flops_real, median, random_coeffs};
 use so3fft::matching::{rotate_s2_coeffs, top_peaks, Correlation, CorrelationOptions, Rotation};
-use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, S2Plan};
 use so3fft::Complex64;
 use std::time::Instant;
 
@@ -63,13 +63,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         for &threads in &opts.threads {
             let runs = opts.runs.unwrap_or(5);
             let truth = Rotation::new(2.1234567, 1.2345678, 0.3456789);
-            let s2 = S2Plan::new(
-                l,
-                &S2Options {
-                    threads,
-                    ..Default::default()
-                },
-            )?;
+            let s2 = S2Plan::new(l, &so3fft::Options::default().with_threads(threads))?;
             let ns = s2.num_samples();
             // Complex inputs.
             let hat = random_coeffs(l * l, 3);

@@ -5,7 +5,7 @@
 
 use crate::cli::Options;
 use crate::workload::random_coeffs;
-use so3fft::{Complex64, Plan, PlanOptions};
+use so3fft::{Complex64, Plan};
 
 /// Cores, memory (bytes) and network bandwidth (bytes/s, each way) of the modelled node.
 const NODE_CORES: f64 = 64.0;
@@ -22,19 +22,17 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
     let b = 128usize;
     let plan = Plan::new(
         b,
-        &PlanOptions {
-            threads: 1,
-            rigor: opts.rigor,
-            ..PlanOptions::default()
-        },
+        &so3fft::Options::default()
+            .with_threads(1)
+            .with_rigor(opts.rigor),
     )?;
     let c = random_coeffs(plan.num_coeffs(), 1);
     let mut x = vec![Complex64::default(); plan.num_samples()];
     let mut back = vec![Complex64::default(); plan.num_coeffs()];
     let (mut dwt, mut fft) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..3 {
-        let i = plan.inverse_timed(&c, &mut x)?;
-        let f = plan.forward_timed(&x, &mut back)?;
+        let i = plan.inverse(&c, &mut x)?;
+        let f = plan.forward(&x, &mut back)?;
         dwt = dwt.min(i.dwt + f.dwt);
         fft = fft.min(i.fft + f.fft);
     }

@@ -338,7 +338,7 @@ mod tests {
     fn inverse_matches_library_samples() {
         let b = 5;
         let n = 2 * b;
-        let plan = so3fft::Plan::new(b, &so3fft::PlanOptions::default()).unwrap();
+        let plan = so3fft::Plan::new(b, &so3fft::Options::default()).unwrap();
         let coeffs = random_coeffs(plan.num_coeffs(), 11);
         let mut f = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
         plan.inverse(&coeffs, &mut f).unwrap();

@@ -5,10 +5,7 @@
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
-use so3fft::{
-    Batch, Betas, Complex64, Direction, PartialOptions, PartialPlan, Plan, PlanOptions, Shape,
-    StageTimes,
-};
+use so3fft::{Batch, Betas, Complex64, Direction, PartialPlan, Plan, Shape, StageTimes};
 
 /// Wigner terms of an inverse or forward: `(l, M, M')` of the shape times the betas.
 fn terms(s: &Shape, betas: usize) -> f64 {
@@ -55,22 +52,18 @@ fn alternate<const K: usize>(
     }))
 }
 
-fn opts(threads: usize, o: &Options) -> PartialOptions {
-    PartialOptions {
-        threads,
-        rigor: o.rigor,
-        ..PartialOptions::default()
-    }
+fn opts(threads: usize, o: &Options) -> so3fft::Options {
+    so3fft::Options::default()
+        .with_threads(threads)
+        .with_rigor(o.rigor)
 }
 
 fn full_plan(b: usize, threads: usize, o: &Options) -> so3fft::Result<Plan> {
     Plan::new(
         b,
-        &PlanOptions {
-            threads,
-            rigor: o.rigor,
-            ..PlanOptions::default()
-        },
+        &so3fft::Options::default()
+            .with_threads(threads)
+            .with_rigor(o.rigor),
     )
 }
 
@@ -102,20 +95,14 @@ fn degree_limited(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()
     let (b, l) = (256, 128);
     let full = full_plan(b, threads, o)?;
     let s = Shape::new(l).with_grid(b, 2 * b, 2 * b);
-    let pp = PartialPlan::new(
-        &s,
-        &PartialOptions {
-            direction: Direction::Inverse,
-            ..opts(threads, o)
-        },
-    )?;
+    let pp = PartialPlan::new(&s, &opts(threads, o).with_direction(Direction::Inverse))?;
     let cf = random_coeffs(full.num_coeffs(), 1);
     let cp = random_coeffs(pp.num_coeffs(), 2);
     let mut x = zeros(full.num_samples());
     let mut y = zeros(pp.num_samples());
     let [tf, tp] = alternate(
         runs,
-        &mut [&mut || full.inverse_timed(&cf, &mut x), &mut || {
+        &mut [&mut || full.inverse(&cf, &mut x), &mut || {
             pp.inverse_many(one(&pp), &cp, &mut y)
         }],
     )?;
@@ -169,13 +156,13 @@ fn order_limited(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()>
         let mut cb = zeros(pp.num_coeffs());
         let [fi, pi] = alternate(
             runs,
-            &mut [&mut || full.inverse_timed(&cf, &mut x), &mut || {
+            &mut [&mut || full.inverse(&cf, &mut x), &mut || {
                 pp.inverse_many(one(&pp), &cp, &mut y)
             }],
         )?;
         let [ff, pf] = alternate(
             runs,
-            &mut [&mut || full.forward_timed(&x, &mut back), &mut || {
+            &mut [&mut || full.forward(&x, &mut back), &mut || {
                 pp.forward_many(one_fwd(&pp), &y, &mut cb)
             }],
         )?;
@@ -240,11 +227,11 @@ fn batched(o: &Options, runs: usize, peak1: f64) -> so3fft::Result<()> {
         // many as the workspace holds (the default 512 MB: two at B = 128); here 8.
         let pp = PartialPlan::new(
             &s,
-            &PartialOptions {
-                general_engine: true,
-                max_workspace_bytes: Some((8 * s.num_samples() * 16 / 20 * 21).max(512 << 20)),
-                ..opts(1, o)
-            },
+            &opts(1, o)
+                .with_general_engine(true)
+                .with_max_workspace_bytes(Some(
+                    (8 * s.num_samples() * 16 / 20 * 21).max(512 << 20),
+                )),
         )?;
         let (nc, ns) = (pp.num_coeffs(), pp.num_samples());
         let c = random_coeffs(8 * nc, 7);
@@ -317,19 +304,13 @@ fn selected_betas(o: &Options, threads: usize, runs: usize) -> so3fft::Result<()
         let s = Shape::new(b);
         let full = full_plan(b, threads, o)?;
         let ks: Vec<usize> = (0..2 * b).step_by(16).collect();
-        let sel = PartialPlan::new(
-            &s,
-            &PartialOptions {
-                betas: Betas::Indices(ks),
-                ..opts(threads, o)
-            },
-        )?;
+        let sel = PartialPlan::new(&s, &opts(threads, o).with_betas(Betas::Indices(ks)))?;
         let c = random_coeffs(full.num_coeffs(), 9);
         let mut x = zeros(full.num_samples());
         let mut y = zeros(sel.num_samples());
         let [tf, ts] = alternate(
             runs,
-            &mut [&mut || full.inverse_timed(&c, &mut x), &mut || {
+            &mut [&mut || full.inverse(&c, &mut x), &mut || {
                 sel.inverse_many(one(&sel), &c, &mut y)
             }],
         )?;
@@ -356,13 +337,7 @@ fn skip_thresholds(o: &Options, threads: usize, runs: usize) -> so3fft::Result<(
     );
     for b in [64, 128, 256] {
         let mk = |bits: Option<u32>| {
-            PartialPlan::new(
-                &Shape::new(b),
-                &PartialOptions {
-                    skip_bits: bits,
-                    ..opts(threads, o)
-                },
-            )
+            PartialPlan::new(&Shape::new(b), &opts(threads, o).with_skip_bits(bits))
         };
         let def = mk(None)?;
         let c = random_coeffs(def.num_coeffs(), 11);

@@ -8,7 +8,7 @@ use crate::report::{self, Memory, Row, Stages, Variant};
 use crate::seeded;
 use crate::timing::{median_of, RunTimes};
 use crate::workload::{self, RoundTripError};
-use so3fft::{Complex64, Direction, Plan, PlanOptions};
+use so3fft::{Complex64, Direction, Plan};
 use std::time::Instant;
 
 /// Share of `MemAvailable` a configuration may use before it is skipped: the machine has no
@@ -181,15 +181,13 @@ fn bench_plan(setup: Setup, threads: usize, variant: Variant) -> Result<Plan, so
     let plan_start = Instant::now();
     let plan = Plan::new(
         b,
-        &PlanOptions {
-            direction: Direction::Both,
-            threads,
-            rigor: opts.rigor,
-            skip_bits: (variant == Variant::NoSkip).then_some(0),
-            real: variant == Variant::Real,
-            fft_threading: opts.fft_threading,
-            ..PlanOptions::default()
-        },
+        &so3fft::Options::default()
+            .with_direction(Direction::Both)
+            .with_threads(threads)
+            .with_rigor(opts.rigor)
+            .with_skip_bits((variant == Variant::NoSkip).then_some(0))
+            .with_real(variant == Variant::Real)
+            .with_fft_threading(opts.fft_threading),
     )?;
     let what = match variant {
         Variant::NoSkip => ", no skipping",
@@ -230,16 +228,17 @@ impl<'a> Config<'a> {
     /// One untimed round trip: faults in the output pages, warms caches and the thread pool.
     fn warm_up(&self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
         self.plan.inverse(coeffs, &mut arrays.samples)?;
-        self.plan.forward(&arrays.samples, &mut arrays.result)
+        self.plan.forward(&arrays.samples, &mut arrays.result)?;
+        Ok(())
     }
 
     /// One timed inverse-then-forward round trip, checked against `coeffs`.
     fn run(&mut self, coeffs: &[Complex64], arrays: &mut Arrays) -> Result<(), so3fft::Error> {
         let plan = &self.plan;
         self.times
-            .inverse(|| plan.inverse_timed(coeffs, &mut arrays.samples))?;
+            .inverse(|| plan.inverse(coeffs, &mut arrays.samples))?;
         self.times
-            .forward(|| plan.forward_timed(&arrays.samples, &mut arrays.result))?;
+            .forward(|| plan.forward(&arrays.samples, &mut arrays.result))?;
         let error = workload::roundtrip_error(coeffs, &arrays.result);
         self.error = self.error.worst(error);
         Ok(())
@@ -342,8 +341,8 @@ pub fn real_row(setup: Setup, threads: usize) -> Result<Row, so3fft::Error> {
     let mut times = RunTimes::default();
     let mut error = RoundTripError::default();
     let mut real_run = |times: &mut RunTimes| -> Result<(), so3fft::Error> {
-        times.inverse(|| real.inverse_real_timed(&coeffs, &mut samples))?;
-        times.forward(|| real.forward_real_timed(&samples, &mut result))?;
+        times.inverse(|| real.inverse_real(&coeffs, &mut samples))?;
+        times.forward(|| real.forward_real(&samples, &mut result))?;
         error = error.worst(seeded::compare_real(seed, b, &result));
         Ok(())
     };

@@ -4,7 +4,7 @@
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
-use so3fft::s2::{s2_coef_index, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, S2Plan};
 use so3fft::Complex64;
 use std::time::Instant;
 
@@ -71,11 +71,9 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         for &threads in &opts.threads {
             let plan = S2Plan::new(
                 b,
-                &S2Options {
-                    threads,
-                    rigor: opts.rigor,
-                    ..Default::default()
-                },
+                &so3fft::Options::default()
+                    .with_threads(threads)
+                    .with_rigor(opts.rigor),
             )?;
             let runs = opts.runs.unwrap_or(if b >= 1024 { 3 } else { 7 });
             let (ns, nc) = (plan.num_samples(), plan.num_coeffs());

@@ -9,7 +9,7 @@
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
-use so3fft::{Complex64, Plan, PlanOptions, StageTimes};
+use so3fft::{Complex64, Plan, StageTimes};
 use std::time::{Duration, Instant};
 
 /// Shortest window, in seconds of the first thread count's round trip.
@@ -83,8 +83,8 @@ impl RoundTrip {
             let mut window = Window::default();
             let share = 1.0 / pairs as f64;
             for _ in 0..pairs {
-                let inverse = plan.inverse_timed(&self.coeffs, &mut self.samples)?;
-                let forward = plan.forward_timed(&self.samples, &mut self.result)?;
+                let inverse = plan.inverse(&self.coeffs, &mut self.samples)?;
+                let forward = plan.forward(&self.samples, &mut self.result)?;
                 for (sum, x) in [
                     (&mut window.inverse, inverse),
                     (&mut window.forward, forward),
@@ -124,12 +124,10 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
             .map(|&threads| {
                 Plan::new(
                     b,
-                    &PlanOptions {
-                        threads,
-                        rigor: opts.rigor,
-                        fft_threading: opts.fft_threading,
-                        ..Default::default()
-                    },
+                    &so3fft::Options::default()
+                        .with_threads(threads)
+                        .with_rigor(opts.rigor)
+                        .with_fft_threading(opts.fft_threading),
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;

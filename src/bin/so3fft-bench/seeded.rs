@@ -206,7 +206,7 @@ impl ErrorSums {
 /// bandwidth `b`, through the library's complex inverse: checks the sign of the symmetry
 /// (about 1e-15 relative if it is right).
 pub fn real_symmetry_check(b: usize, seed: u64) -> Result<(f64, f64), so3fft::Error> {
-    let plan = so3fft::Plan::new(b, &so3fft::PlanOptions::default())?;
+    let plan = so3fft::Plan::new(b, &so3fft::Options::default())?;
     let mut coeffs = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
     fill_real(seed, b, &mut coeffs);
     let mut f = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
@@ -265,7 +265,7 @@ mod tests {
         let (im, abs) = real_symmetry_check(12, 5).unwrap();
         assert!(im < 1e-14 * abs, "max |Im| {im}, max |f| {abs}");
         let b = 12;
-        let plan = so3fft::Plan::new(b, &so3fft::PlanOptions::default()).unwrap();
+        let plan = so3fft::Plan::new(b, &so3fft::Options::default()).unwrap();
         let mut coeffs = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
         fill_real(5, b, &mut coeffs);
         for (m, row) in rows_mut(b, &mut coeffs) {
@@ -285,14 +285,7 @@ mod tests {
     #[test]
     fn real_round_trip() {
         let b = 10;
-        let plan = so3fft::Plan::new(
-            b,
-            &so3fft::PlanOptions {
-                real: true,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let plan = so3fft::Plan::new(b, &so3fft::Options::default().with_real(true)).unwrap();
         let mut c = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
         fill_real(8, b, &mut c);
         let mut f = vec![0.0; plan.num_samples()];

@@ -8,7 +8,7 @@
 
 use crate::workload::{median, random_coeffs};
 use so3fft::soft;
-use so3fft::{Complex64, Plan, PlanOptions, Rigor};
+use so3fft::{Complex64, Options, Plan, Rigor};
 use std::fmt::Write as _;
 use std::os::raw::c_int;
 use std::time::Instant;
@@ -45,26 +45,29 @@ fn as_soft(v: &mut [Complex64]) -> *mut SoftComplex {
 pub fn compare(b: usize, runs: usize) -> Result<Vec<SoftRow>, so3fft::Error> {
     let native = Plan::new(
         b,
-        &PlanOptions {
-            rigor: Rigor::Measure,
-            real: true,
-            ..Default::default()
-        },
+        &Options::default()
+            .with_rigor(Rigor::Measure)
+            .with_real(true),
     )?;
     let n = native.num_samples();
     let mut coeffs = random_coeffs(native.num_coeffs(), 7 + b as u64);
     let mut samples = vec![Complex64::new(0.0, 0.0); n];
     let mut coeffs_out = vec![Complex64::new(0.0, 0.0); native.num_coeffs()];
     native.inverse(&coeffs, &mut samples)?;
-    let native_inverse = time_median(runs, || native.inverse(&coeffs, &mut samples).unwrap());
-    let native_forward = time_median(runs, || native.forward(&samples, &mut coeffs_out).unwrap());
+    let native_inverse = time_median(runs, || {
+        native.inverse(&coeffs, &mut samples).unwrap();
+    });
+    let native_forward = time_median(runs, || {
+        native.forward(&samples, &mut coeffs_out).unwrap();
+    });
     // Real-signal path on real data (real parts of the samples; real-symmetric coefficients
     // are what flag = 1 clients pass, and the timing does not depend on the values).
     let mut real = vec![0.0f64; n];
-    let native_inverse_real =
-        time_median(runs, || native.inverse_real(&coeffs, &mut real).unwrap());
+    let native_inverse_real = time_median(runs, || {
+        native.inverse_real(&coeffs, &mut real).unwrap();
+    });
     let native_forward_real = time_median(runs, || {
-        native.forward_real(&real, &mut coeffs_out).unwrap()
+        native.forward_real(&real, &mut coeffs_out).unwrap();
     });
 
     let bandwidth = b as c_int;

@@ -7,7 +7,7 @@
 
 use crate::cli::{Options, StageMode};
 use crate::workload::{dwt_flops_exact, dwt_flops_real, random_coeffs, XorShift64Star};
-use so3fft::{Complex64, Direction, Plan, PlanOptions};
+use so3fft::{Complex64, Direction, Plan};
 
 /// Stage times of the repetitions of one plan, per transform kind.
 #[derive(Default)]
@@ -58,15 +58,13 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
         for &threads in &opts.threads {
             let plan = Plan::new(
                 b,
-                &PlanOptions {
-                    threads,
-                    rigor: opts.rigor,
-                    max_workspace_bytes: opts.workspace_bytes,
-                    direction: Direction::Both,
-                    real: opts.stage_mode.real(),
-                    fft_threading: opts.fft_threading,
-                    ..Default::default()
-                },
+                &so3fft::Options::default()
+                    .with_threads(threads)
+                    .with_rigor(opts.rigor)
+                    .with_max_workspace_bytes(opts.workspace_bytes)
+                    .with_direction(Direction::Both)
+                    .with_real(opts.stage_mode.real())
+                    .with_fft_threading(opts.fft_threading),
             )?;
             eprintln!(
                 "B = {b}, threads {}, fft threading {:?}",
@@ -104,16 +102,16 @@ fn repeat_complex(
     plan.inverse(&coeffs, &mut samples)?;
     for _ in 0..repetitions {
         if mode.inverse() {
-            times.push("inv", &plan.inverse_timed(&coeffs, &mut samples)?);
+            times.push("inv", &plan.inverse(&coeffs, &mut samples)?);
         }
         if mode == StageMode::ForwardDestroying {
             let mut input = samples.clone();
             times.push(
                 "dfwd",
-                &plan.forward_destroying_input_timed(&mut input, &mut result)?,
+                &plan.forward_destroying_input(&mut input, &mut result)?,
             );
         } else if mode.forward() {
-            times.push("fwd", &plan.forward_timed(&samples, &mut result)?);
+            times.push("fwd", &plan.forward(&samples, &mut result)?);
         }
     }
     Ok(times)
@@ -132,10 +130,10 @@ fn repeat_real(plan: &Plan, mode: StageMode, repetitions: usize) -> Result<Times
     let mut result = coeffs.clone();
     for _ in 0..repetitions {
         if mode.inverse() {
-            times.push("rinv", &plan.inverse_real_timed(&coeffs, &mut samples)?);
+            times.push("rinv", &plan.inverse_real(&coeffs, &mut samples)?);
         }
         if mode.forward() {
-            times.push("rfwd", &plan.forward_real_timed(&samples, &mut result)?);
+            times.push("rfwd", &plan.forward_real(&samples, &mut result)?);
         }
     }
     Ok(times)

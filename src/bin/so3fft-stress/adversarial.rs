@@ -5,10 +5,9 @@
 use crate::record::{bit_differences, errors, Case, Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::{compensated_sum, ORDER_LIMIT};
-use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
+use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Plan};
 use so3fft::{
-    coef_index, num_coeffs, num_samples, sample_index, Complex64, PartialOptions, PartialPlan,
-    Plan, PlanOptions, Shape,
+    coef_index, num_coeffs, num_samples, sample_index, Complex64, Options, PartialPlan, Plan, Shape,
 };
 use std::f64::consts::PI;
 use std::sync::mpsc;
@@ -17,14 +16,7 @@ use std::time::{Duration, Instant};
 const ZERO: Complex64 = Complex64::new(0.0, 0.0);
 
 fn plan(b: usize, threads: usize, real: bool) -> so3fft::Result<Plan> {
-    Plan::new(
-        b,
-        &PlanOptions {
-            threads,
-            real,
-            ..Default::default()
-        },
-    )
+    Plan::new(b, &Options::default().with_threads(threads).with_real(real))
 }
 
 /// `exp(-i pi t / B)` with `t` reduced mod `2B` first (accurate for large `M j`).
@@ -97,13 +89,7 @@ fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
 /// S^2 single coefficients at `l = |m| = B-1`: the synthesis against the closed form
 /// (`s2-top-order-inverse`) and the round trip (`s2-top-order-roundtrip`).
 pub fn s2_top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    let plan = S2Plan::new(
-        b,
-        &S2Options {
-            threads,
-            ..Default::default()
-        },
-    )?;
+    let plan = S2Plan::new(b, &Options::default().with_threads(threads))?;
     let c = Complex64::new(0.75, -0.5);
     let top = b as isize - 1;
     for (m, variant) in [(top, "m=B-1"), (-top, "m=-(B-1)")] {
@@ -259,18 +245,9 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     let shape = Shape::new(b).with_orders(ORDER_LIMIT.min(b - 1), ORDER_LIMIT.min(b - 1));
     let part = std::sync::Arc::new(PartialPlan::new(
         &shape,
-        &PartialOptions {
-            threads,
-            ..Default::default()
-        },
+        &Options::default().with_threads(threads),
     )?);
-    let s2 = std::sync::Arc::new(S2Plan::new(
-        b,
-        &S2Options {
-            threads,
-            ..Default::default()
-        },
-    )?);
+    let s2 = std::sync::Arc::new(S2Plan::new(b, &Options::default().with_threads(threads))?);
     let (nc, ns) = (num_coeffs(b), num_samples(b));
     let (pc, ps) = (part.num_coeffs(), part.num_samples());
     let (sc, ss) = (s2_num_coeffs(b), s2_num_samples(b));
@@ -281,11 +258,9 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     let top_s2 = s2_coef_index(b, b - 1, top);
     let noskip = std::sync::Arc::new(Plan::new(
         b,
-        &PlanOptions {
-            threads,
-            skip_bits: Some(0),
-            ..Default::default()
-        },
+        &Options::default()
+            .with_threads(threads)
+            .with_skip_bits(Some(0)),
     )?);
     let mut out: Vec<Transform> = Vec::new();
     let p = noskip.clone();

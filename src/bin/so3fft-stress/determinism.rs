@@ -4,10 +4,8 @@
 use crate::record::{Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::ORDER_LIMIT;
-use so3fft::s2::{s2_num_coeffs, S2Options, S2Plan};
-use so3fft::{
-    num_coeffs, Complex64, FftThreading, PartialOptions, PartialPlan, Plan, PlanOptions, Shape,
-};
+use so3fft::s2::{s2_num_coeffs, S2Plan};
+use so3fft::{num_coeffs, Complex64, FftThreading, Options, PartialPlan, Plan, Shape};
 use std::time::Instant;
 
 /// The plan kinds checked.
@@ -75,7 +73,7 @@ fn bits_real(values: &[f64], out: &mut Vec<u64>) {
     out.extend(values.iter().map(|x| x.to_bits()));
 }
 
-fn plan_runner(b: usize, opts: PlanOptions) -> so3fft::Result<Runner> {
+fn plan_runner(b: usize, opts: Options) -> so3fft::Result<Runner> {
     let real = opts.real;
     let plan = Plan::new(b, &opts)?;
     let coeffs = SplitMix64::new(100 + b as u64).complex_vec(num_coeffs(b));
@@ -98,7 +96,7 @@ fn plan_runner(b: usize, opts: PlanOptions) -> so3fft::Result<Runner> {
     }))
 }
 
-fn partial_runner(shape: Shape, opts: PartialOptions) -> so3fft::Result<Runner> {
+fn partial_runner(shape: Shape, opts: Options) -> so3fft::Result<Runner> {
     let real = opts.real;
     let plan = PartialPlan::new(&shape, &opts)?;
     let coeffs = SplitMix64::new(200).complex_vec(plan.num_coeffs());
@@ -122,13 +120,7 @@ fn partial_runner(shape: Shape, opts: PartialOptions) -> so3fft::Result<Runner> 
 }
 
 fn s2_runner(b: usize, threads: usize, real: bool) -> so3fft::Result<Runner> {
-    let plan = S2Plan::new(
-        b,
-        &S2Options {
-            threads,
-            ..Default::default()
-        },
-    )?;
+    let plan = S2Plan::new(b, &Options::default().with_threads(threads))?;
     let coeffs = SplitMix64::new(300).complex_vec(s2_num_coeffs(b));
     Ok(Box::new(move || {
         let mut out = Vec::new();
@@ -151,53 +143,24 @@ fn s2_runner(b: usize, threads: usize, real: bool) -> so3fft::Result<Runner> {
 
 /// The runner of `kind` at bandwidth `b` on `threads` threads.
 pub fn runner(kind: Kind, b: usize, threads: usize) -> so3fft::Result<Runner> {
-    let plan_opts = PlanOptions {
-        threads,
-        ..Default::default()
-    };
+    let plan_opts = Options::default().with_threads(threads);
     let m = ORDER_LIMIT.min(b - 1);
-    let partial_opts = PartialOptions {
-        threads,
-        ..Default::default()
-    };
+    let partial_opts = Options::default().with_threads(threads);
     match kind {
         Kind::PlanComplex => plan_runner(b, plan_opts),
-        Kind::PlanChunked => plan_runner(
-            b,
-            PlanOptions {
-                max_workspace_bytes: Some(1 << 20),
-                ..plan_opts
-            },
-        ),
-        Kind::PlanFftwThreads => plan_runner(
-            b,
-            PlanOptions {
-                fft_threading: FftThreading::FftwThreads,
-                ..plan_opts
-            },
-        ),
-        Kind::PlanReal => plan_runner(
-            b,
-            PlanOptions {
-                real: true,
-                ..plan_opts
-            },
-        ),
+        Kind::PlanChunked => plan_runner(b, plan_opts.with_max_workspace_bytes(Some(1 << 20))),
+        Kind::PlanFftwThreads => {
+            plan_runner(b, plan_opts.with_fft_threading(FftThreading::FftwThreads))
+        }
+        Kind::PlanReal => plan_runner(b, plan_opts.with_real(true)),
         Kind::PartialComplex => partial_runner(Shape::new(b).with_orders(m, m), partial_opts),
         Kind::PartialReal => partial_runner(
             Shape::new(b).with_orders(m, m),
-            PartialOptions {
-                real: true,
-                ..partial_opts
-            },
+            partial_opts.with_real(true),
         ),
-        Kind::PartialGeneral => partial_runner(
-            Shape::new(b),
-            PartialOptions {
-                general_engine: true,
-                ..partial_opts
-            },
-        ),
+        Kind::PartialGeneral => {
+            partial_runner(Shape::new(b), partial_opts.with_general_engine(true))
+        }
         Kind::S2Complex => s2_runner(b, threads, false),
         Kind::S2Real => s2_runner(b, threads, true),
     }

@@ -8,21 +8,15 @@
 use crate::record::{Report, Row};
 use crate::rng::SplitMix64;
 use so3fft::matching::{grid_argmax, rotate_s2_coeffs, Correlation, CorrelationOptions, Rotation};
-use so3fft::s2::{S2Options, S2Plan};
-use so3fft::Complex64;
+use so3fft::s2::S2Plan;
+use so3fft::{Complex64, Options};
 use std::time::Instant;
 
 /// Matching at each `L` of `bandwidths` on `threads` workers.
 pub fn run(bandwidths: &[usize], threads: usize, report: &mut Report) -> so3fft::Result<()> {
     let truth = Rotation::new(2.1234567, 1.2345678, 0.3456789);
     for &l in bandwidths {
-        let s2 = S2Plan::new(
-            l,
-            &S2Options {
-                threads,
-                ..S2Options::default()
-            },
-        )?;
+        let s2 = S2Plan::new(l, &Options::default().with_threads(threads))?;
         let mut rng = SplitMix64::new(31 + l as u64);
         let hat = rng.complex_vec(l * l);
         let ns = s2.num_samples();

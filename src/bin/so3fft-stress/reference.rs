@@ -4,7 +4,7 @@
 
 use crate::record::{errors, Case, Report};
 use crate::rng::SplitMix64;
-use so3fft::{coef_index, num_samples, sample_index, Complex64, Isa, Plan, PlanOptions};
+use so3fft::{coef_index, num_samples, sample_index, Complex64, Isa, Options, Plan};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -131,11 +131,7 @@ impl ForwardKind {
 fn plan_on(b: usize, isa: Isa, threads: usize) -> so3fft::Result<Plan> {
     Plan::new(
         b,
-        &PlanOptions {
-            isa: Some(isa),
-            threads,
-            ..Default::default()
-        },
+        &Options::default().with_isa(Some(isa)).with_threads(threads),
     )
 }
 
@@ -243,8 +239,8 @@ pub fn isa_roundtrips(
     threads: usize,
     report: &mut Report,
 ) -> so3fft::Result<()> {
-    use so3fft::s2::{s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
-    use so3fft::{PartialOptions, PartialPlan, Shape};
+    use so3fft::s2::{s2_num_coeffs, s2_num_samples, S2Plan};
+    use so3fft::{PartialPlan, Shape};
     let zero = Complex64::new(0.0, 0.0);
     for isa in supported_isas() {
         let name = isa_name(isa);
@@ -265,11 +261,7 @@ pub fn isa_roundtrips(
 
         let b = bw.partial;
         let m = crate::roundtrip::ORDER_LIMIT;
-        let opts = PartialOptions {
-            isa: Some(isa),
-            threads,
-            ..Default::default()
-        };
+        let opts = Options::default().with_isa(Some(isa)).with_threads(threads);
         let plan = PartialPlan::new(&Shape::new(b).with_orders(m, m), &opts)?;
         let c = SplitMix64::new(30 + b as u64).complex_vec(plan.num_coeffs());
         let (mut f, mut back) = (vec![zero; plan.num_samples()], vec![zero; c.len()]);
@@ -285,11 +277,7 @@ pub fn isa_roundtrips(
         report.push_errors(case, errors(&back, &c), start.elapsed().as_secs_f64(), "");
 
         let b = bw.s2;
-        let opts = S2Options {
-            isa: Some(isa),
-            threads,
-            ..Default::default()
-        };
+        let opts = Options::default().with_isa(Some(isa)).with_threads(threads);
         let plan = S2Plan::new(b, &opts)?;
         let c = SplitMix64::new(40 + b as u64).complex_vec(s2_num_coeffs(b));
         let (mut f, mut back) = (vec![zero; s2_num_samples(b)], vec![zero; c.len()]);

@@ -4,11 +4,8 @@
 
 use crate::record::{errors, errors_real, Case, Errors, Report};
 use crate::rng::SplitMix64;
-use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Options, S2Plan};
-use so3fft::{
-    coef_index, num_coeffs, num_samples, Complex64, PartialOptions, PartialPlan, Plan, PlanOptions,
-    Shape,
-};
+use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Plan};
+use so3fft::{coef_index, num_coeffs, num_samples, Complex64, Options, PartialPlan, Plan, Shape};
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -20,12 +17,12 @@ pub const ORDER_LIMIT: usize = 8;
 pub struct FullVariant {
     /// Row label.
     pub name: &'static str,
-    /// `PlanOptions::skip_bits`.
+    /// `Options::skip_bits`.
     pub skip_bits: Option<u32>,
 }
 
 /// The default plan, skipping off, and the skip thresholds of tolerances 1e-10 and 1e-6
-/// (`ceil(-log2 tol)` bits, at least 24, as `PartialOptions::tolerance` computes them).
+/// (`ceil(-log2 tol)` bits, at least 24).
 pub const FULL_VARIANTS: [FullVariant; 4] = [
     FullVariant {
         name: "complex",
@@ -186,11 +183,9 @@ pub fn full_complex(
     run: RunOptions,
     report: &mut Report,
 ) -> so3fft::Result<()> {
-    let opts = PlanOptions {
-        threads: run.threads,
-        skip_bits: variant.skip_bits,
-        ..Default::default()
-    };
+    let opts = Options::default()
+        .with_threads(run.threads)
+        .with_skip_bits(variant.skip_bits);
     let plan = Plan::new(b, &opts)?;
     let coeffs = SplitMix64::new(10 + b as u64).complex_vec(num_coeffs(b));
     let mut samples = vec![Complex64::new(0.0, 0.0); num_samples(b)];
@@ -199,7 +194,8 @@ pub fn full_complex(
     plan.forward(&samples, &mut back)?;
     let time = best_time(|| {
         plan.inverse(&coeffs, &mut samples)?;
-        plan.forward(&samples, &mut back)
+        plan.forward(&samples, &mut back)?;
+        Ok(())
     })?;
     let case = |test| Case {
         test,
@@ -238,11 +234,7 @@ pub fn full_complex(
 
 /// Full plan, real signals: rows `roundtrip`, `parseval`, `inv-fwd` with variant `real`.
 pub fn full_real(b: usize, run: RunOptions, report: &mut Report) -> so3fft::Result<()> {
-    let opts = PlanOptions {
-        threads: run.threads,
-        real: true,
-        ..Default::default()
-    };
+    let opts = Options::default().with_threads(run.threads).with_real(true);
     let plan = Plan::new(b, &opts)?;
     let mut coeffs = SplitMix64::new(20 + b as u64).complex_vec(num_coeffs(b));
     make_real_so3(&mut coeffs, b, b - 1, |l, m, mp| {
@@ -254,7 +246,8 @@ pub fn full_real(b: usize, run: RunOptions, report: &mut Report) -> so3fft::Resu
     plan.forward_real(&samples, &mut back)?;
     let time = best_time(|| {
         plan.inverse_real(&coeffs, &mut samples)?;
-        plan.forward_real(&samples, &mut back)
+        plan.forward_real(&samples, &mut back)?;
+        Ok(())
     })?;
     let case = |test| Case {
         test,
@@ -282,11 +275,7 @@ pub fn full_real(b: usize, run: RunOptions, report: &mut Report) -> so3fft::Resu
 /// rows `roundtrip`, `parseval`, `inv-fwd` with variant `partial-m8` / `partial-m8-real`.
 pub fn partial(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so3fft::Result<()> {
     let shape = Shape::new(b).with_orders(ORDER_LIMIT, ORDER_LIMIT);
-    let opts = PartialOptions {
-        threads: run.threads,
-        real,
-        ..Default::default()
-    };
+    let opts = Options::default().with_threads(run.threads).with_real(real);
     let plan = PartialPlan::new(&shape, &opts)?;
     let variant = if real {
         "partial-m8-real"
@@ -307,7 +296,7 @@ pub fn partial(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so
         plan.forward_real(&samples, &mut back)?;
         let time = best_time(|| {
             plan.inverse_real(&coeffs, &mut samples)?;
-            plan.forward_real(&samples, &mut back)
+            plan.forward_real(&samples, &mut back).map(|_| ())
         })?;
         let squares: Vec<f64> = samples.iter().map(|x| x * x).collect();
         let n2 = quadrature_norm2(&weights, shape.slice_len(), dphi2, &squares);
@@ -325,7 +314,7 @@ pub fn partial(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so
         plan.forward(&samples, &mut back)?;
         let time = best_time(|| {
             plan.inverse(&coeffs, &mut samples)?;
-            plan.forward(&samples, &mut back)
+            plan.forward(&samples, &mut back).map(|_| ())
         })?;
         let n2 = quadrature_norm2(&weights, shape.slice_len(), dphi2, &abs2(&samples));
         let mut again = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
@@ -344,10 +333,7 @@ pub fn partial(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so
 /// S^2 transforms, complex or real: rows `roundtrip`, `parseval`, `inv-fwd` with variant
 /// `s2-complex` / `s2-real`.
 pub fn sphere(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so3fft::Result<()> {
-    let opts = S2Options {
-        threads: run.threads,
-        ..Default::default()
-    };
+    let opts = Options::default().with_threads(run.threads);
     let plan = S2Plan::new(b, &opts)?;
     let variant = if real { "s2-real" } else { "s2-complex" };
     let case = |test| Case { test, b, variant };

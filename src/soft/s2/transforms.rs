@@ -6,7 +6,8 @@ use super::super::real::try_zeroed;
 use super::super::{guarded, SoftResult};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::CallError;
-use crate::s2::{s2_coef_index, S2Options, S2Plan};
+use crate::options::Options;
+use crate::s2::{s2_coef_index, S2Limits, S2Plan};
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_void};
 use std::sync::{Arc, Mutex, TryLockError};
@@ -59,9 +60,9 @@ impl S2Entry {
     }
 
     /// The plan of bandwidth `b` with `options`.
-    fn new(b: usize, options: &S2Options) -> crate::Result<S2Entry> {
+    fn new(b: usize, options: &Options) -> crate::Result<S2Entry> {
         Ok(S2Entry {
-            plan: S2Plan::new_on(b, options, Some(&layer_workers()?))?,
+            plan: S2Plan::new_on(b, S2Limits::default(), options, Some(&layer_workers()?))?,
             buffers: Mutex::new(None),
         })
     }

@@ -1,0 +1,110 @@
+//! [`Transform`]: the transforms every SO(3) plan offers, with one meaning for each, and
+//! [`Scratch`], workspace the caller owns.
+
+use crate::error::{Error, Result};
+use crate::fft::AlignedBuf;
+use crate::plan::StageTimes;
+use num_complex::Complex64;
+
+/// Workspace for a plan's `*_with_scratch` calls, owned by the caller (64-byte aligned,
+/// backed by huge pages where it is large). One scratch serves any plan whose
+/// [`Transform::scratch_bytes`] it holds, one call at a time.
+pub struct Scratch {
+    buf: AlignedBuf,
+}
+
+impl Scratch {
+    /// A scratch of at least `bytes` bytes (zero-filled and touched).
+    pub fn new(bytes: usize) -> Result<Scratch> {
+        crate::system::check_headroom(bytes)?;
+        Ok(Scratch {
+            buf: AlignedBuf::new(bytes.div_ceil(16))?,
+        })
+    }
+
+    /// A scratch for the calls of `plan`.
+    pub fn for_plan(plan: &(impl Transform + ?Sized)) -> Result<Scratch> {
+        Scratch::new(plan.scratch_bytes())
+    }
+
+    /// Its size in bytes.
+    pub fn bytes(&self) -> usize {
+        16 * self.buf.len()
+    }
+
+    /// The buffer, if it holds `bytes` bytes; else [`Error::LengthMismatch`].
+    pub(crate) fn holding(&self, bytes: usize) -> Result<&AlignedBuf> {
+        if self.bytes() < bytes {
+            return Err(Error::LengthMismatch {
+                what: "scratch bytes",
+                expected: bytes,
+                got: self.bytes(),
+            });
+        }
+        Ok(&self.buf)
+    }
+}
+
+/// The transforms of an SO(3) plan ([`Plan`](crate::Plan), [`PartialPlan`](crate::PartialPlan)):
+/// forward (samples to coefficients), inverse, and their real-signal forms, each returning
+/// the wall time of its stages. The plain calls use the plan's own workspace (made with the
+/// plan or on first use; a call that finds it taken by a concurrent one gets a private
+/// workspace while memory allows, see `docs/c-api.md`); the `*_with_scratch` calls use
+/// the caller's [`Scratch`] and allocate nothing. Both give the same results, bit for bit.
+///
+/// Lengths: [`Transform::num_samples`] samples (complex, or real for the real forms) and
+/// [`Transform::num_coeffs`] coefficients, else [`Error::LengthMismatch`].
+pub trait Transform {
+    /// Samples of one transform.
+    fn num_samples(&self) -> usize;
+
+    /// Coefficients of one transform.
+    fn num_coeffs(&self) -> usize;
+
+    /// Bytes of [`Scratch`] the `*_with_scratch` calls need.
+    fn scratch_bytes(&self) -> usize;
+
+    /// Forward transform: samples to coefficients.
+    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes>;
+
+    /// Inverse transform: coefficients to samples.
+    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes>;
+
+    /// Forward transform of real samples (a plan made with [`Options::real`](crate::Options::real)).
+    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes>;
+
+    /// Inverse transform to real samples (a plan made with [`Options::real`](crate::Options::real)).
+    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes>;
+
+    /// [`Transform::forward`] in the caller's scratch.
+    fn forward_with_scratch(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes>;
+
+    /// [`Transform::inverse`] in the caller's scratch.
+    fn inverse_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes>;
+
+    /// [`Transform::forward_real`] in the caller's scratch.
+    fn forward_real_with_scratch(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes>;
+
+    /// [`Transform::inverse_real`] in the caller's scratch.
+    fn inverse_real_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes>;
+}
