@@ -67,10 +67,8 @@ fn bench(comm: &MpiExchange, b: usize, threads: usize, runs: usize) -> so3fft::R
     let (mut dwt, mut fft) = (Vec::new(), Vec::new());
     for _ in 0..runs {
         // Round trips in place: the coefficients come back to rounding each time.
-        plan.inverse(&c, &mut x)?;
-        let ti = plan.last_times();
-        plan.forward(&x, &mut c)?;
-        let tf = plan.last_times();
+        let ti = plan.inverse(&c, &mut x)?;
+        let tf = plan.forward(&x, &mut c)?;
         inv.push(ti.total);
         fwd.push(tf.total);
         ex.push((ti.exchange + tf.exchange) / (ti.total + tf.total));

@@ -32,6 +32,14 @@ impl Scratch {
         16 * self.buf.len()
     }
 
+    /// Its first `len` doubles, if it holds them; else [`Error::LengthMismatch`].
+    pub(crate) fn doubles(&mut self, len: usize) -> Result<&mut [f64]> {
+        let buf = self.holding(8 * len)?;
+        // SAFETY: the buffer holds at least `len` doubles, initialised (zero-filled at
+        // creation) and owned by `self`, which `&mut self` borrows exclusively.
+        Ok(unsafe { std::slice::from_raw_parts_mut(buf.as_mut_ptr().cast::<f64>(), len) })
+    }
+
     /// The buffer, if it holds `bytes` bytes; else [`Error::LengthMismatch`].
     pub(crate) fn holding(&self, bytes: usize) -> Result<&AlignedBuf> {
         if self.bytes() < bytes {

@@ -5,8 +5,12 @@
 
 mod common;
 
-use common::{direct_inverse, make_hermitian, Rng};
-use so3fft::{Complex64, Error, Isa, Options, PartialPlan, Plan, Scratch, Shape, Transform};
+use common::{direct_inverse, Rng};
+use so3fft::s2::S2Plan;
+use so3fft::{
+    Complex64, DistributedPlan, Error, Exchange, Isa, Options, PartialPlan, Plan, Scratch, Shape,
+    ThreadExchange, Transform,
+};
 
 fn isas() -> impl Iterator<Item = Isa> {
     [Isa::Avx512, Isa::Avx2, Isa::Scalar]
@@ -25,8 +29,9 @@ fn max_diff(a: &[Complex64], b: &[Complex64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Every transform of `plan` in `scratch` against the plain call: identical bits. Returns
-/// the complex inverse of `coeffs` and the forward of that (for the caller's truth).
+/// Every transform of `plan` in `scratch` against the plain call: identical bits; the real
+/// round trip on the samples' side. Returns the complex inverse of `coeffs` and the
+/// forward of that (for the caller's truth).
 fn same_with_scratch(
     plan: &dyn Transform,
     coeffs: &[Complex64],
@@ -57,7 +62,16 @@ fn same_with_scratch(
     plan.forward_real_with_scratch(&r, &mut rcs, scratch)
         .unwrap();
     assert_eq!(bits(&rc), bits(&rcs), "real forward");
-    assert!(max_diff(&rc, real_coeffs) < 1e-12, "real round trip");
+    // The real samples of any coefficients are band-limited: their transform gives them
+    // back.
+    let mut r2 = vec![0.0; ns];
+    plan.inverse_real(&rc, &mut r2).unwrap();
+    let err = r
+        .iter()
+        .zip(&r2)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(err < 1e-12, "real round trip {err:e}");
     (x, c)
 }
 
@@ -67,8 +81,7 @@ fn plan_with_scratch() {
     let b = 6;
     let mut rng = Rng::new(7);
     let coeffs = rng.complex_vec(so3fft::num_coeffs(b));
-    let mut hc = coeffs.clone();
-    make_hermitian(&Shape::new(b), &mut hc);
+    let other = rng.complex_vec(so3fft::num_coeffs(b));
     let direct = direct_inverse(b, &coeffs);
     for isa in isas() {
         let opts = Options::default()
@@ -80,7 +93,7 @@ fn plan_with_scratch() {
         assert!(scratch.bytes() >= plan.scratch_bytes());
         // Twice: a scratch left dirty by earlier calls changes nothing.
         for _ in 0..2 {
-            let (x, c) = same_with_scratch(&plan, &coeffs, &hc, &mut scratch);
+            let (x, c) = same_with_scratch(&plan, &coeffs, &other, &mut scratch);
             assert!(
                 max_diff(&x, &direct) < 1e-12,
                 "{isa:?}: against direct sums"
@@ -104,8 +117,7 @@ fn partial_plans_with_scratch() {
     for s in shapes {
         let mut rng = Rng::new(11);
         let coeffs = rng.complex_vec(s.num_coeffs());
-        let mut hc = coeffs.clone();
-        make_hermitian(&s, &mut hc);
+        let other = rng.complex_vec(s.num_coeffs());
         for isa in isas() {
             for general in [false, true] {
                 let opts = Options::default()
@@ -115,11 +127,57 @@ fn partial_plans_with_scratch() {
                     .with_general_engine(general);
                 let plan = PartialPlan::new(&s, &opts).unwrap();
                 let mut scratch = Scratch::new(plan.scratch_bytes()).unwrap();
-                let (_, c) = same_with_scratch(&plan, &coeffs, &hc, &mut scratch);
+                let (_, c) = same_with_scratch(&plan, &coeffs, &other, &mut scratch);
                 assert!(max_diff(&c, &coeffs) < 1e-12, "{s:?} {isa:?}: round trip");
             }
         }
     }
+}
+
+/// S^2 plans: the same in their ring scratch; the round trip is exact.
+#[test]
+fn s2_plans_with_scratch() {
+    for b in [1, 5, 16] {
+        let mut rng = Rng::new(13);
+        for isa in isas() {
+            let plan =
+                S2Plan::new(b, &Options::default().with_threads(2).with_isa(Some(isa))).unwrap();
+            let coeffs = rng.complex_vec(plan.num_coeffs());
+            let other = rng.complex_vec(plan.num_coeffs());
+            let mut scratch = Scratch::for_plan(&plan).unwrap();
+            let (_, c) = same_with_scratch(&plan, &coeffs, &other, &mut scratch);
+            assert!(max_diff(&c, &coeffs) < 1e-12, "B {b} {isa:?}: round trip");
+        }
+    }
+}
+
+/// Distributed plans (two ranks on threads): the same on each rank's share, in each rank's
+/// scratch; a scratch too small on one rank fails both (collectively, none waits).
+#[test]
+fn distributed_plans_with_scratch() {
+    let s = Shape::new(7).with_grid(8, 16, 16);
+    let group = ThreadExchange::group(2);
+    std::thread::scope(|scope| {
+        for comm in &group {
+            scope.spawn(move || {
+                let opts = Options::default().with_threads(1).with_real(true);
+                let plan = DistributedPlan::new(comm, &s, &opts).unwrap();
+                let mut rng = Rng::new(17 + comm.rank() as u64);
+                let coeffs = rng.complex_vec(plan.local_num_coeffs());
+                let other = rng.complex_vec(plan.local_num_coeffs());
+                let mut scratch = Scratch::for_plan(&plan).unwrap();
+                let (_, c) = same_with_scratch(&plan, &coeffs, &other, &mut scratch);
+                assert!(max_diff(&c, &coeffs) < 1e-12, "round trip");
+                // Rank 1's scratch is too small: both ranks get an error.
+                let bytes = if comm.rank() == 1 { 8 } else { scratch.bytes() };
+                let mut small = Scratch::new(bytes).unwrap();
+                let mut x = vec![Complex64::default(); plan.local_num_samples()];
+                assert!(plan
+                    .inverse_with_scratch(&coeffs, &mut x, &mut small)
+                    .is_err());
+            });
+        }
+    });
 }
 
 /// A scratch smaller than the plan needs is refused before anything runs; a larger one
@@ -132,7 +190,8 @@ fn scratch_too_small_is_an_error() {
         &Options::default().with_threads(1),
     )
     .unwrap();
-    let plans: [&dyn Transform; 2] = [&plan, &partial];
+    let s2 = S2Plan::new(8, &Options::default().with_threads(1)).unwrap();
+    let plans: [&dyn Transform; 3] = [&plan, &partial, &s2];
     for p in plans {
         let mut small = Scratch::new(p.scratch_bytes() / 2).unwrap();
         let c = vec![Complex64::new(1.0, 0.0); p.num_coeffs()];

@@ -226,6 +226,7 @@ unsafe fn execute(
             ),
         }
     }
+    .map(|_| ())
     .map_err(CallError::from)
 }
 

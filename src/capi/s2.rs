@@ -225,7 +225,7 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward_many(
                     k * plan.num_coeffs(),
                     "coefficients",
                 ),
-                |s, c| plan.forward_many(s, c, k),
+                |s, c| plan.forward_many(s, c, k).map(|_| ()),
             )
         }
     })
@@ -256,7 +256,7 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse_many(
                     k * plan.num_samples(),
                     "samples",
                 ),
-                |c, s| plan.inverse_many(c, s, k),
+                |c, s| plan.inverse_many(c, s, k).map(|_| ()),
             )
         }
     })
@@ -284,7 +284,7 @@ pub unsafe extern "C" fn so3fft_s2_execute_forward_real_many(
                     k * plan.num_coeffs(),
                     "coefficients",
                 ),
-                |s, c| plan.forward_real_many(s, c, k),
+                |s, c| plan.forward_real_many(s, c, k).map(|_| ()),
             )
         }
     })
@@ -311,7 +311,7 @@ pub unsafe extern "C" fn so3fft_s2_execute_inverse_real_many(
                     "coefficients",
                 ),
                 (samples, k * plan.num_samples(), "samples"),
-                |c, s| plan.inverse_real_many(c, s, k),
+                |c, s| plan.inverse_real_many(c, s, k).map(|_| ()),
             )
         }
     })

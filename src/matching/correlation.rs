@@ -10,6 +10,7 @@ use crate::grid::{coef_index, num_coeffs};
 use crate::options::{Direction, Options};
 use crate::partial::{PartialPlan, Shape};
 use crate::plan::SliceRef;
+use crate::plan::StageTimes;
 use crate::s2::{S2Limits, S2Plan};
 use crate::workers::WorkerPool;
 use crate::Rigor;
@@ -179,7 +180,7 @@ impl Correlation {
         &self,
         (signal, pattern, weight): (&[T], &[T], f64),
         (forward, half, mode): (
-            &impl Fn(&[T], &mut [Complex64]) -> Result<()>,
+            &impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes>,
             bool,
             Combine,
         ),
@@ -229,7 +230,7 @@ impl Correlation {
     fn combine_shells<T>(
         &self,
         shells: &[(&[T], &[T], f64)],
-        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()>, bool),
+        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes>, bool),
         buf: &mut Buffers,
     ) -> Result<()> {
         if shells.is_empty() {
@@ -467,7 +468,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(false)?;
         let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g).map(|_| ());
+        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
         self.many((signal, patterns, out), (forward, false), inverse)
     }
 
@@ -480,7 +481,7 @@ impl Correlation {
     ) -> Result<()> {
         self.need(true)?;
         let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g).map(|_| ());
+        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
         self.many((signal, patterns, out), (forward, true), inverse)
     }
 
@@ -489,8 +490,11 @@ impl Correlation {
     fn many<T: Sync, G: Send>(
         &self,
         (signal, patterns, out): (&[T], &[T], &mut [G]),
-        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<()> + Sync, bool),
-        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<()> + Sync,
+        (forward, half): (
+            impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes> + Sync,
+            bool,
+        ),
+        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<StageTimes> + Sync,
     ) -> Result<()> {
         let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
         check_many(patterns.len(), ns, out.len(), ng)?;
@@ -501,7 +505,7 @@ impl Correlation {
             let known = |x: &[T], c: &mut [Complex64]| {
                 if std::ptr::eq(x, signal) {
                     c.copy_from_slice(&sig);
-                    Ok(())
+                    Ok(StageTimes::default())
                 } else {
                     forward(x, c)
                 }

@@ -32,7 +32,9 @@ use crate::dwt::Prefetch;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::{Betas, Direction, Options};
+use crate::plan::StageTimes;
 use crate::simd::Isa;
+use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -69,19 +71,6 @@ impl std::ops::DerefMut for Rows {
     }
 }
 
-/// Wall times of a distributed transform's parts on this rank, in seconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct DistributedTimes {
-    /// The slice DFTs and the moves between slices and lane rows.
-    pub fft: f64,
-    /// The all-to-all exchange (with the packing around it).
-    pub exchange: f64,
-    /// The DWT stage.
-    pub dwt: f64,
-    /// The whole call.
-    pub total: f64,
-}
-
 /// A rank's share of the betas and the clusters.
 struct Share {
     /// Lane pairs `j0 .. j1`.
@@ -109,8 +98,6 @@ struct GroupRows {
 pub struct DistributedPlan<X: Exchange> {
     comm: X,
     parts: Parts,
-    /// Times of the last transform on this rank.
-    last: std::sync::Mutex<DistributedTimes>,
     /// The FFT stage's lane rows of other ranks' clusters (`a`) and the DWT stage's lane
     /// rows (`b`), kept between transforms.
     rows: std::sync::Mutex<Option<(Rows, Rows)>>,
@@ -246,7 +233,6 @@ impl<X: Exchange> DistributedPlan<X> {
         Ok(DistributedPlan {
             comm,
             parts,
-            last: std::sync::Mutex::new(DistributedTimes::default()),
             rows: std::sync::Mutex::new(None),
         })
     }
@@ -478,46 +464,43 @@ impl<X: Exchange> DistributedPlan<X> {
         check_length("local coefficients", self.parts.local_coeffs, coeffs)
     }
 
-    /// Forward (collective): this rank's samples to this rank's coefficients.
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
+    /// Forward (collective): this rank's samples to this rank's coefficients; the time of
+    /// each stage on this rank.
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
         collective(
             &self.comm,
             self.check(true, false, samples.len(), coeffs.len()),
         )?;
-        self.forward_impl(SendConstPtr(samples.as_ptr().cast()), coeffs, false)
+        self.forward_impl(SendConstPtr(samples.as_ptr().cast()), coeffs, (false, None))
     }
 
     /// Forward of real samples (collective; plan made with `real`).
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
         collective(
             &self.comm,
             self.check(true, true, samples.len(), coeffs.len()),
         )?;
-        self.forward_impl(SendConstPtr(samples.as_ptr()), coeffs, true)
+        self.forward_impl(SendConstPtr(samples.as_ptr()), coeffs, (true, None))
     }
 
-    /// Inverse (collective): this rank's coefficients to this rank's samples.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
+    /// Inverse (collective): this rank's coefficients to this rank's samples; the time of
+    /// each stage on this rank.
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
         collective(
             &self.comm,
             self.check(false, false, samples.len(), coeffs.len()),
         )?;
-        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr().cast()), false)
+        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr().cast()), (false, None))
     }
 
     /// Inverse to real samples (collective; reads the representatives as
     /// [`PartialPlan::inverse_real`](super::PartialPlan::inverse_real)).
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
         collective(
             &self.comm,
             self.check(false, true, samples.len(), coeffs.len()),
         )?;
-        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr()), true)
-    }
-
-    /// Times of this rank's part of the last transform.
-    pub fn last_times(&self) -> DistributedTimes {
-        *self.last.lock().unwrap_or_else(|e| e.into_inner())
+        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr()), (true, None))
     }
 
     /// Bytes this rank holds during a transform besides its arrays (known at plan time, taken
@@ -563,14 +546,35 @@ impl<X: Exchange> DistributedPlan<X> {
         }
     }
 
+    /// Runs `f` on the two row buffers (see [`DistributedPlan::take_rows`]): in the
+    /// caller's `scratch` if given (collective: a scratch too small on any rank fails
+    /// every rank), else the plan's.
+    fn with_rows<R>(
+        &self,
+        scratch: Option<&mut Scratch>,
+        f: impl FnOnce(&mut [f64], &mut [f64]) -> Result<R>,
+    ) -> Result<R> {
+        let (na, nb) = self.row_sizes();
+        let gap = na.next_multiple_of(8);
+        match scratch {
+            Some(s) => {
+                let rows = collective(&self.comm, s.doubles(gap + nb))?;
+                let (a, b) = rows.split_at_mut(gap);
+                f(&mut a[..na], b)
+            }
+            None => {
+                let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
+                let r = f(&mut a, &mut b);
+                self.put_rows((a, b));
+                r
+            }
+        }
+    }
+
     fn put_rows(&self, rows: (Rows, Rows)) {
         if let Ok(mut g) = self.rows.try_lock() {
             *g = Some(rows);
         }
-    }
-
-    fn record(&self, t: DistributedTimes) {
-        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = t;
     }
 
     /// Where the rows of group `k` are on this rank (made once per group of a transform).
@@ -704,14 +708,23 @@ impl<X: Exchange> DistributedPlan<X> {
         &self,
         inp: SendConstPtr<f64>,
         coeffs: &mut [Complex64],
+        (real, scratch): (bool, Option<&mut Scratch>),
+    ) -> Result<StageTimes> {
+        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
+        self.with_rows(scratch, |a, b| self.forward_rows(inp, coeffs, real, (a, b)))
+    }
+
+    fn forward_rows(
+        &self,
+        inp: SendConstPtr<f64>,
+        coeffs: &mut [Complex64],
         real: bool,
-    ) -> Result<()> {
+        (a, b): (&mut [f64], &mut [f64]),
+    ) -> Result<StageTimes> {
         let g = &self.parts.general;
         let slice_len = self.parts.shape.slice_len();
-        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
-        let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
         let per_value = if real { 1 } else { 2 };
-        let mut times = DistributedTimes::default();
+        let mut times = StageTimes::default();
         let start = std::time::Instant::now();
         for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
@@ -747,7 +760,7 @@ impl<X: Exchange> DistributedPlan<X> {
             });
             collective(&self.comm, done)?;
             let t1 = std::time::Instant::now();
-            self.exchange((&mut a[..], &mut b[..]), true, &gr)?;
+            self.exchange((&mut *a, &mut *b), true, &gr)?;
             // Padding lanes: the kernel multiplies them by exact zeros, which must not meet
             // a non-finite value an inverse left there.
             for half in 0..2 {
@@ -778,18 +791,30 @@ impl<X: Exchange> DistributedPlan<X> {
             times.dwt += (t3 - t2).as_secs_f64();
         }
         times.total = start.elapsed().as_secs_f64();
-        self.record(times);
-        self.put_rows((a, b));
-        Ok(())
+        Ok(times)
     }
 
-    fn inverse_impl(&self, coeffs: &[Complex64], out: SendPtr<f64>, real: bool) -> Result<()> {
+    fn inverse_impl(
+        &self,
+        coeffs: &[Complex64],
+        out: SendPtr<f64>,
+        (real, scratch): (bool, Option<&mut Scratch>),
+    ) -> Result<StageTimes> {
+        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
+        self.with_rows(scratch, |a, b| self.inverse_rows(coeffs, out, real, (a, b)))
+    }
+
+    fn inverse_rows(
+        &self,
+        coeffs: &[Complex64],
+        out: SendPtr<f64>,
+        real: bool,
+        (a, b): (&mut [f64], &mut [f64]),
+    ) -> Result<StageTimes> {
         let g = &self.parts.general;
         let slice_len = self.parts.shape.slice_len();
         let start = std::time::Instant::now();
-        // A rank that cannot have its buffers fails every rank (none waits in an exchange).
-        let (mut a, mut b) = collective(&self.comm, self.take_rows())?;
-        let mut times = DistributedTimes::default();
+        let mut times = StageTimes::default();
         let mut done: Result<()> = Ok(());
         for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
@@ -819,7 +844,7 @@ impl<X: Exchange> DistributedPlan<X> {
                 })
             });
             let t1 = std::time::Instant::now();
-            self.exchange((&mut a[..], &mut b[..]), false, &gr)?;
+            self.exchange((&mut *a, &mut *b), false, &gr)?;
             let t2 = std::time::Instant::now();
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
             let slices = self.group_slices(k);
@@ -857,8 +882,96 @@ impl<X: Exchange> DistributedPlan<X> {
             times.fft += (t3 - t2).as_secs_f64();
         }
         times.total = start.elapsed().as_secs_f64();
-        self.record(times);
-        self.put_rows((a, b));
-        collective(&self.comm, done)
+        collective(&self.comm, done).map(|()| times)
+    }
+}
+
+impl<X: Exchange> Transform for DistributedPlan<X> {
+    /// This rank's samples.
+    fn num_samples(&self) -> usize {
+        self.local_num_samples()
+    }
+
+    /// This rank's coefficients.
+    fn num_coeffs(&self) -> usize {
+        self.local_num_coeffs()
+    }
+
+    /// This rank's two row buffers (see [`DistributedPlan::local_workspace_bytes`]).
+    fn scratch_bytes(&self) -> usize {
+        let (na, nb) = self.row_sizes();
+        8 * (na.next_multiple_of(8) + nb)
+    }
+
+    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        DistributedPlan::forward(self, samples, coeffs)
+    }
+
+    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+        DistributedPlan::inverse(self, coeffs, samples)
+    }
+
+    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        DistributedPlan::forward_real(self, samples, coeffs)
+    }
+
+    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        DistributedPlan::inverse_real(self, coeffs, samples)
+    }
+
+    fn forward_with_scratch(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        collective(
+            &self.comm,
+            self.check(true, false, samples.len(), coeffs.len()),
+        )?;
+        let inp = SendConstPtr(samples.as_ptr().cast());
+        self.forward_impl(inp, coeffs, (false, Some(scratch)))
+    }
+
+    fn inverse_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        collective(
+            &self.comm,
+            self.check(false, false, samples.len(), coeffs.len()),
+        )?;
+        let out = SendPtr(samples.as_mut_ptr().cast());
+        self.inverse_impl(coeffs, out, (false, Some(scratch)))
+    }
+
+    fn forward_real_with_scratch(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        collective(
+            &self.comm,
+            self.check(true, true, samples.len(), coeffs.len()),
+        )?;
+        let inp = SendConstPtr(samples.as_ptr());
+        self.forward_impl(inp, coeffs, (true, Some(scratch)))
+    }
+
+    fn inverse_real_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        collective(
+            &self.comm,
+            self.check(false, true, samples.len(), coeffs.len()),
+        )?;
+        let out = SendPtr(samples.as_mut_ptr());
+        self.inverse_impl(coeffs, out, (true, Some(scratch)))
     }
 }

@@ -1,9 +1,9 @@
 //! Partial plans: SO(3) transforms that compute only what a [`Shape`] holds (degree and
-//! order limits, other sample grids), at selected betas ([`Betas`]), several at once
+//! order limits, other sample grids), at selected betas ([`Betas`](crate::Betas)), several at once
 //! ([`Batch`]), complex or real. See `docs/partial-plans.md`.
 //!
 //! - `shape`: [`Shape`], its validation and coefficient layout;
-//! - `betas`: [`Betas`] and the kernels' lane pairs of a beta and its mirror;
+//! - `betas`: [`Betas`](crate::Betas) (options) and the kernels' lane pairs of a beta and its mirror;
 //! - `dwt_stage`: the clusters of a shape and their kernel calls;
 //! - `fft_stage`: pruned slice DFTs;
 //! - `options`: [`Batch`];
@@ -30,7 +30,7 @@ mod slots;
 #[cfg(test)]
 mod tests;
 
-pub use distributed::{DistributedPlan, DistributedTimes};
+pub use distributed::DistributedPlan;
 pub use exchange::{Exchange, ThreadExchange};
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};

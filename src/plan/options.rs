@@ -11,6 +11,8 @@ pub struct StageTimes {
     /// Discrete Wigner transform stage: recurrence coefficients, starting values, kernels,
     /// and the coefficients' gather (inverse) or accumulation (forward).
     pub dwt: f64,
+    /// Distributed plans: the exchange between the ranks (0 for the other plans).
+    pub exchange: f64,
     /// Whole call.
     pub total: f64,
 }
@@ -20,6 +22,7 @@ impl std::ops::AddAssign for StageTimes {
     fn add_assign(&mut self, other: StageTimes) {
         self.fft += other.fft;
         self.dwt += other.dwt;
+        self.exchange += other.exchange;
         self.total += other.total;
     }
 }

@@ -6,13 +6,16 @@ use super::rings::RingFft;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::Options;
+use crate::plan::StageTimes;
 use crate::simd::Isa;
 use crate::system::check_headroom;
+use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::Mutex;
+use std::time::Instant;
 
 /// Largest bandwidth of the S^2 transforms.
 pub const S2_MAX_BANDWIDTH: usize = 4096;
@@ -170,14 +173,21 @@ impl S2Plan {
         Ok(())
     }
 
-    /// Runs `f` with the plan's ring scratch (and, with `two`, its second one, made on
-    /// first use), or with new ones when they are in use.
+    /// Runs `f` with the caller's `scratch` if given (checked to hold the ring scratch),
+    /// else the plan's ring scratch (and, with `two`, its second one, made on first use),
+    /// or with new ones when they are in use.
     fn with_scratch<R>(
         &self,
-        two: bool,
+        (two, scratch): (bool, Option<&Scratch>),
         f: impl FnOnce(&AlignedBuf, Option<&AlignedBuf>) -> Result<R>,
     ) -> Result<R> {
         let len = scratch_len(self.b);
+        if let Some(s) = scratch {
+            let a = s.holding(16 * len)?;
+            if !two {
+                return f(a, None);
+            }
+        }
         let mut first = try_take(&self.scratch);
         let own = match first.as_mut() {
             Some(g) => g.as_ref(),
@@ -283,9 +293,10 @@ impl S2Plan {
         ([g(m as isize), g(-(m as isize))], if m > 0 { 2 } else { 1 })
     }
 
-    /// Forward transform of complex samples (`(2B)^2`, ring-major) into `B^2` coefficients.
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_many(samples, coeffs, 1)
+    /// Forward transform of complex samples (`(2B)^2`, ring-major) into `B^2` coefficients;
+    /// the time of each stage (`fft`: the ring DFTs, `dwt`: the Legendre stage).
+    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        self.forward_in((samples, coeffs, 1), None)
     }
 
     /// [`S2Plan::forward`] of `howmany` fields stored one after another (`howmany (2B)^2`
@@ -295,11 +306,22 @@ impl S2Plan {
         samples: &[Complex64],
         coeffs: &mut [Complex64],
         howmany: usize,
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
+        self.forward_in((samples, coeffs, howmany), None)
+    }
+
+    /// [`S2Plan::forward_many`] in the caller's `scratch` if given.
+    fn forward_in(
+        &self,
+        (samples, coeffs, howmany): (&[Complex64], &mut [Complex64], usize),
+        scratch: Option<&Scratch>,
+    ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
+        let start = Instant::now();
+        let mut times = StageTimes::default();
         let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = (2.0 * PI).sqrt() / n as f64;
-        self.with_scratch(false, |buf, _| {
+        self.with_scratch((false, scratch), |buf, _| {
             for (field, out) in samples.chunks_exact(n * n).zip(coeffs.chunks_exact_mut(nc)) {
                 let spectra = Spectra {
                     base: buf.as_mut_ptr(),
@@ -308,24 +330,31 @@ impl S2Plan {
                 };
                 let coef = self.coeff_rows(out.as_mut_ptr());
                 self.workers.pool().install(|| {
+                    let t0 = Instant::now();
                     let src = SendConstPtr(field.as_ptr());
                     self.rings_complex(buf.as_mut_ptr(), true, RingCopy::From(src))?;
+                    let t1 = Instant::now();
                     (0..b).into_par_iter().for_each(|m| {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
                         // SAFETY: each task handles orders +-m only; the spectra and the
                         // coefficient array are whole (lengths checked).
                         unsafe { self.analyse(m, &groups[..count], factor) }
                     });
+                    times.fft += (t1 - t0).as_secs_f64();
+                    times.dwt += t1.elapsed().as_secs_f64();
                     Ok::<(), Error>(())
                 })?;
             }
             Ok(())
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
-    /// Inverse transform of `B^2` coefficients into complex samples.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<()> {
-        self.inverse_many(coeffs, samples, 1)
+    /// Inverse transform of `B^2` coefficients into complex samples; the time of each
+    /// stage.
+    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+        self.inverse_in((coeffs, samples, 1), None)
     }
 
     /// [`S2Plan::inverse`] of `howmany` fields stored one after another.
@@ -334,11 +363,22 @@ impl S2Plan {
         coeffs: &[Complex64],
         samples: &mut [Complex64],
         howmany: usize,
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
+        self.inverse_in((coeffs, samples, howmany), None)
+    }
+
+    /// [`S2Plan::inverse_many`] in the caller's `scratch` if given.
+    fn inverse_in(
+        &self,
+        (coeffs, samples, howmany): (&[Complex64], &mut [Complex64], usize),
+        scratch: Option<&Scratch>,
+    ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
+        let start = Instant::now();
+        let mut times = StageTimes::default();
         let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
         let factor = 1.0 / (2.0 * PI).sqrt();
-        self.with_scratch(false, |buf, _| {
+        self.with_scratch((false, scratch), |buf, _| {
             for (field, out) in coeffs.chunks_exact(nc).zip(samples.chunks_exact_mut(n * n)) {
                 // Straight into the output where FFTW may run on it, else through the scratch.
                 let direct = RingFft::aligned(out.as_ptr().cast());
@@ -355,28 +395,35 @@ impl S2Plan {
                 let data = SendPtr(data);
                 let coef = self.coeff_rows(field.as_ptr().cast_mut());
                 self.workers.pool().install(|| {
+                    let t0 = Instant::now();
                     (0..b).into_par_iter().for_each(|m| {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
                         // SAFETY: each task writes the columns of orders +-m only and reads
                         // their coefficient blocks (never written).
                         unsafe { self.synthesise(m, &groups[..count], factor) }
                     });
+                    let t1 = Instant::now();
                     // The frequency B is never used.
                     for k in 0..n {
                         // SAFETY: column B of ring k, inside the n*n values at `data`.
                         unsafe { *data.get().add(k * n + b) = Complex64::default() };
                     }
-                    self.rings_complex(data.get(), false, copy)
+                    self.rings_complex(data.get(), false, copy)?;
+                    times.dwt += (t1 - t0).as_secs_f64();
+                    times.fft += t1.elapsed().as_secs_f64();
+                    Ok::<(), Error>(())
                 })?;
             }
             Ok(())
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
     /// Forward transform of real samples: all `B^2` coefficients, with
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<()> {
-        self.forward_real_many(samples, coeffs, 1)
+    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        self.forward_real_in((samples, coeffs, 1), None)
     }
 
     /// [`S2Plan::forward_real`] of `howmany` fields stored one after another. Two fields
@@ -386,10 +433,21 @@ impl S2Plan {
         samples: &[f64],
         coeffs: &mut [Complex64],
         howmany: usize,
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
+        self.forward_real_in((samples, coeffs, howmany), None)
+    }
+
+    /// [`S2Plan::forward_real_many`] in the caller's `scratch` if given (one field).
+    fn forward_real_in(
+        &self,
+        (samples, coeffs, howmany): (&[f64], &mut [Complex64], usize),
+        scratch: Option<&Scratch>,
+    ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
+        let start = Instant::now();
+        let mut times = StageTimes::default();
         let (n, nc) = (2 * self.b, self.num_coeffs());
-        self.with_scratch(howmany > 1, |first, second| {
+        self.with_scratch((howmany > 1, scratch), |first, second| {
             for (fields, outs) in samples.chunks(2 * n * n).zip(coeffs.chunks_mut(2 * nc)) {
                 let (mut ins, mut outs2) = ([&[][..]; 2], [&mut [][..], &mut [][..]]);
                 let mut count = 0;
@@ -397,10 +455,13 @@ impl S2Plan {
                     (ins[count], outs2[count]) = (field, out);
                     count += 1;
                 }
-                self.real_analysis([Some(first), second], &ins[..count], &mut outs2[..count])?;
+                times +=
+                    self.real_analysis([Some(first), second], &ins[..count], &mut outs2[..count])?;
             }
             Ok(())
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
     /// [`S2Plan::forward_real`] of two fields held in two separate arrays, sharing the
@@ -409,14 +470,17 @@ impl S2Plan {
         &self,
         samples: [&[f64]; 2],
         coeffs: [&mut [Complex64]; 2],
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
         for (s, c) in samples.iter().zip(&coeffs) {
             self.check(s.len(), c.len(), 1)?;
         }
+        let start = Instant::now();
         let [a, b] = coeffs;
-        self.with_scratch(true, |first, second| {
+        let mut times = self.with_scratch((true, None), |first, second| {
             self.real_analysis([Some(first), second], &samples, &mut [a, b])
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
     /// The real analysis of one or two fields (`fields[i]` into `outs[i]`, checked
@@ -426,16 +490,22 @@ impl S2Plan {
         bufs: [Option<&AlignedBuf>; 2],
         fields: &[&[f64]],
         outs: &mut [&mut [Complex64]],
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
         let factor = (2.0 * PI).sqrt() / (2 * self.b) as f64;
+        let t0 = Instant::now();
         let mut groups = [None; 2];
         for (i, (field, out)) in fields.iter().zip(outs.iter_mut()).enumerate().take(2) {
             let buf = bufs[i].expect("a second scratch for two fields");
             groups[i] = Some(self.real_rings_forward(buf, field, out)?);
         }
+        let t1 = Instant::now();
         // SAFETY: as in `forward_many`; each field has its own spectra and coefficients.
         unsafe { self.real_orders(groups, factor, true) };
-        Ok(())
+        Ok(StageTimes {
+            fft: (t1 - t0).as_secs_f64(),
+            dwt: t1.elapsed().as_secs_f64(),
+            ..StageTimes::default()
+        })
     }
 
     /// The Legendre stage of every order for one or two real fields (`groups[1]` `None` for
@@ -519,8 +589,8 @@ impl S2Plan {
     /// Inverse transform into real samples: reads the orders `m >= 0` and takes
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))` (imaginary parts of `fhat(l, 0)` are
     /// ignored).
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<()> {
-        self.inverse_real_many(coeffs, samples, 1)
+    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        self.inverse_real_in((coeffs, samples, 1), None)
     }
 
     /// [`S2Plan::inverse_real`] of `howmany` fields stored one after another, two fields
@@ -530,10 +600,21 @@ impl S2Plan {
         coeffs: &[Complex64],
         samples: &mut [f64],
         howmany: usize,
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
+        self.inverse_real_in((coeffs, samples, howmany), None)
+    }
+
+    /// [`S2Plan::inverse_real_many`] in the caller's `scratch` if given (one field).
+    fn inverse_real_in(
+        &self,
+        (coeffs, samples, howmany): (&[Complex64], &mut [f64], usize),
+        scratch: Option<&Scratch>,
+    ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
+        let start = Instant::now();
+        let mut times = StageTimes::default();
         let (n, nc) = (2 * self.b, self.num_coeffs());
-        self.with_scratch(howmany > 1, |first, second| {
+        self.with_scratch((howmany > 1, scratch), |first, second| {
             for (fields, outs) in coeffs.chunks(2 * nc).zip(samples.chunks_mut(2 * n * n)) {
                 let (mut ins, mut outs2) = ([&[][..]; 2], [&mut [][..], &mut [][..]]);
                 let mut count = 0;
@@ -541,10 +622,13 @@ impl S2Plan {
                     (ins[count], outs2[count]) = (field, out);
                     count += 1;
                 }
-                self.real_synthesis([Some(first), second], &ins[..count], &mut outs2[..count])?;
+                times +=
+                    self.real_synthesis([Some(first), second], &ins[..count], &mut outs2[..count])?;
             }
             Ok(())
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
     /// [`S2Plan::inverse_real`] of two fields into two separate arrays, sharing the kernel
@@ -553,14 +637,17 @@ impl S2Plan {
         &self,
         coeffs: [&[Complex64]; 2],
         samples: [&mut [f64]; 2],
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
         for (c, s) in coeffs.iter().zip(&samples) {
             self.check(s.len(), c.len(), 1)?;
         }
+        let start = Instant::now();
         let [a, b] = samples;
-        self.with_scratch(true, |first, second| {
+        let mut times = self.with_scratch((true, None), |first, second| {
             self.real_synthesis([Some(first), second], &coeffs, &mut [a, b])
-        })
+        })?;
+        times.total = start.elapsed().as_secs_f64();
+        Ok(times)
     }
 
     /// The real synthesis of one or two fields (`fields[i]` into `outs[i]`, checked
@@ -570,7 +657,8 @@ impl S2Plan {
         bufs: [Option<&AlignedBuf>; 2],
         fields: &[&[Complex64]],
         outs: &mut [&mut [f64]],
-    ) -> Result<()> {
+    ) -> Result<StageTimes> {
+        let t0 = Instant::now();
         let (b, n) = (self.b, 2 * self.b);
         let factor = 1.0 / (2.0 * PI).sqrt();
         let half = b + 1;
@@ -591,11 +679,16 @@ impl S2Plan {
         // SAFETY: as in `inverse_many`; each field has its own spectra; the coefficient
         // arrays hold B^2 values (checked by the callers) and are only read.
         unsafe { self.real_orders(groups, factor, false) };
+        let t1 = Instant::now();
         for (i, out) in outs.iter_mut().enumerate().take(fields.len().min(2)) {
             let buf = bufs[i].expect("a second scratch for two fields");
             self.real_rings_inverse(buf, out)?;
         }
-        Ok(())
+        Ok(StageTimes {
+            fft: t1.elapsed().as_secs_f64(),
+            dwt: (t1 - t0).as_secs_f64(),
+            ..StageTimes::default()
+        })
     }
 
     /// The `c2r` of one field's spectra in `buf` into `out`.
@@ -661,4 +754,71 @@ fn try_take(
 fn scratch_len(b: usize) -> usize {
     let n = 2 * b;
     n * n + n
+}
+
+impl Transform for S2Plan {
+    fn num_samples(&self) -> usize {
+        S2Plan::num_samples(self)
+    }
+
+    fn num_coeffs(&self) -> usize {
+        S2Plan::num_coeffs(self)
+    }
+
+    /// The ring scratch.
+    fn scratch_bytes(&self) -> usize {
+        16 * scratch_len(self.b)
+    }
+
+    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        S2Plan::forward(self, samples, coeffs)
+    }
+
+    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+        S2Plan::inverse(self, coeffs, samples)
+    }
+
+    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+        S2Plan::forward_real(self, samples, coeffs)
+    }
+
+    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+        S2Plan::inverse_real(self, coeffs, samples)
+    }
+
+    fn forward_with_scratch(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        self.forward_in((samples, coeffs, 1), Some(scratch))
+    }
+
+    fn inverse_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        self.inverse_in((coeffs, samples, 1), Some(scratch))
+    }
+
+    fn forward_real_with_scratch(
+        &self,
+        samples: &[f64],
+        coeffs: &mut [Complex64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        self.forward_real_in((samples, coeffs, 1), Some(scratch))
+    }
+
+    fn inverse_real_with_scratch(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [f64],
+        scratch: &mut Scratch,
+    ) -> Result<StageTimes> {
+        self.inverse_real_in((coeffs, samples, 1), Some(scratch))
+    }
 }

@@ -47,6 +47,7 @@ fn alternate<const K: usize>(
         StageTimes {
             fft: m(|s| s.fft),
             dwt: m(|s| s.dwt),
+            exchange: m(|s| s.exchange),
             total: m(|s| s.total),
         }
     }))

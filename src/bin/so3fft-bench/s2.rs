@@ -36,7 +36,7 @@ fn rel_l2(got: &[Complex64], want: &[Complex64]) -> f64 {
 }
 
 /// Median seconds of `runs` calls of `f`.
-fn timed(runs: usize, mut f: impl FnMut() -> so3fft::Result<()>) -> so3fft::Result<f64> {
+fn timed<T>(runs: usize, mut f: impl FnMut() -> so3fft::Result<T>) -> so3fft::Result<f64> {
     let mut t = Vec::with_capacity(runs);
     for _ in 0..runs {
         let start = Instant::now();

@@ -349,7 +349,7 @@ pub fn sphere(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so3
         plan.forward_real(&samples, &mut back)?;
         let time = best_time(|| {
             plan.inverse_real(&coeffs, &mut samples)?;
-            plan.forward_real(&samples, &mut back)
+            plan.forward_real(&samples, &mut back).map(|_| ())
         })?;
         let squares: Vec<f64> = samples.iter().map(|x| x * x).collect();
         let n2 = quadrature_norm2(&weights, 2 * b, dphi, &squares);
@@ -367,7 +367,7 @@ pub fn sphere(b: usize, real: bool, run: RunOptions, report: &mut Report) -> so3
         plan.forward(&samples, &mut back)?;
         let time = best_time(|| {
             plan.inverse(&coeffs, &mut samples)?;
-            plan.forward(&samples, &mut back)
+            plan.forward(&samples, &mut back).map(|_| ())
         })?;
         let n2 = quadrature_norm2(&weights, 2 * b, dphi, &abs2(&samples));
         let mut again = vec![Complex64::new(0.0, 0.0); ns];
