@@ -89,14 +89,15 @@ pub struct Lanes<'a> {
     pub row_gap: usize,
 }
 
-/// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually.
+/// Up to [`Prefetch::MAX`] address ranges to be prefetched gradually; a range is a run of
+/// 64-byte lines, or several such runs a fixed stride apart (rows of a lane-major buffer).
 #[derive(Clone, Copy)]
 pub struct Prefetch {
-    /// `(start, 64-byte lines)`.
-    ranges: [(*const u8, usize); Prefetch::MAX],
+    /// `(start, lines per run, bytes from one run to the next, runs)`.
+    ranges: [(*const u8, usize, usize, usize); Prefetch::MAX],
     n: usize,
-    /// Position: range index and line within it.
-    at: (usize, usize),
+    /// Position: range index, run within it, line within the run.
+    at: (usize, usize, usize),
 }
 
 impl Prefetch {
@@ -105,42 +106,53 @@ impl Prefetch {
     /// Nothing to prefetch.
     pub fn none() -> Prefetch {
         Prefetch {
-            ranges: [(std::ptr::null(), 0); Prefetch::MAX],
+            ranges: [(std::ptr::null(), 0, 0, 0); Prefetch::MAX],
             n: 0,
-            at: (0, 0),
+            at: (0, 0, 0),
         }
     }
 
     /// Add `len` doubles from `p` (ignored beyond [`Prefetch::MAX`] ranges).
     pub fn push(&mut self, p: *const f64, len: usize) {
-        if self.n < Prefetch::MAX && len > 0 {
-            self.ranges[self.n] = (p as *const u8, (len * 8).div_ceil(64));
+        self.push_rows(p, len, (0, 1));
+    }
+
+    /// Add `rows` runs of `len` doubles, the first at `p`, each `stride` doubles after the
+    /// one before (ignored beyond [`Prefetch::MAX`] ranges).
+    pub fn push_rows(&mut self, p: *const f64, len: usize, (stride, rows): (usize, usize)) {
+        if self.n < Prefetch::MAX && len > 0 && rows > 0 {
+            self.ranges[self.n] = (p as *const u8, (len * 8).div_ceil(64), 8 * stride, rows);
             self.n += 1;
         }
     }
 
     /// Lines in all ranges.
     pub(crate) fn lines(&self) -> usize {
-        self.ranges[..self.n].iter().map(|r| r.1).sum()
+        self.ranges[..self.n].iter().map(|r| r.1 * r.3).sum()
     }
 
     /// Issue the next `k` prefetches (into L2).
     #[inline(always)]
     pub(crate) fn issue(&mut self, mut k: usize) {
         while k > 0 && self.at.0 < self.n {
-            let (p, len) = self.ranges[self.at.0];
+            let (p, len, stride, rows) = self.ranges[self.at.0];
+            let line = p.wrapping_add(self.at.1 * stride + 64 * self.at.2);
             #[cfg(target_arch = "x86_64")]
             // SAFETY: a prefetch is a hint that never faults, whatever the address; SSE is part
             // of x86-64.
             unsafe {
                 use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
-                _mm_prefetch::<_MM_HINT_T1>(p.wrapping_add(64 * self.at.1) as *const i8);
+                _mm_prefetch::<_MM_HINT_T1>(line as *const i8);
             }
             #[cfg(not(target_arch = "x86_64"))]
-            let _ = p;
-            self.at.1 += 1;
-            if self.at.1 >= len {
-                self.at = (self.at.0 + 1, 0);
+            let _ = line;
+            self.at.2 += 1;
+            if self.at.2 >= len {
+                self.at.2 = 0;
+                self.at.1 += 1;
+                if self.at.1 >= rows {
+                    self.at = (self.at.0 + 1, 0, 0);
+                }
             }
             k -= 1;
         }

@@ -771,16 +771,22 @@ impl<X: Exchange> DistributedPlan<X> {
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendPtr(coeffs.as_mut_ptr());
             g.workers.pool().install(|| {
-                self.parts.local.par_iter().for_each(|cl| {
+                let local = &self.parts.local;
+                local.par_iter().enumerate().for_each(|(i, cl)| {
                     g.dwt.with_scratch(|sc| {
                         let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                        let next = local.get(i + 1).map_or(Prefetch::none(), |nc| {
+                            let rows = b_ptr.get().wrapping_add(nc.offset);
+                            g.dwt.forward_hints(nc, ch, rows, coef.get())
+                        });
                         // SAFETY: this cluster's slots of `b`'s lane rows of the group
                         // (padding rows zero, the others filled by the exchange); its
                         // coefficient blocks are inside the local coefficients (checked
                         // length) and this task's.
                         unsafe {
                             let rows = b_ptr.get().add(cl.offset);
-                            g.dwt.forward(sc, cl, ch, n, rows, coef.get(), k == 0)
+                            g.dwt
+                                .forward(sc, cl, (ch, n), rows, (coef.get(), k == 0, next))
                         }
                     })
                 })

@@ -321,6 +321,27 @@ impl DwtStage {
         pf
     }
 
+    /// What the forward of `cl` will read and write, as prefetch hints (never read through
+    /// them): its lane rows of the chunk (`2 hp` rows of `cl.p` doubles, `ch.row_len`
+    /// apart, from `rows`: in a lane-major buffer far apart, which the hardware does not
+    /// prefetch) and its coefficient blocks at `coef`.
+    pub fn forward_hints(
+        &self,
+        cl: &ClusterPlan,
+        ch: ChunkLanes,
+        rows: *const f64,
+        coef: *const Complex64,
+    ) -> Prefetch {
+        let mut pf = Prefetch::none();
+        pf.push_rows(rows, cl.p, (ch.row_len, ch.lanes()));
+        for s in &cl.slots {
+            let lo = cl.m.max(s.first);
+            let len = self.l.saturating_sub(lo);
+            pf.push(coef.wrapping_add(s.block + lo - s.first).cast(), 2 * len);
+        }
+        pf
+    }
+
     /// The kernels' lanes for a chunk in a lane-major buffer: lower row `j` at
     /// `j row_len`, its mirror `hp row_len` further.
     fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes, stream: bool) -> Lanes<'a> {
@@ -701,7 +722,7 @@ impl DwtStage {
 
     /// Forward kernel of `cl` over its slots of the chunk's lane rows at `block` (as for
     /// [`DwtStage::inverse`]; padding rows zero), accumulated into the coefficients at
-    /// `coef` (`first`: assign instead).
+    /// `coef` (`first`: assign instead), prefetching `next` meanwhile.
     ///
     /// # Safety
     /// The rows at `block` are valid for reads; `coef` holds the shape's coefficients,
@@ -711,11 +732,9 @@ impl DwtStage {
         &self,
         sc: &mut Scratch,
         cl: &ClusterPlan,
-        ch: ChunkLanes,
-        n: usize,
+        (ch, n): (ChunkLanes, usize),
         block: *const f64,
-        coef: *mut Complex64,
-        first: bool,
+        (coef, first, next): (*mut Complex64, bool, Prefetch),
     ) {
         let p = cl.p;
         let mut data = std::mem::take(&mut sc.data);
@@ -723,7 +742,8 @@ impl DwtStage {
             data = vec![0.0; self.data_len()];
         }
         let rec = Rec::new(&sc.rec, n);
-        let lanes = self.lanes(sc, ch, false);
+        let mut lanes = self.lanes(sc, ch, false);
+        lanes.prefetch = next;
         // SAFETY: the `2 hp` rows of `p` doubles at `block`, read only (caller's contract).
         let lo = unsafe { dwt::forward_raw(self.isa, p, &rec, &lanes, block, &mut data) }.min(n);
         // SAFETY: `data` holds the kernel's sums; the blocks are the caller's.

@@ -442,44 +442,66 @@ impl General {
                         // buffer, written by nobody (the FFT stage is finished).
                         unsafe { self.zero_padding(buf.get().add(t * per_t), ch) };
                     }
-                    self.dwt.clusters.par_iter().with_min_len(4).for_each(|cl| {
-                        self.dwt.with_scratch(|sc| {
-                            let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                            for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                                let count = KERNEL_BATCH.min(batch.count - t0);
-                                let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
-                                let c = coef.get().wrapping_add(t0 * batch.out_dist);
-                                // SAFETY: this cluster's slots of the lane rows of
-                                // transforms `t0..t0 + count` (written by the FFT stage or
-                                // zeroed above, finished); their coefficient arrays are
-                                // inside the checked output, and this cluster's slots'
-                                // blocks are this task's.
-                                unsafe {
-                                    if count == 1 {
-                                        self.dwt.forward(sc, cl, ch, n, block, c, first)
-                                    } else {
-                                        self.dwt.forward_many(
-                                            sc,
-                                            cl,
+                    let clusters = &self.dwt.clusters;
+                    clusters
+                        .par_iter()
+                        .enumerate()
+                        .with_min_len(4)
+                        .for_each(|(i, cl)| {
+                            self.dwt.with_scratch(|sc| {
+                                let n = self.dwt.setup(sc, cl, &self.pairs, ch);
+                                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                                    let count = KERNEL_BATCH.min(batch.count - t0);
+                                    let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
+                                    let c = coef.get().wrapping_add(t0 * batch.out_dist);
+                                    // What the next cluster (likely this task's next one)
+                                    // reads and writes.
+                                    let next = match clusters.get(i + 1) {
+                                        Some(nc) if count == 1 => self.dwt.forward_hints(
+                                            nc,
                                             ch,
-                                            n,
-                                            BatchRows {
-                                                base: block.cast_const(),
-                                                dist: per_t,
-                                                count,
-                                            },
-                                            BatchRows {
-                                                base: c,
-                                                dist: batch.out_dist,
-                                                count,
-                                            },
-                                            first,
-                                        )
+                                            buf.get().wrapping_add(t0 * per_t + nc.offset),
+                                            c,
+                                        ),
+                                        _ => Prefetch::none(),
+                                    };
+                                    // SAFETY: this cluster's slots of the lane rows of
+                                    // transforms `t0..t0 + count` (written by the FFT stage or
+                                    // zeroed above, finished); their coefficient arrays are
+                                    // inside the checked output, and this cluster's slots'
+                                    // blocks are this task's.
+                                    unsafe {
+                                        if count == 1 {
+                                            self.dwt.forward(
+                                                sc,
+                                                cl,
+                                                (ch, n),
+                                                block,
+                                                (c, first, next),
+                                            )
+                                        } else {
+                                            self.dwt.forward_many(
+                                                sc,
+                                                cl,
+                                                ch,
+                                                n,
+                                                BatchRows {
+                                                    base: block.cast_const(),
+                                                    dist: per_t,
+                                                    count,
+                                                },
+                                                BatchRows {
+                                                    base: c,
+                                                    dist: batch.out_dist,
+                                                    count,
+                                                },
+                                                first,
+                                            )
+                                        }
                                     }
                                 }
-                            }
-                        })
-                    });
+                            })
+                        });
                     times.dwt += t1.elapsed().as_secs_f64();
                 }
                 Ok(())
