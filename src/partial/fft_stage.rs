@@ -156,6 +156,10 @@ impl TwoWay {
 #[derive(Default)]
 pub(super) struct Work {
     pub inv: Option<AlignedBuf>,
+    /// A second inverse buffer (a slice and its mirror in one task).
+    pub inv2: Option<AlignedBuf>,
+    /// A second half buffer (the real inverse of a slice and its mirror).
+    pub half2: Option<AlignedBuf>,
     pub fwd: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
 }
@@ -287,6 +291,42 @@ impl FftStage {
     }
 
     /// The forward's work buffer.
+    /// Two inverse work buffers (a slice and its mirror).
+    pub fn inv_pair<'a>(
+        &self,
+        work: &'a mut Work,
+    ) -> Result<(&'a mut [Complex64], &'a mut [Complex64])> {
+        let len = self.na * self.rs;
+        for b in [&mut work.inv, &mut work.inv2] {
+            if b.is_none() {
+                *b = Some(AlignedBuf::new(len)?);
+            }
+        }
+        let (a, b) = (work.inv.as_mut(), work.inv2.as_mut());
+        Ok((
+            a.expect("just made").slice_mut(len),
+            b.expect("just made").slice_mut(len),
+        ))
+    }
+
+    /// Two half buffers (the real inverse of a slice and its mirror).
+    pub fn half_pair<'a>(
+        &self,
+        work: &'a mut Work,
+    ) -> Result<(&'a mut [Complex64], &'a mut [Complex64])> {
+        let len = self.na * self.hs;
+        for b in [&mut work.half, &mut work.half2] {
+            if b.is_none() {
+                *b = Some(AlignedBuf::new(len)?);
+            }
+        }
+        let (a, b) = (work.half.as_mut(), work.half2.as_mut());
+        Ok((
+            a.expect("just made").slice_mut(len),
+            b.expect("just made").slice_mut(len),
+        ))
+    }
+
     pub fn fwd_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
         let len = self.na * self.rs;
         if work.fwd.is_none() {

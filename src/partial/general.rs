@@ -352,7 +352,39 @@ impl General {
                         });
                     let t1 = Instant::now();
                     times.dwt += (t1 - t0).as_secs_f64();
+                    // A beta and its mirror in one task where both are written (each lane
+                    // row and slot read once for both), the others alone.
+                    let pair_tasks = self.pair_tasks(ch, batch.count);
+                    pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
+                        self.with_work(|work| {
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
+                            let at = |s: usize| t * batch.out_dist + s * slice_len;
+                            // SAFETY: the lane rows were written by the DWT stage above
+                            // (finished); slices `s0` and `s1` of output `t` are inside the
+                            // checked output and this task's alone.
+                            unsafe {
+                                match out {
+                                    Data::Complex(o) => {
+                                        let (w0, w1) = self.fft.inv_pair(work)?;
+                                        self.scatter_pair((w0, w1), &rows);
+                                        self.fft.inverse(w0, o.get().add(at(s0)));
+                                        self.fft.inverse(w1, o.get().add(at(s1)));
+                                    }
+                                    Data::Real(o) => {
+                                        let (w0, w1) = self.fft.half_pair(work)?;
+                                        self.scatter_real_pair((w0, w1), &rows);
+                                        self.fft.inverse_real(w0, o.get().add(at(s0)));
+                                        self.fft.inverse_real(w1, o.get().add(at(s1)));
+                                    }
+                                }
+                            }
+                            Ok(())
+                        })
+                    })?;
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        if self.paired(ch, jj) {
+                            return Ok(());
+                        }
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
                             let at = t * batch.out_dist + s * slice_len;
@@ -525,6 +557,96 @@ impl General {
             }
         }
         v
+    }
+
+    /// Whether the inverse writes both slices of pair `jj` of `ch` (in one task).
+    fn paired(&self, ch: ChunkLanes, jj: usize) -> bool {
+        !self.pairs.outputs[ch.j0 + jj].contains(&usize::MAX)
+    }
+
+    /// The inverse's tasks of a chunk that write a slice and its mirror:
+    /// `(transform, pair in chunk, [lower slice, upper slice])`.
+    fn pair_tasks(&self, ch: ChunkLanes, count: usize) -> Vec<(usize, usize, [usize; 2])> {
+        let mut v = Vec::new();
+        for t in 0..count {
+            for jj in (0..ch.h).filter(|&jj| self.paired(ch, jj)) {
+                v.push((t, jj, self.pairs.outputs[ch.j0 + jj]));
+            }
+        }
+        v
+    }
+
+    /// [`General::scatter`] of a slice and its mirror at once (complex): from the lane
+    /// rows `rows` (own: the lower point's, mirror: the upper point's) into `w0` (the lower
+    /// slice) and `w1` (the upper one), each lane row and table entry read once.
+    ///
+    /// # Safety
+    /// As for [`General::scatter`].
+    pub(super) unsafe fn scatter_pair(
+        &self,
+        (w0, w1): (&mut [Complex64], &mut [Complex64]),
+        rows: &LaneRows,
+    ) {
+        let (na, ng) = self.fft.dims();
+        let (rs, _) = self.fft.strides();
+        let n = self.layout_n;
+        for w in [&mut *w0, &mut *w1] {
+            for row in w.chunks_exact_mut(rs).take(na) {
+                row[..=n].fill(Complex64::default());
+                row[ng - n..ng].fill(Complex64::default());
+            }
+        }
+        for &(at, work) in self.slots.of(rows.clusters) {
+            let off = (at & !SlotTable::MIRROR) as usize;
+            // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
+            // of `dwt.clusters`' slots).
+            let (a, b) = unsafe {
+                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                (Complex64::new(*x, *x.add(1)), Complex64::new(*y, *y.add(1)))
+            };
+            let (v0, v1) = if at & SlotTable::MIRROR != 0 {
+                (b, a)
+            } else {
+                (a, b)
+            };
+            w0[work as usize] = v0;
+            w1[work as usize] = v1;
+        }
+    }
+
+    /// [`General::scatter_real`] of a slice and its mirror at once, as
+    /// [`General::scatter_pair`].
+    ///
+    /// # Safety
+    /// As for [`General::scatter`].
+    pub(super) unsafe fn scatter_real_pair(
+        &self,
+        (w0, w1): (&mut [Complex64], &mut [Complex64]),
+        rows: &LaneRows,
+    ) {
+        w0.fill(Complex64::default());
+        w1.fill(Complex64::default());
+        for &(at, idx) in self.slots.real_of(rows.clusters) {
+            if idx & SlotTable::CONJ != 0 {
+                continue;
+            }
+            let off = (at & !SlotTable::MIRROR) as usize;
+            // SAFETY: as in `scatter_pair`.
+            let (a, b) = unsafe {
+                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                (
+                    Complex64::new(*x, -*x.add(1)),
+                    Complex64::new(*y, -*y.add(1)),
+                )
+            };
+            let (v0, v1) = if at & SlotTable::MIRROR != 0 {
+                (b, a)
+            } else {
+                (a, b)
+            };
+            w0[idx as usize] = v0;
+            w1[idx as usize] = v1;
+        }
     }
 
     /// The lane rows of a slice (its own, and its mirror's, where its reversed members

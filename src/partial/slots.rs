@@ -59,7 +59,7 @@ pub(super) struct SlotTable {
 }
 
 impl SlotTable {
-    const MIRROR: u32 = 1 << 31;
+    pub(super) const MIRROR: u32 = 1 << 31;
     pub(super) const CONJ: u32 = 1 << 31;
 
     /// The table of `dwt`'s clusters; the real entries for a half buffer of `na` rows `hs`
