@@ -153,12 +153,33 @@ impl TwoWay {
 
 /// A worker's buffers, each made on first use: the inverse's (whose columns outside
 /// `|M'| <= N` stay zero), the forward's, and the real transforms' half spectra.
+/// The work buffers of a slice and its mirror.
+pub(super) type BufPair<'a> = (&'a mut [Complex64], &'a mut [Complex64]);
+
+/// `len` values of two buffers, made on first use.
+fn buf_pair<'a>(
+    (a, b): (&'a mut Option<AlignedBuf>, &'a mut Option<AlignedBuf>),
+    len: usize,
+) -> Result<BufPair<'a>> {
+    for x in [&mut *a, &mut *b] {
+        if x.is_none() {
+            *x = Some(AlignedBuf::new(len)?);
+        }
+    }
+    Ok((
+        a.as_mut().expect("just made").slice_mut(len),
+        b.as_mut().expect("just made").slice_mut(len),
+    ))
+}
+
 #[derive(Default)]
 pub(super) struct Work {
     pub inv: Option<AlignedBuf>,
     /// A second inverse buffer (a slice and its mirror in one task).
     pub inv2: Option<AlignedBuf>,
-    /// A second half buffer (the real inverse of a slice and its mirror).
+    /// A second forward buffer (a slice and its mirror in one task).
+    pub fwd2: Option<AlignedBuf>,
+    /// A second half buffer (the real transforms of a slice and its mirror).
     pub half2: Option<AlignedBuf>,
     pub fwd: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
@@ -292,39 +313,18 @@ impl FftStage {
 
     /// The forward's work buffer.
     /// Two inverse work buffers (a slice and its mirror).
-    pub fn inv_pair<'a>(
-        &self,
-        work: &'a mut Work,
-    ) -> Result<(&'a mut [Complex64], &'a mut [Complex64])> {
-        let len = self.na * self.rs;
-        for b in [&mut work.inv, &mut work.inv2] {
-            if b.is_none() {
-                *b = Some(AlignedBuf::new(len)?);
-            }
-        }
-        let (a, b) = (work.inv.as_mut(), work.inv2.as_mut());
-        Ok((
-            a.expect("just made").slice_mut(len),
-            b.expect("just made").slice_mut(len),
-        ))
+    pub fn inv_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+        buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)
     }
 
-    /// Two half buffers (the real inverse of a slice and its mirror).
-    pub fn half_pair<'a>(
-        &self,
-        work: &'a mut Work,
-    ) -> Result<(&'a mut [Complex64], &'a mut [Complex64])> {
-        let len = self.na * self.hs;
-        for b in [&mut work.half, &mut work.half2] {
-            if b.is_none() {
-                *b = Some(AlignedBuf::new(len)?);
-            }
-        }
-        let (a, b) = (work.half.as_mut(), work.half2.as_mut());
-        Ok((
-            a.expect("just made").slice_mut(len),
-            b.expect("just made").slice_mut(len),
-        ))
+    /// Two forward work buffers (a slice and its mirror).
+    pub fn fwd_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+        buf_pair((&mut work.fwd, &mut work.fwd2), self.na * self.rs)
+    }
+
+    /// Two half buffers (the real transforms of a slice and its mirror).
+    pub fn half_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+        buf_pair((&mut work.half, &mut work.half2), self.na * self.hs)
     }
 
     pub fn fwd_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {

@@ -440,8 +440,38 @@ impl General {
                     let lanes = ch.lanes();
                     let per_t = self.dwt.row_total * lanes;
                     let t0 = Instant::now();
+                    // A beta and its mirror in one task (each lane row written whole by
+                    // one task, each slot read once), as the inverse.
+                    let pair_tasks = self.pair_tasks(ch, batch.count);
+                    pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
+                        self.with_work(|work| {
+                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
+                            let weight = self.pair_weight[ch.j0 + jj];
+                            let at = |s: usize| t * batch.in_dist + s * slice_len;
+                            // SAFETY: slices `s0` and `s1` of input `t` are inside the
+                            // checked input (complex values, or reals for the real
+                            // forward); the two lane rows are this task's alone.
+                            unsafe {
+                                if real {
+                                    let (w0, w1) = self.fft.half_pair(work)?;
+                                    self.fft.forward_real(w0, inp.get().add(at(s0)));
+                                    self.fft.forward_real(w1, inp.get().add(at(s1)));
+                                    self.gather_real_pair((w0, w1), &rows, weight);
+                                } else {
+                                    let (w0, w1) = self.fft.fwd_pair(work)?;
+                                    self.fft.forward(w0, inp.get().add(2 * at(s0)).cast());
+                                    self.fft.forward(w1, inp.get().add(2 * at(s1)).cast());
+                                    self.gather_pair((w0, w1), &rows, weight);
+                                }
+                            }
+                            Ok(())
+                        })
+                    })?;
                     let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+                        if self.paired(ch, jj) {
+                            return Ok(());
+                        }
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
                             let weight = self.pair_weight[ch.j0 + jj];
@@ -646,6 +676,70 @@ impl General {
             };
             w0[idx as usize] = v0;
             w1[idx as usize] = v1;
+        }
+    }
+
+    /// [`General::gather`] of a slice and its mirror at once (`w0` the lower slice's
+    /// values, `w1` the upper one's) into the pair's lane rows `rows` (own: the lower
+    /// point's, mirror: the upper point's), each slot read once.
+    ///
+    /// # Safety
+    /// As for [`General::gather`]; both lane rows are the caller's.
+    pub(super) unsafe fn gather_pair(
+        &self,
+        (w0, w1): (&[Complex64], &[Complex64]),
+        rows: &LaneRows,
+        weight: f64,
+    ) {
+        for &(at, work) in self.slots.of(rows.clusters) {
+            let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
+            let off = (at & !SlotTable::MIRROR) as usize;
+            let (lo, hi) = if at & SlotTable::MIRROR != 0 {
+                (v1, v0)
+            } else {
+                (v0, v1)
+            };
+            // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
+            // of `dwt.clusters`' slots), the caller's.
+            unsafe {
+                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+            }
+        }
+    }
+
+    /// [`General::gather_real`] of a slice and its mirror at once, as
+    /// [`General::gather_pair`].
+    ///
+    /// # Safety
+    /// As for [`General::gather_pair`].
+    pub(super) unsafe fn gather_real_pair(
+        &self,
+        (w0, w1): (&[Complex64], &[Complex64]),
+        rows: &LaneRows,
+        weight: f64,
+    ) {
+        for &(at, idx) in self.slots.real_of(rows.clusters) {
+            let value = |w: &[Complex64]| {
+                let v = if idx & SlotTable::CONJ != 0 {
+                    w[(idx & !SlotTable::CONJ) as usize]
+                } else {
+                    w[idx as usize].conj()
+                };
+                v * weight
+            };
+            let (v0, v1) = (value(w0), value(w1));
+            let off = (at & !SlotTable::MIRROR) as usize;
+            let (lo, hi) = if at & SlotTable::MIRROR != 0 {
+                (v1, v0)
+            } else {
+                (v0, v1)
+            };
+            // SAFETY: as in `gather_pair`.
+            unsafe {
+                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+            }
         }
     }
 
