@@ -132,11 +132,9 @@ fn matching(l: usize, threads: usize) -> Result<(), Box<dyn std::error::Error>> 
     let t = Instant::now();
     let plan = Correlation::new(
         l,
-        &CorrelationOptions {
-            real: true,
-            threads,
-            ..Default::default()
-        },
+        &CorrelationOptions::default()
+            .with_real(true)
+            .with_threads(threads),
     )?;
     let t_plan = t.elapsed().as_secs_f64();
     let mut grid = vec![0.0; plan.num_grid()];

@@ -43,12 +43,10 @@ fn case(name: &str) -> Case {
 fn correlate(c: &Case, b_out: Option<usize>) -> (so3fft::matching::Peak, usize) {
     let plan = Correlation::new(
         c.b,
-        &CorrelationOptions {
-            real: c.real,
-            threads: 2,
-            b_out,
-            ..Default::default()
-        },
+        &CorrelationOptions::default()
+            .with_real(c.real)
+            .with_threads(2)
+            .with_b_out(b_out),
     )
     .unwrap();
     let b_out = plan.b_out();
@@ -127,10 +125,10 @@ fn ties_and_zero_signals_follow_softs_rule() {
 
 #[test]
 fn bad_arguments_are_errors() {
-    let opts = |b_out, deg_lim| CorrelationOptions {
-        b_out,
-        deg_lim,
-        ..Default::default()
+    let opts = |b_out, deg_lim| {
+        CorrelationOptions::default()
+            .with_b_out(b_out)
+            .with_deg_lim(deg_lim)
     };
     assert!(Correlation::new(0, &opts(None, None)).is_err());
     assert!(Correlation::new(8, &opts(Some(4), Some(4))).is_err());
@@ -240,12 +238,10 @@ fn off_grid_rotations_recovered_and_refined() {
         p.inverse(&hat, &mut pat).unwrap();
         let plan = Correlation::new(
             l,
-            &CorrelationOptions {
-                real,
-                b_out,
-                threads: 2,
-                ..Default::default()
-            },
+            &CorrelationOptions::default()
+                .with_real(real)
+                .with_b_out(b_out)
+                .with_threads(2),
         )
         .unwrap();
         let bo = plan.b_out();
@@ -373,11 +369,9 @@ fn normalized_correlation_peaks_at_one() {
     s2_plan(l).inverse(&rotated, &mut sig).unwrap();
     let plan = Correlation::new(
         l,
-        &CorrelationOptions {
-            normalized: true,
-            threads: 2,
-            ..Default::default()
-        },
+        &CorrelationOptions::default()
+            .with_normalized(true)
+            .with_threads(2),
     )
     .unwrap();
     let mut grid = vec![Complex64::default(); plan.num_grid()];
@@ -400,14 +394,7 @@ fn shells_add_up_with_their_weights() {
     let (_, p1) = random_s2_samples(l, 2);
     let (_, s2) = random_s2_samples(l, 3);
     let (_, p2) = random_s2_samples(l, 4);
-    let plan = Correlation::new(
-        l,
-        &CorrelationOptions {
-            threads: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let plan = Correlation::new(l, &CorrelationOptions::default().with_threads(2)).unwrap();
     let n = plan.num_grid();
     let (mut c1, mut c2, mut both) = (
         vec![Complex64::default(); n],
@@ -437,14 +424,7 @@ fn many_patterns_equal_single_correlations() {
     let pats: Vec<Complex64> = (0..3)
         .flat_map(|k| random_s2_samples(l, 10 + k).1)
         .collect();
-    let plan = Correlation::new(
-        l,
-        &CorrelationOptions {
-            threads: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let plan = Correlation::new(l, &CorrelationOptions::default().with_threads(2)).unwrap();
     let (ns, ng) = (4 * l * l, plan.num_grid());
     let mut many = vec![Complex64::default(); 3 * ng];
     plan.correlate_many(&sig, &pats, &mut many).unwrap();
@@ -455,14 +435,7 @@ fn many_patterns_equal_single_correlations() {
         assert!(one == many[k * ng..][..ng], "pattern {k}");
     }
     let re = |v: &[Complex64]| v.iter().map(|z| z.re).collect::<Vec<f64>>();
-    let rplan = Correlation::new(
-        l,
-        &CorrelationOptions {
-            real: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let rplan = Correlation::new(l, &CorrelationOptions::default().with_real(true)).unwrap();
     let mut rmany = vec![0.0; 3 * ng];
     rplan
         .correlate_many_real(&re(&sig), &re(&pats), &mut rmany)
@@ -572,13 +545,11 @@ fn padded_and_degree_limited_grids_match_the_full_inverse() {
         (8, 8, Some(3), false),
         (6, 12, Some(2), true),
     ] {
-        let opts = CorrelationOptions {
-            b_out: Some(b_out),
-            deg_lim,
-            real,
-            threads: 2,
-            ..Default::default()
-        };
+        let opts = CorrelationOptions::default()
+            .with_b_out(Some(b_out))
+            .with_deg_lim(deg_lim)
+            .with_real(real)
+            .with_threads(2);
         let plan = Correlation::new(b_in, &opts).unwrap();
         let n = 4 * b_in * b_in;
         let mut state = 17u64;
@@ -631,14 +602,7 @@ fn peaks_refined_together_reach_the_same_maxima() {
     let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
     p.inverse(&rng.complex_vec(l * l), &mut sig).unwrap();
     p.inverse(&rng.complex_vec(l * l), &mut pat).unwrap();
-    let plan = Correlation::new(
-        l,
-        &CorrelationOptions {
-            threads: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let plan = Correlation::new(l, &CorrelationOptions::default().with_threads(2)).unwrap();
     let mut grid = vec![Complex64::default(); plan.num_grid()];
     plan.correlate(&sig, &pat, &mut grid).unwrap();
     let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
@@ -689,14 +653,7 @@ fn rotations_near_the_poles_refined() {
     let mut rng = common::Rng::new(9);
     let hat = rng.complex_vec(l * l);
     let p = s2_plan(l);
-    let plan = Correlation::new(
-        l,
-        &CorrelationOptions {
-            threads: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let plan = Correlation::new(l, &CorrelationOptions::default().with_threads(2)).unwrap();
     for beta in [1e-3, 0.02, std::f64::consts::PI - 1e-3, 1e-9] {
         let truth = Rotation::new(1.1, beta, 2.3);
         let n = 4 * l * l;
@@ -738,12 +695,10 @@ fn fused_argmax_equals_the_scan() {
         for (b_out, threads) in [(None, 1), (None, 2), (Some(2 * c.b), 2)] {
             let plan = Correlation::new(
                 c.b,
-                &CorrelationOptions {
-                    real: c.real,
-                    threads,
-                    b_out,
-                    ..Default::default()
-                },
+                &CorrelationOptions::default()
+                    .with_real(c.real)
+                    .with_threads(threads)
+                    .with_b_out(b_out),
             )
             .unwrap();
             let b_out = plan.b_out();
@@ -778,14 +733,8 @@ fn fused_argmax_equals_the_scan() {
             }
         }
         // A plan for the other kind of input refuses.
-        let plan = Correlation::new(
-            c.b,
-            &CorrelationOptions {
-                real: !c.real,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let plan =
+            Correlation::new(c.b, &CorrelationOptions::default().with_real(!c.real)).unwrap();
         let n = plan.num_grid();
         if c.real {
             let s = vec![0.0; 4 * c.b * c.b];

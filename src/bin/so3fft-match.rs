@@ -126,12 +126,10 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
     let t = Instant::now();
     let plan = Correlation::new(
         b,
-        &CorrelationOptions {
-            b_out: args.b_out,
-            real,
-            threads: args.threads,
-            ..Default::default()
-        },
+        &CorrelationOptions::default()
+            .with_b_out(args.b_out)
+            .with_real(real)
+            .with_threads(args.threads),
     )
     .map_err(fail)?;
     let t_plan = t.elapsed().as_secs_f64();

@@ -8,6 +8,7 @@ use crate::matching::{
     grid_argmax, grid_argmax_real, top_peaks, top_peaks_real, Correlation, CorrelationOptions,
     Peak, Rotation,
 };
+use crate::options::Options;
 use crate::Complex64;
 use std::ffi::{c_double, c_int, c_uint};
 
@@ -58,8 +59,11 @@ pub extern "C" fn so3fft_plan_correlation(
             deg_lim,
             real: flags & SO3FFT_REAL != 0,
             normalized: flags & SO3FFT_NORMALIZED != 0,
-            threads: threads_of(nthreads)?,
-            rigor: rigor_of(flags & !(SO3FFT_REAL | SO3FFT_NORMALIZED))?,
+            plans: Options {
+                threads: threads_of(nthreads)?,
+                rigor: rigor_of(flags & !(SO3FFT_REAL | SO3FFT_NORMALIZED))?,
+                ..Options::default()
+            },
         };
         let plan = Correlation::new(l, &options)?;
         Ok(Box::into_raw(Box::new(so3fft_correlation_s { plan })))

@@ -7,17 +7,19 @@ use super::peaks::{grid_argmax, grid_argmax_real, Peak, SliceArgmax};
 use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
-use crate::options::{Direction, Options};
+use crate::options::{Betas, Direction, Options};
 use crate::partial::{PartialPlan, Shape};
 use crate::plan::SliceRef;
 use crate::plan::StageTimes;
 use crate::s2::{S2Limits, S2Plan};
 use crate::workers::WorkerPool;
-use crate::Rigor;
 use num_complex::Complex64;
 use std::sync::{Arc, Mutex, OnceLock};
 
-/// Options of a [`Correlation`].
+/// What a [`Correlation`] computes, and the [`Options`] of its plans. Made with
+/// [`CorrelationOptions::default`] and the `with_*` setters (the type is
+/// `#[non_exhaustive]`: fields may be added).
+#[non_exhaustive]
 #[derive(Clone, Debug, Default)]
 pub struct CorrelationOptions {
     /// Bandwidth of the SO(3) grid the correlation is evaluated on (`None`: the input
@@ -27,16 +29,52 @@ pub struct CorrelationOptions {
     pub deg_lim: Option<usize>,
     /// Real inputs: a real correlation through the real-signal inverse (about half the work).
     pub real: bool,
-    /// Worker threads (0 = all cores), shared with the process's other plans of the same
-    /// count (see [`Options::threads`]).
-    pub threads: usize,
-    /// FFTW planner rigour.
-    pub rigor: Rigor,
     /// Normalised cross-correlation: the degree-0 terms (the means) left out and the result
     /// divided by the norms of signal and pattern over degrees `1..=deg_lim`, so that
     /// `|C| <= 1`, with 1 where the signal is an exactly rotated, scaled and shifted copy
     /// of the pattern.
     pub normalized: bool,
+    /// Options of the correlation's S^2 and SO(3) plans (threads, rigour, instruction set,
+    /// skip threshold); their direction and real form follow from the correlation.
+    pub plans: Options,
+}
+
+impl CorrelationOptions {
+    /// With [`CorrelationOptions::b_out`].
+    pub fn with_b_out(mut self, b_out: Option<usize>) -> CorrelationOptions {
+        self.b_out = b_out;
+        self
+    }
+
+    /// With [`CorrelationOptions::deg_lim`].
+    pub fn with_deg_lim(mut self, deg_lim: Option<usize>) -> CorrelationOptions {
+        self.deg_lim = deg_lim;
+        self
+    }
+
+    /// With [`CorrelationOptions::real`].
+    pub fn with_real(mut self, real: bool) -> CorrelationOptions {
+        self.real = real;
+        self
+    }
+
+    /// With [`CorrelationOptions::normalized`].
+    pub fn with_normalized(mut self, normalized: bool) -> CorrelationOptions {
+        self.normalized = normalized;
+        self
+    }
+
+    /// With [`CorrelationOptions::plans`].
+    pub fn with_plans(mut self, plans: Options) -> CorrelationOptions {
+        self.plans = plans;
+        self
+    }
+
+    /// With the plans' [`Options::threads`].
+    pub fn with_threads(mut self, threads: usize) -> CorrelationOptions {
+        self.plans.threads = threads;
+        self
+    }
 }
 
 /// Coefficient arrays of one correlation (signal, pattern, SO(3)).
@@ -81,7 +119,7 @@ impl Correlation {
         // One pool for both plans: an execution enters it once, and each stage of the
         // pipeline runs on its workers directly (at small bandwidths waking the workers
         // for every stage cost as much as the stages).
-        let threads = crate::workers::thread_count(options.threads)?;
+        let threads = crate::workers::thread_count(options.plans.threads)?;
         let workers = WorkerPool::process(threads)?;
         let s2 = S2Plan::new_on(
             b_in,
@@ -90,11 +128,7 @@ impl Correlation {
                 degree_limit: Some(deg_lim + 1),
                 order_limit: None,
             },
-            &Options {
-                threads: options.threads,
-                rigor: options.rigor,
-                ..Options::default()
-            },
+            &options.plans,
             Some(&workers),
         )?;
         // Degrees up to `deg_lim` on the grid of `b_out`: a partial plan when that is less
@@ -103,10 +137,9 @@ impl Correlation {
             &Shape::new(deg_lim + 1).with_grid(b_out, 2 * b_out, 2 * b_out),
             &Options {
                 direction: Direction::Inverse,
-                threads: options.threads,
-                rigor: options.rigor,
                 real: options.real,
-                ..Options::default()
+                betas: Betas::All,
+                ..options.plans.clone()
             },
             Some(&workers),
         )?;

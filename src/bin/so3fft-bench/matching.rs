@@ -75,11 +75,11 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             s2.inverse(&hat, &mut pat)?;
             let plan = Correlation::new(
                 l,
-                &CorrelationOptions {
-                    threads,
-                    rigor: opts.rigor,
-                    ..Default::default()
-                },
+                &CorrelationOptions::default().with_plans(
+                    so3fft::Options::default()
+                        .with_threads(threads)
+                        .with_rigor(opts.rigor),
+                ),
             )?;
             // The floor's FFT part: its runs right after the pipeline's of the same kind
             // (not interleaved with them, which takes the pipeline's data out of the caches
@@ -104,12 +104,11 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             s2.inverse_real(&rhat, &mut rpat)?;
             let rplan = Correlation::new(
                 l,
-                &CorrelationOptions {
-                    real: true,
-                    threads,
-                    rigor: opts.rigor,
-                    ..Default::default()
-                },
+                &CorrelationOptions::default().with_real(true).with_plans(
+                    so3fft::Options::default()
+                        .with_threads(threads)
+                        .with_rigor(opts.rigor),
+                ),
             )?;
             let mut rgrid = vec![0.0; rplan.num_grid()];
             let mut times = Vec::new();
@@ -237,11 +236,11 @@ fn many_and_shells(opts: &Options) -> so3fft::Result<()> {
             let runs = opts.runs.unwrap_or(5);
             let plan = Correlation::new(
                 l,
-                &CorrelationOptions {
-                    threads,
-                    rigor: opts.rigor,
-                    ..Default::default()
-                },
+                &CorrelationOptions::default().with_plans(
+                    so3fft::Options::default()
+                        .with_threads(threads)
+                        .with_rigor(opts.rigor),
+                ),
             )?;
             let ns = 4 * l * l;
             let (sig, pats) = (random_coeffs(ns, 11), random_coeffs(8 * ns, 12));

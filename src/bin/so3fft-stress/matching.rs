@@ -29,11 +29,9 @@ pub fn run(bandwidths: &[usize], threads: usize, report: &mut Report) -> so3fft:
         for (variant, b_out) in [("match-grid", l), ("match-grid-2x", 2 * l)] {
             let plan = Correlation::new(
                 l,
-                &CorrelationOptions {
-                    b_out: Some(b_out),
-                    threads,
-                    ..CorrelationOptions::default()
-                },
+                &CorrelationOptions::default()
+                    .with_b_out(Some(b_out))
+                    .with_threads(threads),
             )?;
             let mut grid = vec![Complex64::default(); plan.num_grid()];
             plan.correlate(&sig, &pat, &mut grid)?; // warm-up (first-touch of buffers)
