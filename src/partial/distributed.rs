@@ -660,15 +660,15 @@ impl<X: Exchange> DistributedPlan<X> {
             .collect()
     }
 
-    /// This rank's slices of group `k`: `(index in the local samples, pair within the
-    /// group, upper)`.
-    fn group_slices(&self, k: usize) -> Vec<(usize, usize, bool)> {
+    /// This rank's pairs of slices of group `k`: `(pair within the group, [index of the
+    /// lower slice, of the upper one] in the local samples)`. The FFT stage handles both
+    /// slices of a pair in one task (as the single-process plan).
+    fn group_pairs(&self, k: usize) -> Vec<(usize, [usize; 2])> {
         let (j0, j1) = self.local_pairs();
         let h = j1 - j0;
         let (g0, g1) = group_range((j0, j1), k, self.parts.groups);
         (g0..g1)
-            .map(|j| (j - j0, j - g0, false))
-            .chain((g0..g1).map(|j| (2 * h - 1 - (j - j0), j - g0, true)))
+            .map(|j| (j - g0, [j - j0, 2 * h - 1 - (j - j0)]))
             .collect()
     }
 
@@ -732,26 +732,27 @@ impl<X: Exchange> DistributedPlan<X> {
             let ch = gr.ch;
             let g0 = group_range(self.local_pairs(), k, self.parts.groups).0;
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
-            let slices = self.group_slices(k);
+            let pairs = self.group_pairs(k);
             let done: Result<()> = g.workers.pool().install(|| {
-                slices.par_iter().try_for_each(|&(s, jj, upper)| {
+                pairs.par_iter().try_for_each(|&(jj, [s0, s1])| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, upper));
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, false));
                         let weight = g.pair_weight[g0 + jj];
-                        // SAFETY: local slice `s` is inside the checked local samples; the
-                        // slots written are this slice's, of its two rows in each part (in
-                        // `a` and `b`, sized for the group); its mirror writes the other
-                        // slots of those rows.
+                        let at = |s: usize| s * slice_len * per_value;
+                        // SAFETY: local slices `s0` and `s1` are inside the checked local
+                        // samples; the slots written are the pair's, of its two rows in each
+                        // part (in `a` and `b`, sized for the group), this task's alone.
                         unsafe {
-                            let at = s * slice_len * per_value;
                             if real {
-                                let w = g.fft.half_buf(work)?;
-                                g.fft.forward_real(w, inp.get().add(at));
-                                g.gather_real(w, &rows, weight);
+                                let (w0, w1) = g.fft.half_pair(work)?;
+                                g.fft.forward_real(w0, inp.get().add(at(s0)));
+                                g.fft.forward_real(w1, inp.get().add(at(s1)));
+                                g.gather_real_pair((w0, w1), &rows, weight);
                             } else {
-                                let w = g.fft.fwd_buf(work)?;
-                                g.fft.forward(w, inp.get().add(at).cast());
-                                g.gather(w, &rows, weight);
+                                let (w0, w1) = g.fft.fwd_pair(work)?;
+                                g.fft.forward(w0, inp.get().add(at(s0)).cast());
+                                g.fft.forward(w1, inp.get().add(at(s1)).cast());
+                                g.gather_pair((w0, w1), &rows, weight);
                             }
                         }
                         Ok(())
@@ -853,24 +854,26 @@ impl<X: Exchange> DistributedPlan<X> {
             self.exchange((&mut *a, &mut *b), false, &gr)?;
             let t2 = std::time::Instant::now();
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
-            let slices = self.group_slices(k);
+            let pairs = self.group_pairs(k);
             let group_done: Result<()> = g.workers.pool().install(|| {
-                slices.par_iter().try_for_each(|&(s, jj, upper)| {
+                pairs.par_iter().try_for_each(|&(jj, [s0, s1])| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, upper));
+                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, false));
                         // SAFETY: the parts' rows were written by the DWT stage (`b`) and
-                        // the exchange (`a`), both finished; local slice `s` is inside the
-                        // checked local samples and this task's.
+                        // the exchange (`a`), both finished; local slices `s0` and `s1` are
+                        // inside the checked local samples and this task's.
                         unsafe {
                             if real {
-                                let w = g.fft.half_buf(work)?;
-                                g.scatter_real(w, &rows);
-                                g.fft.inverse_real(w, out.get().add(s * slice_len));
+                                let (w0, w1) = g.fft.half_pair(work)?;
+                                g.scatter_real_pair((w0, w1), &rows);
+                                g.fft.inverse_real(w0, out.get().add(s0 * slice_len));
+                                g.fft.inverse_real(w1, out.get().add(s1 * slice_len));
                             } else {
-                                let w = g.fft.inv_buf(work)?;
-                                g.scatter(w, &rows);
-                                let at = out.get().cast::<Complex64>().add(s * slice_len);
-                                g.fft.inverse(w, at);
+                                let (w0, w1) = g.fft.inv_pair(work)?;
+                                g.scatter_pair((w0, w1), &rows);
+                                let o = out.get().cast::<Complex64>();
+                                g.fft.inverse(w0, o.add(s0 * slice_len));
+                                g.fft.inverse(w1, o.add(s1 * slice_len));
                             }
                         }
                         Ok(())

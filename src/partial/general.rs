@@ -366,13 +366,13 @@ impl General {
                                 match out {
                                     Data::Complex(o) => {
                                         let (w0, w1) = self.fft.inv_pair(work)?;
-                                        self.scatter_pair((w0, w1), &rows);
+                                        self.scatter_pair((w0, w1), &[rows]);
                                         self.fft.inverse(w0, o.get().add(at(s0)));
                                         self.fft.inverse(w1, o.get().add(at(s1)));
                                     }
                                     Data::Real(o) => {
                                         let (w0, w1) = self.fft.half_pair(work)?;
-                                        self.scatter_real_pair((w0, w1), &rows);
+                                        self.scatter_real_pair((w0, w1), &[rows]);
                                         self.fft.inverse_real(w0, o.get().add(at(s0)));
                                         self.fft.inverse_real(w1, o.get().add(at(s1)));
                                     }
@@ -456,12 +456,12 @@ impl General {
                                     let (w0, w1) = self.fft.half_pair(work)?;
                                     self.fft.forward_real(w0, inp.get().add(at(s0)));
                                     self.fft.forward_real(w1, inp.get().add(at(s1)));
-                                    self.gather_real_pair((w0, w1), &rows, weight);
+                                    self.gather_real_pair((w0, w1), &[rows], weight);
                                 } else {
                                     let (w0, w1) = self.fft.fwd_pair(work)?;
                                     self.fft.forward(w0, inp.get().add(2 * at(s0)).cast());
                                     self.fft.forward(w1, inp.get().add(2 * at(s1)).cast());
-                                    self.gather_pair((w0, w1), &rows, weight);
+                                    self.gather_pair((w0, w1), &[rows], weight);
                                 }
                             }
                             Ok(())
@@ -615,7 +615,7 @@ impl General {
     pub(super) unsafe fn scatter_pair(
         &self,
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
-        rows: &LaneRows,
+        parts: &[LaneRows],
     ) {
         let (na, ng) = self.fft.dims();
         let (rs, _) = self.fft.strides();
@@ -626,21 +626,23 @@ impl General {
                 row[ng - n..ng].fill(Complex64::default());
             }
         }
-        for &(at, work) in self.slots.of(rows.clusters) {
-            let off = (at & !SlotTable::MIRROR) as usize;
-            // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
-            // of `dwt.clusters`' slots).
-            let (a, b) = unsafe {
-                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                (Complex64::new(*x, *x.add(1)), Complex64::new(*y, *y.add(1)))
-            };
-            let (v0, v1) = if at & SlotTable::MIRROR != 0 {
-                (b, a)
-            } else {
-                (a, b)
-            };
-            w0[work as usize] = v0;
-            w1[work as usize] = v1;
+        for rows in parts {
+            for &(at, work) in self.slots.of(rows.clusters) {
+                let off = (at & !SlotTable::MIRROR) as usize;
+                // SAFETY: the slot's two doubles in both lane rows of the part (the table
+                // holds the offsets of `dwt.clusters`' slots).
+                let (a, b) = unsafe {
+                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                    (Complex64::new(*x, *x.add(1)), Complex64::new(*y, *y.add(1)))
+                };
+                let (v0, v1) = if at & SlotTable::MIRROR != 0 {
+                    (b, a)
+                } else {
+                    (a, b)
+                };
+                w0[work as usize] = v0;
+                w1[work as usize] = v1;
+            }
         }
     }
 
@@ -652,30 +654,32 @@ impl General {
     pub(super) unsafe fn scatter_real_pair(
         &self,
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
-        rows: &LaneRows,
+        parts: &[LaneRows],
     ) {
         w0.fill(Complex64::default());
         w1.fill(Complex64::default());
-        for &(at, idx) in self.slots.real_of(rows.clusters) {
-            if idx & SlotTable::CONJ != 0 {
-                continue;
+        for rows in parts {
+            for &(at, idx) in self.slots.real_of(rows.clusters) {
+                if idx & SlotTable::CONJ != 0 {
+                    continue;
+                }
+                let off = (at & !SlotTable::MIRROR) as usize;
+                // SAFETY: as in `scatter_pair`.
+                let (a, b) = unsafe {
+                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                    (
+                        Complex64::new(*x, -*x.add(1)),
+                        Complex64::new(*y, -*y.add(1)),
+                    )
+                };
+                let (v0, v1) = if at & SlotTable::MIRROR != 0 {
+                    (b, a)
+                } else {
+                    (a, b)
+                };
+                w0[idx as usize] = v0;
+                w1[idx as usize] = v1;
             }
-            let off = (at & !SlotTable::MIRROR) as usize;
-            // SAFETY: as in `scatter_pair`.
-            let (a, b) = unsafe {
-                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                (
-                    Complex64::new(*x, -*x.add(1)),
-                    Complex64::new(*y, -*y.add(1)),
-                )
-            };
-            let (v0, v1) = if at & SlotTable::MIRROR != 0 {
-                (b, a)
-            } else {
-                (a, b)
-            };
-            w0[idx as usize] = v0;
-            w1[idx as usize] = v1;
         }
     }
 
@@ -688,22 +692,24 @@ impl General {
     pub(super) unsafe fn gather_pair(
         &self,
         (w0, w1): (&[Complex64], &[Complex64]),
-        rows: &LaneRows,
+        parts: &[LaneRows],
         weight: f64,
     ) {
-        for &(at, work) in self.slots.of(rows.clusters) {
-            let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
-            let off = (at & !SlotTable::MIRROR) as usize;
-            let (lo, hi) = if at & SlotTable::MIRROR != 0 {
-                (v1, v0)
-            } else {
-                (v0, v1)
-            };
-            // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
-            // of `dwt.clusters`' slots), the caller's.
-            unsafe {
-                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+        for rows in parts {
+            for &(at, work) in self.slots.of(rows.clusters) {
+                let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
+                let off = (at & !SlotTable::MIRROR) as usize;
+                let (lo, hi) = if at & SlotTable::MIRROR != 0 {
+                    (v1, v0)
+                } else {
+                    (v0, v1)
+                };
+                // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
+                // of `dwt.clusters`' slots), the caller's.
+                unsafe {
+                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                    (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+                }
             }
         }
     }
@@ -716,29 +722,31 @@ impl General {
     pub(super) unsafe fn gather_real_pair(
         &self,
         (w0, w1): (&[Complex64], &[Complex64]),
-        rows: &LaneRows,
+        parts: &[LaneRows],
         weight: f64,
     ) {
-        for &(at, idx) in self.slots.real_of(rows.clusters) {
-            let value = |w: &[Complex64]| {
-                let v = if idx & SlotTable::CONJ != 0 {
-                    w[(idx & !SlotTable::CONJ) as usize]
-                } else {
-                    w[idx as usize].conj()
+        for rows in parts {
+            for &(at, idx) in self.slots.real_of(rows.clusters) {
+                let value = |w: &[Complex64]| {
+                    let v = if idx & SlotTable::CONJ != 0 {
+                        w[(idx & !SlotTable::CONJ) as usize]
+                    } else {
+                        w[idx as usize].conj()
+                    };
+                    v * weight
                 };
-                v * weight
-            };
-            let (v0, v1) = (value(w0), value(w1));
-            let off = (at & !SlotTable::MIRROR) as usize;
-            let (lo, hi) = if at & SlotTable::MIRROR != 0 {
-                (v1, v0)
-            } else {
-                (v0, v1)
-            };
-            // SAFETY: as in `gather_pair`.
-            unsafe {
-                let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+                let (v0, v1) = (value(w0), value(w1));
+                let off = (at & !SlotTable::MIRROR) as usize;
+                let (lo, hi) = if at & SlotTable::MIRROR != 0 {
+                    (v1, v0)
+                } else {
+                    (v0, v1)
+                };
+                // SAFETY: as in `gather_pair`.
+                unsafe {
+                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
+                    (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
+                }
             }
         }
     }
