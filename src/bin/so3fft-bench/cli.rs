@@ -44,6 +44,10 @@ TOOL (default: the full benchmark described below):
                       one signal (per pattern) and four shells against one correlation
   mpi-model (or --mpi-model)  distributed plans at B = 1024, 2048 on 8..256 nodes: memory
                       per rank, bytes exchanged, expected time, from one-core rates measured here
+  engines             the full shape on the general engine (every partial shape, batch,
+                      beta selection and distributed plan runs on it) against Plan: complex
+                      inverse and forward alternated, median stage times and the ratio;
+                      defaults --bandwidths 64,128 --threads 1,2 --runs 7
   partial (or --partial)  partial plans against the transforms they replace: degree-limited
                       on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
                       1/16 of the betas, skip thresholds 2^-24 and 2^-34 (ratios in one run)
@@ -97,6 +101,8 @@ pub enum Tool {
     S2,
     /// Rotational matching (`matching.rs`).
     Match,
+    /// The general engine against `Plan` at the full shape (`engines.rs`).
+    Engines,
     /// Partial plans (`partial.rs`).
     Partial,
     /// The distributed plans' model for large B (`mpi_model.rs`).
@@ -230,6 +236,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("real") => Tool::Real,
         Some("s2" | "--s2") => Tool::S2,
         Some("match" | "--match") => Tool::Match,
+        Some("engines") => Tool::Engines,
         Some("partial" | "--partial") => Tool::Partial,
         Some("mpi-model" | "--mpi-model") => Tool::MpiModel,
         _ => Tool::Full,
@@ -340,6 +347,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
         Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
+        Tool::Engines => (vec![64, 128], vec![1, 2], Some(7)),
         Tool::Partial => (vec![256], vec![2], None),
         Tool::MpiModel => (vec![128], vec![1], None),
     };
@@ -474,6 +482,9 @@ mod tests {
         let opts = options(&["real"]);
         assert_eq!((opts.tool, opts.runs), (Tool::Real, None));
         assert_eq!(opts.bandwidths, [64, 128, 256]);
+        let opts = options(&["engines", "--bandwidths", "16"]);
+        assert_eq!((opts.tool, opts.runs), (Tool::Engines, Some(7)));
+        assert_eq!((opts.bandwidths, opts.threads), (vec![16], vec![1, 2]));
         assert!(parse(["stages", "--mode", "sideways"].map(String::from)).is_err());
     }
 }

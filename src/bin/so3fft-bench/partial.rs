@@ -31,7 +31,7 @@ fn rel_err(got: &[Complex64], want: &[Complex64]) -> f64 {
 }
 
 /// Medians of the stage times of `runs` calls of each of `fs`, called in turn (A, B, A, B..).
-fn alternate<const K: usize>(
+pub(crate) fn alternate<const K: usize>(
     runs: usize,
     fs: &mut [&mut dyn FnMut() -> so3fft::Result<StageTimes>; K],
 ) -> so3fft::Result<[StageTimes; K]> {
