@@ -57,7 +57,7 @@ impl Scratch {
 /// forward (samples to coefficients), inverse, and their real-signal forms, each returning
 /// the wall time of its stages. The plain calls use the plan's own workspace (made with the
 /// plan or on first use; a call that finds it taken by a concurrent one gets a private
-/// workspace while memory allows, see `docs/c-api.md`); the `*_with_scratch` calls use
+/// workspace while memory allows, see `docs/design.md`, "Memory"); the `*_with_scratch` calls use
 /// the caller's [`Scratch`] and allocate nothing. Both give the same results, bit for bit.
 ///
 /// Lengths: [`Transform::num_samples`] samples (complex, or real for the real forms) and
