@@ -1,4 +1,4 @@
-//! [`Transform`]: the transforms every SO(3) plan offers, with one meaning for each, and
+//! [`Transform`]: the transforms every plan offers, with one meaning for each, and
 //! [`Scratch`], workspace the caller owns.
 
 use crate::error::{Error, Result};
@@ -53,12 +53,14 @@ impl Scratch {
     }
 }
 
-/// The transforms of an SO(3) plan ([`Plan`](crate::Plan), [`PartialPlan`](crate::PartialPlan)):
-/// forward (samples to coefficients), inverse, and their real-signal forms, each returning
-/// the wall time of its stages. The plain calls use the plan's own workspace (made with the
-/// plan or on first use; a call that finds it taken by a concurrent one gets a private
-/// workspace while memory allows, see `docs/design.md`, "Memory"); the `*_with_scratch` calls use
-/// the caller's [`Scratch`] and allocate nothing. Both give the same results, bit for bit.
+/// The transforms of every plan ([`Plan`](crate::Plan), [`PartialPlan`](crate::PartialPlan),
+/// [`DistributedPlan`](crate::DistributedPlan) on each rank's share, collectively, and
+/// [`S2Plan`](crate::s2::S2Plan)): forward (samples to coefficients), inverse, and their
+/// real-signal forms, each returning the wall time of its stages. The plain calls use the
+/// plan's own workspace (made with the plan or on first use; a call that finds it taken by
+/// a concurrent one gets a private workspace while memory allows, see `docs/design.md`,
+/// "Memory"); the `*_with_scratch` calls use the caller's [`Scratch`] and allocate nothing.
+/// Both give the same results, bit for bit.
 ///
 /// Lengths: [`Transform::num_samples`] samples (complex, or real for the real forms) and
 /// [`Transform::num_coeffs`] coefficients, else [`Error::LengthMismatch`].
