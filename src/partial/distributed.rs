@@ -829,10 +829,19 @@ impl<X: Exchange> DistributedPlan<X> {
             let ch = gr.ch;
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendConstPtr(coeffs.as_ptr());
+            // Rows far larger than the caches go out with non-temporal stores (as in the
+            // single-process plan).
+            let stream = 8 * b.len() > 8 << 20;
+            let local = &self.parts.local;
             g.workers.pool().install(|| {
-                self.parts.local.par_iter().for_each(|cl| {
+                local.par_iter().enumerate().for_each(|(i, cl)| {
                     g.dwt.with_scratch(|sc| {
                         let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                        // The coefficient blocks the next cluster (likely this task's next
+                        // one) reads.
+                        let next = local.get(i + 1).map_or(Prefetch::none(), |nc| {
+                            g.dwt.coefficient_hints(nc, coef.get(), real)
+                        });
                         // SAFETY: the local coefficients (checked length), read only; this
                         // cluster's slots of `b`'s lane rows of the group, written by this
                         // task only.
@@ -843,7 +852,7 @@ impl<X: Exchange> DistributedPlan<X> {
                                 ch,
                                 n,
                                 coef.get(),
-                                (real, false, Prefetch::none()),
+                                (real, stream, next),
                                 b_ptr.get().add(cl.offset),
                             )
                         }
