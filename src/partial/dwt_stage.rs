@@ -308,16 +308,7 @@ impl DwtStage {
         real: bool,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
-        for s in &cl.slots {
-            let block = if real && !s.representative {
-                s.partner_block
-            } else {
-                s.block
-            };
-            let lo = cl.m.max(s.first);
-            let len = self.l.saturating_sub(lo);
-            pf.push(coef.wrapping_add(block + lo - s.first).cast(), 2 * len);
-        }
+        self.push_coefficients(&mut pf, cl, coef, real);
         pf
     }
 
@@ -334,12 +325,29 @@ impl DwtStage {
     ) -> Prefetch {
         let mut pf = Prefetch::none();
         pf.push_rows(rows, cl.p, (ch.row_len, ch.lanes()));
+        self.push_coefficients(&mut pf, cl, coef, false);
+        pf
+    }
+
+    /// Adds to `pf` the degrees of the coefficient blocks of `cl`'s slots that a kernel
+    /// touches (with `real`, the partners' blocks of the non-representatives).
+    fn push_coefficients(
+        &self,
+        pf: &mut Prefetch,
+        cl: &ClusterPlan,
+        coef: *const Complex64,
+        real: bool,
+    ) {
         for s in &cl.slots {
+            let block = if real && !s.representative {
+                s.partner_block
+            } else {
+                s.block
+            };
             let lo = cl.m.max(s.first);
             let len = self.l.saturating_sub(lo);
-            pf.push(coef.wrapping_add(s.block + lo - s.first).cast(), 2 * len);
+            pf.push(coef.wrapping_add(block + lo - s.first).cast(), 2 * len);
         }
-        pf
     }
 
     /// The kernels' lanes for a chunk in a lane-major buffer: lower row `j` at

@@ -273,9 +273,11 @@ impl General {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
                 for ch in self.chunks() {
-                    // Chunks of padding pairs only (selections) write nothing.
+                    // Chunks of padding pairs only (selections) write nothing. The FFT
+                    // stage's tasks: pairs of slices, and slices without their mirror.
+                    let pair_tasks = self.pair_tasks(ch, batch.count);
                     let tasks = self.slice_tasks(ch, batch.count);
-                    if tasks.is_empty() {
+                    if tasks.is_empty() && pair_tasks.is_empty() {
                         continue;
                     }
                     let lanes = ch.lanes();
@@ -354,7 +356,6 @@ impl General {
                     times.dwt += (t1 - t0).as_secs_f64();
                     // A beta and its mirror in one task where both are written (each lane
                     // row and slot read once for both), the others alone.
-                    let pair_tasks = self.pair_tasks(ch, batch.count);
                     pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
@@ -382,9 +383,6 @@ impl General {
                         })
                     })?;
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
-                        if self.paired(ch, jj) {
-                            return Ok(());
-                        }
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
                             let at = t * batch.out_dist + s * slice_len;
@@ -469,9 +467,6 @@ impl General {
                     })?;
                     let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
-                        if self.paired(ch, jj) {
-                            return Ok(());
-                        }
                         self.with_work(|work| {
                             let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
                             let weight = self.pair_weight[ch.j0 + jj];
@@ -578,7 +573,7 @@ impl General {
     fn slice_tasks(&self, ch: ChunkLanes, count: usize) -> Vec<(usize, usize, bool, usize)> {
         let mut v = Vec::new();
         for t in 0..count {
-            for jj in 0..ch.h {
+            for jj in (0..ch.h).filter(|&jj| !self.paired(ch, jj)) {
                 for (u, &s) in self.pairs.outputs[ch.j0 + jj].iter().enumerate() {
                     if s != usize::MAX {
                         v.push((t, jj, u == 1, s));
@@ -606,9 +601,38 @@ impl General {
         v
     }
 
+    /// Calls `f(lower, upper, index)` for every slot of `parts` (`real`: the real table's
+    /// entries and half-buffer indices, flags included): `lower` points at the slot's two
+    /// doubles that belong to the lower point's slice, `upper` at the upper slice's (the
+    /// own row for a direct member, the mirror row for a reversed one, and the other way).
+    #[inline(always)]
+    fn for_each_pair_slot(
+        &self,
+        parts: &[LaneRows],
+        real: bool,
+        mut f: impl FnMut(*mut f64, *mut f64, u32),
+    ) {
+        for rows in parts {
+            let table = if real {
+                self.slots.real_of(rows.clusters)
+            } else {
+                self.slots.of(rows.clusters)
+            };
+            for &(at, idx) in table {
+                let off = (at & !SlotTable::MIRROR) as usize;
+                let (own, mirror) = (rows.own.wrapping_add(off), rows.mirror.wrapping_add(off));
+                if at & SlotTable::MIRROR != 0 {
+                    f(mirror, own, idx);
+                } else {
+                    f(own, mirror, idx);
+                }
+            }
+        }
+    }
+
     /// [`General::scatter`] of a slice and its mirror at once (complex): from the lane
-    /// rows `rows` (own: the lower point's, mirror: the upper point's) into `w0` (the lower
-    /// slice) and `w1` (the upper one), each lane row and table entry read once.
+    /// rows of `parts` (own: the lower point's, mirror: the upper point's) into `w0` (the
+    /// lower slice) and `w1` (the upper one), each lane row and table entry read once.
     ///
     /// # Safety
     /// As for [`General::scatter`].
@@ -626,24 +650,14 @@ impl General {
                 row[ng - n..ng].fill(Complex64::default());
             }
         }
-        for rows in parts {
-            for &(at, work) in self.slots.of(rows.clusters) {
-                let off = (at & !SlotTable::MIRROR) as usize;
-                // SAFETY: the slot's two doubles in both lane rows of the part (the table
-                // holds the offsets of `dwt.clusters`' slots).
-                let (a, b) = unsafe {
-                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                    (Complex64::new(*x, *x.add(1)), Complex64::new(*y, *y.add(1)))
-                };
-                let (v0, v1) = if at & SlotTable::MIRROR != 0 {
-                    (b, a)
-                } else {
-                    (a, b)
-                };
-                w0[work as usize] = v0;
-                w1[work as usize] = v1;
+        self.for_each_pair_slot(parts, false, |lo, hi, work| {
+            // SAFETY: the slot's two doubles in both lane rows of the part (the table holds
+            // the offsets of `dwt.clusters`' slots).
+            unsafe {
+                w0[work as usize] = Complex64::new(*lo, *lo.add(1));
+                w1[work as usize] = Complex64::new(*hi, *hi.add(1));
             }
-        }
+        });
     }
 
     /// [`General::scatter_real`] of a slice and its mirror at once, as
@@ -658,60 +672,35 @@ impl General {
     ) {
         w0.fill(Complex64::default());
         w1.fill(Complex64::default());
-        for rows in parts {
-            for &(at, idx) in self.slots.real_of(rows.clusters) {
-                if idx & SlotTable::CONJ != 0 {
-                    continue;
-                }
-                let off = (at & !SlotTable::MIRROR) as usize;
+        self.for_each_pair_slot(parts, true, |lo, hi, idx| {
+            if idx & SlotTable::CONJ == 0 {
                 // SAFETY: as in `scatter_pair`.
-                let (a, b) = unsafe {
-                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                    (
-                        Complex64::new(*x, -*x.add(1)),
-                        Complex64::new(*y, -*y.add(1)),
-                    )
-                };
-                let (v0, v1) = if at & SlotTable::MIRROR != 0 {
-                    (b, a)
-                } else {
-                    (a, b)
-                };
-                w0[idx as usize] = v0;
-                w1[idx as usize] = v1;
+                unsafe {
+                    w0[idx as usize] = Complex64::new(*lo, -*lo.add(1));
+                    w1[idx as usize] = Complex64::new(*hi, -*hi.add(1));
+                }
             }
-        }
+        });
     }
 
     /// [`General::gather`] of a slice and its mirror at once (`w0` the lower slice's
-    /// values, `w1` the upper one's) into the pair's lane rows `rows` (own: the lower
+    /// values, `w1` the upper one's) into the pair's lane rows in `parts` (own: the lower
     /// point's, mirror: the upper point's), each slot read once.
     ///
     /// # Safety
-    /// As for [`General::gather`]; both lane rows are the caller's.
+    /// As for [`General::gather`]; both lane rows of every part are the caller's.
     pub(super) unsafe fn gather_pair(
         &self,
         (w0, w1): (&[Complex64], &[Complex64]),
         parts: &[LaneRows],
         weight: f64,
     ) {
-        for rows in parts {
-            for &(at, work) in self.slots.of(rows.clusters) {
-                let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
-                let off = (at & !SlotTable::MIRROR) as usize;
-                let (lo, hi) = if at & SlotTable::MIRROR != 0 {
-                    (v1, v0)
-                } else {
-                    (v0, v1)
-                };
-                // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
-                // of `dwt.clusters`' slots), the caller's.
-                unsafe {
-                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                    (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
-                }
-            }
-        }
+        self.for_each_pair_slot(parts, false, |lo, hi, work| {
+            let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
+            // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
+            // of `dwt.clusters`' slots), the caller's.
+            unsafe { (*lo, *lo.add(1), *hi, *hi.add(1)) = (v0.re, v0.im, v1.re, v1.im) };
+        });
     }
 
     /// [`General::gather_real`] of a slice and its mirror at once, as
@@ -725,30 +714,19 @@ impl General {
         parts: &[LaneRows],
         weight: f64,
     ) {
-        for rows in parts {
-            for &(at, idx) in self.slots.real_of(rows.clusters) {
-                let value = |w: &[Complex64]| {
-                    let v = if idx & SlotTable::CONJ != 0 {
-                        w[(idx & !SlotTable::CONJ) as usize]
-                    } else {
-                        w[idx as usize].conj()
-                    };
-                    v * weight
-                };
-                let (v0, v1) = (value(w0), value(w1));
-                let off = (at & !SlotTable::MIRROR) as usize;
-                let (lo, hi) = if at & SlotTable::MIRROR != 0 {
-                    (v1, v0)
+        self.for_each_pair_slot(parts, true, |lo, hi, idx| {
+            let value = |w: &[Complex64]| {
+                let v = if idx & SlotTable::CONJ != 0 {
+                    w[(idx & !SlotTable::CONJ) as usize]
                 } else {
-                    (v0, v1)
+                    w[idx as usize].conj()
                 };
-                // SAFETY: as in `gather_pair`.
-                unsafe {
-                    let (x, y) = (rows.own.add(off), rows.mirror.add(off));
-                    (*x, *x.add(1), *y, *y.add(1)) = (lo.re, lo.im, hi.re, hi.im);
-                }
-            }
-        }
+                v * weight
+            };
+            let (v0, v1) = (value(w0), value(w1));
+            // SAFETY: as in `gather_pair`.
+            unsafe { (*lo, *lo.add(1), *hi, *hi.add(1)) = (v0.re, v0.im, v1.re, v1.im) };
+        });
     }
 
     /// The lane rows of a slice (its own, and its mirror's, where its reversed members
