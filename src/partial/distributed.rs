@@ -613,12 +613,14 @@ impl<X: Exchange> DistributedPlan<X> {
                 block
             })
             .collect();
+        let hp = h.next_multiple_of(self.parts.general.lanes_w);
         GroupRows {
             ch: ChunkLanes {
                 j0: first,
                 h,
-                hp: h.next_multiple_of(self.parts.general.lanes_w),
+                hp,
                 row_len: width(&shares[me]),
+                upper_gap: hp * width(&shares[me]),
                 first_upper_pair: None,
             },
             parts: offsets.into_iter().zip(counts).collect(),

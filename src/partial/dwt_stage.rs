@@ -69,6 +69,9 @@ pub(super) struct ChunkLanes {
     /// Doubles of a lane row in the buffer the kernels run on (the DWT stage's
     /// `row_total`, or a distributed plan's segment of it).
     pub row_len: usize,
+    /// Doubles from the first lower lane row to the first upper one (`hp row_len` in a
+    /// buffer in one piece; an inverse's chained buffer has its halves apart).
+    pub upper_gap: usize,
     /// Split chunks (see [`crate::partial::betas::LanePairs::first_upper_pair`]): pairs
     /// `0..k` write their lower point (or nothing: padding, also the chunk's pairs
     /// `h..hp`), pairs `k..hp` their upper one; `k` is a multiple of the vector width.
@@ -264,6 +267,20 @@ impl DwtStage {
         let n = self.l - cl.m;
         sc.rec.resize(n);
         self.recurrence.coeffs(cl.m, cl.mp, &mut sc.rec);
+        self.setup_lanes(sc, cl, pairs, ch);
+        n
+    }
+
+    /// The lane inputs of [`DwtStage::setup`] alone: for another chunk of the cluster last
+    /// set up with this scratch (its recurrence coefficients kept); the number of degrees.
+    pub fn setup_lanes(
+        &self,
+        sc: &mut Scratch,
+        cl: &ClusterPlan,
+        pairs: &LanePairs,
+        ch: ChunkLanes,
+    ) -> usize {
+        let n = self.l - cl.m;
         let t = &pairs.tables;
         let (h, hp) = (ch.h, ch.hp);
         // Runs of lanes: (first lane, upper form, first pair in the chunk, lanes). Unsplit
@@ -324,7 +341,8 @@ impl DwtStage {
         coef: *const Complex64,
     ) -> Prefetch {
         let mut pf = Prefetch::none();
-        pf.push_rows(rows, cl.p, (ch.row_len, ch.lanes()));
+        pf.push_rows(rows, cl.p, (ch.row_len, ch.hp));
+        pf.push_rows(rows.wrapping_add(ch.upper_gap), cl.p, (ch.row_len, ch.hp));
         self.push_coefficients(&mut pf, cl, coef, false);
         pf
     }
@@ -351,7 +369,7 @@ impl DwtStage {
     }
 
     /// The kernels' lanes for a chunk in a lane-major buffer: lower row `j` at
-    /// `j row_len`, its mirror `hp row_len` further.
+    /// `j row_len`, its mirror `upper_gap` further.
     fn lanes<'a>(&self, sc: &'a Scratch, ch: ChunkLanes, stream: bool) -> Lanes<'a> {
         let nl = ch.lanes();
         Lanes {
@@ -365,7 +383,7 @@ impl DwtStage {
             prefetch: Prefetch::none(),
             stream,
             pair_stride: ch.row_len,
-            row_gap: ch.hp * ch.row_len,
+            row_gap: ch.upper_gap,
         }
     }
 
@@ -565,7 +583,7 @@ impl DwtStage {
         if data.len() < self.data_len() {
             data = vec![0.0; self.data_len()];
         }
-        let (k, hp, len) = (split.first_upper, ch.hp, ch.row_len);
+        let (k, hp, len, gap) = (split.first_upper, ch.hp, ch.row_len, ch.upper_gap);
         debug_assert!(k <= hp && k.is_multiple_of(self.isa.lanes()));
         let (fin_direct, fin_reversed) = data.split_at_mut(n * split.direct_p);
         let scales = &sc.rec.s;
@@ -580,7 +598,7 @@ impl DwtStage {
                 lanes: 0..hp,
                 upper_from: k,
                 first_pair: 0,
-                row_gap: (k + hp) * len,
+                row_gap: gap + k * len,
             },
             SplitCall {
                 slots: split.direct..cl.slots.len(),
@@ -592,7 +610,7 @@ impl DwtStage {
                 // Without lower lanes the upper rows are addressed from the first pair (a
                 // zero gap would mean rows side by side).
                 first_pair: if k < hp { k } else { 0 },
-                row_gap: if k < hp { (hp - k) * len } else { hp * len },
+                row_gap: if k < hp { gap - k * len } else { gap },
             },
         ];
         for c in calls {

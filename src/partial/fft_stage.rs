@@ -14,7 +14,7 @@
 //! and (`FFTW_UNALIGNED`) for the others; plans inside the page-aligned work buffers once.
 
 use crate::error::Result;
-use crate::fft::{plan_guarded, AlignedBuf, RawPlan, Rigor, SIGN_MINUS, SIGN_PLUS};
+use crate::fft::{copy_rows, plan_guarded, AlignedBuf, RawPlan, Rigor, SIGN_MINUS, SIGN_PLUS};
 use fftw_sys as fftw;
 use num_complex::Complex64;
 use std::ffi::c_int;
@@ -197,7 +197,13 @@ pub(super) struct FftStage {
     inv_cols: [Option<RawPlan>; 2],
     fwd_cols: [Option<RawPlan>; 2],
     inv_rows: TwoWay,
-    fwd_rows: TwoWay,
+    /// The inverse's rows in place in the work buffer (then streamed to the caller's
+    /// slice), where most columns are in the band (`2N + 1 >= n_gamma / 2`): FFTW's own
+    /// stores into the caller's slice would first read each of its lines from memory.
+    inv_rows_in_place: Option<RawPlan>,
+    /// The forward's rows in place in the work buffer, after a copy of the caller's slice
+    /// there (a sequential read the prefetchers follow).
+    fwd_rows_in_place: RawPlan,
     real: Option<RealFfts>,
 }
 
@@ -256,9 +262,15 @@ impl FftStage {
         // SAFETY: as above.
         let inv_rows =
             unsafe { TwoWay::new(rows(rs, ng), Kind::Complex(SIGN_MINUS), (pa, pb), rigor)? };
-        // SAFETY: as above.
-        let fwd_rows =
-            unsafe { TwoWay::new(rows(ng, rs), Kind::Complex(SIGN_PLUS), (pb, pa), rigor)? };
+        let inv_rows_in_place = if 2 * n + 1 >= ng / 2 {
+            // SAFETY: as above, in place in `a`.
+            Some(unsafe { plan_batch(rows(rs, rs), Kind::Complex(SIGN_MINUS), (pa, pa), flags)? })
+        } else {
+            None
+        };
+        // SAFETY: as above, in place in `a`.
+        let fwd_rows_in_place =
+            unsafe { plan_batch(rows(rs, rs), Kind::Complex(SIGN_PLUS), (pa, pa), flags)? };
         let real = if real {
             let half_cols =
                 |sign| col_plan(n + 1, 0, hs, sign).map(|p| p.expect("N + 1 > 0 columns"));
@@ -282,7 +294,8 @@ impl FftStage {
             inv_cols,
             fwd_cols,
             inv_rows,
-            fwd_rows,
+            inv_rows_in_place,
+            fwd_rows_in_place,
             real,
         })
     }
@@ -360,9 +373,36 @@ impl FftStage {
                 unsafe { fftw::fftw_execute_dft(p.0, w.add(at), w.add(at)) };
             }
         }
+        if let Some(p) = &self.inv_rows_in_place {
+            // SAFETY: as for the columns; then `out` holds the slice's `na` rows of `ng`
+            // values (caller's contract), apart from the work buffer.
+            unsafe {
+                fftw::fftw_execute_dft(p.0, w, w);
+                copy_rows(
+                    w.cast::<f64>(),
+                    2 * self.rs,
+                    out.cast::<f64>(),
+                    2 * self.ng,
+                    self.na,
+                    2 * self.ng,
+                    true,
+                );
+            }
+            return;
+        }
         // SAFETY: `out` holds the slice (caller's contract); the variant matches the
         // arrays' alignment; the input rows are only read (out of place).
         unsafe { fftw::fftw_execute_dft(self.inv_rows.pick(w, out), w, out) };
+    }
+
+    /// Columns of the inverse's work buffer to clear before each slice is placed: `|M'| <=
+    /// N` (the others stay zero), or every one where the rows run in place.
+    pub fn inverse_clears(&self) -> [std::ops::Range<usize>; 2] {
+        if self.inv_rows_in_place.is_some() {
+            [0..self.ng, 0..0]
+        } else {
+            [0..self.n + 1, self.ng - self.n..self.ng]
+        }
     }
 
     /// Forward of the slice at `inp`: its rows over gamma into `w` (the forward's work
@@ -372,10 +412,21 @@ impl FftStage {
     /// `inp` is valid for reads of `na ng` values; `w` is [`FftStage::fwd_buf`]'s.
     pub unsafe fn forward(&self, w: &mut [Complex64], inp: *const Complex64) {
         let w = w.as_mut_ptr();
-        let inp = inp.cast_mut();
-        // SAFETY: `inp` holds the slice and is only read (FFTW preserves the input of an
-        // out-of-place complex DFT); the variant matches the arrays' alignment.
-        unsafe { fftw::fftw_execute_dft(self.fwd_rows.pick(inp, w), inp, w) };
+        // SAFETY: `inp` holds the slice's `na` rows of `ng` values and is only read; the
+        // work buffer (`na` rows of `rs`) is this worker's; the plan was made in place on a
+        // same-size page-aligned buffer.
+        unsafe {
+            copy_rows(
+                inp.cast::<f64>(),
+                2 * self.ng,
+                w.cast::<f64>(),
+                2 * self.rs,
+                self.na,
+                2 * self.ng,
+                false,
+            );
+            fftw::fftw_execute_dft(self.fwd_rows_in_place.0, w, w);
+        }
         for (plan, at) in self.fwd_cols.iter().zip([0, self.ng - self.n]) {
             if let Some(p) = plan {
                 // SAFETY: as in `inverse`: same offset in a same-size page-aligned buffer.

@@ -40,9 +40,15 @@ pub(super) struct General {
     buf: ChunkBuffer,
     budget: usize,
     pub(super) lanes_w: usize,
-    /// The order limit `N` of `M'`.
-    layout_n: usize,
     pub(super) workers: WorkerPool,
+}
+
+/// A chunk and its buffer (lane row `r < hp` at `buf + r row_len`, the upper half
+/// `ch.upper_gap` further).
+#[derive(Clone, Copy)]
+struct PlacedLanes {
+    ch: ChunkLanes,
+    buf: SendPtr<f64>,
 }
 
 /// Pointers of one execution (all arrays of a batch).
@@ -109,7 +115,6 @@ impl General {
             buf: ChunkBuffer::new(None),
             budget,
             lanes_w: w,
-            layout_n: shape.order_limit_gamma,
             workers: WorkerPool::shared_or_new(shared, threads)?,
         })
     }
@@ -119,13 +124,18 @@ impl General {
         (self.dwt.row_total * 2 * 8).max(1)
     }
 
+    /// Lane pairs the workspace cap holds for one transform (at least one).
+    fn most_pairs(&self) -> usize {
+        (self.budget / self.pair_bytes()).clamp(1, self.pairs.pairs)
+    }
+
     /// Lane pairs per chunk: what the workspace cap holds for one transform (at least
     /// one), the pairs spread evenly over the fewest chunks, a multiple of the vector
     /// width when that is at least one vector. It does not depend on the batch, so a batch
     /// sums in the order of single executes.
     fn chunk_pairs(&self) -> usize {
         let pairs = self.pairs.pairs;
-        let most = (self.budget / self.pair_bytes()).clamp(1, pairs);
+        let most = self.most_pairs();
         let h = pairs.div_ceil(pairs.div_ceil(most));
         let w = self.lanes_w;
         if h >= w && h.next_multiple_of(w) <= most {
@@ -227,9 +237,8 @@ impl General {
         }
     }
 
-    /// The chunks of lane pairs for `count` transforms.
-    fn chunks(&self) -> impl Iterator<Item = ChunkLanes> + '_ {
-        let h = self.chunk_pairs();
+    /// The chunks of `h` lane pairs (the last one shorter).
+    fn chunks(&self, h: usize) -> impl Iterator<Item = ChunkLanes> + '_ {
         let w = self.lanes_w;
         (0..self.pairs.pairs).step_by(h).map(move |j0| {
             let h = h.min(self.pairs.pairs - j0);
@@ -248,12 +257,28 @@ impl General {
                 h,
                 hp,
                 row_len: self.dwt.row_total,
+                upper_gap: hp * self.dwt.row_total,
                 first_upper_pair,
             }
         })
     }
 
-    /// Inverse of a group of transforms, chunk by chunk.
+    /// The number of chunks a single inverse (complex, or `real`) chains into one pass of
+    /// the DWT stage (see [`General::inverse_chain`]), 0 if it runs them one by one.
+    pub(super) fn chained_chunks(&self, real: bool) -> usize {
+        // Only the output's alignment matters (a page boundary here); nothing is accessed.
+        let at = std::ptr::null_mut::<u8>().wrapping_add(4096);
+        let out = if real {
+            Data::Real(SendPtr(at.cast()))
+        } else {
+            Data::Complex(SendPtr(at.cast()))
+        };
+        self.inverse_chain(1, out, SendPtr(at.cast()))
+            .map_or(0, |c| c.len())
+    }
+
+    /// Inverse of a group of transforms: chunk by chunk, or all chunks in one pass of the
+    /// DWT stage where [`General::inverse_chain`] places their buffers.
     fn inverse_group(
         &self,
         batch: Batch,
@@ -265,150 +290,37 @@ impl General {
         let mut times = StageTimes::default();
         let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
         let per_t_max = self.dwt.row_total * 2 * hp_max;
-        let slice_len = self.fft.slice_len();
         let real = matches!(out, Data::Real(_));
-        // Rows far larger than the caches go out with non-temporal stores.
-        let stream = batch.count * per_t_max * 8 > 8 << 20;
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
-            let buf = SendPtr(buf);
+            let own = SendPtr(buf);
+            let groups: Vec<Vec<PlacedLanes>> = match self.inverse_chain(batch.count, out, own) {
+                Some(chain) => vec![chain],
+                None => self
+                    .chunks(self.chunk_pairs())
+                    .map(|ch| vec![PlacedLanes { ch, buf: own }])
+                    .collect(),
+            };
             self.workers.pool().install(|| {
-                for ch in self.chunks() {
-                    // Chunks of padding pairs only (selections) write nothing. The FFT
-                    // stage's tasks: pairs of slices, and slices without their mirror.
-                    let pair_tasks = self.pair_tasks(ch, batch.count);
-                    let tasks = self.slice_tasks(ch, batch.count);
-                    if tasks.is_empty() && pair_tasks.is_empty() {
+                for group in groups {
+                    // Chunks of padding pairs only (selections) write nothing.
+                    let group: Vec<PlacedLanes> = group
+                        .into_iter()
+                        .filter(|pl| (0..pl.ch.h).any(|jj| self.writes(pl.ch, jj)))
+                        .collect();
+                    if group.is_empty() {
                         continue;
                     }
-                    let lanes = ch.lanes();
-                    let per_t = self.dwt.row_total * lanes;
+                    // Rows far larger than the caches go out with non-temporal stores.
+                    let stream = group.len() * batch.count * per_t_max * 8 > 8 << 20;
                     let t0 = Instant::now();
-                    let clusters = &self.dwt.clusters;
-                    clusters
-                        .par_iter()
-                        .enumerate()
-                        .with_min_len(4)
-                        .for_each(|(i, cl)| {
-                            self.dwt.with_scratch(|sc| {
-                                let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                                    let count = KERNEL_BATCH.min(batch.count - t0);
-                                    // What the next kernel call will gather: this cluster
-                                    // for the next transforms, else the next cluster (likely
-                                    // this task's next one) for the first ones.
-                                    let next = if t0 + count < batch.count {
-                                        Some((cl, t0 + count))
-                                    } else {
-                                        clusters.get(i + 1).map(|c| (c, 0))
-                                    };
-                                    let next = next.map(|(c, u)| {
-                                        let rows = BatchRows {
-                                            base: coef.get().wrapping_add(u * batch.in_dist),
-                                            dist: batch.in_dist,
-                                            count: KERNEL_BATCH.min(batch.count - u),
-                                        };
-                                        (c, rows)
-                                    });
-                                    let c = BatchRows {
-                                        base: coef.get().wrapping_add(t0 * batch.in_dist),
-                                        dist: batch.in_dist,
-                                        count,
-                                    };
-                                    let b = BatchRows {
-                                        base: buf.get().wrapping_add(t0 * per_t + cl.offset),
-                                        dist: per_t,
-                                        count,
-                                    };
-                                    // SAFETY: coefficient arrays `t0..t0 + count` of the
-                                    // batch (checked lengths), read only; this cluster's
-                                    // `cl.p` doubles of the lane rows of those transforms,
-                                    // inside the chunk buffer, written by this task only.
-                                    unsafe {
-                                        if count == 1 {
-                                            let hints = next.map_or(Prefetch::none(), |(c, r)| {
-                                                self.dwt.coefficient_hints(c, r.base, real)
-                                            });
-                                            self.dwt.inverse(
-                                                sc,
-                                                cl,
-                                                ch,
-                                                n,
-                                                c.base,
-                                                (real, stream, hints),
-                                                b.base,
-                                            )
-                                        } else {
-                                            self.dwt.inverse_many(
-                                                sc,
-                                                cl,
-                                                ch,
-                                                n,
-                                                c,
-                                                (real, stream, next),
-                                                b,
-                                            )
-                                        }
-                                    }
-                                }
-                            })
-                        });
+                    self.inverse_dwt(batch, coef, &group, (real, stream));
                     let t1 = Instant::now();
                     times.dwt += (t1 - t0).as_secs_f64();
-                    // A beta and its mirror in one task where both are written (each lane
-                    // row and slot read once for both), the others alone.
-                    pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
-                        self.with_work(|work| {
-                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
-                            let at = |s: usize| t * batch.out_dist + s * slice_len;
-                            // SAFETY: the lane rows were written by the DWT stage above
-                            // (finished); slices `s0` and `s1` of output `t` are inside the
-                            // checked output and this task's alone.
-                            unsafe {
-                                match out {
-                                    Data::Complex(o) => {
-                                        let (w0, w1) = self.fft.inv_pair(work)?;
-                                        self.scatter_pair((w0, w1), &[rows]);
-                                        self.fft.inverse(w0, o.get().add(at(s0)));
-                                        self.fft.inverse(w1, o.get().add(at(s1)));
-                                    }
-                                    Data::Real(o) => {
-                                        let (w0, w1) = self.fft.half_pair(work)?;
-                                        self.scatter_real_pair((w0, w1), &[rows]);
-                                        self.fft.inverse_real(w0, o.get().add(at(s0)));
-                                        self.fft.inverse_real(w1, o.get().add(at(s1)));
-                                    }
-                                }
-                            }
-                            Ok(())
-                        })
-                    })?;
-                    tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
-                        self.with_work(|work| {
-                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
-                            let at = t * batch.out_dist + s * slice_len;
-                            match out {
-                                Data::Complex(o) => {
-                                    let w = self.fft.inv_buf(work)?;
-                                    // SAFETY: the lane rows were written by the DWT stage
-                                    // above (finished); slice `s` of output `t` is inside
-                                    // the checked output and this task's alone.
-                                    unsafe {
-                                        self.scatter(w, &[rows]);
-                                        self.fft.inverse(w, o.get().add(at));
-                                    }
-                                }
-                                Data::Real(o) => {
-                                    let w = self.fft.half_buf(work)?;
-                                    // SAFETY: as above, for the real output.
-                                    unsafe {
-                                        self.scatter_real(w, &[rows]);
-                                        self.fft.inverse_real(w, o.get().add(at));
-                                    }
-                                }
-                            }
-                            Ok(())
-                        })
-                    })?;
+                    // Last chunk first: a chained chunk's buffer is in the slices of the
+                    // chunk before it, which its FFT stage writes.
+                    for pl in group.iter().rev() {
+                        self.inverse_fft(batch, *pl, out)?;
+                    }
                     times.fft += t1.elapsed().as_secs_f64();
                 }
                 Ok(())
@@ -416,6 +328,238 @@ impl General {
         })?;
         times.total = start.elapsed().as_secs_f64();
         Ok(times)
+    }
+
+    /// Whether pair `jj` of `ch` writes a slice.
+    fn writes(&self, ch: ChunkLanes, jj: usize) -> bool {
+        self.pairs.outputs[ch.j0 + jj]
+            .iter()
+            .any(|&s| s != usize::MAX)
+    }
+
+    /// The inverse's buffers of every chunk of a single transform as one chain, if they
+    /// fit: chunk 0 in the plan's buffer `own`, chunk `k` in two halves, its lower lanes'
+    /// rows in the output slices of the lower points of chunk `k - 1` and its upper lanes'
+    /// rows in those of its upper points. The DWT stage then runs once over all chunks
+    /// (each cluster's coefficients read once), and the FFT stage runs the chunks last to
+    /// first: chunk `k` reads its rows before chunk `k - 1` writes its slices. The chunks
+    /// are a multiple of the vector width (the padding rows need room too); the slices of a
+    /// chunk's lower (upper) points must be consecutive. `None` for batches, fewer than two
+    /// chunks, or rows that do not fit.
+    fn inverse_chain(
+        &self,
+        count: usize,
+        out: Data,
+        own: SendPtr<f64>,
+    ) -> Option<Vec<PlacedLanes>> {
+        // The most pairs the plan's buffer holds, rounded down to the vector width.
+        let w = self.lanes_w;
+        let most = self
+            .chunk_pairs()
+            .next_multiple_of(w)
+            .min(self.most_pairs());
+        let h = if most >= w { most / w * w } else { most };
+        let chunks: Vec<ChunkLanes> = self.chunks(h).collect();
+        if count != 1 || chunks.len() < 2 {
+            return None;
+        }
+        let (base, value_bytes) = match out {
+            Data::Complex(p) => (p.get().cast::<u8>(), 16),
+            Data::Real(p) => (p.get().cast::<u8>(), 8),
+        };
+        let slice_bytes = self.fft.slice_len() * value_bytes;
+        let rt = self.dwt.row_total;
+        let mut chain = vec![PlacedLanes {
+            ch: chunks[0],
+            buf: own,
+        }];
+        for pair in chunks.windows(2) {
+            let (host, ch) = (pair[0], pair[1]);
+            let half_bytes = 8 * ch.hp * rt;
+            // The first slice of `host`'s consecutive lower (u = 0) or upper (u = 1)
+            // points, aligned room for a half from there.
+            let region = |u: usize| -> Option<*mut u8> {
+                let first = self.pairs.outputs[host.j0 + if u == 0 { 0 } else { host.h - 1 }][u];
+                let consecutive = (0..host.h).all(|jj| {
+                    let s = self.pairs.outputs[host.j0 + jj][u];
+                    s != usize::MAX
+                        && s == if u == 0 {
+                            first + jj
+                        } else {
+                            first + host.h - 1 - jj
+                        }
+                });
+                let from = base.wrapping_add(first * slice_bytes);
+                let skip = from.align_offset(64);
+                (consecutive && skip + half_bytes <= host.h * slice_bytes)
+                    .then(|| from.wrapping_add(skip))
+            };
+            let (lower, upper) = (region(0)?, region(1)?);
+            // Both halves as one lane-major buffer: rows `0..hp` at `lower`, rows
+            // `hp..2 hp` from `upper`, which must follow.
+            if (upper as usize) < lower as usize + half_bytes {
+                return None;
+            }
+            let gap = (upper as usize - lower as usize) / 8;
+            if gap * 8 != upper as usize - lower as usize {
+                return None;
+            }
+            chain.push(PlacedLanes {
+                ch: ChunkLanes {
+                    upper_gap: gap,
+                    ..ch
+                },
+                buf: SendPtr(lower.cast::<f64>()),
+            });
+        }
+        Some(chain)
+    }
+
+    /// The inverse's DWT stage of the chunks of `group` (each cluster over every chunk in
+    /// turn, its coefficients cached after the first).
+    fn inverse_dwt(
+        &self,
+        batch: Batch,
+        coef: SendConstPtr<Complex64>,
+        group: &[PlacedLanes],
+        (real, stream): (bool, bool),
+    ) {
+        let clusters = &self.dwt.clusters;
+        clusters
+            .par_iter()
+            .enumerate()
+            .with_min_len(4)
+            .for_each(|(i, cl)| {
+                self.dwt.with_scratch(|sc| {
+                    for (k, pl) in group.iter().enumerate() {
+                        let ch = pl.ch;
+                        let per_t = self.dwt.row_total * ch.lanes();
+                        let n = if k == 0 {
+                            self.dwt.setup(sc, cl, &self.pairs, ch)
+                        } else {
+                            self.dwt.setup_lanes(sc, cl, &self.pairs, ch)
+                        };
+                        let last_chunk = k + 1 == group.len();
+                        for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                            let count = KERNEL_BATCH.min(batch.count - t0);
+                            // What the next kernel call will gather: this cluster for the
+                            // next transforms, nothing new for the next chunk (the same
+                            // blocks), else the next cluster (likely this task's next one)
+                            // for the first transforms.
+                            let next = if t0 + count < batch.count {
+                                Some((cl, t0 + count))
+                            } else if last_chunk {
+                                clusters.get(i + 1).map(|c| (c, 0))
+                            } else {
+                                None
+                            };
+                            let next = next.map(|(c, u)| {
+                                let rows = BatchRows {
+                                    base: coef.get().wrapping_add(u * batch.in_dist),
+                                    dist: batch.in_dist,
+                                    count: KERNEL_BATCH.min(batch.count - u),
+                                };
+                                (c, rows)
+                            });
+                            let c = BatchRows {
+                                base: coef.get().wrapping_add(t0 * batch.in_dist),
+                                dist: batch.in_dist,
+                                count,
+                            };
+                            let b = BatchRows {
+                                base: pl.buf.get().wrapping_add(t0 * per_t + cl.offset),
+                                dist: per_t,
+                                count,
+                            };
+                            // SAFETY: coefficient arrays `t0..t0 + count` of the batch
+                            // (checked lengths), read only; this cluster's `cl.p` doubles of
+                            // the lane rows of those transforms in the chunk's buffer (the
+                            // plan's, or output slices no FFT task writes before the stage
+                            // ends, see `inverse_chain`), written by this task only.
+                            unsafe {
+                                if count == 1 {
+                                    let hints = next.map_or(Prefetch::none(), |(c, r)| {
+                                        self.dwt.coefficient_hints(c, r.base, real)
+                                    });
+                                    self.dwt.inverse(
+                                        sc,
+                                        cl,
+                                        ch,
+                                        n,
+                                        c.base,
+                                        (real, stream, hints),
+                                        b.base,
+                                    )
+                                } else {
+                                    self.dwt
+                                        .inverse_many(sc, cl, ch, n, c, (real, stream, next), b)
+                                }
+                            }
+                        }
+                    }
+                })
+            });
+    }
+
+    /// The inverse's FFT stage of one chunk: a beta and its mirror in one task where both
+    /// are written (each lane row and slot read once for both), the others alone.
+    fn inverse_fft(&self, batch: Batch, pl: PlacedLanes, out: Data) -> Result<()> {
+        let (ch, buf) = (pl.ch, pl.buf);
+        let per_t = self.dwt.row_total * ch.lanes();
+        let slice_len = self.fft.slice_len();
+        let pair_tasks = self.pair_tasks(ch, batch.count);
+        pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
+            self.with_work(|work| {
+                let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
+                let at = |s: usize| t * batch.out_dist + s * slice_len;
+                // SAFETY: the lane rows were written by the DWT stage (finished); slices `s0`
+                // and `s1` of output `t` are inside the checked output and this task's
+                // alone, and hold no chunk's rows still to be read (see `inverse_chain`).
+                unsafe {
+                    match out {
+                        Data::Complex(o) => {
+                            let (w0, w1) = self.fft.inv_pair(work)?;
+                            self.scatter_pair((w0, w1), &[rows]);
+                            self.fft.inverse(w0, o.get().add(at(s0)));
+                            self.fft.inverse(w1, o.get().add(at(s1)));
+                        }
+                        Data::Real(o) => {
+                            let (w0, w1) = self.fft.half_pair(work)?;
+                            self.scatter_real_pair((w0, w1), &[rows]);
+                            self.fft.inverse_real(w0, o.get().add(at(s0)));
+                            self.fft.inverse_real(w1, o.get().add(at(s1)));
+                        }
+                    }
+                }
+                Ok(())
+            })
+        })?;
+        let tasks = self.slice_tasks(ch, batch.count);
+        tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
+            self.with_work(|work| {
+                let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                let at = t * batch.out_dist + s * slice_len;
+                match out {
+                    Data::Complex(o) => {
+                        let w = self.fft.inv_buf(work)?;
+                        // SAFETY: as for the pairs above, for slice `s` of output `t`.
+                        unsafe {
+                            self.scatter(w, &[rows]);
+                            self.fft.inverse(w, o.get().add(at));
+                        }
+                    }
+                    Data::Real(o) => {
+                        let w = self.fft.half_buf(work)?;
+                        // SAFETY: as above, for the real output.
+                        unsafe {
+                            self.scatter_real(w, &[rows]);
+                            self.fft.inverse_real(w, o.get().add(at));
+                        }
+                    }
+                }
+                Ok(())
+            })
+        })
     }
 
     /// Forward of a group of transforms, chunk by chunk.
@@ -434,7 +578,7 @@ impl General {
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
-                for ch in self.chunks() {
+                for ch in self.chunks(self.chunk_pairs()) {
                     let lanes = ch.lanes();
                     let per_t = self.dwt.row_total * lanes;
                     let t0 = Instant::now();
@@ -641,15 +785,8 @@ impl General {
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
         parts: &[LaneRows],
     ) {
-        let (na, ng) = self.fft.dims();
-        let (rs, _) = self.fft.strides();
-        let n = self.layout_n;
-        for w in [&mut *w0, &mut *w1] {
-            for row in w.chunks_exact_mut(rs).take(na) {
-                row[..=n].fill(Complex64::default());
-                row[ng - n..ng].fill(Complex64::default());
-            }
-        }
+        self.clear_inverse_buffer(w0);
+        self.clear_inverse_buffer(w1);
         self.for_each_pair_slot(parts, false, |lo, hi, work| {
             // SAFETY: the slot's two doubles in both lane rows of the part (the table holds
             // the offsets of `dwt.clusters`' slots).
@@ -738,16 +875,30 @@ impl General {
         ch: ChunkLanes,
         (jj, upper): (usize, bool),
     ) -> LaneRows {
-        let rt = self.dwt.row_total;
-        let (r, rm) = if upper {
-            (ch.hp + jj, jj)
+        let lower = buf.wrapping_add(at + jj * self.dwt.row_total);
+        let mirror = lower.wrapping_add(ch.upper_gap);
+        let (own, mirror) = if upper {
+            (mirror, lower)
         } else {
-            (jj, ch.hp + jj)
+            (lower, mirror)
         };
         LaneRows {
-            own: buf.wrapping_add(at + r * rt),
-            mirror: buf.wrapping_add(at + rm * rt),
+            own,
+            mirror,
             clusters: (0, self.dwt.clusters.len()),
+        }
+    }
+
+    /// Zeroes the columns of the inverse's work buffer `w` that a slice may not fill (see
+    /// `FftStage::inverse_clears`).
+    fn clear_inverse_buffer(&self, w: &mut [Complex64]) {
+        let (na, _) = self.fft.dims();
+        let (rs, _) = self.fft.strides();
+        let cols = self.fft.inverse_clears();
+        for row in w.chunks_exact_mut(rs).take(na) {
+            for c in &cols {
+                row[c.clone()].fill(Complex64::default());
+            }
         }
     }
 
@@ -757,13 +908,7 @@ impl General {
     /// # Safety
     /// Each part's lane rows hold its clusters' slots, written by the DWT stage.
     pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: &[LaneRows]) {
-        let (na, ng) = self.fft.dims();
-        let (rs, _) = self.fft.strides();
-        let n = self.layout_n;
-        for row in w.chunks_exact_mut(rs).take(na) {
-            row[..=n].fill(Complex64::default());
-            row[ng - n..ng].fill(Complex64::default());
-        }
+        self.clear_inverse_buffer(w);
         for part in rows {
             for &(at, work) in self.slots.of(part.clusters) {
                 let x = part.at(at);
@@ -841,10 +986,9 @@ impl General {
     /// The chunk's `2 hp` lane rows at `rows` are the caller's.
     pub(super) unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
         let rt = self.dwt.row_total;
-        for half in 0..2 {
-            let from = half * ch.hp + ch.h;
-            // SAFETY: lane rows `from..(half + 1) hp`, inside the chunk's rows.
-            unsafe { std::ptr::write_bytes(rows.add(from * rt), 0, (ch.hp - ch.h) * rt) };
+        for half in [0, ch.upper_gap] {
+            // SAFETY: lane rows `h..hp` of the half, inside the chunk's rows.
+            unsafe { std::ptr::write_bytes(rows.add(half + ch.h * rt), 0, (ch.hp - ch.h) * rt) };
         }
     }
 }

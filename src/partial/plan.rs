@@ -119,6 +119,17 @@ impl PartialPlan {
         matches!(self.engine, Engine::Full(_))
     }
 
+    /// The number of chunks a single inverse (complex, or `real`) on the general engine
+    /// runs as one chain (their buffers in the output, each cluster's coefficients read
+    /// once), 0 where it runs them one by one or on [`Plan`]. For tests and benchmarks.
+    #[doc(hidden)]
+    pub fn chained_inverse_chunks(&self, real: bool) -> usize {
+        match &self.engine {
+            Engine::Full(_) => 0,
+            Engine::General(g) => g.chained_chunks(real),
+        }
+    }
+
     /// Coefficients of one transform ([`Shape::num_coeffs`]).
     pub fn num_coeffs(&self) -> usize {
         match &self.engine {
