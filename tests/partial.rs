@@ -469,7 +469,9 @@ fn selections_without_mirrors() {
     }
 }
 
-/// Real plans against complex ones, also on the full plan.
+/// Real plans against complex ones, also on the full plan; the general engine (whose real
+/// transforms run only the members `M' >= 0`) on every instruction set, in one chunk and in
+/// several.
 #[test]
 fn real_against_complex() {
     let shapes = [
@@ -479,10 +481,20 @@ fn real_against_complex() {
             .with_grid(8, 6, 14)
             .with_degree_min(2),
         Shape::new(6),
+        Shape::new(13),
     ];
+    let isas = [Isa::Avx512, Isa::Avx2, Isa::Scalar];
+    let general = isas
+        .into_iter()
+        .filter(|i| i.is_supported())
+        .flat_map(|isa| [None, Some(20_000)].map(|cap| (true, Some(isa), cap)));
     for s in shapes {
-        for general in [false, true] {
-            let o = opts().with_real(true).with_general_engine(general);
+        for (general, isa, cap) in std::iter::once((false, None, None)).chain(general.clone()) {
+            let o = opts()
+                .with_real(true)
+                .with_general_engine(general)
+                .with_isa(isa)
+                .with_max_workspace_bytes(cap);
             let pp = PartialPlan::new(&s, &o).unwrap();
             let mut c = random_coeffs(&s, 17);
             common::make_hermitian(&s, &mut c);
@@ -503,11 +515,11 @@ fn real_against_complex() {
                 .zip(&z)
                 .map(|(a, b)| (a - b.re).abs())
                 .fold(0.0, f64::max);
-            assert!(e < 1e-13, "{s:?}: real inverse {e:e}");
+            assert!(e < 1e-13, "{s:?} {isa:?} {cap:?}: real inverse {e:e}");
             let mut back = zeros(c.len());
             pp.forward_real(&re, &mut back).unwrap();
             let e = max_diff(&back, &c);
-            assert!(e < 1e-12, "{s:?}: real forward {e:e}");
+            assert!(e < 1e-12, "{s:?} {isa:?} {cap:?}: real forward {e:e}");
         }
     }
 }

@@ -749,12 +749,12 @@ impl<X: Exchange> DistributedPlan<X> {
                                 let (w0, w1) = g.fft.half_pair(work)?;
                                 g.fft.forward_real(w0, inp.get().add(at(s0)));
                                 g.fft.forward_real(w1, inp.get().add(at(s1)));
-                                g.gather_real_pair((w0, w1), &rows, weight);
+                                g.gather_real_pair(g.members(false), (w0, w1), &rows, weight);
                             } else {
                                 let (w0, w1) = g.fft.fwd_pair(work)?;
                                 g.fft.forward(w0, inp.get().add(at(s0)).cast());
                                 g.fft.forward(w1, inp.get().add(at(s1)).cast());
-                                g.gather_pair((w0, w1), &rows, weight);
+                                g.gather_pair(g.members(false), (w0, w1), &rows, weight);
                             }
                         }
                         Ok(())
@@ -876,12 +876,12 @@ impl<X: Exchange> DistributedPlan<X> {
                         unsafe {
                             if real {
                                 let (w0, w1) = g.fft.half_pair(work)?;
-                                g.scatter_real_pair((w0, w1), &rows);
+                                g.scatter_real_pair(g.members(false), (w0, w1), &rows);
                                 g.fft.inverse_real(w0, out.get().add(s0 * slice_len));
                                 g.fft.inverse_real(w1, out.get().add(s1 * slice_len));
                             } else {
                                 let (w0, w1) = g.fft.inv_pair(work)?;
-                                g.scatter_pair((w0, w1), &rows);
+                                g.scatter_pair(g.members(false), (w0, w1), &rows);
                                 let o = out.get().cast::<Complex64>();
                                 g.fft.inverse(w0, o.add(s0 * slice_len));
                                 g.fft.inverse(w1, o.add(s1 * slice_len));

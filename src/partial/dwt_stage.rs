@@ -20,6 +20,7 @@ use crate::simd::Isa;
 use crate::symmetry::{Cluster, Member};
 use crate::wigner::{big, start_norm, RecCoeffs, RecTables};
 use num_complex::Complex64;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::Mutex;
 
@@ -166,19 +167,27 @@ pub(super) struct DwtStage {
     pub clusters: Vec<ClusterPlan>,
     /// Doubles of a lane row (all clusters).
     pub row_total: usize,
+    /// Doubles from one lane row to the next in a lane-major chunk buffer: `row_total`
+    /// padded to an odd number of cache lines, so that the rows' lines of one cluster
+    /// fall in different cache sets (rows of a multiple of 4 KiB put them all in one).
+    pub row_stride: usize,
     recurrence: RecTables,
     skip_bits: u32,
     skip: bool,
+    /// Only the members `M' >= 0` (see [`DwtStage::new`]).
+    half: bool,
     scratch: Vec<Mutex<Scratch>>,
     max_lanes: usize,
 }
 
 impl DwtStage {
     /// The clusters of `layout` (slices of `n_alpha x n_gamma` values, work buffers with
-    /// rows `row_stride` apart), scratch for
-    /// `workers` workers and chunks of up to `max_lanes` lanes.
+    /// rows `row_stride` apart), scratch for `workers` workers and chunks of up to
+    /// `max_lanes` lanes. With `half`, the clusters hold only their members `M' >= 0`: the
+    /// half spectrum of real signals, whose forward writes each member's partner
+    /// `(-M, -M')` from it (`fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`).
     pub fn new(
-        layout: &CoefLayout,
+        (layout, half): (&CoefLayout, bool),
         (n_alpha, n_gamma, row_stride): (usize, usize, usize),
         isa: Isa,
         (skip_bits, skip): (u32, bool),
@@ -193,7 +202,7 @@ impl DwtStage {
                 let slots: Vec<Slot> = cl
                     .members()
                     .iter()
-                    .filter(|mem| layout.holds(mem.m, mem.mp))
+                    .filter(|mem| layout.holds(mem.m, mem.mp) && (!half || mem.mp >= 0))
                     .map(|mem| Slot {
                         member: *mem,
                         work: mem.m.rem_euclid(n_alpha as isize) as usize * row_stride
@@ -226,6 +235,7 @@ impl DwtStage {
             l,
             clusters,
             row_total: offset,
+            row_stride: offset + if (offset / 8) % 2 == 0 { 8 } else { 0 },
             recurrence: RecTables::for_orders(l, &orders),
             skip_bits,
             skip,
@@ -233,6 +243,7 @@ impl DwtStage {
                 .map(|_| Mutex::new(Scratch::new(l, max_lanes)))
                 .collect(),
             max_lanes,
+            half,
         }
     }
 
@@ -241,6 +252,21 @@ impl DwtStage {
         32 * (l + 1) * (l + 2)
             + clusters * 256
             + workers * 8 * (3 * max_lanes + (KERNEL_BATCH + 1) * 16 * (l + 8) + 21 * l)
+    }
+
+    /// Runs `f(scratch, index, cluster)` on every cluster in parallel: work stealing over
+    /// runs of consecutive clusters (consecutive slots of a lane row), a scratch taken once
+    /// per run.
+    pub fn for_each_cluster(&self, f: impl Fn(&mut Scratch, usize, &ClusterPlan) + Sync) {
+        const RUN: usize = 8;
+        let nc = self.clusters.len();
+        (0..nc.div_ceil(RUN)).into_par_iter().for_each(|r| {
+            self.with_scratch(|sc| {
+                for i in r * RUN..((r + 1) * RUN).min(nc) {
+                    f(sc, i, &self.clusters[i]);
+                }
+            })
+        });
     }
 
     /// Runs `f` with a free scratch (a private one when all are busy).
@@ -773,7 +799,7 @@ impl DwtStage {
         // SAFETY: the `2 hp` rows of `p` doubles at `block`, read only (caller's contract).
         let lo = unsafe { dwt::forward_raw(self.isa, p, &rec, &lanes, block, &mut data) }.min(n);
         // SAFETY: `data` holds the kernel's sums; the blocks are the caller's.
-        unsafe { Self::scatter_sums(cl, (n, lo), &sc.rec.s, data.as_ptr(), (coef, first)) };
+        unsafe { self.scatter_sums(cl, (n, lo), &sc.rec.s, data.as_ptr(), (coef, first)) };
         sc.data = data;
     }
 
@@ -811,7 +837,7 @@ impl DwtStage {
         for t in 0..block.count {
             // SAFETY: sums `t` of the kernel; the blocks of transform `t` are the caller's.
             unsafe {
-                Self::scatter_sums(
+                self.scatter_sums(
                     cl,
                     (n, lo),
                     &sc.rec.s,
@@ -832,6 +858,7 @@ impl DwtStage {
     /// `sums` holds the `n` rows; the blocks of this cluster's slots in `coef` are valid
     /// and nobody else's meanwhile.
     unsafe fn scatter_sums(
+        &self,
         cl: &ClusterPlan,
         (n, lo): (usize, usize),
         scales: &[f64],
@@ -845,10 +872,22 @@ impl DwtStage {
             // Degrees below the kernel's `lo` are zero: assigned on the first chunk, else
             // nothing to add.
             let from = i0.max(lo);
+            // A half stage's member `M' > 0` also writes its partner `(-M, -M')` (whose
+            // degrees start at the same one), from the final sums.
+            let partner = (self.half && mem.mp > 0).then(|| {
+                let sign = if (mem.m - mem.mp).rem_euclid(2) == 0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                (s.partner_block, sign)
+            });
             if first && lo > i0 {
-                // SAFETY: degrees `s.first .. cl.m + lo` of the pair's block, this
-                // cluster's (caller's contract).
-                unsafe { std::ptr::write_bytes(coef.add(s.block), 0, lo - i0) };
+                for block in std::iter::once(s.block).chain(partner.map(|p| p.0)) {
+                    // SAFETY: degrees `s.first .. cl.m + lo` of the pair's block (or its
+                    // partner's), this cluster's (caller's contract).
+                    unsafe { std::ptr::write_bytes(coef.add(block), 0, lo - i0) };
+                }
             }
             if from >= n {
                 continue;
@@ -860,8 +899,10 @@ impl DwtStage {
             // SAFETY: degrees `cl.m + from .. L` of the pair's block (this cluster's, caller's
             // contract); `sums` holds the kernel's `n` rows of `p >= 2q + 2` sums.
             unsafe {
-                let dst = coef.add(s.block + cl.m + from - s.first);
-                coeffs::scatter(dst, sums.add(from * p + 2 * q), p, factors, !first, None);
+                let at = cl.m + from - s.first;
+                let dst = coef.add(s.block + at);
+                let partner = partner.map(|(block, sign)| (coef.add(block + at), sign));
+                coeffs::scatter(dst, sums.add(from * p + 2 * q), p, factors, !first, partner);
             }
         }
     }

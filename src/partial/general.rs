@@ -27,11 +27,15 @@ use std::time::Instant;
 pub(super) struct General {
     pub(super) layout: CoefLayout,
     pub(super) pairs: LanePairs,
-    /// Its clusters are never changed after `new`: `slots` is made from them.
+    /// Every member of each cluster (complex transforms, distributed plans). Its clusters
+    /// are never changed after `new`: `slots` is made from them.
     pub(super) dwt: DwtStage,
     pub(super) fft: FftStage,
     /// The slots of a lane row, flat (for the scatters and gathers, complex and real).
-    slots: SlotTable,
+    pub(super) slots: SlotTable,
+    /// The real transforms' members (`M' >= 0`, see `DwtStage::new`) with their slots, for
+    /// plans made with `Options::real`.
+    half: Option<(DwtStage, SlotTable)>,
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
     pub(super) pair_weight: Vec<f64>,
     /// Per-worker FFT buffers (made on first use).
@@ -41,6 +45,13 @@ pub(super) struct General {
     budget: usize,
     pub(super) lanes_w: usize,
     pub(super) workers: WorkerPool,
+}
+
+/// The clusters and slots a transform runs on (see [`General::members`]).
+#[derive(Clone, Copy)]
+pub(super) struct Members<'a> {
+    pub(super) dwt: &'a DwtStage,
+    pub(super) slots: &'a SlotTable,
 }
 
 /// A chunk and its buffer (lane row `r < hp` at `buf + r row_len`, the upper half
@@ -89,13 +100,16 @@ impl General {
             options.real,
             options.rigor,
         )?;
-        let dwt = DwtStage::new(
-            &layout,
-            (na, ng, fft.strides().0),
-            isa,
-            skip,
-            (threads, max_lanes),
-        );
+        let stage = |half: bool| {
+            DwtStage::new(
+                (&layout, half),
+                (na, ng, fft.strides().0),
+                isa,
+                skip,
+                (threads, max_lanes),
+            )
+        };
+        let dwt = stage(false);
         let pair_weight = if options.betas == Betas::All {
             let wts = crate::grid::weights(shape.grid_bandwidth);
             let f = 2.0 * PI / (na * ng) as f64;
@@ -104,7 +118,15 @@ impl General {
             Vec::new()
         };
         let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
+        let half = if options.real {
+            let dwt = stage(true);
+            let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
+            Some((dwt, slots))
+        } else {
+            None
+        };
         Ok(General {
+            half,
             layout,
             pairs,
             slots,
@@ -120,22 +142,22 @@ impl General {
     }
 
     /// Bytes of one transform's blocks per lane pair.
-    fn pair_bytes(&self) -> usize {
-        (self.dwt.row_total * 2 * 8).max(1)
+    fn pair_bytes(m: Members) -> usize {
+        (m.dwt.row_stride * 2 * 8).max(1)
     }
 
     /// Lane pairs the workspace cap holds for one transform (at least one).
-    fn most_pairs(&self) -> usize {
-        (self.budget / self.pair_bytes()).clamp(1, self.pairs.pairs)
+    fn most_pairs(&self, m: Members) -> usize {
+        (self.budget / Self::pair_bytes(m)).clamp(1, self.pairs.pairs)
     }
 
     /// Lane pairs per chunk: what the workspace cap holds for one transform (at least
     /// one), the pairs spread evenly over the fewest chunks, a multiple of the vector
     /// width when that is at least one vector. It does not depend on the batch, so a batch
     /// sums in the order of single executes.
-    fn chunk_pairs(&self) -> usize {
+    fn chunk_pairs(&self, m: Members) -> usize {
         let pairs = self.pairs.pairs;
-        let most = self.most_pairs();
+        let most = self.most_pairs(m);
         let h = pairs.div_ceil(pairs.div_ceil(most));
         let w = self.lanes_w;
         if h >= w && h.next_multiple_of(w) <= most {
@@ -148,19 +170,19 @@ impl General {
     /// Transforms of a batch run together (sharing each cluster's recurrence coefficients,
     /// starting values and d values, see `dwt/batch.rs`): as many as the workspace cap holds
     /// at the chunk size (at least one).
-    fn group_size(&self) -> usize {
-        let hp = self.chunk_pairs().next_multiple_of(self.lanes_w);
-        (self.budget / (hp * self.pair_bytes())).max(1)
+    fn group_size(&self, m: Members) -> usize {
+        let hp = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        (self.budget / (hp * Self::pair_bytes(m))).max(1)
     }
 
     /// Runs `run(first, sub_batch)` on the groups of `batch` (see [`General::group_size`]),
     /// summing the stage times.
     fn by_groups(
         &self,
-        batch: Batch,
+        (batch, m): (Batch, Members),
         mut run: impl FnMut(usize, Batch) -> Result<StageTimes>,
     ) -> Result<StageTimes> {
-        let g = self.group_size();
+        let g = self.group_size(m);
         let mut sum = StageTimes::default();
         let mut t0 = 0;
         while t0 < batch.count {
@@ -179,7 +201,8 @@ impl General {
         out: Data,
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
-        self.by_groups(batch, |t0, b| {
+        let m = self.members(matches!(out, Data::Real(_)));
+        self.by_groups((batch, m), |t0, b| {
             let c = SendConstPtr(coef.get().wrapping_add(t0 * batch.in_dist));
             let o = match out {
                 Data::Complex(p) => {
@@ -187,7 +210,7 @@ impl General {
                 }
                 Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(t0 * batch.out_dist))),
             };
-            self.inverse_group(b, c, o, scratch)
+            self.inverse_group((b, m), c, o, scratch)
         })
     }
 
@@ -201,10 +224,11 @@ impl General {
         (real, scratch): (bool, Option<&Scratch>),
     ) -> Result<StageTimes> {
         let per_value = if real { 1 } else { 2 };
-        self.by_groups(batch, |t0, b| {
+        let m = self.members(real);
+        self.by_groups((batch, m), |t0, b| {
             let i = SendConstPtr(inp.get().wrapping_add(t0 * batch.in_dist * per_value));
             let c = SendPtr(coef.get().wrapping_add(t0 * batch.out_dist));
-            self.forward_group(b, i, c, (real, scratch))
+            self.forward_group((b, m), i, c, (real, scratch))
         })
     }
 
@@ -225,8 +249,27 @@ impl General {
 
     /// Bytes of the chunk buffer of one transform (the scratch a single call needs).
     pub(super) fn scratch_bytes(&self) -> usize {
-        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
-        8 * self.dwt.row_total * 2 * hp_max
+        [false, true]
+            .map(|real| {
+                let m = self.members(real);
+                let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+                8 * m.dwt.row_stride * 2 * hp_max
+            })
+            .into_iter()
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// The clusters and slots of the complex transforms (every member), or of the real
+    /// ones (`real`: the members `M' >= 0` where the plan has them).
+    pub(super) fn members(&self, real: bool) -> Members<'_> {
+        match (&self.half, real) {
+            (Some((dwt, slots)), true) => Members { dwt, slots },
+            _ => Members {
+                dwt: &self.dwt,
+                slots: &self.slots,
+            },
+        }
     }
 
     /// Runs `f` with a worker's FFT buffers (a private set when all are busy).
@@ -238,7 +281,8 @@ impl General {
     }
 
     /// The chunks of `h` lane pairs (the last one shorter).
-    fn chunks(&self, h: usize) -> impl Iterator<Item = ChunkLanes> + '_ {
+    fn chunks(&self, (h, m): (usize, Members)) -> impl Iterator<Item = ChunkLanes> + '_ {
+        let row_len = m.dwt.row_stride;
         let w = self.lanes_w;
         (0..self.pairs.pairs).step_by(h).map(move |j0| {
             let h = h.min(self.pairs.pairs - j0);
@@ -256,8 +300,8 @@ impl General {
                 j0,
                 h,
                 hp,
-                row_len: self.dwt.row_total,
-                upper_gap: hp * self.dwt.row_total,
+                row_len,
+                upper_gap: hp * row_len,
                 first_upper_pair,
             }
         })
@@ -273,7 +317,7 @@ impl General {
         } else {
             Data::Complex(SendPtr(at.cast()))
         };
-        self.inverse_chain(1, out, SendPtr(at.cast()))
+        self.inverse_chain((1, self.members(real)), out, SendPtr(at.cast()))
             .map_or(0, |c| c.len())
     }
 
@@ -281,22 +325,23 @@ impl General {
     /// DWT stage where [`General::inverse_chain`] places their buffers.
     fn inverse_group(
         &self,
-        batch: Batch,
+        (batch, m): (Batch, Members),
         coef: SendConstPtr<Complex64>,
         out: Data,
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
-        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
-        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        let per_t_max = m.dwt.row_stride * 2 * hp_max;
         let real = matches!(out, Data::Real(_));
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let own = SendPtr(buf);
-            let groups: Vec<Vec<PlacedLanes>> = match self.inverse_chain(batch.count, out, own) {
+            let chain = self.inverse_chain((batch.count, m), out, own);
+            let groups: Vec<Vec<PlacedLanes>> = match chain {
                 Some(chain) => vec![chain],
                 None => self
-                    .chunks(self.chunk_pairs())
+                    .chunks((self.chunk_pairs(m), m))
                     .map(|ch| vec![PlacedLanes { ch, buf: own }])
                     .collect(),
             };
@@ -313,13 +358,13 @@ impl General {
                     // Rows far larger than the caches go out with non-temporal stores.
                     let stream = group.len() * batch.count * per_t_max * 8 > 8 << 20;
                     let t0 = Instant::now();
-                    self.inverse_dwt(batch, coef, &group, (real, stream));
+                    self.inverse_dwt((batch, m), coef, &group, (real, stream));
                     let t1 = Instant::now();
                     times.dwt += (t1 - t0).as_secs_f64();
                     // Last chunk first: a chained chunk's buffer is in the slices of the
                     // chunk before it, which its FFT stage writes.
                     for pl in group.iter().rev() {
-                        self.inverse_fft(batch, *pl, out)?;
+                        self.inverse_fft((batch, m), *pl, out)?;
                     }
                     times.fft += t1.elapsed().as_secs_f64();
                 }
@@ -348,18 +393,15 @@ impl General {
     /// chunks, or rows that do not fit.
     fn inverse_chain(
         &self,
-        count: usize,
+        (count, m): (usize, Members),
         out: Data,
         own: SendPtr<f64>,
     ) -> Option<Vec<PlacedLanes>> {
         // The most pairs the plan's buffer holds, rounded down to the vector width.
         let w = self.lanes_w;
-        let most = self
-            .chunk_pairs()
-            .next_multiple_of(w)
-            .min(self.most_pairs());
+        let most = (self.chunk_pairs(m).next_multiple_of(w)).min(self.most_pairs(m));
         let h = if most >= w { most / w * w } else { most };
-        let chunks: Vec<ChunkLanes> = self.chunks(h).collect();
+        let chunks: Vec<ChunkLanes> = self.chunks((h, m)).collect();
         if count != 1 || chunks.len() < 2 {
             return None;
         }
@@ -368,7 +410,7 @@ impl General {
             Data::Real(p) => (p.get().cast::<u8>(), 8),
         };
         let slice_bytes = self.fft.slice_len() * value_bytes;
-        let rt = self.dwt.row_total;
+        let rt = m.dwt.row_stride;
         let mut chain = vec![PlacedLanes {
             ch: chunks[0],
             buf: own,
@@ -419,98 +461,85 @@ impl General {
     /// turn, its coefficients cached after the first).
     fn inverse_dwt(
         &self,
-        batch: Batch,
+        (batch, m): (Batch, Members),
         coef: SendConstPtr<Complex64>,
         group: &[PlacedLanes],
         (real, stream): (bool, bool),
     ) {
-        let clusters = &self.dwt.clusters;
-        clusters
-            .par_iter()
-            .enumerate()
-            .with_min_len(4)
-            .for_each(|(i, cl)| {
-                self.dwt.with_scratch(|sc| {
-                    for (k, pl) in group.iter().enumerate() {
-                        let ch = pl.ch;
-                        let per_t = self.dwt.row_total * ch.lanes();
-                        let n = if k == 0 {
-                            self.dwt.setup(sc, cl, &self.pairs, ch)
-                        } else {
-                            self.dwt.setup_lanes(sc, cl, &self.pairs, ch)
+        let clusters = &m.dwt.clusters;
+        m.dwt.for_each_cluster(|sc, i, cl| {
+            for (k, pl) in group.iter().enumerate() {
+                let ch = pl.ch;
+                let per_t = m.dwt.row_stride * ch.lanes();
+                let n = if k == 0 {
+                    m.dwt.setup(sc, cl, &self.pairs, ch)
+                } else {
+                    m.dwt.setup_lanes(sc, cl, &self.pairs, ch)
+                };
+                let last_chunk = k + 1 == group.len();
+                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                    let count = KERNEL_BATCH.min(batch.count - t0);
+                    // What the next kernel call will gather: this cluster for the
+                    // next transforms, nothing new for the next chunk (the same
+                    // blocks), else the next cluster (likely this task's next one)
+                    // for the first transforms.
+                    let next = if t0 + count < batch.count {
+                        Some((cl, t0 + count))
+                    } else if last_chunk {
+                        clusters.get(i + 1).map(|c| (c, 0))
+                    } else {
+                        None
+                    };
+                    let next = next.map(|(c, u)| {
+                        let rows = BatchRows {
+                            base: coef.get().wrapping_add(u * batch.in_dist),
+                            dist: batch.in_dist,
+                            count: KERNEL_BATCH.min(batch.count - u),
                         };
-                        let last_chunk = k + 1 == group.len();
-                        for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                            let count = KERNEL_BATCH.min(batch.count - t0);
-                            // What the next kernel call will gather: this cluster for the
-                            // next transforms, nothing new for the next chunk (the same
-                            // blocks), else the next cluster (likely this task's next one)
-                            // for the first transforms.
-                            let next = if t0 + count < batch.count {
-                                Some((cl, t0 + count))
-                            } else if last_chunk {
-                                clusters.get(i + 1).map(|c| (c, 0))
-                            } else {
-                                None
-                            };
-                            let next = next.map(|(c, u)| {
-                                let rows = BatchRows {
-                                    base: coef.get().wrapping_add(u * batch.in_dist),
-                                    dist: batch.in_dist,
-                                    count: KERNEL_BATCH.min(batch.count - u),
-                                };
-                                (c, rows)
+                        (c, rows)
+                    });
+                    let c = BatchRows {
+                        base: coef.get().wrapping_add(t0 * batch.in_dist),
+                        dist: batch.in_dist,
+                        count,
+                    };
+                    let b = BatchRows {
+                        base: pl.buf.get().wrapping_add(t0 * per_t + cl.offset),
+                        dist: per_t,
+                        count,
+                    };
+                    // SAFETY: coefficient arrays `t0..t0 + count` of the batch
+                    // (checked lengths), read only; this cluster's `cl.p` doubles of
+                    // the lane rows of those transforms in the chunk's buffer (the
+                    // plan's, or output slices no FFT task writes before the stage
+                    // ends, see `inverse_chain`), written by this task only.
+                    unsafe {
+                        if count == 1 {
+                            let hints = next.map_or(Prefetch::none(), |(c, r)| {
+                                m.dwt.coefficient_hints(c, r.base, real)
                             });
-                            let c = BatchRows {
-                                base: coef.get().wrapping_add(t0 * batch.in_dist),
-                                dist: batch.in_dist,
-                                count,
-                            };
-                            let b = BatchRows {
-                                base: pl.buf.get().wrapping_add(t0 * per_t + cl.offset),
-                                dist: per_t,
-                                count,
-                            };
-                            // SAFETY: coefficient arrays `t0..t0 + count` of the batch
-                            // (checked lengths), read only; this cluster's `cl.p` doubles of
-                            // the lane rows of those transforms in the chunk's buffer (the
-                            // plan's, or output slices no FFT task writes before the stage
-                            // ends, see `inverse_chain`), written by this task only.
-                            unsafe {
-                                if count == 1 {
-                                    let hints = next.map_or(Prefetch::none(), |(c, r)| {
-                                        self.dwt.coefficient_hints(c, r.base, real)
-                                    });
-                                    self.dwt.inverse(
-                                        sc,
-                                        cl,
-                                        ch,
-                                        n,
-                                        c.base,
-                                        (real, stream, hints),
-                                        b.base,
-                                    )
-                                } else {
-                                    self.dwt
-                                        .inverse_many(sc, cl, ch, n, c, (real, stream, next), b)
-                                }
-                            }
+                            m.dwt
+                                .inverse(sc, cl, ch, n, c.base, (real, stream, hints), b.base)
+                        } else {
+                            m.dwt
+                                .inverse_many(sc, cl, ch, n, c, (real, stream, next), b)
                         }
                     }
-                })
-            });
+                }
+            }
+        });
     }
 
     /// The inverse's FFT stage of one chunk: a beta and its mirror in one task where both
     /// are written (each lane row and slot read once for both), the others alone.
-    fn inverse_fft(&self, batch: Batch, pl: PlacedLanes, out: Data) -> Result<()> {
+    fn inverse_fft(&self, (batch, m): (Batch, Members), pl: PlacedLanes, out: Data) -> Result<()> {
         let (ch, buf) = (pl.ch, pl.buf);
-        let per_t = self.dwt.row_total * ch.lanes();
+        let per_t = m.dwt.row_stride * ch.lanes();
         let slice_len = self.fft.slice_len();
         let pair_tasks = self.pair_tasks(ch, batch.count);
         pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
             self.with_work(|work| {
-                let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
+                let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, false));
                 let at = |s: usize| t * batch.out_dist + s * slice_len;
                 // SAFETY: the lane rows were written by the DWT stage (finished); slices `s0`
                 // and `s1` of output `t` are inside the checked output and this task's
@@ -519,13 +548,13 @@ impl General {
                     match out {
                         Data::Complex(o) => {
                             let (w0, w1) = self.fft.inv_pair(work)?;
-                            self.scatter_pair((w0, w1), &[rows]);
+                            self.scatter_pair(m, (w0, w1), &[rows]);
                             self.fft.inverse(w0, o.get().add(at(s0)));
                             self.fft.inverse(w1, o.get().add(at(s1)));
                         }
                         Data::Real(o) => {
                             let (w0, w1) = self.fft.half_pair(work)?;
-                            self.scatter_real_pair((w0, w1), &[rows]);
+                            self.scatter_real_pair(m, (w0, w1), &[rows]);
                             self.fft.inverse_real(w0, o.get().add(at(s0)));
                             self.fft.inverse_real(w1, o.get().add(at(s1)));
                         }
@@ -537,14 +566,14 @@ impl General {
         let tasks = self.slice_tasks(ch, batch.count);
         tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
             self.with_work(|work| {
-                let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, upper));
                 let at = t * batch.out_dist + s * slice_len;
                 match out {
                     Data::Complex(o) => {
                         let w = self.fft.inv_buf(work)?;
                         // SAFETY: as for the pairs above, for slice `s` of output `t`.
                         unsafe {
-                            self.scatter(w, &[rows]);
+                            self.scatter(m, w, &[rows]);
                             self.fft.inverse(w, o.get().add(at));
                         }
                     }
@@ -552,7 +581,7 @@ impl General {
                         let w = self.fft.half_buf(work)?;
                         // SAFETY: as above, for the real output.
                         unsafe {
-                            self.scatter_real(w, &[rows]);
+                            self.scatter_real(m, w, &[rows]);
                             self.fft.inverse_real(w, o.get().add(at));
                         }
                     }
@@ -565,29 +594,29 @@ impl General {
     /// Forward of a group of transforms, chunk by chunk.
     fn forward_group(
         &self,
-        batch: Batch,
+        (batch, m): (Batch, Members),
         inp: SendConstPtr<f64>,
         coef: SendPtr<Complex64>,
         (real, scratch): (bool, Option<&Scratch>),
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
-        let hp_max = self.chunk_pairs().next_multiple_of(self.lanes_w);
-        let per_t_max = self.dwt.row_total * 2 * hp_max;
+        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        let per_t_max = m.dwt.row_stride * 2 * hp_max;
         let slice_len = self.fft.slice_len();
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
-                for ch in self.chunks(self.chunk_pairs()) {
+                for ch in self.chunks((self.chunk_pairs(m), m)) {
                     let lanes = ch.lanes();
-                    let per_t = self.dwt.row_total * lanes;
+                    let per_t = m.dwt.row_stride * lanes;
                     let t0 = Instant::now();
                     // A beta and its mirror in one task (each lane row written whole by
                     // one task, each slot read once), as the inverse.
                     let pair_tasks = self.pair_tasks(ch, batch.count);
                     pair_tasks.par_iter().try_for_each(|&(t, jj, [s0, s1])| {
                         self.with_work(|work| {
-                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, false));
+                            let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, false));
                             let weight = self.pair_weight[ch.j0 + jj];
                             let at = |s: usize| t * batch.in_dist + s * slice_len;
                             // SAFETY: slices `s0` and `s1` of input `t` are inside the
@@ -598,12 +627,12 @@ impl General {
                                     let (w0, w1) = self.fft.half_pair(work)?;
                                     self.fft.forward_real(w0, inp.get().add(at(s0)));
                                     self.fft.forward_real(w1, inp.get().add(at(s1)));
-                                    self.gather_real_pair((w0, w1), &[rows], weight);
+                                    self.gather_real_pair(m, (w0, w1), &[rows], weight);
                                 } else {
                                     let (w0, w1) = self.fft.fwd_pair(work)?;
                                     self.fft.forward(w0, inp.get().add(2 * at(s0)).cast());
                                     self.fft.forward(w1, inp.get().add(2 * at(s1)).cast());
-                                    self.gather_pair((w0, w1), &[rows], weight);
+                                    self.gather_pair(m, (w0, w1), &[rows], weight);
                                 }
                             }
                             Ok(())
@@ -612,7 +641,7 @@ impl General {
                     let tasks = self.slice_tasks(ch, batch.count);
                     tasks.par_iter().try_for_each(|&(t, jj, upper, s)| {
                         self.with_work(|work| {
-                            let rows = self.lane_rows(buf.get(), t * per_t, ch, (jj, upper));
+                            let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, upper));
                             let weight = self.pair_weight[ch.j0 + jj];
                             // SAFETY: slice `s` of input `t` is inside the checked input
                             // (complex values, or reals for the real forward); the values
@@ -624,12 +653,12 @@ impl General {
                                     let w = self.fft.half_buf(work)?;
                                     let at = t * batch.in_dist + s * slice_len;
                                     self.fft.forward_real(w, inp.get().add(at));
-                                    self.gather_real(w, &[rows], weight);
+                                    self.gather_real(m, w, &[rows], weight);
                                 } else {
                                     let w = self.fft.fwd_buf(work)?;
                                     let at = 2 * (t * batch.in_dist + s * slice_len);
                                     self.fft.forward(w, inp.get().add(at).cast());
-                                    self.gather(w, &[rows], weight);
+                                    self.gather(m, w, &[rows], weight);
                                 }
                             }
                             Ok(())
@@ -641,68 +670,56 @@ impl General {
                     for t in 0..batch.count {
                         // SAFETY: the padding lane rows of transform `t` in the chunk
                         // buffer, written by nobody (the FFT stage is finished).
-                        unsafe { self.zero_padding(buf.get().add(t * per_t), ch) };
+                        unsafe { Self::zero_padding(m, buf.get().add(t * per_t), ch) };
                     }
-                    let clusters = &self.dwt.clusters;
-                    clusters
-                        .par_iter()
-                        .enumerate()
-                        .with_min_len(4)
-                        .for_each(|(i, cl)| {
-                            self.dwt.with_scratch(|sc| {
-                                let n = self.dwt.setup(sc, cl, &self.pairs, ch);
-                                for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                                    let count = KERNEL_BATCH.min(batch.count - t0);
-                                    let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
-                                    let c = coef.get().wrapping_add(t0 * batch.out_dist);
-                                    // What the next cluster (likely this task's next one)
-                                    // reads and writes.
-                                    let next = match clusters.get(i + 1) {
-                                        Some(nc) if count == 1 => self.dwt.forward_hints(
-                                            nc,
-                                            ch,
-                                            buf.get().wrapping_add(t0 * per_t + nc.offset),
-                                            c,
-                                        ),
-                                        _ => Prefetch::none(),
-                                    };
-                                    // SAFETY: this cluster's slots of the lane rows of
-                                    // transforms `t0..t0 + count` (written by the FFT stage or
-                                    // zeroed above, finished); their coefficient arrays are
-                                    // inside the checked output, and this cluster's slots'
-                                    // blocks are this task's.
-                                    unsafe {
-                                        if count == 1 {
-                                            self.dwt.forward(
-                                                sc,
-                                                cl,
-                                                (ch, n),
-                                                block,
-                                                (c, first, next),
-                                            )
-                                        } else {
-                                            self.dwt.forward_many(
-                                                sc,
-                                                cl,
-                                                ch,
-                                                n,
-                                                BatchRows {
-                                                    base: block.cast_const(),
-                                                    dist: per_t,
-                                                    count,
-                                                },
-                                                BatchRows {
-                                                    base: c,
-                                                    dist: batch.out_dist,
-                                                    count,
-                                                },
-                                                first,
-                                            )
-                                        }
-                                    }
+                    let clusters = &m.dwt.clusters;
+                    m.dwt.for_each_cluster(|sc, i, cl| {
+                        let n = m.dwt.setup(sc, cl, &self.pairs, ch);
+                        for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
+                            let count = KERNEL_BATCH.min(batch.count - t0);
+                            let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
+                            let c = coef.get().wrapping_add(t0 * batch.out_dist);
+                            // What the next cluster (likely this task's next one)
+                            // reads and writes.
+                            let next = match clusters.get(i + 1) {
+                                Some(nc) if count == 1 => m.dwt.forward_hints(
+                                    nc,
+                                    ch,
+                                    buf.get().wrapping_add(t0 * per_t + nc.offset),
+                                    c,
+                                ),
+                                _ => Prefetch::none(),
+                            };
+                            // SAFETY: this cluster's slots of the lane rows of
+                            // transforms `t0..t0 + count` (written by the FFT stage or
+                            // zeroed above, finished); their coefficient arrays are
+                            // inside the checked output, and this cluster's slots'
+                            // blocks are this task's.
+                            unsafe {
+                                if count == 1 {
+                                    m.dwt.forward(sc, cl, (ch, n), block, (c, first, next))
+                                } else {
+                                    m.dwt.forward_many(
+                                        sc,
+                                        cl,
+                                        ch,
+                                        n,
+                                        BatchRows {
+                                            base: block.cast_const(),
+                                            dist: per_t,
+                                            count,
+                                        },
+                                        BatchRows {
+                                            base: c,
+                                            dist: batch.out_dist,
+                                            count,
+                                        },
+                                        first,
+                                    )
                                 }
-                            })
-                        });
+                            }
+                        }
+                    });
                     times.dwt += t1.elapsed().as_secs_f64();
                 }
                 Ok(())
@@ -751,16 +768,16 @@ impl General {
     /// own row for a direct member, the mirror row for a reversed one, and the other way).
     #[inline(always)]
     fn for_each_pair_slot(
-        &self,
+        m: Members,
         parts: &[LaneRows],
         real: bool,
         mut f: impl FnMut(*mut f64, *mut f64, u32),
     ) {
         for rows in parts {
             let table = if real {
-                self.slots.real_of(rows.clusters)
+                m.slots.real_of(rows.clusters)
             } else {
-                self.slots.of(rows.clusters)
+                m.slots.of(rows.clusters)
             };
             for &(at, idx) in table {
                 let off = (at & !SlotTable::MIRROR) as usize;
@@ -782,12 +799,13 @@ impl General {
     /// As for [`General::scatter`].
     pub(super) unsafe fn scatter_pair(
         &self,
+        m: Members,
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
         parts: &[LaneRows],
     ) {
         self.clear_inverse_buffer(w0);
         self.clear_inverse_buffer(w1);
-        self.for_each_pair_slot(parts, false, |lo, hi, work| {
+        Self::for_each_pair_slot(m, parts, false, |lo, hi, work| {
             // SAFETY: the slot's two doubles in both lane rows of the part (the table holds
             // the offsets of `dwt.clusters`' slots).
             unsafe {
@@ -804,12 +822,13 @@ impl General {
     /// As for [`General::scatter`].
     pub(super) unsafe fn scatter_real_pair(
         &self,
+        m: Members,
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
         parts: &[LaneRows],
     ) {
         w0.fill(Complex64::default());
         w1.fill(Complex64::default());
-        self.for_each_pair_slot(parts, true, |lo, hi, idx| {
+        Self::for_each_pair_slot(m, parts, true, |lo, hi, idx| {
             if idx & SlotTable::CONJ == 0 {
                 // SAFETY: as in `scatter_pair`.
                 unsafe {
@@ -828,11 +847,12 @@ impl General {
     /// As for [`General::gather`]; both lane rows of every part are the caller's.
     pub(super) unsafe fn gather_pair(
         &self,
+        m: Members,
         (w0, w1): (&[Complex64], &[Complex64]),
         parts: &[LaneRows],
         weight: f64,
     ) {
-        self.for_each_pair_slot(parts, false, |lo, hi, work| {
+        Self::for_each_pair_slot(m, parts, false, |lo, hi, work| {
             let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
             // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
             // of `dwt.clusters`' slots), the caller's.
@@ -847,11 +867,12 @@ impl General {
     /// As for [`General::gather_pair`].
     pub(super) unsafe fn gather_real_pair(
         &self,
+        m: Members,
         (w0, w1): (&[Complex64], &[Complex64]),
         parts: &[LaneRows],
         weight: f64,
     ) {
-        self.for_each_pair_slot(parts, true, |lo, hi, idx| {
+        Self::for_each_pair_slot(m, parts, true, |lo, hi, idx| {
             let value = |w: &[Complex64]| {
                 let v = if idx & SlotTable::CONJ != 0 {
                     w[(idx & !SlotTable::CONJ) as usize]
@@ -869,13 +890,12 @@ impl General {
     /// The lane rows of a slice (its own, and its mirror's, where its reversed members
     /// are) in the chunk buffer at `buf`, transform offset `at`.
     pub(super) fn lane_rows(
-        &self,
-        buf: *mut f64,
-        at: usize,
+        m: Members,
+        (buf, at): (*mut f64, usize),
         ch: ChunkLanes,
         (jj, upper): (usize, bool),
     ) -> LaneRows {
-        let lower = buf.wrapping_add(at + jj * self.dwt.row_total);
+        let lower = buf.wrapping_add(at + jj * m.dwt.row_stride);
         let mirror = lower.wrapping_add(ch.upper_gap);
         let (own, mirror) = if upper {
             (mirror, lower)
@@ -885,7 +905,7 @@ impl General {
         LaneRows {
             own,
             mirror,
-            clusters: (0, self.dwt.clusters.len()),
+            clusters: (0, m.dwt.clusters.len()),
         }
     }
 
@@ -907,10 +927,10 @@ impl General {
     ///
     /// # Safety
     /// Each part's lane rows hold its clusters' slots, written by the DWT stage.
-    pub(super) unsafe fn scatter(&self, w: &mut [Complex64], rows: &[LaneRows]) {
+    pub(super) unsafe fn scatter(&self, m: Members, w: &mut [Complex64], rows: &[LaneRows]) {
         self.clear_inverse_buffer(w);
         for part in rows {
-            for &(at, work) in self.slots.of(part.clusters) {
+            for &(at, work) in m.slots.of(part.clusters) {
                 let x = part.at(at);
                 // SAFETY: the slot's two doubles are inside the part's lane row (the table
                 // holds the offsets of `dwt.clusters`' slots).
@@ -923,10 +943,10 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`].
-    pub(super) unsafe fn scatter_real(&self, w: &mut [Complex64], rows: &[LaneRows]) {
+    pub(super) unsafe fn scatter_real(&self, m: Members, w: &mut [Complex64], rows: &[LaneRows]) {
         w.fill(Complex64::default());
         for part in rows {
-            for &(at, idx) in self.slots.real_of(part.clusters) {
+            for &(at, idx) in m.slots.real_of(part.clusters) {
                 if idx & SlotTable::CONJ != 0 {
                     continue;
                 }
@@ -942,9 +962,15 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::scatter`], for writes; no other task writes these slots.
-    pub(super) unsafe fn gather(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
+    pub(super) unsafe fn gather(
+        &self,
+        m: Members,
+        w: &[Complex64],
+        rows: &[LaneRows],
+        weight: f64,
+    ) {
         for part in rows {
-            for &(at, work) in self.slots.of(part.clusters) {
+            for &(at, work) in m.slots.of(part.clusters) {
                 let v = w[work as usize] * weight;
                 let x = part.at(at);
                 // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
@@ -961,9 +987,15 @@ impl General {
     ///
     /// # Safety
     /// As for [`General::gather`].
-    pub(super) unsafe fn gather_real(&self, w: &[Complex64], rows: &[LaneRows], weight: f64) {
+    pub(super) unsafe fn gather_real(
+        &self,
+        m: Members,
+        w: &[Complex64],
+        rows: &[LaneRows],
+        weight: f64,
+    ) {
         for part in rows {
-            for &(at, idx) in self.slots.real_of(part.clusters) {
+            for &(at, idx) in m.slots.real_of(part.clusters) {
                 let v = if idx & SlotTable::CONJ != 0 {
                     w[(idx & !SlotTable::CONJ) as usize]
                 } else {
@@ -984,8 +1016,8 @@ impl General {
     ///
     /// # Safety
     /// The chunk's `2 hp` lane rows at `rows` are the caller's.
-    pub(super) unsafe fn zero_padding(&self, rows: *mut f64, ch: ChunkLanes) {
-        let rt = self.dwt.row_total;
+    pub(super) unsafe fn zero_padding(m: Members, rows: *mut f64, ch: ChunkLanes) {
+        let rt = m.dwt.row_stride;
         for half in [0, ch.upper_gap] {
             // SAFETY: lane rows `h..hp` of the half, inside the chunk's rows.
             unsafe { std::ptr::write_bytes(rows.add(half + ch.h * rt), 0, (ch.hp - ch.h) * rt) };

@@ -1,12 +1,12 @@
 //! `so3fft-bench engines`: the full shape on the general engine (the one every partial
 //! shape, batch, beta selection and distributed plan runs on) against `Plan`, the gate of
-//! the single engine. Complex inverse and forward, the four calls alternated run by run;
-//! medians of the stage times.
+//! the single engine. Complex inverse and forward, the four calls alternated run by run,
+//! then the real-signal ones likewise; medians of the stage times.
 
 use crate::cli::Options;
 use crate::partial::alternate;
 use crate::workload::random_coeffs;
-use so3fft::{Batch, Complex64, PartialPlan, Plan, Shape, StageTimes};
+use so3fft::{Batch, Complex64, PartialPlan, Plan, Shape, StageTimes, Transform};
 
 /// Prints one table row per bandwidth, thread count and direction.
 pub fn run(opts: &Options) -> so3fft::Result<()> {
@@ -22,7 +22,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                 .with_threads(threads)
                 .with_rigor(opts.rigor);
             let plan = Plan::new(b, &o)?;
-            let general = PartialPlan::new(&Shape::new(b), &o.with_general_engine(true))?;
+            let general = PartialPlan::new(&Shape::new(b), &o.clone().with_general_engine(true))?;
             let (nc, ns) = (plan.num_coeffs(), plan.num_samples());
             let c = random_coeffs(nc, 0x5EED_0000 + b as u64);
             // The forwards' input: the samples of `c`.
@@ -55,6 +55,29 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                     &mut || general.forward_many(fwd, &xs, &mut c1),
                 ],
             )?;
+            drop((plan, general, xs, x0, x1, c0, c1, c));
+            // The real-signal transforms, on plans made for them.
+            let o = o.with_real(true);
+            let plan = Plan::new(b, &o)?;
+            let general = PartialPlan::new(&Shape::new(b), &o.with_general_engine(true))?;
+            let mut hc = vec![Complex64::default(); nc];
+            crate::seeded::fill_real(0x5EED_0001 + b as u64, b, &mut hc);
+            let mut xs = vec![0.0; ns];
+            plan.inverse_real(&hc, &mut xs)?;
+            let (mut x0, mut x1) = (vec![0.0; ns], vec![0.0; ns]);
+            let (mut c0, mut c1) = (
+                vec![Complex64::default(); nc],
+                vec![Complex64::default(); nc],
+            );
+            let [rpi, rgi, rpf, rgf] = alternate(
+                runs,
+                &mut [
+                    &mut || Transform::inverse_real(&plan, &hc, &mut x0),
+                    &mut || Transform::inverse_real(&general, &hc, &mut x1),
+                    &mut || Transform::forward_real(&plan, &xs, &mut c0),
+                    &mut || Transform::forward_real(&general, &xs, &mut c1),
+                ],
+            )?;
             let ms = |t: &StageTimes| {
                 format!(
                     "{:8.3} ({:7.3} / {:7.3})",
@@ -63,7 +86,13 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
                     1e3 * t.dwt
                 )
             };
-            for (dir, p, g) in [("inv", pi, gi), ("fwd", pf, gf)] {
+            let rows = [
+                ("inv", pi, gi),
+                ("fwd", pf, gf),
+                ("rinv", rpi, rgi),
+                ("rfwd", rpf, rgf),
+            ];
+            for (dir, p, g) in rows {
                 println!(
                     "{b:>5} {threads:>3} {dir:>4} | {:>28} | {:>28} | {:6.3}",
                     ms(&p),
