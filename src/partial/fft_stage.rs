@@ -300,11 +300,6 @@ impl FftStage {
         })
     }
 
-    /// `(n_alpha, n_gamma)`.
-    pub fn dims(&self) -> (usize, usize) {
-        (self.na, self.ng)
-    }
-
     /// Values of a slice, `n_alpha n_gamma`.
     pub fn slice_len(&self) -> usize {
         self.na * self.ng

@@ -7,7 +7,7 @@ use super::dwt_stage::{ChunkLanes, DwtStage, KERNEL_BATCH};
 use super::fft_stage::{FftStage, Work};
 use super::options::Batch;
 use super::shape::{CoefLayout, Shape};
-use super::slots::{LaneRows, SlotTable};
+use super::slots::{Clear, LaneRows, SlotTable};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::Result;
 use crate::fft::ChunkBuffer;
@@ -36,6 +36,8 @@ pub(super) struct General {
     /// The real transforms' members (`M' >= 0`, see `DwtStage::new`) with their slots, for
     /// plans made with `Options::real`.
     half: Option<(DwtStage, SlotTable)>,
+    /// What the complex and the real inverse zero in a worker's buffer before each slice.
+    clears: [Clear; 2],
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
     pub(super) pair_weight: Vec<f64>,
     /// Per-worker FFT buffers (made on first use).
@@ -118,6 +120,11 @@ impl General {
             Vec::new()
         };
         let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
+        let (rs, hs) = fft.strides();
+        let clears = [
+            Clear::new(&slots, false, (na, rs), fft.inverse_clears().to_vec()),
+            Clear::new(&slots, true, (na, hs), vec![0..ng / 2 + 1]),
+        ];
         let half = if options.real {
             let dwt = stage(true);
             let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
@@ -127,6 +134,7 @@ impl General {
         };
         Ok(General {
             half,
+            clears,
             layout,
             pairs,
             slots,
@@ -826,8 +834,8 @@ impl General {
         (w0, w1): (&mut [Complex64], &mut [Complex64]),
         parts: &[LaneRows],
     ) {
-        w0.fill(Complex64::default());
-        w1.fill(Complex64::default());
+        self.clears[1].apply(w0);
+        self.clears[1].apply(w1);
         Self::for_each_pair_slot(m, parts, true, |lo, hi, idx| {
             if idx & SlotTable::CONJ == 0 {
                 // SAFETY: as in `scatter_pair`.
@@ -909,17 +917,10 @@ impl General {
         }
     }
 
-    /// Zeroes the columns of the inverse's work buffer `w` that a slice may not fill (see
-    /// `FftStage::inverse_clears`).
+    /// Zeroes what the complex inverse's work buffer `w` holds from the previous slice
+    /// where this slice places no value (see [`Clear`]).
     fn clear_inverse_buffer(&self, w: &mut [Complex64]) {
-        let (na, _) = self.fft.dims();
-        let (rs, _) = self.fft.strides();
-        let cols = self.fft.inverse_clears();
-        for row in w.chunks_exact_mut(rs).take(na) {
-            for c in &cols {
-                row[c.clone()].fill(Complex64::default());
-            }
-        }
+        self.clears[0].apply(w);
     }
 
     /// Complex inverse: a slice's values from its lane rows into the inverse's work buffer
@@ -944,7 +945,7 @@ impl General {
     /// # Safety
     /// As for [`General::scatter`].
     pub(super) unsafe fn scatter_real(&self, m: Members, w: &mut [Complex64], rows: &[LaneRows]) {
-        w.fill(Complex64::default());
+        self.clears[1].apply(w);
         for part in rows {
             for &(at, idx) in m.slots.real_of(part.clusters) {
                 if idx & SlotTable::CONJ != 0 {

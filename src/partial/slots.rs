@@ -97,6 +97,28 @@ impl SlotTable {
         })
     }
 
+    /// The positions of a work buffer (`rows` rows `stride` apart) in the columns `cols` of
+    /// each row that no entry fills: of the complex table, or with `real` of the real one
+    /// (its entries `M' >= 0`).
+    pub(super) fn holes(
+        &self,
+        real: bool,
+        (rows, stride): (usize, usize),
+        cols: &[std::ops::Range<usize>],
+    ) -> Vec<usize> {
+        let mut filled = vec![false; rows * stride];
+        let entries = if real { &self.real } else { &self.entries };
+        for &(_, idx) in entries {
+            if !real || idx & Self::CONJ == 0 {
+                filled[idx as usize] = true;
+            }
+        }
+        (0..rows)
+            .flat_map(|r| cols.iter().flat_map(move |c| c.clone().map(move |j| r * stride + j)))
+            .filter(|&i| !filled[i])
+            .collect()
+    }
+
     /// The entries of clusters `a..b`.
     pub(super) fn of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
         &self.entries[self.start[a]..self.start[b]]
@@ -105,5 +127,52 @@ impl SlotTable {
     /// The real entries of clusters `a..b`.
     pub(super) fn real_of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
         &self.real[self.start[a]..self.start[b]]
+    }
+}
+
+/// What the inverse zeroes in a worker's buffer before a slice's values go in: the
+/// positions the previous slice's transforms wrote that no slot fills.
+pub(super) enum Clear {
+    /// Few positions (the full shape: the Nyquist row and column), one by one.
+    Holes(Vec<usize>),
+    /// These columns of every row (`rows` rows `stride` apart).
+    Columns {
+        cols: Vec<std::ops::Range<usize>>,
+        rows: usize,
+        stride: usize,
+    },
+}
+
+impl Clear {
+    /// The clear of the columns `cols` of a buffer of `rows` rows `stride` apart, of which
+    /// the slots of `table` (complex, or `real`) fill all but `holes`.
+    pub(super) fn new(
+        table: &SlotTable,
+        real: bool,
+        (rows, stride): (usize, usize),
+        cols: Vec<std::ops::Range<usize>>,
+    ) -> Clear {
+        let holes = table.holes(real, (rows, stride), &cols);
+        let written: usize = rows * cols.iter().map(|c| c.len()).sum::<usize>();
+        if 8 * holes.len() <= written {
+            Clear::Holes(holes)
+        } else {
+            Clear::Columns { cols, rows, stride }
+        }
+    }
+
+    /// Zeroes them in `w`.
+    pub(super) fn apply(&self, w: &mut [num_complex::Complex64]) {
+        let zero = num_complex::Complex64::default();
+        match self {
+            Clear::Holes(h) => h.iter().for_each(|&i| w[i] = zero),
+            Clear::Columns { cols, rows, stride } => {
+                for row in w.chunks_exact_mut(*stride).take(*rows) {
+                    for c in cols {
+                        row[c.clone()].fill(zero);
+                    }
+                }
+            }
+        }
     }
 }
