@@ -77,8 +77,17 @@ struct Share {
     pairs: (usize, usize),
     /// Clusters `c0 .. c1` (indices into the DWT stage's cluster list).
     clusters: (usize, usize),
-    /// The clusters' doubles in a lane row: `offset(c0) .. offset(c1)`.
-    segment: (usize, usize),
+}
+
+/// The lane rows of one member set (every member, or the real transforms' `M' >= 0`, see
+/// `General::members`): where each rank's clusters are in a lane row, and this rank's
+/// clusters.
+struct RankView {
+    /// Per rank, its clusters' doubles in a lane row: `offset(c0) .. offset(c1)`.
+    segments: Vec<(usize, usize)>,
+    /// This rank's clusters, their blocks at local coefficient offsets and their slots at
+    /// offsets within its segment of a lane row.
+    local: Vec<ClusterPlan>,
 }
 
 /// Where one group's rows are on a rank.
@@ -160,15 +169,22 @@ fn group_range((j0, j1): (usize, usize), k: usize, groups: usize) -> (usize, usi
     (j0 + k * h / groups, j0 + (k + 1) * h / groups)
 }
 
+/// Doubles of a row of a rank's segment of `len` doubles in the row buffers: padded to an
+/// odd number of cache lines, so that a cluster's values in all rows fall in different
+/// cache sets (as the single-process plan's `row_stride`).
+fn padded(len: usize) -> usize {
+    len + if (len / 8).is_multiple_of(2) { 8 } else { 0 }
+}
+
 /// Doubles of rank `rank`'s two buffers when the transforms run in `groups` groups, for
-/// lane rows of `row_total` doubles and vectors of `w` lanes: `a`, the lane rows of its
-/// slices in one group for the other ranks' clusters, and `b`, the group's lane rows of its
-/// own clusters (every rank's pairs, padded to vectors).
+/// rows of every rank's segment of `widths` doubles ([`padded`]) and vectors of `w` lanes:
+/// `a`, the lane rows of its slices in one group for the other ranks' clusters, and `b`,
+/// the group's lane rows of its own clusters (every rank's pairs, padded to vectors).
 fn row_sizes(
-    shares: &[Share],
+    (shares, widths): (&[Share], &[usize]),
     rank: usize,
     groups: usize,
-    (row_total, w): (usize, usize),
+    w: usize,
 ) -> (usize, usize) {
     let count = |r: usize, k: usize| {
         let (g0, g1) = group_range(shares[r].pairs, k, groups);
@@ -180,8 +196,15 @@ fn row_sizes(
         .max()
         .unwrap_or(0)
         .next_multiple_of(w);
-    let mine = shares[rank].segment.1 - shares[rank].segment.0;
-    (2 * n_me * (row_total - mine), 2 * hp * mine)
+    let others: usize = widths.iter().sum::<usize>() - widths[rank];
+    (2 * n_me * others, 2 * hp * widths[rank])
+}
+
+impl RankView {
+    /// Every rank's row length in the row buffers ([`padded`] segments).
+    fn widths(&self) -> Vec<usize> {
+        self.segments.iter().map(|s| padded(s.1 - s.0)).collect()
+    }
 }
 
 /// What a rank builds of a plan (everything but the exchange and the buffers).
@@ -191,9 +214,8 @@ struct Parts {
     direction: Direction,
     general: General,
     shares: Vec<Share>,
-    /// The local clusters, their blocks at local coefficient offsets and their slots at
-    /// offsets within the local segment of a lane row.
-    local: Vec<ClusterPlan>,
+    /// The lane rows of every member, and with `real` those of the real transforms.
+    views: Vec<RankView>,
     local_coeffs: usize,
     /// Groups of pairs the transforms run in (see [`DistributedPlan::groups`]).
     groups: usize,
@@ -290,24 +312,28 @@ impl<X: Exchange> DistributedPlan<X> {
             *b = clusters.len();
         }
         bounds[p] = clusters.len();
-        let offset = |c: usize| {
-            clusters
-                .get(c)
-                .map_or(general.dwt.row_total, |cl| cl.offset)
-        };
         let shares: Vec<Share> = (0..p)
             .map(|r| Share {
                 pairs: (r * np / p, (r + 1) * np / p),
                 clusters: (bounds[r], bounds[r + 1]),
-                segment: (offset(bounds[r]), offset(bounds[r + 1])),
             })
             .collect();
+        // Every rank's segment of a lane row of the clusters `all`.
+        let segments = |all: &[ClusterPlan], row_total: usize| -> Vec<(usize, usize)> {
+            let offset = |c: usize| all.get(c).map_or(row_total, |cl| cl.offset);
+            shares
+                .iter()
+                .map(|s| (offset(s.clusters.0), offset(s.clusters.1)))
+                .collect()
+        };
         let me = &shares[comm.rank()];
+        let full_segments = segments(clusters, general.dwt.row_total);
+        let seg0 = full_segments[comm.rank()].0;
         let mut local = Vec::new();
         let mut at = 0;
         for cl in &clusters[me.clusters.0..me.clusters.1] {
             let mut c = cl.clone();
-            c.offset -= me.segment.0;
+            c.offset -= seg0;
             let starts: Vec<usize> = c
                 .slots
                 .iter()
@@ -334,8 +360,40 @@ impl<X: Exchange> DistributedPlan<X> {
             }
             local.push(c);
         }
+        let mut views = vec![RankView {
+            segments: full_segments,
+            local,
+        }];
+        if options.real {
+            // The real transforms' clusters (the same clusters, members `M' >= 0`), their
+            // slots at the blocks of the same members in the local coefficients.
+            let half = general.members(true).dwt;
+            assert_eq!(half.clusters.len(), clusters.len());
+            let segments = segments(&half.clusters, half.row_total);
+            let seg0 = segments[comm.rank()].0;
+            let local = half.clusters[me.clusters.0..me.clusters.1]
+                .iter()
+                .zip(&views[0].local)
+                .map(|(cl, full)| {
+                    let block = |m: isize, mp: isize| {
+                        full.slots
+                            .iter()
+                            .find(|s| (s.member.m, s.member.mp) == (m, mp))
+                            .map_or(usize::MAX, |s| s.block)
+                    };
+                    let mut c = cl.clone();
+                    c.offset -= seg0;
+                    for s in &mut c.slots {
+                        s.block = block(s.member.m, s.member.mp);
+                        s.partner_block = block(-s.member.m, -s.member.mp);
+                    }
+                    c
+                })
+                .collect();
+            views.push(RankView { segments, local });
+        }
         // Every rank computes the same group count: from every rank's sizes and budget.
-        let geometry = (general.dwt.row_total, general.lanes_w);
+        let widths = views[0].widths();
         let sample_bytes = if options.real { 8 } else { 16 };
         let coeffs_of = |share: &Share| -> usize {
             clusters[share.clusters.0..share.clusters.1]
@@ -360,7 +418,7 @@ impl<X: Exchange> DistributedPlan<X> {
         let groups = (1..=most)
             .find(|&k| {
                 (0..p).all(|r| {
-                    let (a, b) = row_sizes(&shares, r, k, geometry);
+                    let (a, b) = row_sizes((&shares, &widths), r, k, general.lanes_w);
                     8 * (a + b) <= budget(&shares[r])
                 })
             })
@@ -385,7 +443,7 @@ impl<X: Exchange> DistributedPlan<X> {
             direction: options.direction,
             general,
             shares,
-            local,
+            views,
             local_coeffs: at,
             groups,
         })
@@ -522,13 +580,19 @@ impl<X: Exchange> DistributedPlan<X> {
         self.parts.groups
     }
 
+    /// The lane rows of the complex transforms, or of the real ones (`real`).
+    fn view(&self, real: bool) -> &RankView {
+        &self.parts.views[usize::from(real).min(self.parts.views.len() - 1)]
+    }
+
+    /// The sizes of the two row buffers (those of every member: the real transforms' rows
+    /// are shorter and fit).
     fn row_sizes(&self) -> (usize, usize) {
-        let geometry = (self.parts.general.dwt.row_total, self.parts.general.lanes_w);
         row_sizes(
-            &self.parts.shares,
+            (&self.parts.shares, &self.parts.views[0].widths()),
             self.comm.rank(),
             self.parts.groups,
-            geometry,
+            self.parts.general.lanes_w,
         )
     }
 
@@ -578,7 +642,7 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     /// Where the rows of group `k` are on this rank (made once per group of a transform).
-    fn group_rows(&self, k: usize) -> GroupRows {
+    fn group_rows(&self, k: usize, view: &RankView) -> GroupRows {
         let (me, shares) = (self.comm.rank(), &self.parts.shares);
         let counts: Vec<usize> = shares
             .iter()
@@ -600,15 +664,14 @@ impl<X: Exchange> DistributedPlan<X> {
             .sum();
         let h: usize = counts.iter().sum();
         let n_me = counts[me];
-        let width = |s: &Share| s.segment.1 - s.segment.0;
+        let widths = view.widths();
+        let width = |q: usize| widths[q];
         let mut at = 0;
-        let blocks = shares
-            .iter()
-            .enumerate()
-            .map(|(q, s)| {
-                let block = (at, width(s));
+        let blocks = (0..shares.len())
+            .map(|q| {
+                let block = (at, width(q));
                 if q != me {
-                    at += 2 * n_me * width(s);
+                    at += 2 * n_me * width(q);
                 }
                 block
             })
@@ -619,8 +682,8 @@ impl<X: Exchange> DistributedPlan<X> {
                 j0: first,
                 h,
                 hp,
-                row_len: width(&shares[me]),
-                upper_gap: hp * width(&shares[me]),
+                row_len: width(me),
+                upper_gap: hp * width(me),
                 first_upper_pair: None,
             },
             parts: offsets.into_iter().zip(counts).collect(),
@@ -635,7 +698,7 @@ impl<X: Exchange> DistributedPlan<X> {
     fn slice_parts(
         &self,
         (a, b): (*mut f64, *mut f64),
-        gr: &GroupRows,
+        (gr, view): (&GroupRows, &RankView),
         (jj, upper): (usize, bool),
     ) -> Vec<LaneRows> {
         let me = self.comm.rank();
@@ -657,7 +720,7 @@ impl<X: Exchange> DistributedPlan<X> {
                     (lane, half + lane)
                 };
                 let rows = (base.wrapping_add(r * len), base.wrapping_add(rm * len));
-                LaneRows::part(rows, sh.clusters, sh.segment.0)
+                LaneRows::part(rows, sh.clusters, view.segments[q].0)
             })
             .collect()
     }
@@ -724,13 +787,14 @@ impl<X: Exchange> DistributedPlan<X> {
         (a, b): (&mut [f64], &mut [f64]),
     ) -> Result<StageTimes> {
         let g = &self.parts.general;
+        let (view, m) = (self.view(real), g.members(real));
         let slice_len = self.parts.shape.slice_len();
         let per_value = if real { 1 } else { 2 };
         let mut times = StageTimes::default();
         let start = std::time::Instant::now();
         for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
-            let gr = self.group_rows(k);
+            let gr = self.group_rows(k, view);
             let ch = gr.ch;
             let g0 = group_range(self.local_pairs(), k, self.parts.groups).0;
             let ab = (SendPtr(a.as_mut_ptr()), SendPtr(b.as_mut_ptr()));
@@ -738,7 +802,8 @@ impl<X: Exchange> DistributedPlan<X> {
             let done: Result<()> = g.workers.pool().install(|| {
                 pairs.par_iter().try_for_each(|&(jj, [s0, s1])| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, false));
+                        let rows =
+                            self.slice_parts((ab.0.get(), ab.1.get()), (&gr, view), (jj, false));
                         let weight = g.pair_weight[g0 + jj];
                         let at = |s: usize| s * slice_len * per_value;
                         // SAFETY: local slices `s0` and `s1` are inside the checked local
@@ -749,12 +814,12 @@ impl<X: Exchange> DistributedPlan<X> {
                                 let (w0, w1) = g.fft.half_pair(work)?;
                                 g.fft.forward_real(w0, inp.get().add(at(s0)));
                                 g.fft.forward_real(w1, inp.get().add(at(s1)));
-                                g.gather_real_pair(g.members(false), (w0, w1), &rows, weight);
+                                g.gather_real_pair(m, (w0, w1), &rows, weight);
                             } else {
                                 let (w0, w1) = g.fft.fwd_pair(work)?;
                                 g.fft.forward(w0, inp.get().add(at(s0)).cast());
                                 g.fft.forward(w1, inp.get().add(at(s1)).cast());
-                                g.gather_pair(g.members(false), (w0, w1), &rows, weight);
+                                g.gather_pair(m, (w0, w1), &rows, weight);
                             }
                         }
                         Ok(())
@@ -774,13 +839,13 @@ impl<X: Exchange> DistributedPlan<X> {
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendPtr(coeffs.as_mut_ptr());
             g.workers.pool().install(|| {
-                let local = &self.parts.local;
+                let local = &view.local;
                 local.par_iter().enumerate().for_each(|(i, cl)| {
-                    g.dwt.with_scratch(|sc| {
-                        let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                    m.dwt.with_scratch(|sc| {
+                        let n = m.dwt.setup(sc, cl, &g.pairs, ch);
                         let next = local.get(i + 1).map_or(Prefetch::none(), |nc| {
                             let rows = b_ptr.get().wrapping_add(nc.offset);
-                            g.dwt.forward_hints(nc, ch, rows, coef.get())
+                            m.dwt.forward_hints(nc, ch, rows, coef.get())
                         });
                         // SAFETY: this cluster's slots of `b`'s lane rows of the group
                         // (padding rows zero, the others filled by the exchange); its
@@ -788,7 +853,7 @@ impl<X: Exchange> DistributedPlan<X> {
                         // length) and this task's.
                         unsafe {
                             let rows = b_ptr.get().add(cl.offset);
-                            g.dwt
+                            m.dwt
                                 .forward(sc, cl, (ch, n), rows, (coef.get(), k == 0, next))
                         }
                     })
@@ -821,34 +886,35 @@ impl<X: Exchange> DistributedPlan<X> {
         (a, b): (&mut [f64], &mut [f64]),
     ) -> Result<StageTimes> {
         let g = &self.parts.general;
+        let (view, m) = (self.view(real), g.members(real));
         let slice_len = self.parts.shape.slice_len();
         let start = std::time::Instant::now();
         let mut times = StageTimes::default();
         let mut done: Result<()> = Ok(());
         for k in 0..self.parts.groups {
             let t0 = std::time::Instant::now();
-            let gr = self.group_rows(k);
+            let gr = self.group_rows(k, view);
             let ch = gr.ch;
             let b_ptr = SendPtr(b.as_mut_ptr());
             let coef = SendConstPtr(coeffs.as_ptr());
             // Rows far larger than the caches go out with non-temporal stores (as in the
             // single-process plan).
             let stream = 8 * b.len() > 8 << 20;
-            let local = &self.parts.local;
+            let local = &view.local;
             g.workers.pool().install(|| {
                 local.par_iter().enumerate().for_each(|(i, cl)| {
-                    g.dwt.with_scratch(|sc| {
-                        let n = g.dwt.setup(sc, cl, &g.pairs, ch);
+                    m.dwt.with_scratch(|sc| {
+                        let n = m.dwt.setup(sc, cl, &g.pairs, ch);
                         // The coefficient blocks the next cluster (likely this task's next
                         // one) reads.
                         let next = local.get(i + 1).map_or(Prefetch::none(), |nc| {
-                            g.dwt.coefficient_hints(nc, coef.get(), real)
+                            m.dwt.coefficient_hints(nc, coef.get(), real)
                         });
                         // SAFETY: the local coefficients (checked length), read only; this
                         // cluster's slots of `b`'s lane rows of the group, written by this
                         // task only.
                         unsafe {
-                            g.dwt.inverse(
+                            m.dwt.inverse(
                                 sc,
                                 cl,
                                 ch,
@@ -869,19 +935,20 @@ impl<X: Exchange> DistributedPlan<X> {
             let group_done: Result<()> = g.workers.pool().install(|| {
                 pairs.par_iter().try_for_each(|&(jj, [s0, s1])| {
                     g.with_work(|work| {
-                        let rows = self.slice_parts((ab.0.get(), ab.1.get()), &gr, (jj, false));
+                        let rows =
+                            self.slice_parts((ab.0.get(), ab.1.get()), (&gr, view), (jj, false));
                         // SAFETY: the parts' rows were written by the DWT stage (`b`) and
                         // the exchange (`a`), both finished; local slices `s0` and `s1` are
                         // inside the checked local samples and this task's.
                         unsafe {
                             if real {
                                 let (w0, w1) = g.fft.half_pair(work)?;
-                                g.scatter_real_pair(g.members(false), (w0, w1), &rows);
+                                g.scatter_real_pair(m, (w0, w1), &rows);
                                 g.fft.inverse_real(w0, out.get().add(s0 * slice_len));
                                 g.fft.inverse_real(w1, out.get().add(s1 * slice_len));
                             } else {
                                 let (w0, w1) = g.fft.inv_pair(work)?;
-                                g.scatter_pair(g.members(false), (w0, w1), &rows);
+                                g.scatter_pair(m, (w0, w1), &rows);
                                 let o = out.get().cast::<Complex64>();
                                 g.fft.inverse(w0, o.add(s0 * slice_len));
                                 g.fft.inverse(w1, o.add(s1 * slice_len));

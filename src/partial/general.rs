@@ -121,9 +121,10 @@ impl General {
         };
         let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
         let (rs, hs) = fft.strides();
+        let half_spectrum = 0..ng / 2 + 1;
         let clears = [
-            Clear::new(&slots, false, (na, rs), fft.inverse_clears().to_vec()),
-            Clear::new(&slots, true, (na, hs), vec![0..ng / 2 + 1]),
+            Clear::new(&slots, false, (na, rs), &fft.inverse_clears()),
+            Clear::new(&slots, true, (na, hs), std::slice::from_ref(&half_spectrum)),
         ];
         let half = if options.real {
             let dwt = stage(true);

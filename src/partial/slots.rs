@@ -114,7 +114,10 @@ impl SlotTable {
             }
         }
         (0..rows)
-            .flat_map(|r| cols.iter().flat_map(move |c| c.clone().map(move |j| r * stride + j)))
+            .flat_map(|r| {
+                cols.iter()
+                    .flat_map(move |c| c.clone().map(move |j| r * stride + j))
+            })
             .filter(|&i| !filled[i])
             .collect()
     }
@@ -150,14 +153,18 @@ impl Clear {
         table: &SlotTable,
         real: bool,
         (rows, stride): (usize, usize),
-        cols: Vec<std::ops::Range<usize>>,
+        cols: &[std::ops::Range<usize>],
     ) -> Clear {
-        let holes = table.holes(real, (rows, stride), &cols);
+        let holes = table.holes(real, (rows, stride), cols);
         let written: usize = rows * cols.iter().map(|c| c.len()).sum::<usize>();
         if 8 * holes.len() <= written {
             Clear::Holes(holes)
         } else {
-            Clear::Columns { cols, rows, stride }
+            Clear::Columns {
+                cols: cols.to_vec(),
+                rows,
+                stride,
+            }
         }
     }
 
