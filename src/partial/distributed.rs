@@ -293,9 +293,13 @@ impl<X: Exchange> DistributedPlan<X> {
         let mut general = General::new(shape, pairs, (isa, skip, threads), &opts, None)?;
         let p = comm.size();
         let clusters = &general.dwt.clusters;
+        // A cluster's DWT work: its degrees times its columns, plus what each cluster costs
+        // besides the kernel's steps (starting values, recurrence coefficients, gathers and
+        // scatters of its coefficients), about `CLUSTER_STEPS` steps.
+        const CLUSTER_STEPS: usize = 12;
         let cost: Vec<usize> = clusters
             .iter()
-            .map(|c| (shape.degree_limit - c.m) * c.p)
+            .map(|c| (shape.degree_limit - c.m + CLUSTER_STEPS) * c.p)
             .collect();
         let total: usize = cost.iter().sum();
         let mut bounds = vec![0usize; p + 1];
