@@ -46,8 +46,9 @@ TOOL (default: the full benchmark described below):
                       per rank, bytes exchanged, expected time, from one-core rates measured here
   engines             the full shape on the general engine (every partial shape, batch,
                       beta selection and distributed plan runs on it) against Plan: complex
-                      inverse and forward alternated, median stage times and the ratio;
-                      defaults --bandwidths 64,128 --threads 1,2 --runs 7
+                      inverse and forward alternated, then the real ones, median stage
+                      times and the ratio; defaults --bandwidths 64,128 --threads 1,2
+                      --runs 7
   partial (or --partial)  partial plans against the transforms they replace: degree-limited
                       on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
                       1/16 of the betas, skip thresholds 2^-24 and 2^-34 (ratios in one run)
