@@ -667,3 +667,20 @@ fn chained_inverse_against_direct_summation() {
         }
     }
 }
+
+/// The default workspace rule leaves the chunk buffer room for every beta when the rows
+/// of all of them are far below it: an order-limited shape at a large degree limit (its
+/// tables per beta grow with `L`) runs in one chunk, not one beta pair at a time.
+#[test]
+fn default_workspace_holds_all_pairs_of_a_small_shape() {
+    let b = 2048;
+    let s = Shape::new(b).with_orders(8, 8).with_grid(b, 17, 17);
+    let pp = PartialPlan::new(&s, &opts()).unwrap();
+    // Two lane rows per beta pair, each with at least the 17 x 17 in-band order pairs.
+    let all_rows = b * 2 * 17 * 17 * 16;
+    let scratch = pp.scratch_bytes();
+    assert!(
+        (all_rows..=512 << 20).contains(&scratch),
+        "chunk buffer {scratch} bytes, the rows of every pair {all_rows}"
+    );
+}

@@ -34,6 +34,13 @@ fn half_angle_point(x: Dd) -> (Dd, Dd) {
 }
 
 impl LanePairs {
+    /// Bytes of the tables per pair at degree limit `l`: two points, each with its powers
+    /// of the half-angle cosine and sine up to `2L` (about `64 (66 + L/32)` bytes), and the
+    /// bookkeeping.
+    pub fn bytes_per_pair(l: usize) -> usize {
+        2 * (64 * (66 + l / 32) + 64) + 96
+    }
+
     /// The lanes of `betas` on `shape`'s grid. With `split = Some(w)` and no pair writing
     /// both its points, the pairs are ordered by the point they write, lower first, padded
     /// to a multiple of `w` with pairs that write nothing (see
@@ -41,15 +48,13 @@ impl LanePairs {
     pub fn new(shape: &Shape, betas: &Betas, split: Option<usize>) -> Result<LanePairs> {
         let bg = shape.grid_bandwidth;
         let nb = 2 * bg;
-        // What the tables take per pair (two points, each with its powers of the half-angle
-        // cosine and sine up to 2L, about 64 (66 + L/32) bytes, and the bookkeeping here),
-        // checked before anything is made.
+        // What the tables take, checked before anything is made.
         let count = match betas {
             Betas::All => bg,
             Betas::Indices(v) => v.len(),
             Betas::Values(v) => v.len(),
         };
-        let per_pair = 2 * (64 * (66 + shape.degree_limit / 32) + 64) + 96;
+        let per_pair = LanePairs::bytes_per_pair(shape.degree_limit);
         crate::system::check_headroom(count.saturating_mul(per_pair))?;
         // Half angles of the lower points, and which slices each pair writes.
         let mut half: Vec<Dd> = Vec::new();

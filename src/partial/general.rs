@@ -84,7 +84,7 @@ impl General {
         let w = isa.lanes();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
         let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
-        let tables = 64 * 2 * pairs.pairs * (2 * shape.degree_limit + 66);
+        let tables = pairs.pairs * LanePairs::bytes_per_pair(shape.degree_limit);
         // Everything but the chunk buffer.
         let rest = DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
             .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
