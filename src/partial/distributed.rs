@@ -23,7 +23,7 @@
 //!   bitwise equal. With several groups the forward adds the same terms in another order.
 
 use super::betas::LanePairs;
-use super::dwt_stage::{ChunkLanes, ClusterPlan};
+use super::dwt_stage::{padded_row, ChunkLanes, ClusterPlan};
 use super::exchange::Exchange;
 use super::general::General;
 use super::shape::Shape;
@@ -169,15 +169,8 @@ fn group_range((j0, j1): (usize, usize), k: usize, groups: usize) -> (usize, usi
     (j0 + k * h / groups, j0 + (k + 1) * h / groups)
 }
 
-/// Doubles of a row of a rank's segment of `len` doubles in the row buffers: padded to an
-/// odd number of cache lines, so that a cluster's values in all rows fall in different
-/// cache sets (as the single-process plan's `row_stride`).
-fn padded(len: usize) -> usize {
-    len + if (len / 8).is_multiple_of(2) { 8 } else { 0 }
-}
-
 /// Doubles of rank `rank`'s two buffers when the transforms run in `groups` groups, for
-/// rows of every rank's segment of `widths` doubles ([`padded`]) and vectors of `w` lanes:
+/// rows of every rank's segment of `widths` doubles (padded, see [`RankView::widths`]) and vectors of `w` lanes:
 /// `a`, the lane rows of its slices in one group for the other ranks' clusters, and `b`,
 /// the group's lane rows of its own clusters (every rank's pairs, padded to vectors).
 fn row_sizes(
@@ -201,9 +194,12 @@ fn row_sizes(
 }
 
 impl RankView {
-    /// Every rank's row length in the row buffers ([`padded`] segments).
+    /// Every rank's row length in the row buffers: its segment, padded ([`padded_row`]).
     fn widths(&self) -> Vec<usize> {
-        self.segments.iter().map(|s| padded(s.1 - s.0)).collect()
+        self.segments
+            .iter()
+            .map(|s| padded_row(s.1 - s.0))
+            .collect()
     }
 }
 

@@ -59,6 +59,13 @@ pub(super) struct ClusterPlan {
     pub offset: usize,
 }
 
+/// Doubles from one lane row of `len` doubles (a multiple of 8) to the next in a buffer:
+/// `len` padded to an odd number of cache lines, so that a cluster's values in all rows
+/// fall in different cache sets (rows of a multiple of 4 KiB put them all in one).
+pub(super) fn padded_row(len: usize) -> usize {
+    len + if (len / 8).is_multiple_of(2) { 8 } else { 0 }
+}
+
 /// What one kernel call of a cluster works on: the lanes of a chunk.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct ChunkLanes {
@@ -168,8 +175,7 @@ pub(super) struct DwtStage {
     /// Doubles of a lane row (all clusters).
     pub row_total: usize,
     /// Doubles from one lane row to the next in a lane-major chunk buffer: `row_total`
-    /// padded to an odd number of cache lines, so that the rows' lines of one cluster
-    /// fall in different cache sets (rows of a multiple of 4 KiB put them all in one).
+    /// padded ([`padded_row`]).
     pub row_stride: usize,
     recurrence: RecTables,
     skip_bits: u32,
@@ -235,7 +241,7 @@ impl DwtStage {
             l,
             clusters,
             row_total: offset,
-            row_stride: offset + if (offset / 8) % 2 == 0 { 8 } else { 0 },
+            row_stride: padded_row(offset),
             recurrence: RecTables::for_orders(l, &orders),
             skip_bits,
             skip,
