@@ -525,40 +525,28 @@ impl<X: Exchange> DistributedPlan<X> {
     /// Forward (collective): this rank's samples to this rank's coefficients; the time of
     /// each stage on this rank.
     pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(true, false, samples.len(), coeffs.len()),
-        )?;
-        self.forward_impl(SendConstPtr(samples.as_ptr().cast()), coeffs, (false, None))
+        let inp = (SendConstPtr(samples.as_ptr().cast()), samples.len());
+        self.forward_impl(inp, coeffs, (false, None))
     }
 
     /// Forward of real samples (collective; plan made with `real`).
     pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(true, true, samples.len(), coeffs.len()),
-        )?;
-        self.forward_impl(SendConstPtr(samples.as_ptr()), coeffs, (true, None))
+        let inp = (SendConstPtr(samples.as_ptr()), samples.len());
+        self.forward_impl(inp, coeffs, (true, None))
     }
 
     /// Inverse (collective): this rank's coefficients to this rank's samples; the time of
     /// each stage on this rank.
     pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(false, false, samples.len(), coeffs.len()),
-        )?;
-        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr().cast()), (false, None))
+        let out = (SendPtr(samples.as_mut_ptr().cast()), samples.len());
+        self.inverse_impl(coeffs, out, (false, None))
     }
 
     /// Inverse to real samples (collective; reads the representatives as
     /// [`PartialPlan::inverse_real`](super::PartialPlan::inverse_real)).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(false, true, samples.len(), coeffs.len()),
-        )?;
-        self.inverse_impl(coeffs, SendPtr(samples.as_mut_ptr()), (true, None))
+        let out = (SendPtr(samples.as_mut_ptr()), samples.len());
+        self.inverse_impl(coeffs, out, (true, None))
     }
 
     /// Bytes this rank holds during a transform besides its arrays (known at plan time, taken
@@ -769,12 +757,15 @@ impl<X: Exchange> DistributedPlan<X> {
         Ok(())
     }
 
+    /// A forward (collective) from `inp.1` samples at `inp.0` (complex values, or reals
+    /// with `real`) after the checks, in the caller's `scratch` if given.
     fn forward_impl(
         &self,
-        inp: SendConstPtr<f64>,
+        (inp, samples): (SendConstPtr<f64>, usize),
         coeffs: &mut [Complex64],
         (real, scratch): (bool, Option<&mut Scratch>),
     ) -> Result<StageTimes> {
+        collective(&self.comm, self.check(true, real, samples, coeffs.len()))?;
         // A rank that cannot have its buffers fails every rank (none waits in an exchange).
         self.with_rows(scratch, |a, b| self.forward_rows(inp, coeffs, real, (a, b)))
     }
@@ -868,12 +859,15 @@ impl<X: Exchange> DistributedPlan<X> {
         Ok(times)
     }
 
+    /// An inverse (collective) into `out.1` samples at `out.0` (complex values, or reals
+    /// with `real`) after the checks, in the caller's `scratch` if given.
     fn inverse_impl(
         &self,
         coeffs: &[Complex64],
-        out: SendPtr<f64>,
+        (out, samples): (SendPtr<f64>, usize),
         (real, scratch): (bool, Option<&mut Scratch>),
     ) -> Result<StageTimes> {
+        collective(&self.comm, self.check(false, real, samples, coeffs.len()))?;
         // A rank that cannot have its buffers fails every rank (none waits in an exchange).
         self.with_rows(scratch, |a, b| self.inverse_rows(coeffs, out, real, (a, b)))
     }
@@ -1012,11 +1006,7 @@ impl<X: Exchange> Transform for DistributedPlan<X> {
         coeffs: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(true, false, samples.len(), coeffs.len()),
-        )?;
-        let inp = SendConstPtr(samples.as_ptr().cast());
+        let inp = (SendConstPtr(samples.as_ptr().cast()), samples.len());
         self.forward_impl(inp, coeffs, (false, Some(scratch)))
     }
 
@@ -1026,11 +1016,7 @@ impl<X: Exchange> Transform for DistributedPlan<X> {
         samples: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(false, false, samples.len(), coeffs.len()),
-        )?;
-        let out = SendPtr(samples.as_mut_ptr().cast());
+        let out = (SendPtr(samples.as_mut_ptr().cast()), samples.len());
         self.inverse_impl(coeffs, out, (false, Some(scratch)))
     }
 
@@ -1040,11 +1026,7 @@ impl<X: Exchange> Transform for DistributedPlan<X> {
         coeffs: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(true, true, samples.len(), coeffs.len()),
-        )?;
-        let inp = SendConstPtr(samples.as_ptr());
+        let inp = (SendConstPtr(samples.as_ptr()), samples.len());
         self.forward_impl(inp, coeffs, (true, Some(scratch)))
     }
 
@@ -1054,11 +1036,7 @@ impl<X: Exchange> Transform for DistributedPlan<X> {
         samples: &mut [f64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        collective(
-            &self.comm,
-            self.check(false, true, samples.len(), coeffs.len()),
-        )?;
-        let out = SendPtr(samples.as_mut_ptr());
+        let out = (SendPtr(samples.as_mut_ptr()), samples.len());
         self.inverse_impl(coeffs, out, (true, Some(scratch)))
     }
 }

@@ -61,9 +61,14 @@ pub(super) struct ClusterPlan {
 
 /// Doubles from one lane row of `len` doubles (a multiple of 8) to the next in a buffer:
 /// `len` padded to an odd number of cache lines, so that a cluster's values in all rows
-/// fall in different cache sets (rows of a multiple of 4 KiB put them all in one).
+/// fall in different cache sets (rows of a multiple of 4 KiB put them all in one); empty
+/// rows stay empty.
 pub(super) fn padded_row(len: usize) -> usize {
-    len + if (len / 8).is_multiple_of(2) { 8 } else { 0 }
+    len + if len > 0 && (len / 8).is_multiple_of(2) {
+        8
+    } else {
+        0
+    }
 }
 
 /// What one kernel call of a cluster works on: the lanes of a chunk.

@@ -196,15 +196,23 @@ pub(super) struct FftStage {
     /// Columns `0..=N` and `-N..-1` over alpha, in place: sign -1 (inverse), +1 (forward).
     inv_cols: [Option<RawPlan>; 2],
     fwd_cols: [Option<RawPlan>; 2],
-    inv_rows: TwoWay,
-    /// The inverse's rows in place in the work buffer (then streamed to the caller's
-    /// slice), where most columns are in the band (`2N + 1 >= n_gamma / 2`): FFTW's own
-    /// stores into the caller's slice would first read each of its lines from memory.
-    inv_rows_in_place: Option<RawPlan>,
+    inv_rows: InverseRows,
     /// The forward's rows in place in the work buffer, after a copy of the caller's slice
     /// there (a sequential read the prefetchers follow).
     fwd_rows_in_place: RawPlan,
     real: Option<RealFfts>,
+}
+
+/// The inverse's rows over gamma.
+enum InverseRows {
+    /// In place in the work buffer, then streamed to the caller's slice: where most
+    /// columns are in the band (`2N + 1 >= n_gamma / 2`), so the rows are transformed
+    /// whole anyway and FFTW's own stores into the caller's slice would first read each of
+    /// its lines from memory.
+    InPlace(RawPlan),
+    /// Straight into the caller's slice (the columns outside the band stay zero in the
+    /// work buffer).
+    IntoSlice(TwoWay),
 }
 
 struct RealFfts {
@@ -259,14 +267,16 @@ impl FftStage {
             col_plan(n + 1, 0, rs, SIGN_PLUS)?,
             col_plan(n, ng - n, rs, SIGN_PLUS)?,
         ];
-        // SAFETY: as above.
-        let inv_rows =
-            unsafe { TwoWay::new(rows(rs, ng), Kind::Complex(SIGN_MINUS), (pa, pb), rigor)? };
-        let inv_rows_in_place = if 2 * n + 1 >= ng / 2 {
+        let inv_rows = if 2 * n + 1 >= ng / 2 {
             // SAFETY: as above, in place in `a`.
-            Some(unsafe { plan_batch(rows(rs, rs), Kind::Complex(SIGN_MINUS), (pa, pa), flags)? })
+            InverseRows::InPlace(unsafe {
+                plan_batch(rows(rs, rs), Kind::Complex(SIGN_MINUS), (pa, pa), flags)?
+            })
         } else {
-            None
+            // SAFETY: as above, from `a` into `b`.
+            InverseRows::IntoSlice(unsafe {
+                TwoWay::new(rows(rs, ng), Kind::Complex(SIGN_MINUS), (pa, pb), rigor)?
+            })
         };
         // SAFETY: as above, in place in `a`.
         let fwd_rows_in_place =
@@ -294,7 +304,6 @@ impl FftStage {
             inv_cols,
             fwd_cols,
             inv_rows,
-            inv_rows_in_place,
             fwd_rows_in_place,
             real,
         })
@@ -368,10 +377,10 @@ impl FftStage {
                 unsafe { fftw::fftw_execute_dft(p.0, w.add(at), w.add(at)) };
             }
         }
-        if let Some(p) = &self.inv_rows_in_place {
+        match &self.inv_rows {
             // SAFETY: as for the columns; then `out` holds the slice's `na` rows of `ng`
             // values (caller's contract), apart from the work buffer.
-            unsafe {
+            InverseRows::InPlace(p) => unsafe {
                 fftw::fftw_execute_dft(p.0, w, w);
                 copy_rows(
                     w.cast::<f64>(),
@@ -382,18 +391,19 @@ impl FftStage {
                     2 * self.ng,
                     true,
                 );
-            }
-            return;
+            },
+            // SAFETY: `out` holds the slice (caller's contract); the variant matches the
+            // arrays' alignment; the input rows are only read (out of place).
+            InverseRows::IntoSlice(two) => unsafe {
+                fftw::fftw_execute_dft(two.pick(w, out), w, out)
+            },
         }
-        // SAFETY: `out` holds the slice (caller's contract); the variant matches the
-        // arrays' alignment; the input rows are only read (out of place).
-        unsafe { fftw::fftw_execute_dft(self.inv_rows.pick(w, out), w, out) };
     }
 
     /// Columns of the inverse's work buffer to clear before each slice is placed: `|M'| <=
     /// N` (the others stay zero), or every one where the rows run in place.
     pub fn inverse_clears(&self) -> [std::ops::Range<usize>; 2] {
-        if self.inv_rows_in_place.is_some() {
+        if matches!(self.inv_rows, InverseRows::InPlace(_)) {
             [0..self.ng, 0..0]
         } else {
             [0..self.n + 1, self.ng - self.n..self.ng]
