@@ -13,8 +13,8 @@
  * Layouts are SOFT 2.0's: (2B)^3 samples f(alpha_j1, beta_k, gamma_j2) at k*(2B)^2 + j1*(2B) + j2;
  * (4B^3-B)/3 coefficients in so3CoefLoc order. Errors: NULL / negative SO3FFT_E* code plus a
  * thread-local error state. so3fft serialises its FFTW planner calls, calls
- * fftw_make_planner_thread_safe() once, and may call fftw_init_threads() and briefly set
- * fftw_plan_with_nthreads() (plans with SO3FFT_MEASURE+ and several threads).
+ * fftw_make_planner_thread_safe() once; a host's fftw_plan_with_nthreads() setting above 1
+ * is set to 1 during so3fft's own planner calls and restored.
  * Full reference: docs/c-api.md (conventions: docs/conventions.md).
  */
 
@@ -46,7 +46,8 @@
 // Planner flag: FFTW measures every candidate (the most rigorous flag given applies).
 #define SO3FFT_EXHAUSTIVE 4
 
-// Planner flag: the forward transform may overwrite its sample array.
+// Planner flag: the forward transform may overwrite its sample array (accepted; the
+// library leaves the samples as they are at present).
 #define SO3FFT_DESTROY_INPUT 16
 
 // Planner flag: real-valued signal (same layouts, about half the work).
@@ -64,7 +65,8 @@
 // FFT threading: each worker transforms whole slices with a single-threaded FFTW plan.
 #define SO3FFT_FFT_SLICES_ACROSS_WORKERS 1
 
-// FFT threading: slices one after another, each on FFTW's own threads.
+// FFT threading: formerly slices on FFTW's own threads; accepted, same plan as
+// `SO3FFT_FFT_SLICES_ACROSS_WORKERS`.
 #define SO3FFT_FFT_FFTW_THREADS 2
 
 // Success.
@@ -180,8 +182,9 @@ int so3fft_plan_with_max_workspace(size_t bytes);
 size_t so3fft_planner_max_workspace(void);
 
 // Sets how plans made afterwards use their threads in the FFT stage (process-wide):
-// 0 = library's choice (timed with `SO3FFT_MEASURE`+), `SO3FFT_FFT_SLICES_ACROSS_WORKERS`
-// or `SO3FFT_FFT_FFTW_THREADS`. `SO3FFT_EINVAL` for other values.
+// 0 = library's choice, `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS`, all
+// accepted and giving the same plan (slices across workers). `SO3FFT_EINVAL` for other
+// values.
 int so3fft_plan_with_fft_threading(int mode);
 
 // The setting of `so3fft_plan_with_fft_threading` (0 = library's choice).
@@ -223,11 +226,11 @@ int so3fft_get_nthreads(so3fft_plan p);
 // Bytes of memory a plan holds (`SO3FFT_ENULL` for NULL).
 ptrdiff_t so3fft_get_memory(so3fft_plan p);
 
-// Bytes a plan made now with these arguments would hold, computed without making it;
-// or a negative `SO3FFT_E*` code.
+// Bytes a plan for both directions made now with these arguments would hold, computed
+// without making it; or a negative `SO3FFT_E*` code.
 ptrdiff_t so3fft_plan_memory(int B, unsigned int flags, int nthreads);
 
-// `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS` (`SO3FFT_ENULL` for NULL).
+// `SO3FFT_FFT_SLICES_ACROSS_WORKERS`, what every plan uses (`SO3FFT_ENULL` for NULL).
 int so3fft_get_fft_threading(so3fft_plan p);
 
 // Number of samples `(2B)^3` (0 for an invalid `B`).

@@ -4,6 +4,9 @@
 use crate::error::{Error, Result};
 use std::f64::consts::PI;
 
+/// Largest bandwidth an SO(3) plan accepts.
+pub const MAX_BANDWIDTH: usize = 2048;
+
 /// Number of samples `(2B)^3` of a bandwidth-`b` signal.
 pub fn num_samples(b: usize) -> usize {
     8 * b * b * b

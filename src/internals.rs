@@ -5,7 +5,6 @@ pub use crate::dwt::fixtures::{aligned, cluster_setup, grid_lanes, ClusterInputs
 pub use crate::dwt::lanes::Rec;
 pub use crate::dwt::{forward, inverse};
 pub use crate::numeric::Ext;
-pub use crate::plan::{fft_stage_alone, BlockCopies};
 pub use crate::simd::peak::fma_peak;
 pub use crate::symmetry::cluster_pairs;
 pub use crate::wigner::recurrence::{RecCoeffs, RecTables};

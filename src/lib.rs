@@ -48,12 +48,13 @@ mod workers;
 
 pub use error::{Error, Result};
 pub use fft::{wisdom, Rigor};
+pub use grid::MAX_BANDWIDTH;
 pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
 pub use num_complex::Complex64;
 pub use options::{Betas, Direction, FftThreading, Options};
 pub use partial::{Batch, DistributedPlan, Exchange, PartialPlan, Shape, ThreadExchange};
-pub use plan::{Plan, StageTimes, MAX_BANDWIDTH};
+pub use plan::Plan;
 pub use simd::{Isa, ISA_VARIABLE};
-pub use transform::{Scratch, Transform};
+pub use transform::{Scratch, StageTimes, Transform};

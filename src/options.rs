@@ -37,36 +37,21 @@ impl Direction {
     }
 }
 
-/// How the FFT stage of a [`Plan`](crate::Plan) is parallelised.
+/// How the FFT stage of a [`Plan`](crate::Plan) is parallelised. Every plan now spreads
+/// its beta slices across its workers, each slice on a single-threaded FFTW plan: that was
+/// the faster way at every bandwidth measured, and FFTW's process-wide thread settings stay
+/// the host's. The other variants are accepted and give the same plan
+/// ([`Plan::fft_threading`](crate::Plan::fft_threading) reports
+/// [`FftThreading::SlicesAcrossWorkers`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum FftThreading {
-    /// Library's choice, made when the plan is created: [`FftThreading::SlicesAcrossWorkers`]
-    /// with [`Rigor::Estimate`] or one thread. With a measuring rigour and more than one
-    /// thread, both variants are planned and timed on a sample of the plan's own work (the
-    /// FFT stage of the first slice groups of a chunk, for every direction the plan has, on
-    /// a scratch array of at most 64 MiB and the plan's chunk buffer) in alternating rounds,
-    /// and the faster one is kept; FFTW's threads must be at least 10% faster.
-    /// [`Plan::fft_threading`](crate::Plan::fft_threading) tells which was kept. When the
-    /// FFTW-threaded variant cannot be planned, or the scratch array would take more than a
-    /// quarter of the available memory, slices across workers are kept.
-    ///
-    /// Timing plans the FFTW-threaded variant, which touches FFTW's process-wide thread
-    /// settings as described under [`FftThreading::FftwThreads`], even when it is not kept.
-    ///
-    /// The real-signal transforms ([`Options::real`]) always spread slices across the
-    /// workers.
+    /// Library's choice: slices across workers.
     #[default]
     Auto,
     /// Each worker transforms whole beta slices with a single-threaded FFTW plan.
     SlicesAcrossWorkers,
-    /// Slices one after another, each on FFTW's own threads (`fftw3_threads`); the copies
-    /// into and out of the chunk buffer are spread over the workers. Making such a plan
-    /// calls `fftw_init_threads` (once per process) and, while its slice FFTs are planned,
-    /// sets FFTW's process-wide thread count for new plans with `fftw_plan_with_nthreads`,
-    /// restoring the previous value before returning. Our own planner calls are serialised,
-    /// but a host thread that plans an FFTW transform at that same moment may pick up this
-    /// thread count. `Auto` does this only when it measures (see above). With one thread
-    /// this is the same as `SlicesAcrossWorkers`.
+    /// Formerly: slices one after another, each on FFTW's own threads. Accepted; the plan
+    /// spreads slices across its workers.
     FftwThreads,
 }
 
@@ -126,16 +111,11 @@ pub struct Options {
     /// whole memory, see [`Options::default_workspace`]). SO(3) plans; for a distributed
     /// plan, per rank.
     pub max_workspace_bytes: Option<usize>,
-    /// How the FFT stage uses the threads. [`Plan`](crate::Plan) (and the full shape of a
-    /// [`PartialPlan`](crate::PartialPlan)).
+    /// How the FFT stage uses the threads (accepted; see [`FftThreading`]).
     pub fft_threading: FftThreading,
     /// The betas the inverse evaluates (default all; a plan with a selection runs the
     /// inverse only). [`PartialPlan`](crate::PartialPlan).
     pub betas: Betas,
-    /// Run the full shape of a [`PartialPlan`](crate::PartialPlan) on the general engine
-    /// too: for tests and benchmarks.
-    #[doc(hidden)]
-    pub general_engine: bool,
 }
 
 impl Options {
@@ -190,13 +170,6 @@ impl Options {
     /// With [`Options::betas`].
     pub fn with_betas(mut self, betas: Betas) -> Options {
         self.betas = betas;
-        self
-    }
-
-    /// With the hidden engine switch (tests and benchmarks).
-    #[doc(hidden)]
-    pub fn with_general_engine(mut self, general_engine: bool) -> Options {
-        self.general_engine = general_engine;
         self
     }
 

@@ -120,14 +120,10 @@ impl Cluster {
     pub fn members(&self) -> &[Member] {
         &self.slots[..self.len]
     }
-
-    /// Lowest degree present in the cluster.
-    pub fn l0(&self) -> usize {
-        self.m
-    }
 }
 
 /// Number of generic clusters (`m > m' > 0`): `(B-1)(B-2)/2`.
+#[cfg(test)]
 pub(crate) fn num_generic(b: usize) -> usize {
     if b < 3 {
         0
@@ -138,6 +134,7 @@ pub(crate) fn num_generic(b: usize) -> usize {
 
 /// The seed paper's map from the linear index `kappa` to the base pair `(m, m')`,
 /// `1 <= m' < m <= B-1`, through the rectangle indices `(i, j)`.
+#[cfg(any(test, feature = "internals"))]
 pub(crate) fn kappa_to_pair(b: usize, kappa: usize) -> (usize, usize) {
     let i = kappa / (b - 1) + 1;
     let j = kappa % (b - 1) + 1;
@@ -149,6 +146,7 @@ pub(crate) fn kappa_to_pair(b: usize, kappa: usize) -> (usize, usize) {
 }
 
 /// Side of the square tiles of base pairs that [`cluster_pairs`] keeps together.
+#[cfg(any(test, feature = "internals"))]
 pub(crate) const TILE: usize = 8;
 
 /// Base pairs of all clusters of bandwidth `b`, `0 <= m' <= m < B`, in processing order.
@@ -163,6 +161,7 @@ pub(crate) const TILE: usize = 8;
 /// enumerated with the seed paper's index map ([`kappa_to_pair`] on the triangle
 /// `1 <= tb + 1 < ta + 2 <= T + 1`), which interleaves expensive rows of tiles (small
 /// `m`) with cheap ones, so any contiguous run of tiles carries a similar amount of work.
+#[cfg(any(test, feature = "internals"))]
 pub fn cluster_pairs(b: usize) -> Vec<(u32, u32)> {
     let t = b.div_ceil(TILE);
     let tiles = (0..t * (t + 1) / 2).map(|k| {
@@ -229,7 +228,7 @@ mod tests {
                 assert_eq!(c.members().len(), expect);
                 for mem in c.members() {
                     assert!(mem.m.abs() < bi && mem.mp.abs() < bi);
-                    assert_eq!(mem.m.unsigned_abs().max(mem.mp.unsigned_abs()), c.l0());
+                    assert_eq!(mem.m.unsigned_abs().max(mem.mp.unsigned_abs()), c.m);
                     assert!(seen.insert((mem.m, mem.mp)));
                 }
             }

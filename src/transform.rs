@@ -1,10 +1,33 @@
 //! [`Transform`]: the transforms every plan offers, with one meaning for each, and
-//! [`Scratch`], workspace the caller owns.
+//! [`Scratch`], workspace the caller owns, and [`StageTimes`], what each call reports.
 
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
-use crate::plan::StageTimes;
 use num_complex::Complex64;
+
+/// Wall time of each stage of one execution, in seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    /// FFT stage: FFTW and the copies between the slices and the chunk buffer.
+    pub fft: f64,
+    /// Discrete Wigner transform stage: recurrence coefficients, starting values, kernels,
+    /// and the coefficients' gather (inverse) or accumulation (forward).
+    pub dwt: f64,
+    /// Distributed plans: the exchange between the ranks (0 for the other plans).
+    pub exchange: f64,
+    /// Whole call.
+    pub total: f64,
+}
+
+impl std::ops::AddAssign for StageTimes {
+    /// Stage by stage (the times of several executions, as a batch reports them).
+    fn add_assign(&mut self, other: StageTimes) {
+        self.fft += other.fft;
+        self.dwt += other.dwt;
+        self.exchange += other.exchange;
+        self.total += other.total;
+    }
+}
 
 /// Workspace for a plan's `*_with_scratch` calls, owned by the caller (64-byte aligned,
 /// backed by huge pages where it is large). One scratch serves any plan whose

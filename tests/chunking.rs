@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use so3fft::{Complex64, Isa, Options, Plan};
 
-/// Doubles per beta of the complex chunk layout (see `Plan::workspace_bytes`).
+/// Doubles per beta of the complex lane rows, unpadded (see `Plan::workspace_bytes`).
 fn lane_doubles(b: usize) -> usize {
     8 * b * b - 8 * b + 8
 }
@@ -130,8 +130,7 @@ fn chunks_near_the_poles_round_trip() {
     round_trips_with_small_chunks(640, false);
 }
 
-/// The forward that may overwrite its input: its later chunk buffers live in the sample
-/// slices already read and the sums go to the coefficients once per group of chunks.
+/// The forward that may overwrite its input gives the forward's coefficients.
 #[test]
 fn forward_destroying_input_round_trips() {
     round_trips_with_small_chunks(641, true);

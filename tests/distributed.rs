@@ -8,10 +8,7 @@ mod common;
 use so3fft::{Complex64, DistributedPlan, Exchange, Options, PartialPlan, Shape, ThreadExchange};
 
 fn opts(real: bool) -> Options {
-    Options::default()
-        .with_threads(1)
-        .with_real(real)
-        .with_general_engine(true)
+    Options::default().with_threads(1).with_real(real)
 }
 
 /// Every `(l, m, mp)` the shape holds, with its global index.
@@ -134,8 +131,10 @@ fn check_grouped(s: Shape, ranks: usize, real: bool, cap: Option<usize>) {
                     if let Some(at) = plan.local_coef_index(l, m, mp) {
                         assert!(
                             (back[at] - want_c[i]).norm() <= tol * big,
-                            "forward ({l},{m},{mp}) on {} ranks",
-                            ranks
+                            "forward ({l},{m},{mp}) on {} ranks: {} vs {}",
+                            ranks,
+                            back[at],
+                            want_c[i]
                         );
                     }
                 }

@@ -441,11 +441,23 @@ fn memory_estimate_matches_plans() {
                 assert!(plan.workspace_bytes() < plan.memory_bytes());
                 if let Some(cap) = cap {
                     // The documented formula (`Plan::workspace_bytes`), written out here:
-                    // per layout, h = min(B, max(8, 8 floor(cap / (128 d)))) betas of d
-                    // doubles, h rounded up to 8, two halves; the buffer is the larger.
+                    // rows of d doubles per beta (16 per 8-member cluster, 8 per other:
+                    // 8B^2 - 8B + 8; the real rows 4B^2 + 4B) padded to an odd number of
+                    // cache lines; two rows per pair; the cap holds `room` pairs, a whole
+                    // number of vectors of them where it holds one; the B pairs spread
+                    // evenly over the fewest chunks of at most that, rounded up to the
+                    // vector width where that still fits; the buffer holds each chunk
+                    // rounded up to the vector width. It is the larger of the two.
+                    let w = plan.isa().lanes();
                     let bytes = |d: usize| {
-                        let h = (8 * (cap / (128 * d))).max(8).min(b);
-                        2 * h.next_multiple_of(8) * 8 * d
+                        let rs = if (d / 8).is_multiple_of(2) { d + 8 } else { d };
+                        let room = cap / (16 * rs);
+                        let fit = if room >= w { room / w * w } else { room }.clamp(1, b);
+                        let mut h = b.div_ceil(b.div_ceil(fit));
+                        if h >= w && h.next_multiple_of(w) <= fit {
+                            h = h.next_multiple_of(w);
+                        }
+                        16 * rs * h.next_multiple_of(w)
                     };
                     let mut want = bytes(8 * b * b - 8 * b + 8);
                     if real {

@@ -20,10 +20,7 @@ use std::time::{Duration, Instant};
 const TIMEOUT: Duration = Duration::from_secs(600);
 
 fn opts(real: bool) -> Options {
-    Options::default()
-        .with_threads(1)
-        .with_real(real)
-        .with_general_engine(true)
+    Options::default().with_threads(1).with_real(real)
 }
 
 /// Local coefficients of `plan` taken from the global array `c`.

@@ -132,30 +132,6 @@ fn limited_layout_is_dense_and_ordered() {
     assert_eq!(s.coef_index(1, 0, 0), None);
 }
 
-/// The general engine on the full shape agrees with the full plan.
-#[test]
-fn general_engine_matches_full_plan() {
-    for b in [1, 2, 5, 8, 16] {
-        let s = Shape::new(b);
-        let o = opts().with_general_engine(true);
-        let pp = PartialPlan::new(&s, &o).unwrap();
-        assert!(!pp.uses_full_plan());
-        let full = Plan::new(b, &Options::default()).unwrap();
-        let c = random_coeffs(&s, 7 + b as u64);
-        let (mut x, mut y) = (zeros(s.num_samples()), zeros(s.num_samples()));
-        pp.inverse(&c, &mut x).unwrap();
-        full.inverse(&c, &mut y).unwrap();
-        let e = max_diff(&x, &y) / max_abs(&y);
-        assert!(e < 1e-13, "B={b}: inverse differs by {e:e}");
-        let (mut c1, mut c2) = (zeros(c.len()), zeros(c.len()));
-        pp.forward(&x, &mut c1).unwrap();
-        full.forward(&x, &mut c2).unwrap();
-        let e = max_diff(&c1, &c2);
-        assert!(e < 1e-12, "B={b}: forward differs by {e:e}");
-        assert!(max_diff(&c1, &c) < 1e-12);
-    }
-}
-
 /// Limited shapes on SOFT's grid against the full plan with the absent coefficients zeroed
 /// (inverse), and the full forward restricted to the shape (forward).
 #[test]
@@ -469,9 +445,8 @@ fn selections_without_mirrors() {
     }
 }
 
-/// Real plans against complex ones, also on the full plan; the general engine (whose real
-/// transforms run only the members `M' >= 0`) on every instruction set, in one chunk and in
-/// several.
+/// Real plans (whose real transforms run only the members `M' >= 0`) against complex ones,
+/// on every instruction set, in one chunk and in several.
 #[test]
 fn real_against_complex() {
     let shapes = [
@@ -484,15 +459,14 @@ fn real_against_complex() {
         Shape::new(13),
     ];
     let isas = [Isa::Avx512, Isa::Avx2, Isa::Scalar];
-    let general = isas
+    let runs = isas
         .into_iter()
         .filter(|i| i.is_supported())
-        .flat_map(|isa| [None, Some(20_000)].map(|cap| (true, Some(isa), cap)));
+        .flat_map(|isa| [None, Some(20_000)].map(|cap| (Some(isa), cap)));
     for s in shapes {
-        for (general, isa, cap) in std::iter::once((false, None, None)).chain(general.clone()) {
+        for (isa, cap) in runs.clone() {
             let o = opts()
                 .with_real(true)
-                .with_general_engine(general)
                 .with_isa(isa)
                 .with_max_workspace_bytes(cap);
             let pp = PartialPlan::new(&s, &o).unwrap();
@@ -645,7 +619,6 @@ fn chained_inverse_against_direct_summation() {
             let mut chained = 0;
             for cap in [60_000, 150_000, 300_000] {
                 let o = opts()
-                    .with_general_engine(true)
                     .with_isa(Some(isa))
                     .with_max_workspace_bytes(Some(cap));
                 let pp = PartialPlan::new(&s, &o).unwrap();

@@ -35,18 +35,6 @@ unsafe fn run_forward(
     // SAFETY: checked non-NULL, aligned and disjoint; `nc` values by this function's
     // contract. Complex64 is #[repr(C)] { re: f64, im: f64 }, the layout of double[2].
     let coeffs = unsafe { std::slice::from_raw_parts_mut(coeffs.cast::<Complex64>(), nc) };
-    if state.destroy_input {
-        // SAFETY: as above, `ns` values; the caller allowed the samples to be overwritten
-        // (SO3FFT_DESTROY_INPUT), so no one else reads them during the call.
-        let samples = unsafe { std::slice::from_raw_parts_mut(samples.cast::<Complex64>(), ns) };
-        return if state.real {
-            plan.forward_real_parts_destroying_input(samples, coeffs)
-        } else {
-            plan.forward_destroying_input(samples, coeffs)
-        }
-        .map(|_| ())
-        .map_err(CallError::from);
-    }
     // SAFETY: as above, `ns` values, only read.
     let samples =
         unsafe { std::slice::from_raw_parts(samples.cast_const().cast::<Complex64>(), ns) };

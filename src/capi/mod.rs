@@ -114,8 +114,6 @@ pub struct so3fft_plan_s {
     output: *mut so3fft_complex,
     /// Made with `SO3FFT_REAL`: transforms take the real-signal path.
     real: bool,
-    /// Made with `SO3FFT_DESTROY_INPUT`: the forward may overwrite its samples.
-    destroy_input: bool,
 }
 
 /// A plan: a pointer to an opaque object (like `fftw_plan`).
@@ -137,7 +135,8 @@ pub const SO3FFT_MEASURE: c_uint = 1;
 pub const SO3FFT_PATIENT: c_uint = 2;
 /// Planner flag: FFTW measures every candidate (the most rigorous flag given applies).
 pub const SO3FFT_EXHAUSTIVE: c_uint = 4;
-/// Planner flag: the forward transform may overwrite its sample array.
+/// Planner flag: the forward transform may overwrite its sample array (accepted; the
+/// library leaves the samples as they are at present).
 pub const SO3FFT_DESTROY_INPUT: c_uint = 16;
 /// Planner flag: real-valued signal (same layouts, about half the work).
 pub const SO3FFT_REAL: c_uint = 32;
@@ -154,7 +153,8 @@ pub const SO3FFT_BOTH: c_int = 3;
 
 /// FFT threading: each worker transforms whole slices with a single-threaded FFTW plan.
 pub const SO3FFT_FFT_SLICES_ACROSS_WORKERS: c_int = 1;
-/// FFT threading: slices one after another, each on FFTW's own threads.
+/// FFT threading: formerly slices on FFTW's own threads; accepted, same plan as
+/// `SO3FFT_FFT_SLICES_ACROSS_WORKERS`.
 pub const SO3FFT_FFT_FFTW_THREADS: c_int = 2;
 
 /// Success.

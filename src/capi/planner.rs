@@ -3,8 +3,8 @@
 
 use super::{
     direction_of, guarded, guarded_code, rigor_of, so3fft_complex, so3fft_plan, so3fft_plan_s,
-    threads_of, SO3FFT_BOTH, SO3FFT_DESTROY_INPUT, SO3FFT_FFT_FFTW_THREADS,
-    SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_FORWARD, SO3FFT_INVERSE, SO3FFT_OK, SO3FFT_REAL,
+    threads_of, SO3FFT_BOTH, SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS,
+    SO3FFT_FORWARD, SO3FFT_INVERSE, SO3FFT_OK, SO3FFT_REAL,
 };
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{last_error, CallError, ErrorKind};
@@ -72,8 +72,9 @@ pub(super) fn planner_workspace_cap() -> Option<usize> {
 static PLANNER_FFT_THREADING: AtomicI32 = AtomicI32::new(0);
 
 /// Sets how plans made afterwards use their threads in the FFT stage (process-wide):
-/// 0 = library's choice (timed with `SO3FFT_MEASURE`+), `SO3FFT_FFT_SLICES_ACROSS_WORKERS`
-/// or `SO3FFT_FFT_FFTW_THREADS`. `SO3FFT_EINVAL` for other values.
+/// 0 = library's choice, `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS`, all
+/// accepted and giving the same plan (slices across workers). `SO3FFT_EINVAL` for other
+/// values.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_with_fft_threading(mode: c_int) -> c_int {
     guarded_code(|| {
@@ -160,7 +161,6 @@ fn make_plan(
             input,
             output,
             real,
-            destroy_input: flags & SO3FFT_DESTROY_INPUT != 0,
         })))
     })
 }

@@ -37,8 +37,8 @@ pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
     })
 }
 
-/// Bytes a plan made now with these arguments would hold, computed without making it;
-/// or a negative `SO3FFT_E*` code.
+/// Bytes a plan for both directions made now with these arguments would hold, computed
+/// without making it; or a negative `SO3FFT_E*` code.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -> isize {
     guarded_count(|| {
@@ -56,7 +56,7 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
     })
 }
 
-/// `SO3FFT_FFT_SLICES_ACROSS_WORKERS` or `SO3FFT_FFT_FFTW_THREADS` (`SO3FFT_ENULL` for NULL).
+/// `SO3FFT_FFT_SLICES_ACROSS_WORKERS`, what every plan uses (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_get_fft_threading(p: so3fft_plan) -> c_int {
     guarded(SO3FFT_ENULL, || {

@@ -1,4 +1,4 @@
-//! Page-aligned buffers, the padded layout of a slice in the FFT scratch, and row copies.
+//! Page-aligned buffers, the chunk buffer of a plan, and row copies.
 
 use crate::error::{Error, Result};
 use num_complex::Complex64;
@@ -120,17 +120,6 @@ impl Drop for AlignedBuf {
     }
 }
 
-/// Complex values of padding after each row of a slice in the FFT scratch. A slice's rows
-/// of `2B` values are a multiple of 4 KiB apart for many B, so a walk down a column stays
-/// in one set of the caches and FFTW copies columns out and back (`fftw_cpy2d`). One
-/// cache line of padding avoids that.
-pub(crate) const SLICE_PAD: usize = 4;
-
-/// Row stride, in complex values, of an `n x n` slice in the FFT scratch.
-pub(crate) const fn slice_stride(n: usize) -> usize {
-    n + SLICE_PAD
-}
-
 /// Copy `rows` rows of `len` doubles from rows `ss` doubles apart at `src` to rows `ds`
 /// apart at `dst`; with `stream`, by non-temporal stores where `dst` and its rows are
 /// 16-byte aligned (for memory the transform does not read again: ordinary stores would
@@ -173,37 +162,6 @@ pub(crate) unsafe fn copy_rows(
         // SAFETY: row `r` of both extents is in bounds and they do not overlap (this
         // function's contract).
         unsafe { std::ptr::copy_nonoverlapping(src.add(r * ss), dst.add(r * ds), len) };
-    }
-}
-
-/// Write the `n` reals at `src` as `n` complex values `(x, 0)` at `dst` (`2n` doubles); with
-/// `stream`, by non-temporal stores where `dst` is 16-byte aligned (output too large to stay
-/// in the cache: ordinary stores would first read every line), else by plain stores.
-///
-/// # Safety
-/// `src` is valid for reading `n` doubles and `dst` for writing `2n`; they do not overlap.
-pub(crate) unsafe fn spread_reals(src: *const f64, dst: *mut f64, n: usize, stream: bool) {
-    #[cfg(target_arch = "x86_64")]
-    if stream && (dst as usize).is_multiple_of(16) {
-        use std::arch::x86_64::{_mm_load_sd, _mm_sfence, _mm_stream_pd};
-        for i in 0..n {
-            // SAFETY: `src + i` and the 16-byte aligned pair `dst + 2i` are in bounds (this
-            // function's contract); `_mm_load_sd` puts the real in the low lane and 0 in the
-            // high one, which is (x, 0); SSE2 is part of x86_64.
-            unsafe { _mm_stream_pd(dst.add(2 * i), _mm_load_sd(src.add(i))) };
-        }
-        // SAFETY: a store fence (SSE, part of x86_64) orders the streaming stores before
-        // any later access.
-        unsafe { _mm_sfence() };
-        return;
-    }
-    let _ = stream;
-    for i in 0..n {
-        // SAFETY: in bounds by this function's contract.
-        unsafe {
-            *dst.add(2 * i) = *src.add(i);
-            *dst.add(2 * i + 1) = 0.0;
-        }
     }
 }
 

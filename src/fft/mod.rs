@@ -6,25 +6,21 @@
 //! is serialised with ours. Executing a plan on new arrays is thread-safe, so slices are
 //! transformed in parallel on the plan's rayon pool.
 //!
-//! FFTW's process-wide thread settings: a slice plan on FFTW's own threads (asked for with
-//! more than one thread) makes this module call `fftw_init_threads()` once, and set
-//! `fftw_plan_with_nthreads()` to the plan's thread count for the duration of that one
-//! planner call, under the planner lock, restoring the previous value afterwards (FFTW's
-//! default 1 where FFTW older than 3.3.9 cannot report it).
+//! FFTW's process-wide thread setting: every plan is single-threaded (it runs inside the
+//! library's workers); a host that has set FFTW's thread count for new plans above 1
+//! keeps its setting, which is set to 1 only for the duration of each of the library's
+//! planner calls, under the planner lock.
 //!
-//! - `planner`: the planner lock, FFTW's thread initialisation, owned FFTW plans;
-//! - `slices`: the slice transforms ([`SliceFft`], [`SliceFftReal`]);
-//! - `buf`: page-aligned buffers, the padded slice layout and row copies;
+//! - `planner`: the planner lock, owned FFTW plans;
+//! - `buf`: page-aligned buffers and row copies;
 //! - `wisdom`: FFTW's wisdom, exported and imported.
 
 mod buf;
 mod planner;
-mod slices;
 pub mod wisdom;
 
-pub(crate) use buf::{copy_rows, slice_stride, spread_reals, AlignedBuf, ChunkBuffer};
+pub(crate) use buf::{copy_rows, AlignedBuf, ChunkBuffer};
 pub(crate) use planner::{plan_guarded, planning_bytes, RawPlan};
-pub(crate) use slices::{SliceFft, SliceFftReal};
 
 use fftw_sys as fftw;
 

@@ -1,5 +1,4 @@
-//! FFTW's global state: the planner lock, the one-time initialisation of FFTW's threads, and
-//! owned FFTW plans (destroyed under the lock).
+//! FFTW's global state: the planner lock and owned FFTW plans (destroyed under the lock).
 //!
 //! When the library is loaded (before `main`, or at `dlopen`), FFTW's planner is made
 //! thread-safe process-wide and the planner lock's `fork()` handlers are registered: a host
@@ -8,10 +7,9 @@
 //! first planner call does the same.)
 
 use crate::error::{Error, Result};
-use crate::system::{check_headroom, thread_stack_bytes, ForkLock, ForkLockGuard};
+use crate::system::{check_headroom, ForkLock, ForkLockGuard};
 use fftw_sys as fftw;
 use std::ffi::c_int;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Once;
 
 /// Serialises every FFTW planner call (plan creation and destruction, wisdom) of this
@@ -56,19 +54,10 @@ pub(crate) fn planner_lock() -> ForkLockGuard<'static> {
     PLANNER_LOCK.lock()
 }
 
-/// Bytes FFTW's planner may allocate for a plan of `elements` complex values on `nthreads`
-/// threads: 2 MiB plus 32 bytes per element (plans, twiddles, buffers), and with more than
-/// one thread, per thread the stack of a new POSIX thread plus 1 MiB (FFTW starts its
-/// worker threads while measuring, and waits forever for one it could not start).
-pub(crate) fn planning_bytes(elements: usize, nthreads: usize) -> usize {
-    let threads = if nthreads > 1 {
-        nthreads.saturating_mul(thread_stack_bytes() + (1 << 20))
-    } else {
-        0
-    };
-    (2usize << 20)
-        .saturating_add(elements.saturating_mul(32))
-        .saturating_add(threads)
+/// Bytes FFTW's planner may allocate for a plan of `elements` complex values: 2 MiB plus
+/// 32 bytes per element (plans, twiddles, buffers).
+pub(crate) fn planning_bytes(elements: usize) -> usize {
+    (2usize << 20).saturating_add(elements.saturating_mul(32))
 }
 
 /// An FFTW plan owned by this crate, destroyed under the planner lock.
@@ -101,67 +90,28 @@ fn fftw_planner_nthreads() -> c_int {
         return 1;
     }
     // SAFETY: the symbol, when present, is FFTW's `int fftw_planner_nthreads(void)`, which
-    // only reads FFTW's planner setting (we hold the planner lock, see `with_nthreads`).
+    // only reads FFTW's planner setting (we hold the planner lock, see `plan_guarded`).
     unsafe { std::mem::transmute::<*mut libc::c_void, PlannerNthreads>(sym)() }
 }
 
-/// `fftw_init_threads()` is called once, the first time a threaded plan is asked for.
-static THREADS_INIT: Once = Once::new();
-/// `fftw_init_threads()` succeeded.
-static THREADS_OK: AtomicBool = AtomicBool::new(false);
-/// The process that initialised FFTW's threads: in a child made by `fork()` FFTW's worker
-/// threads do not exist, and a threaded FFTW plan would wait for them forever, so plans
-/// made there are single-threaded.
-static THREADS_PID: AtomicU32 = AtomicU32::new(0);
-
-/// Whether FFTW's own threads can be used in this process (initialising them on the first
-/// call). Call with the planner lock held.
-fn fftw_threads_usable(_lock: &ForkLockGuard<'static>) -> bool {
-    THREADS_INIT.call_once(|| {
-        // SAFETY: called once per process, under the planner lock (no planner call runs).
-        let ok = unsafe { fftw::fftw_init_threads() } != 0;
-        THREADS_OK.store(ok, Ordering::Relaxed);
-        THREADS_PID.store(std::process::id(), Ordering::Relaxed);
-    });
-    THREADS_OK.load(Ordering::Relaxed) && THREADS_PID.load(Ordering::Relaxed) == std::process::id()
-}
-
-/// Runs the FFTW planner call `plan` for an `n x n` slice under the planner lock (see
-/// [`plan_guarded`]).
-pub(crate) fn plan_slice(
-    n: usize,
-    nthreads: usize,
-    plan: impl FnOnce() -> fftw::fftw_plan,
-) -> Result<RawPlan> {
-    plan_guarded(n.saturating_mul(n), nthreads, plan).map_err(|e| match e {
-        Error::Fftw(_) => Error::Fftw(format!("could not plan an {n}x{n} DFT")),
-        other => other,
-    })
-}
-
-/// Runs the FFTW planner call `plan` for a transform of `elements` values under the planner lock, with
-/// FFTW's thread count for new plans set to `nthreads` when that is more than 1 and FFTW's
-/// threads are usable here; the previous thread count is restored before the lock is
-/// released. FFTW aborts the process when an allocation fails inside its planner, so the
-/// call is not made without [`planning_bytes`] of headroom ([`Error::OutOfMemory`]); a
-/// null plan is [`Error::Fftw`].
+/// Runs the FFTW planner call `plan` for a transform of `elements` values under the
+/// planner lock, as a single-threaded plan (the plans run inside the library's own
+/// workers): where the host has set FFTW's thread count for new plans above 1, it is set
+/// to 1 for this call and restored before the lock is released. FFTW aborts the process
+/// when an allocation fails inside its planner, so the call is not made without
+/// [`planning_bytes`] of headroom ([`Error::OutOfMemory`]); a null plan is
+/// [`Error::Fftw`].
 pub(crate) fn plan_guarded(
     elements: usize,
-    nthreads: usize,
     plan: impl FnOnce() -> fftw::fftw_plan,
 ) -> Result<RawPlan> {
     let lock = planner_lock();
-    let threaded = nthreads > 1 && fftw_threads_usable(&lock);
-    check_headroom(planning_bytes(
-        elements,
-        if threaded { nthreads } else { 1 },
-    ))?;
-    let made = if threaded {
-        let host = fftw_planner_nthreads();
-        let count = c_int::try_from(nthreads).unwrap_or(c_int::MAX);
-        // SAFETY: FFTW's threads are initialised (fftw_threads_usable); the setting is
-        // changed under the planner lock and restored below, before the lock is released.
-        unsafe { fftw::fftw_plan_with_nthreads(count) };
+    check_headroom(planning_bytes(elements))?;
+    let host = fftw_planner_nthreads();
+    let made = if host > 1 {
+        // SAFETY: a count above 1 means the host initialised FFTW's threads; the setting
+        // is changed under the planner lock and restored below, before it is released.
+        unsafe { fftw::fftw_plan_with_nthreads(1) };
         let made = plan();
         // SAFETY: as above.
         unsafe { fftw::fftw_plan_with_nthreads(host) };

@@ -95,12 +95,14 @@ pub fn forget() {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fft::{Rigor, SliceFft, SIGN_PLUS};
+    use crate::fft::Rigor;
+    use crate::{Options, PartialPlan, Shape};
 
     #[test]
     fn wisdom_survives_a_round_trip_through_a_file() {
-        // A measured plan leaves wisdom about a 12 x 12 transform.
-        SliceFft::new(12, SIGN_PLUS, Rigor::Measure, 1).unwrap();
+        // A measured plan leaves wisdom about its 12-point slice DFTs.
+        let options = Options::default().with_rigor(Rigor::Measure);
+        PartialPlan::new(&Shape::new(6), &options).unwrap();
         let before = export_to_string().unwrap();
         assert!(before.starts_with("(fftw-3"), "{before}");
         let path = std::env::temp_dir().join(format!("so3fft-wisdom-{}", std::process::id()));

@@ -3,15 +3,15 @@
 //! inverse SO(3) transform.
 
 use super::combine::{add_combined, Combine};
-use super::peaks::{grid_argmax, grid_argmax_real, Peak, SliceArgmax};
+use super::peaks::{Peak, SliceArgmax};
 use super::series::SeriesTables;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::options::{Betas, Direction, Options};
+use crate::partial::SliceRef;
 use crate::partial::{PartialPlan, Shape};
-use crate::plan::SliceRef;
-use crate::plan::StageTimes;
 use crate::s2::{S2Limits, S2Plan};
+use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
 use num_complex::Complex64;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -445,9 +445,7 @@ impl Correlation {
 
     /// [`Correlation::correlate`] and the grid's largest `|C|^2` ([`grid_argmax`]: the
     /// same point, value and tie rule), found while the inverse computes each slice of the
-    /// grid instead of in a second pass over it (when the grid's plan is the full
-    /// transform, `b_out` the input bandwidth and every degree combined; else by a scan
-    /// after the inverse).
+    /// grid instead of in a second pass over it.
     pub fn correlate_argmax(
         &self,
         signal: &[Complex64],
@@ -460,11 +458,8 @@ impl Correlation {
             self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
             let seen = SliceArgmax::new(self.b_out);
             let watch = |k: usize, s: SliceRef| seen.watch(k, s);
-            Ok(if self.so3.inverse_watched(&buf.so3, out, &watch)? {
-                seen.peak()
-            } else {
-                grid_argmax(self.b_out, out)
-            })
+            self.so3.inverse_watched(&buf.so3, out, &watch)?;
+            Ok(seen.peak())
         })
     }
 
@@ -482,11 +477,8 @@ impl Correlation {
             self.combine_shells(&[(signal, pattern, 1.0)], (fwd, true), buf)?;
             let seen = SliceArgmax::new(self.b_out);
             let watch = |k: usize, s: SliceRef| seen.watch(k, s);
-            Ok(if self.so3.inverse_real_watched(&buf.so3, out, &watch)? {
-                seen.peak()
-            } else {
-                grid_argmax_real(self.b_out, out)
-            })
+            self.so3.inverse_real_watched(&buf.so3, out, &watch)?;
+            Ok(seen.peak())
         })
     }
 

@@ -54,8 +54,10 @@ impl LanePairs {
             Betas::Indices(v) => v.len(),
             Betas::Values(v) => v.len(),
         };
+        // Twice the tables (their vectors grow by copies) and 1 MiB for the rest of
+        // planning's small allocations, which have no checks of their own.
         let per_pair = LanePairs::bytes_per_pair(shape.degree_limit);
-        crate::system::check_headroom(count.saturating_mul(per_pair))?;
+        crate::system::check_headroom(count.saturating_mul(2 * per_pair).saturating_add(1 << 20))?;
         // Half angles of the lower points, and which slices each pair writes.
         let mut half: Vec<Dd> = Vec::new();
         let mut outputs: Vec<[usize; 2]> = Vec::new();

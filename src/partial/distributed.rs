@@ -32,8 +32,8 @@ use crate::dwt::Prefetch;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::{Betas, Direction, Options};
-use crate::plan::StageTimes;
 use crate::simd::Isa;
+use crate::transform::StageTimes;
 use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr};
 use num_complex::Complex64;
@@ -938,14 +938,14 @@ impl<X: Exchange> DistributedPlan<X> {
                             if real {
                                 let (w0, w1) = g.fft.half_pair(work)?;
                                 g.scatter_real_pair(m, (w0, w1), &rows);
-                                g.fft.inverse_real(w0, out.get().add(s0 * slice_len));
-                                g.fft.inverse_real(w1, out.get().add(s1 * slice_len));
+                                g.fft.inverse_real(w0, out.get().add(s0 * slice_len), None);
+                                g.fft.inverse_real(w1, out.get().add(s1 * slice_len), None);
                             } else {
                                 let (w0, w1) = g.fft.inv_pair(work)?;
                                 g.scatter_pair(m, (w0, w1), &rows);
                                 let o = out.get().cast::<Complex64>();
-                                g.fft.inverse(w0, o.add(s0 * slice_len));
-                                g.fft.inverse(w1, o.add(s1 * slice_len));
+                                g.fft.inverse(w0, o.add(s0 * slice_len), None);
+                                g.fft.inverse(w1, o.add(s1 * slice_len), None);
                             }
                         }
                         Ok(())

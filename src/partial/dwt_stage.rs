@@ -12,10 +12,10 @@
 //! transform `t` follow those of transform `t - 1`.
 
 use super::betas::LanePairs;
+use super::coeffs::{self, DegreeFactors};
 use super::shape::CoefLayout;
 use crate::dwt::{self, BatchRows, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
-use crate::plan::coeffs::{self, DegreeFactors};
 use crate::simd::Isa;
 use crate::symmetry::{Cluster, Member};
 use crate::wigner::{big, start_norm, RecCoeffs, RecTables};
@@ -213,7 +213,7 @@ impl DwtStage {
                 let slots: Vec<Slot> = cl
                     .members()
                     .iter()
-                    .filter(|mem| layout.holds(mem.m, mem.mp) && (!half || mem.mp >= 0))
+                    .filter(|mem| Self::held(layout, half, mem))
                     .map(|mem| Slot {
                         member: *mem,
                         work: mem.m.rem_euclid(n_alpha as isize) as usize * row_stride
@@ -256,6 +256,32 @@ impl DwtStage {
             max_lanes,
             half,
         }
+    }
+
+    /// Whether the clusters of `layout` (with `half`: the members `M' >= 0`) hold `mem`.
+    fn held(layout: &CoefLayout, half: bool, mem: &Member) -> bool {
+        layout.holds(mem.m, mem.mp) && (!half || mem.mp >= 0)
+    }
+
+    /// [`DwtStage::row_stride`] of the stage [`DwtStage::new`] makes of `(layout, half)`,
+    /// without making it.
+    pub fn row_stride_of(layout: &CoefLayout, half: bool) -> usize {
+        let mut offset = 0;
+        for m in 0..layout.l {
+            for mp in 0..=m {
+                let cl = Cluster::new(m, mp);
+                let held = cl
+                    .members()
+                    .iter()
+                    .filter(|mem| Self::held(layout, half, mem));
+                offset += match held.count() {
+                    0 => 0,
+                    1..=4 => 8,
+                    _ => 16,
+                };
+            }
+        }
+        padded_row(offset)
     }
 
     /// Bytes of the stage's tables and scratch (approximately).

@@ -22,6 +22,28 @@ use std::ffi::c_int;
 /// Complex values of padding after each row of a work buffer.
 pub(super) const ROW_PAD: usize = 4;
 
+/// One output slice of an inverse, handed to a [`SliceWatch`] right after it is
+/// computed (while in the cache): the real slice as written, or a complex slice in a work
+/// buffer or the output, `row` values per row and rows `stride` values apart.
+pub(crate) enum SliceRef<'a> {
+    /// The `n_alpha n_gamma` reals of the slice.
+    Real(&'a [f64]),
+    /// The `n_alpha` rows of the slice.
+    Complex {
+        values: &'a [Complex64],
+        row: usize,
+        stride: usize,
+    },
+}
+
+/// What an inverse calls with the slice index and the values of each output slice, once
+/// per slice, from whichever worker computed it (for scans fused into the transform, such
+/// as a grid's argmax).
+pub(crate) type SliceWatch<'a> = &'a (dyn Fn(usize, SliceRef) + Sync);
+
+/// A [`SliceWatch`] bound to one slice, for the FFT stage.
+pub(super) type Seen<'a> = Option<&'a dyn Fn(SliceRef)>;
+
 /// A batch of 1-D DFTs: `howmany` transforms of `n` points, `stride` apart within one,
 /// `dist` from one to the next, on the input and the output side.
 #[derive(Clone, Copy)]
@@ -59,7 +81,7 @@ unsafe fn plan_batch(
         b.idist as c_int,
         b.odist as c_int,
     );
-    plan_guarded(b.n * b.howmany, 1, || {
+    plan_guarded(b.n * b.howmany, || {
         // SAFETY: under the planner lock (plan_guarded); the arrays cover the batch
         // (caller's contract); FFTW keeps no pointer to `dims`.
         unsafe {
@@ -183,6 +205,8 @@ pub(super) struct Work {
     pub half2: Option<AlignedBuf>,
     pub fwd: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
+    /// Reals of a slice (the real forward of the real parts of complex samples).
+    pub reals: Option<AlignedBuf>,
 }
 
 /// The slice DFTs of one shape.
@@ -328,7 +352,6 @@ impl FftStage {
         Ok(work.inv.as_mut().expect("just made").slice_mut(len))
     }
 
-    /// The forward's work buffer.
     /// Two inverse work buffers (a slice and its mirror).
     pub fn inv_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
         buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)
@@ -344,12 +367,19 @@ impl FftStage {
         buf_pair((&mut work.half, &mut work.half2), self.na * self.hs)
     }
 
-    pub fn fwd_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
-        let len = self.na * self.rs;
-        if work.fwd.is_none() {
-            work.fwd = Some(AlignedBuf::new(len)?);
+    /// Two half buffers and the reals of a slice (the real forward of real parts).
+    pub fn half_pair_reals<'a>(&self, work: &'a mut Work) -> Result<(BufPair<'a>, &'a mut [f64])> {
+        let len = self.slice_len().div_ceil(2);
+        if work.reals.is_none() {
+            work.reals = Some(AlignedBuf::new(len)?);
         }
-        Ok(work.fwd.as_mut().expect("just made").slice_mut(len))
+        let reals = work.reals.as_mut().expect("just made").slice_mut(len);
+        // SAFETY: `len` complex values of a buffer of that many, as doubles (twice as
+        // many, at least `na ng`), borrowed as long as the complex slice.
+        let reals =
+            unsafe { std::slice::from_raw_parts_mut(reals.as_mut_ptr().cast::<f64>(), 2 * len) };
+        let pair = buf_pair((&mut work.half, &mut work.half2), self.na * self.hs)?;
+        Ok((pair, reals))
     }
 
     /// The real transforms' half-spectrum buffer.
@@ -368,7 +398,7 @@ impl FftStage {
     /// # Safety
     /// `w` is [`FftStage::inv_buf`]'s; `out` is valid for writes of `na ng` values, nobody
     /// else's meanwhile.
-    pub unsafe fn inverse(&self, w: &mut [Complex64], out: *mut Complex64) {
+    pub unsafe fn inverse(&self, w: &mut [Complex64], out: *mut Complex64, seen: Seen) {
         let w = w.as_mut_ptr();
         for (plan, at) in self.inv_cols.iter().zip([0, self.ng - self.n]) {
             if let Some(p) = plan {
@@ -382,6 +412,14 @@ impl FftStage {
             // values (caller's contract), apart from the work buffer.
             InverseRows::InPlace(p) => unsafe {
                 fftw::fftw_execute_dft(p.0, w, w);
+                if let Some(seen) = seen {
+                    let len = (self.na - 1) * self.rs + self.ng;
+                    seen(SliceRef::Complex {
+                        values: std::slice::from_raw_parts(w, len),
+                        row: self.ng,
+                        stride: self.rs,
+                    });
+                }
                 copy_rows(
                     w.cast::<f64>(),
                     2 * self.rs,
@@ -395,7 +433,14 @@ impl FftStage {
             // SAFETY: `out` holds the slice (caller's contract); the variant matches the
             // arrays' alignment; the input rows are only read (out of place).
             InverseRows::IntoSlice(two) => unsafe {
-                fftw::fftw_execute_dft(two.pick(w, out), w, out)
+                fftw::fftw_execute_dft(two.pick(w, out), w, out);
+                if let Some(seen) = seen {
+                    seen(SliceRef::Complex {
+                        values: std::slice::from_raw_parts(out, self.na * self.ng),
+                        row: self.ng,
+                        stride: self.ng,
+                    });
+                }
             },
         }
     }
@@ -447,7 +492,7 @@ impl FftStage {
     /// # Safety
     /// `out` valid for writes of `na ng` doubles, nobody else's; the plan is real; `w` is
     /// [`FftStage::half_buf`]'s.
-    pub unsafe fn inverse_real(&self, w: &mut [Complex64], out: *mut f64) {
+    pub unsafe fn inverse_real(&self, w: &mut [Complex64], out: *mut f64, seen: Seen) {
         let r = self.real.as_ref().expect("real plans");
         let w = w.as_mut_ptr();
         // SAFETY: plan made on a same-size page-aligned buffer; the buffer is this worker's.
@@ -455,6 +500,35 @@ impl FftStage {
         let o = out.cast::<Complex64>();
         // SAFETY: `out` holds the slice's reals (caller's contract); variant by alignment.
         unsafe { fftw::fftw_execute_dft_c2r(r.c2r.pick(w, o), w, out) };
+        if let Some(seen) = seen {
+            // SAFETY: the reals just written, this caller's alone.
+            seen(SliceRef::Real(unsafe {
+                std::slice::from_raw_parts(out, self.slice_len())
+            }));
+        }
+    }
+
+    /// [`FftStage::inverse_real`] into the real parts of the complex slice at `out`, whose
+    /// imaginary parts are set to 0: the reals go into the slice's first half, then move
+    /// out to their places from the last one down (each lands at or after where it was
+    /// read, in the cache).
+    ///
+    /// # Safety
+    /// As for [`FftStage::inverse_real`], with `out` valid for writes of `na ng` complex
+    /// values.
+    pub unsafe fn inverse_real_parts(&self, w: &mut [Complex64], out: *mut Complex64, seen: Seen) {
+        let reals = out.cast::<f64>();
+        // SAFETY: the first `na ng` doubles of the caller's slice (caller's contract).
+        unsafe { self.inverse_real(w, reals, seen) };
+        for i in (0..self.slice_len()).rev() {
+            // SAFETY: `i` and `2 i + 1 < 2 na ng` inside the slice; value `i` is read
+            // before anything at or below `2 i` (written only for larger `i`) changes it.
+            unsafe {
+                let x = *reals.add(i);
+                *reals.add(2 * i + 1) = 0.0;
+                *reals.add(2 * i) = x;
+            }
+        }
     }
 
     /// Real forward of the `na ng` reals at `inp`: rows `r2c` into `w` (the half buffer),
@@ -463,6 +537,25 @@ impl FftStage {
     /// # Safety
     /// `inp` valid for reads of `na ng` doubles; the plan is real; `w` is
     /// [`FftStage::half_buf`]'s.
+    /// [`FftStage::forward_real`] of the real parts of the `na ng` complex values at `inp`
+    /// (the imaginary parts are not read), through `reals` (`na ng` doubles, page-aligned).
+    ///
+    /// # Safety
+    /// `inp` valid for reads of `na ng` complex values; the plan is real; `w` is
+    /// [`FftStage::half_buf`]'s; `reals` this caller's.
+    pub unsafe fn forward_real_parts(
+        &self,
+        (w, reals): (&mut [Complex64], &mut [f64]),
+        inp: *const Complex64,
+    ) {
+        for (i, x) in reals[..self.slice_len()].iter_mut().enumerate() {
+            // SAFETY: `i < na ng` (caller's contract).
+            *x = unsafe { (*inp.add(i)).re };
+        }
+        // SAFETY: `reals` holds the slice's reals (just written), page-aligned.
+        unsafe { self.forward_real(w, reals.as_ptr()) };
+    }
+
     pub unsafe fn forward_real(&self, w: &mut [Complex64], inp: *const f64) {
         let r = self.real.as_ref().expect("real plans");
         let w = w.as_mut_ptr();

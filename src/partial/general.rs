@@ -1,21 +1,21 @@
-//! The general engine of a [`PartialPlan`](super::PartialPlan) (every shape but the full
-//! one with all betas): its construction, and its transforms one chunk of lane pairs at a
-//! time (the DWT stage over all clusters, then the FFT stage over the chunk's slices).
+//! The engine of every plan shape (a [`PartialPlan`](super::PartialPlan); [`Plan`](crate::Plan)
+//! is its full shape): its construction, and its transforms one chunk of lane pairs at a
+//! time (the DWT stage over all clusters, and the FFT stage over the chunk's slices).
 
 use super::betas::LanePairs;
 use super::dwt_stage::{ChunkLanes, DwtStage, KERNEL_BATCH};
-use super::fft_stage::{FftStage, Work};
+use super::fft_stage::{BufPair, FftStage, SliceRef, SliceWatch, Work, ROW_PAD};
 use super::options::Batch;
 use super::shape::{CoefLayout, Shape};
 use super::slots::{Clear, LaneRows, SlotTable};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::Result;
 use crate::fft::ChunkBuffer;
-use crate::options::{Betas, Options};
-use crate::plan::StageTimes;
+use crate::options::{Betas, Direction, Options};
 use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::transform::Scratch;
+use crate::transform::StageTimes;
 use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -44,9 +44,116 @@ pub(super) struct General {
     work: Vec<Mutex<Work>>,
     /// The chunk buffer (taken by one execution at a time).
     buf: ChunkBuffer,
-    budget: usize,
+    footprint: Footprint,
     pub(super) lanes_w: usize,
     pub(super) workers: WorkerPool,
+}
+
+/// What a plan of the general engine holds, known before it is made.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Footprint {
+    /// Everything but the chunk buffer: the DWT stage's tables and per-worker scratch, the
+    /// workers' FFT buffers and stacks, the lane pairs' tables.
+    rest: usize,
+    /// What the chunk buffer may take (the workspace cap).
+    budget: usize,
+    /// Lane pairs and lanes per vector.
+    pairs: usize,
+    lanes_w: usize,
+    /// Lane-row strides of the complex transforms and (real plans) of the real ones.
+    strides: [Option<usize>; 2],
+}
+
+impl Footprint {
+    /// The footprint of the plan [`General::new`] makes of these arguments.
+    pub(super) fn new(
+        shape: &Shape,
+        pairs: &LanePairs,
+        (isa, threads): (Isa, usize),
+        options: &Options,
+    ) -> Footprint {
+        let layout = CoefLayout::new(shape);
+        let w = isa.lanes();
+        let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
+        let tables = pairs.pairs * LanePairs::bytes_per_pair(shape.degree_limit);
+        let rest = DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
+            .saturating_add(threads * (Self::work_bytes(shape, options) + WORKER_STACK_BYTES))
+            .saturating_add(tables);
+        // The library's one rule (see `Options::default_workspace`).
+        let sample_bytes = if options.real { 8 } else { 16 };
+        let arrays = sample_bytes * shape.num_samples() + 16 * shape.num_coeffs();
+        let budget = options
+            .max_workspace_bytes
+            .unwrap_or_else(|| Options::default_workspace_here(arrays).saturating_sub(rest));
+        let strides = [
+            Some(DwtStage::row_stride_of(&layout, false)),
+            options.real.then(|| DwtStage::row_stride_of(&layout, true)),
+        ];
+        Footprint {
+            rest,
+            budget,
+            pairs: pairs.pairs,
+            lanes_w: w,
+            strides,
+        }
+    }
+
+    /// Bytes of one worker's FFT buffers (see [`General::reserve`]): two work buffers of
+    /// a slice per direction the plan runs, and on a real plan two half-spectrum buffers
+    /// and the reals of a slice.
+    fn work_bytes(shape: &Shape, options: &Options) -> usize {
+        let (na, ng) = (shape.n_alpha, shape.n_gamma);
+        let directions = if options.direction == Direction::Both {
+            2
+        } else {
+            1
+        };
+        let mut bytes = directions * 2 * na * (ng + ROW_PAD) * 16;
+        if options.real {
+            bytes += 2 * na * (ng / 2 + 1 + ROW_PAD) * 16 + na * ng * 8;
+        }
+        bytes
+    }
+
+    /// Lane pairs the workspace cap holds for one transform with lane rows `row_stride`
+    /// doubles apart (at least one).
+    fn most_pairs(&self, row_stride: usize) -> usize {
+        (self.budget / (row_stride * 2 * 8).max(1)).clamp(1, self.pairs)
+    }
+
+    /// Lane pairs per chunk: what the workspace cap holds for one transform with the rows
+    /// of the padding lanes (a chunk's pairs rounded up to the vector width; at least one
+    /// pair), the pairs spread evenly over the fewest chunks, a multiple of the vector
+    /// width when that fits. It does not depend on the batch, so a batch sums in the order
+    /// of single executes.
+    fn chunk_pairs(&self, row_stride: usize) -> usize {
+        let pairs = self.pairs;
+        let w = self.lanes_w;
+        let room = self.budget / (row_stride * 2 * 8).max(1);
+        let fit = if room >= w { room / w * w } else { room }.clamp(1, pairs);
+        let h = pairs.div_ceil(pairs.div_ceil(fit));
+        if h >= w && h.next_multiple_of(w) <= fit {
+            h.next_multiple_of(w)
+        } else {
+            h
+        }
+    }
+
+    /// Bytes of the chunk buffer of one transform (the scratch a single call needs): the
+    /// larger of the complex and the real transforms'.
+    pub(super) fn scratch_bytes(&self) -> usize {
+        self.strides
+            .iter()
+            .flatten()
+            .map(|&rs| 8 * rs * 2 * self.chunk_pairs(rs).next_multiple_of(self.lanes_w))
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Bytes of the whole plan: the chunk buffer and the rest.
+    pub(super) fn total(&self) -> usize {
+        self.rest.saturating_add(self.scratch_bytes())
+    }
 }
 
 /// The clusters and slots a transform runs on (see [`General::members`]).
@@ -64,11 +171,39 @@ struct PlacedLanes {
     buf: SendPtr<f64>,
 }
 
-/// Pointers of one execution (all arrays of a batch).
+/// The samples of one execution (all arrays of a batch) and how they are stored. A
+/// forward only reads them.
 #[derive(Clone, Copy)]
 pub(super) enum Data {
     Complex(SendPtr<Complex64>),
     Real(SendPtr<f64>),
+    /// Reals in the real parts of complex values: the inverse sets the imaginary parts to
+    /// 0, the forward does not read them.
+    RealParts(SendPtr<Complex64>),
+}
+
+impl Data {
+    /// Whether the samples are a real signal.
+    pub(super) fn is_real(self) -> bool {
+        !matches!(self, Data::Complex(_))
+    }
+
+    /// The samples `values` values further on (in the samples' own type).
+    fn offset(self, values: usize) -> Data {
+        match self {
+            Data::Complex(p) => Data::Complex(SendPtr(p.get().wrapping_add(values))),
+            Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(values))),
+            Data::RealParts(p) => Data::RealParts(SendPtr(p.get().wrapping_add(values))),
+        }
+    }
+
+    /// Bytes of one value.
+    fn value_bytes(self) -> usize {
+        match self {
+            Data::Real(_) => 8,
+            _ => 16,
+        }
+    }
 }
 
 impl General {
@@ -83,19 +218,12 @@ impl General {
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
         let w = isa.lanes();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
-        let slice_bytes = na * ng * 16 * if options.real { 2 } else { 1 };
-        let tables = pairs.pairs * LanePairs::bytes_per_pair(shape.degree_limit);
-        // Everything but the chunk buffer.
-        let rest = DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
-            .saturating_add(threads * (slice_bytes + WORKER_STACK_BYTES))
-            .saturating_add(tables);
-        check_headroom(rest.saturating_add(crate::fft::planning_bytes(4 * na * ng, 1)))?;
-        // The library's one rule (see `Options::default_workspace`).
-        let sample_bytes = if options.real { 8 } else { 16 };
-        let arrays = sample_bytes * shape.num_samples() + 16 * shape.num_coeffs();
-        let budget = options
-            .max_workspace_bytes
-            .unwrap_or_else(|| Options::default_workspace_here(arrays).saturating_sub(rest));
+        let footprint = Footprint::new(shape, &pairs, (isa, threads), options);
+        check_headroom(
+            footprint
+                .rest
+                .saturating_add(crate::fft::planning_bytes(4 * na * ng)),
+        )?;
         let fft = FftStage::new(
             (na, ng),
             shape.order_limit_gamma,
@@ -144,36 +272,20 @@ impl General {
             pair_weight,
             work: (0..threads).map(|_| Mutex::new(Work::default())).collect(),
             buf: ChunkBuffer::new(None),
-            budget,
+            footprint,
             lanes_w: w,
             workers: WorkerPool::shared_or_new(shared, threads)?,
         })
     }
 
-    /// Bytes of one transform's blocks per lane pair.
-    fn pair_bytes(m: Members) -> usize {
-        (m.dwt.row_stride * 2 * 8).max(1)
-    }
-
     /// Lane pairs the workspace cap holds for one transform (at least one).
     fn most_pairs(&self, m: Members) -> usize {
-        (self.budget / Self::pair_bytes(m)).clamp(1, self.pairs.pairs)
+        self.footprint.most_pairs(m.dwt.row_stride)
     }
 
-    /// Lane pairs per chunk: what the workspace cap holds for one transform (at least
-    /// one), the pairs spread evenly over the fewest chunks, a multiple of the vector
-    /// width when that is at least one vector. It does not depend on the batch, so a batch
-    /// sums in the order of single executes.
+    /// Lane pairs per chunk (see [`Footprint::chunk_pairs`]).
     fn chunk_pairs(&self, m: Members) -> usize {
-        let pairs = self.pairs.pairs;
-        let most = self.most_pairs(m);
-        let h = pairs.div_ceil(pairs.div_ceil(most));
-        let w = self.lanes_w;
-        if h >= w && h.next_multiple_of(w) <= most {
-            h.next_multiple_of(w)
-        } else {
-            h
-        }
+        self.footprint.chunk_pairs(m.dwt.row_stride)
     }
 
     /// Transforms of a batch run together (sharing each cluster's recurrence coefficients,
@@ -181,7 +293,7 @@ impl General {
     /// at the chunk size (at least one).
     fn group_size(&self, m: Members) -> usize {
         let hp = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
-        (self.budget / (hp * Self::pair_bytes(m))).max(1)
+        (self.footprint.budget / (hp * m.dwt.row_stride * 2 * 8).max(1)).max(1)
     }
 
     /// Runs `run(first, sub_batch)` on the groups of `batch` (see [`General::group_size`]),
@@ -208,36 +320,30 @@ impl General {
         batch: Batch,
         coef: SendConstPtr<Complex64>,
         out: Data,
-        scratch: Option<&Scratch>,
+        (scratch, watch): (Option<&Scratch>, Option<SliceWatch>),
     ) -> Result<StageTimes> {
-        let m = self.members(matches!(out, Data::Real(_)));
+        let m = self.members(out.is_real());
         self.by_groups((batch, m), |t0, b| {
             let c = SendConstPtr(coef.get().wrapping_add(t0 * batch.in_dist));
-            let o = match out {
-                Data::Complex(p) => {
-                    Data::Complex(SendPtr(p.get().wrapping_add(t0 * batch.out_dist)))
-                }
-                Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(t0 * batch.out_dist))),
-            };
-            self.inverse_group((b, m), c, o, scratch)
+            let o = out.offset(t0 * batch.out_dist);
+            self.inverse_group((b, m), c, o, (scratch, watch))
         })
     }
 
-    /// Forward of a batch, group by group (`inp` complex values, or reals with `real`;
-    /// chunk buffer: the caller's `scratch` if given).
+    /// Forward of a batch, group by group (the samples `inp` only read; chunk buffer: the
+    /// caller's `scratch` if given).
     pub(super) fn forward(
         &self,
         batch: Batch,
-        inp: SendConstPtr<f64>,
+        inp: Data,
         coef: SendPtr<Complex64>,
-        (real, scratch): (bool, Option<&Scratch>),
+        scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
-        let per_value = if real { 1 } else { 2 };
-        let m = self.members(real);
+        let m = self.members(inp.is_real());
         self.by_groups((batch, m), |t0, b| {
-            let i = SendConstPtr(inp.get().wrapping_add(t0 * batch.in_dist * per_value));
+            let i = inp.offset(t0 * batch.in_dist);
             let c = SendPtr(coef.get().wrapping_add(t0 * batch.out_dist));
-            self.forward_group((b, m), i, c, (real, scratch))
+            self.forward_group((b, m), i, c, scratch)
         })
     }
 
@@ -256,17 +362,36 @@ impl General {
         }
     }
 
+    /// Makes the buffers a single transform in `direction` needs now (the chunk buffer and
+    /// each worker's FFT buffers), so that executing allocates nothing large and a plan
+    /// that cannot have them is refused when it is made.
+    pub(super) fn reserve(&self, direction: Direction) -> Result<()> {
+        self.buf
+            .with(self.scratch_bytes().div_ceil(16), |_| Ok(()))?;
+        let real = self.half.is_some();
+        for w in &self.work {
+            let mut w = w.lock().unwrap_or_else(|e| e.into_inner());
+            if direction != Direction::Forward {
+                self.fft.inv_pair(&mut w)?;
+            }
+            if direction != Direction::Inverse {
+                self.fft.fwd_pair(&mut w)?;
+            }
+            if real {
+                self.fft.half_pair_reals(&mut w)?;
+            }
+        }
+        Ok(())
+    }
+
     /// Bytes of the chunk buffer of one transform (the scratch a single call needs).
     pub(super) fn scratch_bytes(&self) -> usize {
-        [false, true]
-            .map(|real| {
-                let m = self.members(real);
-                let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
-                8 * m.dwt.row_stride * 2 * hp_max
-            })
-            .into_iter()
-            .max()
-            .unwrap_or(0)
+        self.footprint.scratch_bytes()
+    }
+
+    /// Bytes the plan holds (see [`Footprint`]).
+    pub(super) fn memory_bytes(&self) -> usize {
+        self.footprint.total()
     }
 
     /// The clusters and slots of the complex transforms (every member), or of the real
@@ -337,13 +462,13 @@ impl General {
         (batch, m): (Batch, Members),
         coef: SendConstPtr<Complex64>,
         out: Data,
-        scratch: Option<&Scratch>,
+        (scratch, watch): (Option<&Scratch>, Option<SliceWatch>),
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
         let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
         let per_t_max = m.dwt.row_stride * 2 * hp_max;
-        let real = matches!(out, Data::Real(_));
+        let real = out.is_real();
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let own = SendPtr(buf);
             let chain = self.inverse_chain((batch.count, m), out, own);
@@ -373,7 +498,7 @@ impl General {
                     // Last chunk first: a chained chunk's buffer is in the slices of the
                     // chunk before it, which its FFT stage writes.
                     for pl in group.iter().rev() {
-                        self.inverse_fft((batch, m), *pl, out)?;
+                        self.inverse_fft((batch, m), *pl, (out, watch))?;
                     }
                     times.fft += t1.elapsed().as_secs_f64();
                 }
@@ -414,11 +539,11 @@ impl General {
         if count != 1 || chunks.len() < 2 {
             return None;
         }
-        let (base, value_bytes) = match out {
-            Data::Complex(p) => (p.get().cast::<u8>(), 16),
-            Data::Real(p) => (p.get().cast::<u8>(), 8),
+        let base = match out {
+            Data::Complex(p) | Data::RealParts(p) => p.get().cast::<u8>(),
+            Data::Real(p) => p.get().cast::<u8>(),
         };
-        let slice_bytes = self.fft.slice_len() * value_bytes;
+        let slice_bytes = self.fft.slice_len() * out.value_bytes();
         let rt = m.dwt.row_stride;
         let mut chain = vec![PlacedLanes {
             ch: chunks[0],
@@ -540,8 +665,14 @@ impl General {
     }
 
     /// The inverse's FFT stage of one chunk: a beta and its mirror in one task where both
-    /// are written (each lane row and slot read once for both), the others alone.
-    fn inverse_fft(&self, (batch, m): (Batch, Members), pl: PlacedLanes, out: Data) -> Result<()> {
+    /// are written (each lane row and slot read once for both), the others alone; each
+    /// slice shown to `watch` if given.
+    fn inverse_fft(
+        &self,
+        (batch, m): (Batch, Members),
+        pl: PlacedLanes,
+        (out, watch): (Data, Option<SliceWatch>),
+    ) -> Result<()> {
         let (ch, buf) = (pl.ch, pl.buf);
         let per_t = m.dwt.row_stride * ch.lanes();
         let slice_len = self.fft.slice_len();
@@ -550,24 +681,22 @@ impl General {
             self.with_work(|work| {
                 let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, false));
                 let at = |s: usize| t * batch.out_dist + s * slice_len;
+                let (w0, w1) = if out.is_real() {
+                    self.fft.half_pair(work)?
+                } else {
+                    self.fft.inv_pair(work)?
+                };
                 // SAFETY: the lane rows were written by the DWT stage (finished); slices `s0`
                 // and `s1` of output `t` are inside the checked output and this task's
                 // alone, and hold no chunk's rows still to be read (see `inverse_chain`).
                 unsafe {
-                    match out {
-                        Data::Complex(o) => {
-                            let (w0, w1) = self.fft.inv_pair(work)?;
-                            self.scatter_pair(m, (w0, w1), &[rows]);
-                            self.fft.inverse(w0, o.get().add(at(s0)));
-                            self.fft.inverse(w1, o.get().add(at(s1)));
-                        }
-                        Data::Real(o) => {
-                            let (w0, w1) = self.fft.half_pair(work)?;
-                            self.scatter_real_pair(m, (w0, w1), &[rows]);
-                            self.fft.inverse_real(w0, o.get().add(at(s0)));
-                            self.fft.inverse_real(w1, o.get().add(at(s1)));
-                        }
+                    if out.is_real() {
+                        self.scatter_real_pair(m, (w0, w1), &[rows]);
+                    } else {
+                        self.scatter_pair(m, (w0, w1), &[rows]);
                     }
+                    self.slice_out(w0, out.offset(at(s0)), (watch, s0));
+                    self.slice_out(w1, out.offset(at(s1)), (watch, s1));
                 }
                 Ok(())
             })
@@ -577,42 +706,96 @@ impl General {
             self.with_work(|work| {
                 let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, upper));
                 let at = t * batch.out_dist + s * slice_len;
-                match out {
-                    Data::Complex(o) => {
-                        let w = self.fft.inv_buf(work)?;
-                        // SAFETY: as for the pairs above, for slice `s` of output `t`.
-                        unsafe {
-                            self.scatter(m, w, &[rows]);
-                            self.fft.inverse(w, o.get().add(at));
-                        }
+                let w = if out.is_real() {
+                    self.fft.half_buf(work)?
+                } else {
+                    self.fft.inv_buf(work)?
+                };
+                // SAFETY: as for the pairs above, for slice `s` of output `t`.
+                unsafe {
+                    if out.is_real() {
+                        self.scatter_real(m, w, &[rows]);
+                    } else {
+                        self.scatter(m, w, &[rows]);
                     }
-                    Data::Real(o) => {
-                        let w = self.fft.half_buf(work)?;
-                        // SAFETY: as above, for the real output.
-                        unsafe {
-                            self.scatter_real(m, w, &[rows]);
-                            self.fft.inverse_real(w, o.get().add(at));
-                        }
-                    }
+                    self.slice_out(w, out.offset(at), (watch, s));
                 }
                 Ok(())
             })
         })
     }
 
+    /// The slice DFT of an inverse from the work buffer `w` (filled by a scatter) into the
+    /// slice at `out`, shown to `watch` as slice `s` if given.
+    ///
+    /// # Safety
+    /// `out` is valid for writes of one slice, nobody else's meanwhile; `w` is the work
+    /// buffer of `out`'s kind (half buffer for the real kinds).
+    unsafe fn slice_out(
+        &self,
+        w: &mut [Complex64],
+        out: Data,
+        (watch, s): (Option<SliceWatch>, usize),
+    ) {
+        let bound = watch.map(|f| move |r: SliceRef| f(s, r));
+        let seen = bound.as_ref().map(|f| f as &dyn Fn(SliceRef));
+        // SAFETY: the caller's contract.
+        unsafe {
+            match out {
+                Data::Complex(o) => self.fft.inverse(w, o.get(), seen),
+                Data::Real(o) => self.fft.inverse_real(w, o.get(), seen),
+                Data::RealParts(o) => self.fft.inverse_real_parts(w, o.get(), seen),
+            }
+        }
+    }
+
+    /// The slice DFTs of a forward from the slices `inp` (one or two, of one kind) into
+    /// `work`'s two buffers for that kind, in order; returns the buffers (for a gather).
+    ///
+    /// # Safety
+    /// Each of `inp` is valid for reads of one slice.
+    unsafe fn slices_in<'a>(&self, work: &'a mut Work, inp: &[Data]) -> Result<BufPair<'a>> {
+        let (w0, w1) = match inp[0] {
+            Data::Complex(_) => self.fft.fwd_pair(work)?,
+            Data::Real(_) => self.fft.half_pair(work)?,
+            Data::RealParts(_) => {
+                let ((w0, w1), reals) = self.fft.half_pair_reals(work)?;
+                for (w, i) in [&mut *w0, &mut *w1].into_iter().zip(inp) {
+                    if let Data::RealParts(i) = i {
+                        // SAFETY: the caller's contract; the buffers are this worker's.
+                        unsafe { self.fft.forward_real_parts((w, &mut *reals), i.get()) };
+                    }
+                }
+                return Ok((w0, w1));
+            }
+        };
+        for (w, i) in [&mut *w0, &mut *w1].into_iter().zip(inp) {
+            // SAFETY: the caller's contract; the buffers are this worker's.
+            unsafe {
+                match i {
+                    Data::Complex(i) => self.fft.forward(w, i.get()),
+                    Data::Real(i) => self.fft.forward_real(w, i.get()),
+                    Data::RealParts(_) => unreachable!("one kind per call"),
+                }
+            }
+        }
+        Ok((w0, w1))
+    }
+
     /// Forward of a group of transforms, chunk by chunk.
     fn forward_group(
         &self,
         (batch, m): (Batch, Members),
-        inp: SendConstPtr<f64>,
+        inp: Data,
         coef: SendPtr<Complex64>,
-        (real, scratch): (bool, Option<&Scratch>),
+        scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
         let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
         let per_t_max = m.dwt.row_stride * 2 * hp_max;
         let slice_len = self.fft.slice_len();
+        let real = inp.is_real();
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let buf = SendPtr(buf);
             self.workers.pool().install(|| {
@@ -627,20 +810,14 @@ impl General {
                         self.with_work(|work| {
                             let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, false));
                             let weight = self.pair_weight[ch.j0 + jj];
-                            let at = |s: usize| t * batch.in_dist + s * slice_len;
+                            let at = |s: usize| inp.offset(t * batch.in_dist + s * slice_len);
                             // SAFETY: slices `s0` and `s1` of input `t` are inside the
-                            // checked input (complex values, or reals for the real
-                            // forward); the two lane rows are this task's alone.
+                            // checked input; the two lane rows are this task's alone.
                             unsafe {
+                                let (w0, w1) = self.slices_in(work, &[at(s0), at(s1)])?;
                                 if real {
-                                    let (w0, w1) = self.fft.half_pair(work)?;
-                                    self.fft.forward_real(w0, inp.get().add(at(s0)));
-                                    self.fft.forward_real(w1, inp.get().add(at(s1)));
                                     self.gather_real_pair(m, (w0, w1), &[rows], weight);
                                 } else {
-                                    let (w0, w1) = self.fft.fwd_pair(work)?;
-                                    self.fft.forward(w0, inp.get().add(2 * at(s0)).cast());
-                                    self.fft.forward(w1, inp.get().add(2 * at(s1)).cast());
                                     self.gather_pair(m, (w0, w1), &[rows], weight);
                                 }
                             }
@@ -652,21 +829,16 @@ impl General {
                         self.with_work(|work| {
                             let rows = Self::lane_rows(m, (buf.get(), t * per_t), ch, (jj, upper));
                             let weight = self.pair_weight[ch.j0 + jj];
-                            // SAFETY: slice `s` of input `t` is inside the checked input
-                            // (complex values, or reals for the real forward); the values
-                            // written are this slice's slots of two lane rows: no other
-                            // task writes them (its mirror writes the other slots of the
-                            // same rows).
+                            let at = inp.offset(t * batch.in_dist + s * slice_len);
+                            // SAFETY: slice `s` of input `t` is inside the checked input;
+                            // the values written are this slice's slots of two lane rows:
+                            // no other task writes them (its mirror writes the other slots
+                            // of the same rows).
                             unsafe {
+                                let (w, _) = self.slices_in(work, &[at])?;
                                 if real {
-                                    let w = self.fft.half_buf(work)?;
-                                    let at = t * batch.in_dist + s * slice_len;
-                                    self.fft.forward_real(w, inp.get().add(at));
                                     self.gather_real(m, w, &[rows], weight);
                                 } else {
-                                    let w = self.fft.fwd_buf(work)?;
-                                    let at = 2 * (t * batch.in_dist + s * slice_len);
-                                    self.fft.forward(w, inp.get().add(at).cast());
                                     self.gather(m, w, &[rows], weight);
                                 }
                             }

@@ -1,39 +1,43 @@
-//! [`PartialPlan`]: the public face of a partial plan: construction (the choice between
-//! [`Plan`] for the full shape and the general engine, `general.rs`), the argument checks
-//! and the transforms, single and batched.
+//! [`PartialPlan`]: the public face of the engine: construction, the argument checks and
+//! the transforms, single and batched.
 
 use super::betas::LanePairs;
-use super::general::{Data, General};
+use super::fft_stage::SliceWatch;
+use super::general::{Data, Footprint, General};
 use super::options::Batch;
 use super::shape::Shape;
 use crate::error::{Error, Result};
 use crate::options::{Betas, Direction, Options};
-use crate::plan::{Plan, SliceWatch, StageTimes};
 use crate::simd::Isa;
-use crate::transform::{Scratch, Transform};
+use crate::system::{mem_available, mem_total};
+use crate::transform::{Scratch, StageTimes, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool};
 use num_complex::Complex64;
-
-enum Engine {
-    Full(Box<Plan>),
-    General(Box<General>),
-}
 
 /// A transform on SO(3) that computes only what a [`Shape`] holds: band-limited,
 /// order-limited, oversampled or undersampled in alpha and gamma, restricted to some
 /// betas, several at once ([`Batch`]), complex or real.
 ///
-/// The full shape ([`Shape::new`]) with all betas runs on [`Plan`]; everything else on
-/// the general engine: the DWT kernels per cluster of order pairs over chunks of beta
-/// pairs, and pruned slice DFTs. Execution takes `&self`; one plan may run on different
-/// arrays from several threads.
+/// Every shape runs on one engine: the DWT kernels per cluster of order pairs over
+/// chunks of beta pairs, and pruned slice DFTs ([`Plan`](crate::Plan) is its full shape).
+/// Execution takes `&self`; one plan may run on different arrays from several threads.
 pub struct PartialPlan {
     shape: Shape,
     direction: Direction,
     real: bool,
     threads: usize,
     n_slices: usize,
-    engine: Engine,
+    isa: Isa,
+    engine: Box<General>,
+}
+
+/// What [`PartialPlan::new`] checks and resolves before it builds anything.
+struct Checked {
+    direction: Direction,
+    threads: usize,
+    isa: Isa,
+    skip: (u32, bool),
+    pairs: LanePairs,
 }
 
 impl PartialPlan {
@@ -49,6 +53,50 @@ impl PartialPlan {
         options: &Options,
         shared: Option<&WorkerPool>,
     ) -> Result<PartialPlan> {
+        let c = PartialPlan::validate(shape, options)?;
+        // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
+        // available memory, and plan plus the caller's arrays in the machine.
+        let need = Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total();
+        let arrays = (c.pairs.n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
+        let too_big = match (mem_available(), mem_total()) {
+            (Some(avail), Some(total)) => need > avail || need.saturating_add(arrays) > total,
+            _ => false,
+        };
+        if too_big {
+            return Err(Error::OutOfMemory { bytes: need });
+        }
+        let n_slices = c.pairs.n_slices;
+        let engine = Box::new(General::new(
+            shape,
+            c.pairs,
+            (c.isa, c.skip, c.threads),
+            options,
+            shared,
+        )?);
+        engine.reserve(c.direction)?;
+        Ok(PartialPlan {
+            shape: *shape,
+            direction: c.direction,
+            real: options.real,
+            threads: c.threads,
+            n_slices,
+            isa: c.isa,
+            engine,
+        })
+    }
+
+    /// Bytes of memory a plan made now with these arguments would hold
+    /// ([`PartialPlan::memory_bytes`]), without making it: the same checks as
+    /// [`PartialPlan::new`] and the same formulas, nothing large allocated. The default
+    /// workspace depends on the memory available at the time of the call (at most half of
+    /// it is used), so a plan made later may differ if that has changed.
+    pub fn memory_needed(shape: &Shape, options: &Options) -> Result<usize> {
+        let c = PartialPlan::validate(shape, options)?;
+        Ok(Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total())
+    }
+
+    /// The checks of [`PartialPlan::new`].
+    fn validate(shape: &Shape, options: &Options) -> Result<Checked> {
         shape.validate()?;
         let restricted = options.betas != Betas::All;
         let direction = if restricted {
@@ -71,32 +119,37 @@ impl PartialPlan {
         let skip = options.skip()?;
         options.check_workspace()?;
         let pairs = LanePairs::new(shape, &options.betas, Some(isa.lanes()))?;
-        let n_slices = pairs.n_slices;
-        let engine = if shape.is_full() && !restricted && !options.general_engine {
-            let po = Options {
-                direction,
-                threads,
-                isa: Some(isa),
-                ..options.clone()
-            };
-            Engine::Full(Box::new(Plan::new_on(shape.degree_limit, &po, shared)?))
-        } else {
-            Engine::General(Box::new(General::new(
-                shape,
-                pairs,
-                (isa, skip, threads),
-                options,
-                shared,
-            )?))
-        };
-        Ok(PartialPlan {
-            shape: *shape,
+        Ok(Checked {
             direction,
-            real: options.real,
             threads,
-            n_slices,
-            engine,
+            isa,
+            skip,
+            pairs,
         })
+    }
+
+    /// Bytes of memory the plan holds: the chunk buffer ([`PartialPlan::scratch_bytes`]),
+    /// the workers' FFT buffers and stacks, and the tables. A transform needs the caller's
+    /// arrays on top and nothing else large. [`PartialPlan::memory_needed`] gives the same
+    /// number before planning.
+    pub fn memory_bytes(&self) -> usize {
+        self.engine.memory_bytes()
+    }
+
+    /// The plan's worker threads.
+    pub(crate) fn workers(&self) -> &WorkerPool {
+        &self.engine.workers
+    }
+
+    /// Instruction set of the DWT kernels.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Runs `f` on the plan's worker threads (rayon's parallel iterators inside it use
+    /// them), for work that goes with a transform, such as the SOFT layer's checks.
+    pub(crate) fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
+        self.workers().pool().install(f)
     }
 
     /// The plan's shape.
@@ -114,28 +167,17 @@ impl PartialPlan {
         self.threads
     }
 
-    /// Whether the plan runs on [`Plan`] (the full shape) rather than the general engine.
-    pub fn uses_full_plan(&self) -> bool {
-        matches!(self.engine, Engine::Full(_))
-    }
-
-    /// The number of chunks a single inverse (complex, or `real`) on the general engine
-    /// runs as one chain (their buffers in the output, each cluster's coefficients read
-    /// once), 0 where it runs them one by one or on [`Plan`]. For tests and benchmarks.
+    /// The number of chunks a single inverse (complex, or `real`) runs as one chain
+    /// (their buffers in the output, each cluster's coefficients read once), 0 where it
+    /// runs them one by one. For tests and benchmarks.
     #[doc(hidden)]
     pub fn chained_inverse_chunks(&self, real: bool) -> usize {
-        match &self.engine {
-            Engine::Full(_) => 0,
-            Engine::General(g) => g.chained_chunks(real),
-        }
+        self.engine.chained_chunks(real)
     }
 
     /// Coefficients of one transform ([`Shape::num_coeffs`]).
     pub fn num_coeffs(&self) -> usize {
-        match &self.engine {
-            Engine::Full(p) => p.num_coeffs(),
-            Engine::General(g) => g.layout.total,
-        }
+        self.engine.layout.total
     }
 
     /// Samples of one transform: `n_alpha n_gamma` per beta slice, times the number of
@@ -170,29 +212,24 @@ impl PartialPlan {
         self.inverse_real_in(one(coeffs.len(), samples.len()), coeffs, samples, None)
     }
 
-    /// Bytes of [`Scratch`] a single transform with scratch needs.
+    /// Bytes of [`Scratch`] a single transform with scratch needs: the chunk buffer of
+    /// its lane rows (the larger of the complex and, on a real plan, the real transforms').
     pub fn scratch_bytes(&self) -> usize {
-        match &self.engine {
-            Engine::Full(p) => p.workspace_bytes(),
-            Engine::General(g) => g.scratch_bytes(),
-        }
+        self.engine.scratch_bytes()
     }
 
     /// [`PartialPlan::inverse`] that shows every output slice to `watch` as it is
-    /// computed, where the plan runs on [`Plan`] (the full shape); `Ok(false)` (and
-    /// `watch` never called) on the general engine.
+    /// computed (a single transform; the slice index is the watch's first argument).
     pub(crate) fn inverse_watched(
         &self,
         coeffs: &[Complex64],
         samples: &mut [Complex64],
         watch: SliceWatch,
-    ) -> Result<bool> {
-        match &self.engine {
-            Engine::Full(p) if self.direction != Direction::Forward => {
-                p.inverse_watched(coeffs, samples, watch).map(|()| true)
-            }
-            _ => self.inverse(coeffs, samples).map(|_| false),
-        }
+    ) -> Result<StageTimes> {
+        let b = one(coeffs.len(), samples.len());
+        self.check(false, false, b, coeffs.len(), samples.len())?;
+        let out = Data::Complex(SendPtr(samples.as_mut_ptr()));
+        self.run_inverse(b, coeffs, out, (None, Some(watch)))
     }
 
     /// [`PartialPlan::inverse_real`] with a watch, as [`PartialPlan::inverse_watched`].
@@ -201,13 +238,62 @@ impl PartialPlan {
         coeffs: &[Complex64],
         samples: &mut [f64],
         watch: SliceWatch,
-    ) -> Result<bool> {
-        match &self.engine {
-            Engine::Full(p) if self.real && self.direction != Direction::Forward => p
-                .inverse_real_watched(coeffs, samples, watch)
-                .map(|()| true),
-            _ => self.inverse_real(coeffs, samples).map(|_| false),
-        }
+    ) -> Result<StageTimes> {
+        let b = one(coeffs.len(), samples.len());
+        self.check(false, true, b, coeffs.len(), samples.len())?;
+        let out = Data::Real(SendPtr(samples.as_mut_ptr()));
+        self.run_inverse(b, coeffs, out, (None, Some(watch)))
+    }
+
+    /// [`PartialPlan::inverse_real`] into a complex sample array: real parts are the
+    /// samples, imaginary parts exactly 0 (for callers whose interface is complex, such as
+    /// the C API with `SO3FFT_REAL` and the SOFT layer).
+    pub(crate) fn inverse_real_to_complex(
+        &self,
+        coeffs: &[Complex64],
+        samples: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        let b = one(coeffs.len(), samples.len());
+        self.check(false, true, b, coeffs.len(), samples.len())?;
+        let out = Data::RealParts(SendPtr(samples.as_mut_ptr()));
+        self.run_inverse(b, coeffs, out, (None, None))
+    }
+
+    /// Real forward of the real parts of complex samples (the imaginary parts are not
+    /// read): the real path for callers whose real data sit in a complex array.
+    pub(crate) fn forward_real_parts(
+        &self,
+        samples: &[Complex64],
+        coeffs: &mut [Complex64],
+    ) -> Result<StageTimes> {
+        let b = one(samples.len(), coeffs.len());
+        self.check(true, true, b, samples.len(), coeffs.len())?;
+        let inp = Data::RealParts(SendPtr(samples.as_ptr().cast_mut()));
+        self.run_forward(b, inp, coeffs, None)
+    }
+
+    /// The engine's inverse of checked arguments.
+    fn run_inverse(
+        &self,
+        batch: Batch,
+        coeffs: &[Complex64],
+        out: Data,
+        extras: (Option<&Scratch>, Option<SliceWatch>),
+    ) -> Result<StageTimes> {
+        self.engine
+            .inverse(batch, SendConstPtr(coeffs.as_ptr()), out, extras)
+    }
+
+    /// The engine's forward of checked arguments (`inp` only read).
+    fn run_forward(
+        &self,
+        batch: Batch,
+        inp: Data,
+        coeffs: &mut [Complex64],
+        scratch: Option<&Scratch>,
+    ) -> Result<StageTimes> {
+        self.engine
+            .forward(batch, inp, SendPtr(coeffs.as_mut_ptr()), scratch)
     }
 
     /// `batch.count` forwards; the time of each stage.
@@ -259,18 +345,9 @@ impl PartialPlan {
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(true, false, batch, samples.len(), coeffs.len())?;
-        match (&self.engine, scratch) {
-            (Engine::Full(p), Some(s)) => p.forward_with_scratch(samples, coeffs, s),
-            (Engine::Full(p), None) => full_many(batch, self.sizes(true), |i, o| {
-                p.forward(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
-            }),
-            (Engine::General(g), s) => g.forward(
-                batch,
-                SendConstPtr(samples.as_ptr().cast()),
-                SendPtr(coeffs.as_mut_ptr()),
-                (false, s.as_deref()),
-            ),
-        }
+        // The samples are only read (see `Data`).
+        let inp = Data::Complex(SendPtr(samples.as_ptr().cast_mut()));
+        self.run_forward(batch, inp, coeffs, scratch.as_deref())
     }
 
     /// [`PartialPlan::inverse_many`] in the caller's `scratch` if given (one transform).
@@ -282,18 +359,8 @@ impl PartialPlan {
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(false, false, batch, coeffs.len(), samples.len())?;
-        match (&self.engine, scratch) {
-            (Engine::Full(p), Some(s)) => p.inverse_with_scratch(coeffs, samples, s),
-            (Engine::Full(p), None) => full_many(batch, self.sizes(false), |i, o| {
-                p.inverse(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
-            }),
-            (Engine::General(g), s) => g.inverse(
-                batch,
-                SendConstPtr(coeffs.as_ptr()),
-                Data::Complex(SendPtr(samples.as_mut_ptr())),
-                s.as_deref(),
-            ),
-        }
+        let out = Data::Complex(SendPtr(samples.as_mut_ptr()));
+        self.run_inverse(batch, coeffs, out, (scratch.as_deref(), None))
     }
 
     /// [`PartialPlan::forward_real_many`] in the caller's `scratch` if given (one
@@ -306,18 +373,9 @@ impl PartialPlan {
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(true, true, batch, samples.len(), coeffs.len())?;
-        match (&self.engine, scratch) {
-            (Engine::Full(p), Some(s)) => p.forward_real_with_scratch(samples, coeffs, s),
-            (Engine::Full(p), None) => full_many(batch, self.sizes(true), |i, o| {
-                p.forward_real(&samples[i..][..o.0], &mut coeffs[o.1..][..o.2])
-            }),
-            (Engine::General(g), s) => g.forward(
-                batch,
-                SendConstPtr(samples.as_ptr().cast()),
-                SendPtr(coeffs.as_mut_ptr()),
-                (true, s.as_deref()),
-            ),
-        }
+        // The samples are only read (see `Data`).
+        let inp = Data::Real(SendPtr(samples.as_ptr().cast_mut()));
+        self.run_forward(batch, inp, coeffs, scratch.as_deref())
     }
 
     /// [`PartialPlan::inverse_real_many`] in the caller's `scratch` if given (one
@@ -330,18 +388,8 @@ impl PartialPlan {
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(false, true, batch, coeffs.len(), samples.len())?;
-        match (&self.engine, scratch) {
-            (Engine::Full(p), Some(s)) => p.inverse_real_with_scratch(coeffs, samples, s),
-            (Engine::Full(p), None) => full_many(batch, self.sizes(false), |i, o| {
-                p.inverse_real(&coeffs[i..][..o.0], &mut samples[o.1..][..o.2])
-            }),
-            (Engine::General(g), s) => g.inverse(
-                batch,
-                SendConstPtr(coeffs.as_ptr()),
-                Data::Real(SendPtr(samples.as_mut_ptr())),
-                s.as_deref(),
-            ),
-        }
+        let out = Data::Real(SendPtr(samples.as_mut_ptr()));
+        self.run_inverse(batch, coeffs, out, (scratch.as_deref(), None))
     }
 
     /// Input and output lengths of one transform.
@@ -354,10 +402,7 @@ impl PartialPlan {
     }
 
     fn check(&self, forward: bool, real: bool, b: Batch, inp: usize, out: usize) -> Result<()> {
-        if let Engine::General(g) = &self.engine {
-            // (A full plan checks its own.)
-            g.workers.check_process()?;
-        }
+        self.engine.workers.check_process()?;
         self.direction.check_runs(forward)?;
         if real && !self.real {
             return Err(Error::InvalidArgument(
@@ -421,19 +466,6 @@ fn one(inp: usize, out: usize) -> Batch {
         in_dist: inp,
         out_dist: out,
     }
-}
-
-/// A batch on the full plan: `run(in_offset, (in_len, out_offset, out_len))` per transform.
-fn full_many(
-    b: Batch,
-    (ilen, olen): (usize, usize),
-    mut run: impl FnMut(usize, (usize, usize, usize)) -> Result<StageTimes>,
-) -> Result<StageTimes> {
-    let mut sum = StageTimes::default();
-    for t in 0..b.count {
-        sum += run(t * b.in_dist, (ilen, t * b.out_dist, olen))?;
-    }
-    Ok(sum)
 }
 
 impl Transform for PartialPlan {

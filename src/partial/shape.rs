@@ -2,7 +2,7 @@
 //! the conditions a shape must meet.
 
 use crate::error::{Error, Result};
-use crate::plan::MAX_BANDWIDTH;
+use crate::grid::MAX_BANDWIDTH;
 use std::f64::consts::PI;
 
 /// Largest alpha or gamma sample count of a partial plan.

@@ -1,11 +1,8 @@
-//! [`Transform`] for [`Plan`]: the caller's scratch is the chunk buffer.
+//! [`Transform`] for [`Plan`]: the engine's, with the caller's scratch as its chunk buffer.
 
-use super::fft_stage::{RealInput, RealOutput};
-use super::schedule::Spare;
-use super::shared::{SendConstPtr, SendPtr};
-use super::{Plan, StageTimes};
+use super::Plan;
 use crate::error::Result;
-use crate::transform::{Scratch, Transform};
+use crate::transform::{Scratch, StageTimes, Transform};
 use num_complex::Complex64;
 
 impl Transform for Plan {
@@ -44,8 +41,7 @@ impl Transform for Plan {
         coeffs: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        self.check(true, samples.len(), coeffs.len())?;
-        self.forward_impl(samples.as_ptr(), coeffs, (None, Some(scratch)))
+        self.engine().forward_with_scratch(samples, coeffs, scratch)
     }
 
     fn inverse_with_scratch(
@@ -54,8 +50,7 @@ impl Transform for Plan {
         samples: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        self.check(false, samples.len(), coeffs.len())?;
-        self.inverse_impl(coeffs, samples, (None, Some(scratch)))
+        self.engine().inverse_with_scratch(coeffs, samples, scratch)
     }
 
     fn forward_real_with_scratch(
@@ -64,12 +59,8 @@ impl Transform for Plan {
         coeffs: &mut [Complex64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        self.check(true, samples.len(), coeffs.len())?;
-        self.forward_real_impl(
-            RealInput::Real(SendConstPtr(samples.as_ptr())),
-            coeffs,
-            (None, Some(scratch)),
-        )
+        self.engine()
+            .forward_real_with_scratch(samples, coeffs, scratch)
     }
 
     fn inverse_real_with_scratch(
@@ -78,12 +69,7 @@ impl Transform for Plan {
         samples: &mut [f64],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
-        self.check(false, samples.len(), coeffs.len())?;
-        let out = samples.as_mut_ptr();
-        self.inverse_real_impl(
-            coeffs,
-            (RealOutput::Real(SendPtr(out)), None),
-            (Spare::over(out, self.b), Some(scratch)),
-        )
+        self.engine()
+            .inverse_real_with_scratch(coeffs, samples, scratch)
     }
 }

@@ -6,9 +6,9 @@ use super::rings::RingFft;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::Options;
-use crate::plan::StageTimes;
 use crate::simd::Isa;
 use crate::system::check_headroom;
+use crate::transform::StageTimes;
 use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::Complex64;
@@ -92,7 +92,7 @@ impl S2Plan {
         check_headroom(
             bytes
                 .saturating_add(threads * WORKER_STACK_BYTES)
-                .saturating_add(crate::fft::planning_bytes(16 * n, 1)),
+                .saturating_add(crate::fft::planning_bytes(16 * n)),
         )?;
         let scratch = AlignedBuf::new(scratch_len(b))?;
         let rings = RingFft::new(n, options.rigor)?;

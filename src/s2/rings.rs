@@ -34,7 +34,7 @@ impl RingFft {
         let (howmany, dist, half) = (per_call as c_int, n as c_int, (n / 2 + 1) as c_int);
         let data = scratch.as_mut_ptr();
         let complex = |sign: i32| {
-            plan_guarded(len, 1, || {
+            plan_guarded(len, || {
                 // SAFETY: under the planner lock (plan_guarded); `per_call` rows of `n` values
                 // in `scratch` (which outlives the call); FFTW keeps no pointer to `dims`.
                 unsafe {
@@ -57,7 +57,7 @@ impl RingFft {
             })
         };
         let reals = real_in.as_mut_ptr().cast::<f64>();
-        let r2c = plan_guarded(len, 1, || {
+        let r2c = plan_guarded(len, || {
             // SAFETY: as above: `per_call` rows of `n` reals in `real_in` into rows of
             // `n/2 + 1` values in `scratch` (both hold `per_call * n` complex values).
             unsafe {
@@ -77,7 +77,7 @@ impl RingFft {
                 )
             }
         })?;
-        let c2r = plan_guarded(len, 1, || {
+        let c2r = plan_guarded(len, || {
             // SAFETY: as for `r2c`, in the other direction.
             unsafe {
                 fftw::fftw_plan_many_dft_c2r(

@@ -290,8 +290,9 @@ fn inverse_flag0_symmetric_coefficients() {
             );
             let mut real = vec![Complex64::default(); got.len()];
             cached.inverse_real_to_complex(c, &mut real).unwrap();
+            // (At small B the two may round alike, and this check would say nothing.)
             assert!(
-                b < 5 || bits(&real) != bits(&complex),
+                b < 8 || bits(&real) != bits(&complex),
                 "B={b} {what}: indistinct"
             );
         }

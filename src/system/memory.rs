@@ -91,14 +91,6 @@ fn address_space_left() -> Option<usize> {
     Some(limit.saturating_sub(pages.saturating_mul(page)))
 }
 
-/// The stack a new POSIX thread gets by default (glibc: the `RLIMIT_STACK` soft limit, 2 MiB
-/// when unlimited): what each of FFTW's worker threads maps.
-pub(crate) fn thread_stack_bytes() -> usize {
-    soft_limit(libc::RLIMIT_STACK)
-        .unwrap_or(2 << 20)
-        .max(16 << 10)
-}
-
 /// `Ok` when `bytes` more can be mapped: within the address-space limit and, where
 /// `/proc/meminfo` tells, within the available memory; else [`Error::OutOfMemory`].
 pub(crate) fn check_headroom(bytes: usize) -> Result<()> {

@@ -8,4 +8,4 @@ mod fork_lock;
 mod memory;
 
 pub(crate) use fork_lock::{ForkLock, ForkLockGuard};
-pub(crate) use memory::{check_headroom, mem_available, mem_total, thread_stack_bytes};
+pub(crate) use memory::{check_headroom, mem_available, mem_total};

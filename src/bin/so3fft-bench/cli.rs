@@ -3,7 +3,7 @@
 //! Hand-written parser: the binary may only depend on std and the crate's own dependencies,
 //! so no argument-parsing crate is available.
 
-use so3fft::{FftThreading, Rigor};
+use so3fft::Rigor;
 use std::path::PathBuf;
 
 /// Runs per configuration when `--runs` is not given (smaller at large B, see [`Options::runs_for`]).
@@ -44,10 +44,6 @@ TOOL (default: the full benchmark described below):
                       one signal (per pattern) and four shells against one correlation
   mpi-model (or --mpi-model)  distributed plans at B = 1024, 2048 on 8..256 nodes: memory
                       per rank, bytes exchanged, expected time, from one-core rates measured here
-  engines             the full shape on the general engine (every partial shape, batch,
-                      beta selection and distributed plan runs on it) against Plan: complex
-                      inverse and forward alternated, then the real ones, median stage
-                      times and the ratio; defaults --bandwidths 64,128 --threads 1,2
                       --runs 7
   partial (or --partial)  partial plans against the transforms they replace: degree-limited
                       on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
@@ -72,8 +68,6 @@ options:
                       with a message when MemAvailable is too small.
   --quick             CI smoke test: only B <= 64, 3 runs, plain DWT at B = 16 only
   --soft              also time the SOFT 2.0 entry points against the native plan (each B)
-  --fft-threading F   FFT-stage threading: auto | fftw | slices (default auto, the plan's
-                      choice by timing)
   --mode M            stages: inv | fwd | both | dfwd (the forward that may overwrite its
                       input) | rinv | rfwd | rboth (real signals); default both
   --isa I             kernels' instruction set: avx512 | avx2 | scalar (default: the best this
@@ -102,8 +96,6 @@ pub enum Tool {
     S2,
     /// Rotational matching (`matching.rs`).
     Match,
-    /// The general engine against `Plan` at the full shape (`engines.rs`).
-    Engines,
     /// Partial plans (`partial.rs`).
     Partial,
     /// The distributed plans' model for large B (`mpi_model.rs`).
@@ -165,8 +157,6 @@ pub struct Options {
     pub plot: PathBuf,
     /// Largest bandwidth of the plain DWT (0: none).
     pub naive_max: usize,
-    /// FFT-stage threading of the plans.
-    pub fft_threading: FftThreading,
     /// Transforms of the `stages` tool.
     pub stage_mode: StageMode,
     /// Cap on the chunk buffer of the `stages` tool's plan (`None`: the plan's default).
@@ -192,7 +182,6 @@ impl Default for Options {
             big: false,
             plot: PathBuf::from("bench.svg"),
             naive_max: DEFAULT_NAIVE_MAX,
-            fft_threading: FftThreading::Auto,
             stage_mode: StageMode::Both,
             workspace_bytes: None,
             isa: None,
@@ -237,7 +226,6 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
         Some("real") => Tool::Real,
         Some("s2" | "--s2") => Tool::S2,
         Some("match" | "--match") => Tool::Match,
-        Some("engines") => Tool::Engines,
         Some("partial" | "--partial") => Tool::Partial,
         Some("mpi-model" | "--mpi-model") => Tool::MpiModel,
         _ => Tool::Full,
@@ -281,7 +269,6 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
                 opts.threads = parse_list(&value()?, "--threads")?;
                 threads_given = true;
             }
-            "--fft-threading" => opts.fft_threading = parse_fft_threading(&value()?)?,
             "--mode" => opts.stage_mode = parse_stage_mode(&value()?)?,
             "--workspace-mib" => {
                 let text = value()?;
@@ -348,7 +335,6 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
         Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
-        Tool::Engines => (vec![64, 128], vec![1, 2], Some(7)),
         Tool::Partial => (vec![256], vec![2], None),
         Tool::MpiModel => (vec![128], vec![1], None),
     };
@@ -411,17 +397,6 @@ fn parse_rigor(text: &str) -> Result<Rigor, String> {
     }
 }
 
-fn parse_fft_threading(text: &str) -> Result<FftThreading, String> {
-    match text.to_ascii_lowercase().as_str() {
-        "auto" => Ok(FftThreading::Auto),
-        "fftw" => Ok(FftThreading::FftwThreads),
-        "slices" | "workers" => Ok(FftThreading::SlicesAcrossWorkers),
-        _ => Err(format!(
-            "--fft-threading: '{text}' is not auto, fftw or slices"
-        )),
-    }
-}
-
 fn parse_stage_mode(text: &str) -> Result<StageMode, String> {
     match text {
         "inv" => Ok(StageMode::Inverse),
@@ -449,7 +424,7 @@ pub fn rigor_name(rigor: Rigor) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::{parse, Command, FftThreading, StageMode, Tool};
+    use super::{parse, Command, StageMode, Tool};
 
     fn options(args: &[&str]) -> super::Options {
         match parse(args.iter().map(|a| a.to_string())) {
@@ -470,12 +445,11 @@ mod tests {
 
     #[test]
     fn tools_and_their_defaults() {
-        let opts = options(&["stages", "--mode", "rfwd", "--fft-threading=fftw"]);
+        let opts = options(&["stages", "--mode=rfwd"]);
         assert_eq!(opts.tool, Tool::Stages);
         assert_eq!((opts.bandwidths, opts.threads), (vec![256], vec![1]));
         assert_eq!(opts.runs, Some(3));
         assert_eq!(opts.stage_mode, StageMode::RealForward);
-        assert_eq!(opts.fft_threading, FftThreading::FftwThreads);
         let opts = options(&["scaling", "--bandwidths", "32", "--runs", "2"]);
         assert_eq!(opts.tool, Tool::Scaling);
         assert_eq!((opts.bandwidths, opts.threads), (vec![32], vec![1, 2]));
@@ -483,9 +457,6 @@ mod tests {
         let opts = options(&["real"]);
         assert_eq!((opts.tool, opts.runs), (Tool::Real, None));
         assert_eq!(opts.bandwidths, [64, 128, 256]);
-        let opts = options(&["engines", "--bandwidths", "16"]);
-        assert_eq!((opts.tool, opts.runs), (Tool::Engines, Some(7)));
-        assert_eq!((opts.bandwidths, opts.threads), (vec![16], vec![1, 2]));
         assert!(parse(["stages", "--mode", "sideways"].map(String::from)).is_err());
     }
 }

@@ -21,7 +21,6 @@
 
 mod big;
 mod cli;
-mod engines;
 mod floor;
 mod matching;
 mod memory;
@@ -78,7 +77,6 @@ fn run_tool(opts: &Options) -> ExitCode {
         Tool::Real => report_failure("real", run_real(opts)),
         Tool::S2 => report_failure("s2", s2::run(opts)),
         Tool::Match => report_failure("match", matching::run(opts)),
-        Tool::Engines => report_failure("engines", engines::run(opts)),
         Tool::Partial => report_failure("partial", partial::run(opts)),
         Tool::MpiModel => report_failure("mpi-model", mpi_model::run(opts)),
     }

@@ -228,11 +228,9 @@ fn batched(o: &Options, runs: usize, peak1: f64) -> so3fft::Result<()> {
         // many as the workspace holds (the default 512 MB: two at B = 128); here 8.
         let pp = PartialPlan::new(
             &s,
-            &opts(1, o)
-                .with_general_engine(true)
-                .with_max_workspace_bytes(Some(
-                    (8 * s.num_samples() * 16 / 20 * 21).max(512 << 20),
-                )),
+            &opts(1, o).with_max_workspace_bytes(Some(
+                (8 * s.num_samples() * 16 / 20 * 21).max(512 << 20),
+            )),
         )?;
         let (nc, ns) = (pp.num_coeffs(), pp.num_samples());
         let c = random_coeffs(8 * nc, 7);

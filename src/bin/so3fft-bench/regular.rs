@@ -186,8 +186,7 @@ fn bench_plan(setup: Setup, threads: usize, variant: Variant) -> Result<Plan, so
             .with_threads(threads)
             .with_rigor(opts.rigor)
             .with_skip_bits((variant == Variant::NoSkip).then_some(0))
-            .with_real(variant == Variant::Real)
-            .with_fft_threading(opts.fft_threading),
+            .with_real(variant == Variant::Real),
     )?;
     let what = match variant {
         Variant::NoSkip => ", no skipping",
@@ -195,10 +194,9 @@ fn bench_plan(setup: Setup, threads: usize, variant: Variant) -> Result<Plan, so
         _ => "",
     };
     eprintln!(
-        "  (B = {b}, threads = {}{what}: plan created in {:.3} s, FFT stage {:?})",
+        "  (B = {b}, threads = {}{what}: plan created in {:.3} s)",
         plan.threads(),
         plan_start.elapsed().as_secs_f64(),
-        plan.fft_threading()
     );
     Ok(plan)
 }

@@ -126,8 +126,7 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
                     b,
                     &so3fft::Options::default()
                         .with_threads(threads)
-                        .with_rigor(opts.rigor)
-                        .with_fft_threading(opts.fft_threading),
+                        .with_rigor(opts.rigor),
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -163,7 +162,7 @@ fn scale_bandwidth(b: usize, plans: &[Plan], runs: usize) -> Result<(), so3fft::
     for (plan, windows) in plans.iter().zip(&windows) {
         let of = |f: fn(&Window) -> f64| median(&windows.iter().map(f).collect::<Vec<_>>());
         println!(
-            "{:>5} {:>3} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e}  {:?}",
+            "{:>5} {:>3} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e}",
             b,
             plan.threads(),
             of(|w| w.inverse.total),
@@ -172,7 +171,6 @@ fn scale_bandwidth(b: usize, plans: &[Plan], runs: usize) -> Result<(), so3fft::
             of(|w| w.forward.total),
             of(|w| w.forward.fft),
             of(|w| w.forward.dwt),
-            plan.fft_threading()
         );
         round_trip_medians.push((
             of(|w| w.inverse.total + w.forward.total),

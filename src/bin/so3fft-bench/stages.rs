@@ -63,14 +63,9 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
                     .with_rigor(opts.rigor)
                     .with_max_workspace_bytes(opts.workspace_bytes)
                     .with_direction(Direction::Both)
-                    .with_real(opts.stage_mode.real())
-                    .with_fft_threading(opts.fft_threading),
+                    .with_real(opts.stage_mode.real()),
             )?;
-            eprintln!(
-                "B = {b}, threads {}, fft threading {:?}",
-                plan.threads(),
-                plan.fft_threading()
-            );
+            eprintln!("B = {b}, threads {}", plan.threads(),);
             let (times, flops) = if opts.stage_mode.real() {
                 (
                     repeat_real(&plan, opts.stage_mode, repetitions)?,

@@ -5,7 +5,7 @@ use crate::record::{Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::ORDER_LIMIT;
 use so3fft::s2::{s2_num_coeffs, S2Plan};
-use so3fft::{num_coeffs, Complex64, FftThreading, Options, PartialPlan, Plan, Shape};
+use so3fft::{num_coeffs, Complex64, Options, PartialPlan, Plan, Shape};
 use std::time::Instant;
 
 /// The plan kinds checked.
@@ -15,16 +15,12 @@ pub enum Kind {
     PlanComplex,
     /// [`Plan`], complex, a 1 MiB chunk buffer (many chunks).
     PlanChunked,
-    /// [`Plan`], complex, FFTW's own threads for the slice FFTs.
-    PlanFftwThreads,
     /// [`Plan`], real signals.
     PlanReal,
     /// [`PartialPlan`], `|M|, |M'| <= 8`, complex.
     PartialComplex,
     /// [`PartialPlan`], `|M|, |M'| <= 8`, real.
     PartialReal,
-    /// [`PartialPlan`] of the full shape on the general engine.
-    PartialGeneral,
     /// [`S2Plan`], complex.
     S2Complex,
     /// [`S2Plan`], real.
@@ -32,14 +28,12 @@ pub enum Kind {
 }
 
 /// Every kind.
-pub const KINDS: [Kind; 9] = [
+pub const KINDS: [Kind; 7] = [
     Kind::PlanComplex,
     Kind::PlanChunked,
-    Kind::PlanFftwThreads,
     Kind::PlanReal,
     Kind::PartialComplex,
     Kind::PartialReal,
-    Kind::PartialGeneral,
     Kind::S2Complex,
     Kind::S2Real,
 ];
@@ -50,11 +44,9 @@ impl Kind {
         match self {
             Kind::PlanComplex => "plan-complex",
             Kind::PlanChunked => "plan-complex-chunked",
-            Kind::PlanFftwThreads => "plan-fftw-threads",
             Kind::PlanReal => "plan-real",
             Kind::PartialComplex => "partial-m8",
             Kind::PartialReal => "partial-m8-real",
-            Kind::PartialGeneral => "partial-general-full",
             Kind::S2Complex => "s2-complex",
             Kind::S2Real => "s2-real",
         }
@@ -149,18 +141,12 @@ pub fn runner(kind: Kind, b: usize, threads: usize) -> so3fft::Result<Runner> {
     match kind {
         Kind::PlanComplex => plan_runner(b, plan_opts),
         Kind::PlanChunked => plan_runner(b, plan_opts.with_max_workspace_bytes(Some(1 << 20))),
-        Kind::PlanFftwThreads => {
-            plan_runner(b, plan_opts.with_fft_threading(FftThreading::FftwThreads))
-        }
         Kind::PlanReal => plan_runner(b, plan_opts.with_real(true)),
         Kind::PartialComplex => partial_runner(Shape::new(b).with_orders(m, m), partial_opts),
         Kind::PartialReal => partial_runner(
             Shape::new(b).with_orders(m, m),
             partial_opts.with_real(true),
         ),
-        Kind::PartialGeneral => {
-            partial_runner(Shape::new(b), partial_opts.with_general_engine(true))
-        }
         Kind::S2Complex => s2_runner(b, threads, false),
         Kind::S2Real => s2_runner(b, threads, true),
     }

@@ -102,20 +102,6 @@ pub(crate) unsafe fn scatter(
     }
 }
 
-/// `d2[i] = ps * conj(src[i])` for `i < n`: partner values of coefficients that a last
-/// group of chunks did not touch.
-///
-/// # Safety
-/// `src` valid for `n` reads, `d2` for `n` writes; no overlap.
-pub(super) unsafe fn partner_copy(d2: *mut Complex64, src: *const Complex64, n: usize, ps: f64) {
-    // SAFETY: the caller's contract: `n` reads of `src`, `n` writes of `d2`, no overlap.
-    unsafe {
-        for i in 0..n {
-            *d2.add(i) = (*src.add(i)).conj() * ps;
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -206,12 +192,6 @@ mod tests {
                     assert_eq!(y, want.conj() * -2.0, "add={add} off={off} i={i}");
                 }
             }
-        }
-        let mut d2 = vec![Complex64::new(0.0, 0.0); n];
-        // SAFETY: `n` values of `z` and of `d2`, distinct.
-        unsafe { partner_copy(d2.as_mut_ptr(), z.as_ptr(), n, -1.0) };
-        for i in 0..n {
-            assert_eq!(d2[i], -z[i].conj());
         }
     }
 }
