@@ -226,8 +226,8 @@ int so3fft_get_nthreads(so3fft_plan p);
 // Bytes of memory a plan holds (`SO3FFT_ENULL` for NULL).
 ptrdiff_t so3fft_get_memory(so3fft_plan p);
 
-// Bytes a plan for both directions made now with these arguments would hold, computed
-// without making it; or a negative `SO3FFT_E*` code.
+// Bytes a plan made now with these arguments would hold (whatever its direction),
+// computed without making it; or a negative `SO3FFT_E*` code.
 ptrdiff_t so3fft_plan_memory(int B, unsigned int flags, int nthreads);
 
 // `SO3FFT_FFT_SLICES_ACROSS_WORKERS`, what every plan uses (`SO3FFT_ENULL` for NULL).

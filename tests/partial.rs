@@ -657,3 +657,29 @@ fn default_workspace_holds_all_pairs_of_a_small_shape() {
         "chunk buffer {scratch} bytes, the rows of every pair {all_rows}"
     );
 }
+
+/// The forward and the inverse share each worker's slice buffers: an inverse after a
+/// forward on the same plan gives the bits of an inverse before it (the forward leaves
+/// values where the inverse expects zeros), with the rows in place (most columns in the
+/// band) and straight into the output (few columns: the others must stay zero).
+#[test]
+fn inverse_after_forward_is_unchanged() {
+    for s in [
+        Shape::new(12),
+        Shape::new(16).with_orders(2, 2).with_grid(16, 32, 32),
+    ] {
+        let pp = PartialPlan::new(&s, &opts()).unwrap();
+        let c = random_coeffs(&s, 31);
+        let mut before = zeros(s.num_samples());
+        pp.inverse(&c, &mut before).unwrap();
+        let mut st = 77u64;
+        let noise: Vec<Complex64> = (0..s.num_samples())
+            .map(|_| Complex64::new(common::rnd(&mut st), common::rnd(&mut st)))
+            .collect();
+        let mut back = zeros(c.len());
+        pp.forward(&noise, &mut back).unwrap();
+        let mut after = zeros(s.num_samples());
+        pp.inverse(&c, &mut after).unwrap();
+        assert!(same_bits(&before, &after), "{s:?}");
+    }
+}

@@ -37,8 +37,8 @@ pub unsafe extern "C" fn so3fft_get_memory(p: so3fft_plan) -> isize {
     })
 }
 
-/// Bytes a plan for both directions made now with these arguments would hold, computed
-/// without making it; or a negative `SO3FFT_E*` code.
+/// Bytes a plan made now with these arguments would hold (whatever its direction),
+/// computed without making it; or a negative `SO3FFT_E*` code.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -> isize {
     guarded_count(|| {

@@ -194,19 +194,20 @@ fn buf_pair<'a>(
     ))
 }
 
+/// A worker's buffers, each made on first use (a plan makes them, `General::reserve`):
+/// two complex work buffers (a slice and its mirror in one task) that the forward and the
+/// inverse share, two half-spectrum buffers of the real transforms, and a slice of reals.
 #[derive(Default)]
 pub(super) struct Work {
     pub inv: Option<AlignedBuf>,
-    /// A second inverse buffer (a slice and its mirror in one task).
     pub inv2: Option<AlignedBuf>,
-    /// A second forward buffer (a slice and its mirror in one task).
-    pub fwd2: Option<AlignedBuf>,
-    /// A second half buffer (the real transforms of a slice and its mirror).
-    pub half2: Option<AlignedBuf>,
-    pub fwd: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
+    pub half2: Option<AlignedBuf>,
     /// Reals of a slice (the real forward of the real parts of complex samples).
     pub reals: Option<AlignedBuf>,
+    /// A forward has written the complex buffers: the inverse, which relies on the values
+    /// no slot fills staying zero, clears them first.
+    pub dirty: bool,
 }
 
 /// The slice DFTs of one shape.
@@ -345,21 +346,25 @@ impl FftStage {
 
     /// The inverse's work buffer, zero where no value is ever placed.
     pub fn inv_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
-        let len = self.na * self.rs;
-        if work.inv.is_none() {
-            work.inv = Some(AlignedBuf::new(len)?);
-        }
-        Ok(work.inv.as_mut().expect("just made").slice_mut(len))
+        self.inv_pair(work).map(|(a, _)| a)
     }
 
-    /// Two inverse work buffers (a slice and its mirror).
+    /// Two inverse work buffers (a slice and its mirror), zero where no value is ever
+    /// placed (cleared whole after a forward used them).
     pub fn inv_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
-        buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)
+        let clear = std::mem::take(&mut work.dirty);
+        let (a, b) = buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)?;
+        if clear {
+            a.fill(Complex64::new(0.0, 0.0));
+            b.fill(Complex64::new(0.0, 0.0));
+        }
+        Ok((a, b))
     }
 
-    /// Two forward work buffers (a slice and its mirror).
+    /// Two forward work buffers (a slice and its mirror): the inverse's, marked as written.
     pub fn fwd_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
-        buf_pair((&mut work.fwd, &mut work.fwd2), self.na * self.rs)
+        work.dirty = true;
+        buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)
     }
 
     /// Two half buffers (the real transforms of a slice and its mirror).

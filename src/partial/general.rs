@@ -11,7 +11,7 @@ use super::slots::{Clear, LaneRows, SlotTable};
 use crate::dwt::{BatchRows, Prefetch};
 use crate::error::Result;
 use crate::fft::ChunkBuffer;
-use crate::options::{Betas, Direction, Options};
+use crate::options::{Betas, Options};
 use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::transform::Scratch;
@@ -99,16 +99,11 @@ impl Footprint {
     }
 
     /// Bytes of one worker's FFT buffers (see [`General::reserve`]): two work buffers of
-    /// a slice per direction the plan runs, and on a real plan two half-spectrum buffers
-    /// and the reals of a slice.
+    /// a slice (the forward's and the inverse's), and on a real plan two half-spectrum
+    /// buffers and the reals of a slice.
     fn work_bytes(shape: &Shape, options: &Options) -> usize {
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
-        let directions = if options.direction == Direction::Both {
-            2
-        } else {
-            1
-        };
-        let mut bytes = directions * 2 * na * (ng + ROW_PAD) * 16;
+        let mut bytes = 2 * na * (ng + ROW_PAD) * 16;
         if options.real {
             bytes += 2 * na * (ng / 2 + 1 + ROW_PAD) * 16 + na * ng * 8;
         }
@@ -362,21 +357,16 @@ impl General {
         }
     }
 
-    /// Makes the buffers a single transform in `direction` needs now (the chunk buffer and
-    /// each worker's FFT buffers), so that executing allocates nothing large and a plan
-    /// that cannot have them is refused when it is made.
-    pub(super) fn reserve(&self, direction: Direction) -> Result<()> {
+    /// Makes the buffers a single transform needs now (the chunk buffer and each worker's
+    /// FFT buffers), so that executing allocates nothing large and a plan that cannot have
+    /// them is refused when it is made.
+    pub(super) fn reserve(&self) -> Result<()> {
         self.buf
             .with(self.scratch_bytes().div_ceil(16), |_| Ok(()))?;
         let real = self.half.is_some();
         for w in &self.work {
             let mut w = w.lock().unwrap_or_else(|e| e.into_inner());
-            if direction != Direction::Forward {
-                self.fft.inv_pair(&mut w)?;
-            }
-            if direction != Direction::Inverse {
-                self.fft.fwd_pair(&mut w)?;
-            }
+            self.fft.inv_pair(&mut w)?;
             if real {
                 self.fft.half_pair_reals(&mut w)?;
             }

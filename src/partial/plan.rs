@@ -73,7 +73,7 @@ impl PartialPlan {
             options,
             shared,
         )?);
-        engine.reserve(c.direction)?;
+        engine.reserve()?;
         Ok(PartialPlan {
             shape: *shape,
             direction: c.direction,

@@ -121,8 +121,8 @@ impl Plan {
 
     /// Bytes of memory the plan holds, all made with the plan: the chunk buffer
     /// ([`Plan::workspace_bytes`]), per worker a stack and two slice buffers of `2B (2B + 4)`
-    /// complex values per direction the plan runs (on a real plan also two half-spectrum
-    /// buffers and a slice of reals), and the tables (`O(B^2)`). A transform needs the
+    /// complex values, which the forward and the inverse share (on a real plan also two
+    /// half-spectrum buffers and a slice of reals), and the tables (`O(B^2)`). A transform needs the
     /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
     /// large. [`Plan::memory_needed`] gives the same number before planning. [`Plan::new`]
     /// fails with [`Error::OutOfMemory`](crate::Error::OutOfMemory) when this exceeds the
