@@ -678,8 +678,8 @@ fn rotations_near_the_poles_refined() {
 
 /// The argmax found while the inverse computes the grid (`correlate_argmax`,
 /// `correlate_real_argmax`) is the scan's (`grid_argmax`) exactly, index and value, and
-/// the grid is the plain correlation's bit for bit: on the full transform (slices watched)
-/// and on a finer grid (the general engine, scanned after), with one and two threads,
+/// the grid is the plain correlation's bit for bit: on the full transform and on a finer
+/// grid (both with their slices watched), with one and two threads,
 /// including an all-zero grid and exact ties.
 #[test]
 fn fused_argmax_equals_the_scan() {

@@ -591,7 +591,7 @@ fn skip_threshold_bounds_the_error() {
     }
 }
 
-/// The general engine's inverse with its chunks chained (each chunk's rows in the output
+/// The engine's inverse with its chunks chained (each chunk's rows in the output
 /// slices of the chunk before it, one pass of the DWT stage) against direct summation at
 /// points of every beta slice, on every instruction set, for the full shape, an
 /// order-limited one and an oversampled grid.

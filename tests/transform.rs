@@ -104,7 +104,7 @@ fn plan_with_scratch() {
 }
 
 /// Partial shapes (band- and order-limited, oversampled, a lower degree limit) and the
-/// full shape on the general engine: results in the scratch equal the plain ones, and
+/// full shape: results in the scratch equal the plain ones, and
 /// the round trip is exact.
 #[test]
 fn partial_plans_with_scratch() {

@@ -23,7 +23,7 @@ use std::f64::consts::PI;
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// A plan of the general engine.
+/// A plan of the engine.
 pub(super) struct General {
     pub(super) layout: CoefLayout,
     pub(super) pairs: LanePairs,
@@ -49,7 +49,7 @@ pub(super) struct General {
     pub(super) workers: WorkerPool,
 }
 
-/// What a plan of the general engine holds, known before it is made.
+/// What a plan of the engine holds, known before it is made.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Footprint {
     /// Everything but the chunk buffer: the DWT stage's tables and per-worker scratch, the

@@ -66,7 +66,7 @@ impl SlotTable {
     /// apart.
     pub(super) fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
         let too_large =
-            || Error::InvalidArgument("shape too large for the general engine's slot table".into());
+            || Error::InvalidArgument("shape too large for the engine's slot table".into());
         let fits = |x: usize| u32::try_from(x).ok().filter(|a| a & (1 << 31) == 0);
         let half = |m: isize, mp: isize| m.rem_euclid(na as isize) as usize * hs + mp as usize;
         let mut entries = Vec::new();
