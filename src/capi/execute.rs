@@ -40,6 +40,7 @@ unsafe fn run_forward(
         unsafe { std::slice::from_raw_parts(samples.cast_const().cast::<Complex64>(), ns) };
     if state.real {
         return plan
+            .engine()
             .forward_real_parts(samples, coeffs)
             .map(|_| ())
             .map_err(CallError::from);
@@ -81,7 +82,9 @@ unsafe fn run_inverse(
     };
     if state.real {
         return plan
+            .engine()
             .inverse_real_to_complex(coeffs, samples)
+            .map(|_| ())
             .map_err(CallError::from);
     }
     plan.inverse(coeffs, samples)

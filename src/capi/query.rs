@@ -4,10 +4,10 @@
 use super::planner::planner_workspace_cap;
 use super::{
     guarded, guarded_count, plan_ref, rigor_of, so3fft_plan, threads_of, SO3FFT_ENULL,
-    SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_REAL,
+    SO3FFT_FFT_SLICES_ACROSS_WORKERS, SO3FFT_REAL,
 };
 use crate::ffi::checks;
-use crate::{FftThreading, Options, Plan};
+use crate::{Options, Plan};
 use std::ffi::{c_int, c_uint};
 
 /// The bandwidth of a plan (`SO3FFT_ENULL` for NULL).
@@ -61,9 +61,7 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
 pub unsafe extern "C" fn so3fft_get_fft_threading(p: so3fft_plan) -> c_int {
     guarded(SO3FFT_ENULL, || {
         // SAFETY: `p` is NULL or a live plan (the caller's contract, see the module doc).
-        Ok(match unsafe { plan_ref(p) }?.plan.fft_threading() {
-            FftThreading::FftwThreads => SO3FFT_FFT_FFTW_THREADS,
-            _ => SO3FFT_FFT_SLICES_ACROSS_WORKERS,
-        })
+        unsafe { plan_ref(p) }?;
+        Ok(SO3FFT_FFT_SLICES_ACROSS_WORKERS)
     })
 }

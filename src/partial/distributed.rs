@@ -418,7 +418,7 @@ impl<X: Exchange> DistributedPlan<X> {
         let groups = (1..=most)
             .find(|&k| {
                 (0..p).all(|r| {
-                    let (a, b) = row_sizes((&shares, &widths), r, k, general.lanes_w);
+                    let (a, b) = row_sizes((&shares, &widths), r, k, general.lanes_w());
                     8 * (a + b) <= budget(&shares[r])
                 })
             })
@@ -580,7 +580,7 @@ impl<X: Exchange> DistributedPlan<X> {
             (&self.parts.shares, &self.parts.views[0].widths()),
             self.comm.rank(),
             self.parts.groups,
-            self.parts.general.lanes_w,
+            self.parts.general.lanes_w(),
         )
     }
 
@@ -664,7 +664,7 @@ impl<X: Exchange> DistributedPlan<X> {
                 block
             })
             .collect();
-        let hp = h.next_multiple_of(self.parts.general.lanes_w);
+        let hp = h.next_multiple_of(self.parts.general.lanes_w());
         GroupRows {
             ch: ChunkLanes {
                 j0: first,

@@ -224,10 +224,10 @@ impl DwtStage {
                         partner_block: layout.block_start(-mem.m, -mem.mp),
                     })
                     .collect();
-                if slots.is_empty() {
+                let p = Self::slot_doubles(slots.len());
+                if p == 0 {
                     continue;
                 }
-                let p = if slots.len() > 4 { 16 } else { 8 };
                 clusters.push(ClusterPlan {
                     m,
                     mp,
@@ -258,6 +258,16 @@ impl DwtStage {
         }
     }
 
+    /// Doubles of a cluster with `n` slots in a lane row: 16 for more than four, 8 for one
+    /// to four, none for none.
+    fn slot_doubles(n: usize) -> usize {
+        match n {
+            0 => 0,
+            1..=4 => 8,
+            _ => 16,
+        }
+    }
+
     /// Whether the clusters of `layout` (with `half`: the members `M' >= 0`) hold `mem`.
     fn held(layout: &CoefLayout, half: bool, mem: &Member) -> bool {
         layout.holds(mem.m, mem.mp) && (!half || mem.mp >= 0)
@@ -274,11 +284,7 @@ impl DwtStage {
                     .members()
                     .iter()
                     .filter(|mem| Self::held(layout, half, mem));
-                offset += match held.count() {
-                    0 => 0,
-                    1..=4 => 8,
-                    _ => 16,
-                };
+                offset += Self::slot_doubles(held.count());
             }
         }
         padded_row(offset)

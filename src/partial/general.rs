@@ -45,7 +45,6 @@ pub(super) struct General {
     /// The chunk buffer (taken by one execution at a time).
     buf: ChunkBuffer,
     footprint: Footprint,
-    pub(super) lanes_w: usize,
     pub(super) workers: WorkerPool,
 }
 
@@ -110,10 +109,14 @@ impl Footprint {
         bytes
     }
 
-    /// Lane pairs the workspace cap holds for one transform with lane rows `row_stride`
-    /// doubles apart (at least one).
+    /// Lane pairs whose rows, `row_stride` doubles apart, the workspace cap holds.
+    fn room(&self, row_stride: usize) -> usize {
+        self.budget / (row_stride * 2 * 8).max(1)
+    }
+
+    /// [`Footprint::room`] for one transform: at least one pair, at most all.
     fn most_pairs(&self, row_stride: usize) -> usize {
-        (self.budget / (row_stride * 2 * 8).max(1)).clamp(1, self.pairs)
+        self.room(row_stride).clamp(1, self.pairs)
     }
 
     /// Lane pairs per chunk: what the workspace cap holds for one transform with the rows
@@ -124,7 +127,7 @@ impl Footprint {
     fn chunk_pairs(&self, row_stride: usize) -> usize {
         let pairs = self.pairs;
         let w = self.lanes_w;
-        let room = self.budget / (row_stride * 2 * 8).max(1);
+        let room = self.room(row_stride);
         let fit = if room >= w { room / w * w } else { room }.clamp(1, pairs);
         let h = pairs.div_ceil(pairs.div_ceil(fit));
         if h >= w && h.next_multiple_of(w) <= fit {
@@ -235,6 +238,7 @@ impl General {
             )
         };
         let dwt = stage(false);
+        debug_assert_eq!(Some(dwt.row_stride), footprint.strides[0]);
         let pair_weight = if options.betas == Betas::All {
             let wts = crate::grid::weights(shape.grid_bandwidth);
             let f = 2.0 * PI / (na * ng) as f64;
@@ -251,6 +255,7 @@ impl General {
         ];
         let half = if options.real {
             let dwt = stage(true);
+            debug_assert_eq!(Some(dwt.row_stride), footprint.strides[1]);
             let slots = SlotTable::new(&dwt, (na, fft.strides().1))?;
             Some((dwt, slots))
         } else {
@@ -268,7 +273,6 @@ impl General {
             work: (0..threads).map(|_| Mutex::new(Work::default())).collect(),
             buf: ChunkBuffer::new(None),
             footprint,
-            lanes_w: w,
             workers: WorkerPool::shared_or_new(shared, threads)?,
         })
     }
@@ -287,7 +291,7 @@ impl General {
     /// starting values and d values, see `dwt/batch.rs`): as many as the workspace cap holds
     /// at the chunk size (at least one).
     fn group_size(&self, m: Members) -> usize {
-        let hp = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        let hp = self.chunk_pairs(m).next_multiple_of(self.lanes_w());
         (self.footprint.budget / (hp * m.dwt.row_stride * 2 * 8).max(1)).max(1)
     }
 
@@ -374,6 +378,11 @@ impl General {
         Ok(())
     }
 
+    /// Lanes per vector of the plan's kernels.
+    pub(super) fn lanes_w(&self) -> usize {
+        self.footprint.lanes_w
+    }
+
     /// Bytes of the chunk buffer of one transform (the scratch a single call needs).
     pub(super) fn scratch_bytes(&self) -> usize {
         self.footprint.scratch_bytes()
@@ -407,7 +416,7 @@ impl General {
     /// The chunks of `h` lane pairs (the last one shorter).
     fn chunks(&self, (h, m): (usize, Members)) -> impl Iterator<Item = ChunkLanes> + '_ {
         let row_len = m.dwt.row_stride;
-        let w = self.lanes_w;
+        let w = self.lanes_w();
         (0..self.pairs.pairs).step_by(h).map(move |j0| {
             let h = h.min(self.pairs.pairs - j0);
             let hp = h.next_multiple_of(w);
@@ -456,7 +465,7 @@ impl General {
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
-        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w());
         let per_t_max = m.dwt.row_stride * 2 * hp_max;
         let real = out.is_real();
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
@@ -522,7 +531,7 @@ impl General {
         own: SendPtr<f64>,
     ) -> Option<Vec<PlacedLanes>> {
         // The most pairs the plan's buffer holds, rounded down to the vector width.
-        let w = self.lanes_w;
+        let w = self.lanes_w();
         let most = (self.chunk_pairs(m).next_multiple_of(w)).min(self.most_pairs(m));
         let h = if most >= w { most / w * w } else { most };
         let chunks: Vec<ChunkLanes> = self.chunks((h, m)).collect();
@@ -782,7 +791,7 @@ impl General {
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
-        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w);
+        let hp_max = self.chunk_pairs(m).next_multiple_of(self.lanes_w());
         let per_t_max = m.dwt.row_stride * 2 * hp_max;
         let slice_len = self.fft.slice_len();
         let real = inp.is_real();

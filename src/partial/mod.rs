@@ -32,7 +32,7 @@ mod slots;
 
 pub use distributed::DistributedPlan;
 pub use exchange::{Exchange, ThreadExchange};
-pub(crate) use fft_stage::{SliceRef, SliceWatch};
+pub(crate) use fft_stage::SliceRef;
 #[cfg(feature = "mpi")]
 pub use mpi::{mpi_finalize, mpi_init, MpiExchange};
 pub use options::Batch;

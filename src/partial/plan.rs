@@ -54,17 +54,6 @@ impl PartialPlan {
         shared: Option<&WorkerPool>,
     ) -> Result<PartialPlan> {
         let c = PartialPlan::validate(shape, options)?;
-        // Fail cleanly instead of meeting the OOM killer: the plan must fit in the
-        // available memory, and plan plus the caller's arrays in the machine.
-        let need = Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total();
-        let arrays = (c.pairs.n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
-        let too_big = match (mem_available(), mem_total()) {
-            (Some(avail), Some(total)) => need > avail || need.saturating_add(arrays) > total,
-            _ => false,
-        };
-        if too_big {
-            return Err(Error::OutOfMemory { bytes: need });
-        }
         let n_slices = c.pairs.n_slices;
         let engine = Box::new(General::new(
             shape,
@@ -73,6 +62,18 @@ impl PartialPlan {
             options,
             shared,
         )?);
+        // Fail cleanly instead of meeting the OOM killer before the large buffers are
+        // made: the plan must fit in the available memory, and plan plus the caller's
+        // arrays in the machine.
+        let need = engine.memory_bytes();
+        let arrays = (n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
+        let too_big = match (mem_available(), mem_total()) {
+            (Some(avail), Some(total)) => need > avail || need.saturating_add(arrays) > total,
+            _ => false,
+        };
+        if too_big {
+            return Err(Error::OutOfMemory { bytes: need });
+        }
         engine.reserve()?;
         Ok(PartialPlan {
             shape: *shape,

@@ -10,7 +10,7 @@ mod transform;
 use crate::error::{Error, Result};
 use crate::grid::{num_coeffs, num_samples, MAX_BANDWIDTH};
 use crate::options::{Direction, FftThreading, Options};
-use crate::partial::{PartialPlan, Shape, SliceWatch};
+use crate::partial::{PartialPlan, Shape};
 use crate::simd::Isa;
 use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
@@ -197,55 +197,8 @@ impl Plan {
         self.engine.forward_real(samples, coeffs)
     }
 
-    /// [`Plan::inverse`] that shows every output slice to `watch` as it is computed.
-    pub(crate) fn inverse_watched(
-        &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
-        watch: SliceWatch,
-    ) -> Result<()> {
-        self.engine
-            .inverse_watched(coeffs, samples, watch)
-            .map(|_| ())
-    }
-
-    /// [`Plan::inverse_real`] that shows every output slice to `watch` as it is computed.
-    pub(crate) fn inverse_real_watched(
-        &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
-        watch: SliceWatch,
-    ) -> Result<()> {
-        self.engine
-            .inverse_real_watched(coeffs, samples, watch)
-            .map(|_| ())
-    }
-
-    /// [`Plan::inverse_real`] into a complex sample array: real parts are the samples,
-    /// imaginary parts exactly 0 (for callers whose interface is complex, such as the C API
-    /// with `SO3FFT_REAL`, SOFT's `flag = 1` and SOFT's `flag = 0` on real-symmetric
-    /// coefficients).
-    pub(crate) fn inverse_real_to_complex(
-        &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
-    ) -> Result<()> {
-        self.engine
-            .inverse_real_to_complex(coeffs, samples)
-            .map(|_| ())
-    }
-
-    /// Forward transform of the real parts of complex samples (the imaginary parts are not
-    /// read): the real path for callers whose real data sit in a complex array.
-    pub(crate) fn forward_real_parts(
-        &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
-    ) -> Result<StageTimes> {
-        self.engine.forward_real_parts(samples, coeffs)
-    }
-
-    /// The engine's plan of the full shape.
+    /// The engine's plan of the full shape, for the crate's calls beyond the public ones
+    /// (watched inverses, real data in complex arrays).
     pub(crate) fn engine(&self) -> &PartialPlan {
         &self.engine
     }

@@ -144,7 +144,7 @@ fn real_inverse_into_complex_matches_real_samples() {
                 let ptr = raw[skip..].as_mut_ptr() as *mut Complex64;
                 // SAFETY: 2 ns doubles from `skip` lie in `raw`; Complex64 needs 8 bytes.
                 let out = unsafe { std::slice::from_raw_parts_mut(ptr, ns) };
-                plan.inverse_real_to_complex(&coefs, out).unwrap();
+                plan.engine().inverse_real_to_complex(&coefs, out).unwrap();
                 let scale = want.iter().fold(0.0f64, |a, w| a.max(w.abs()));
                 let tol = if aligned { 0.0 } else { 1e-15 * scale };
                 let ok = out
@@ -201,7 +201,9 @@ fn watched_inverse_shows_every_slice_once() {
             assert!(old.is_none(), "B={b}: slice {k} twice");
         };
         let mut out = vec![Complex64::default(); plan.num_samples()];
-        plan.inverse_watched(&coeffs, &mut out, &watch).unwrap();
+        plan.engine()
+            .inverse_watched(&coeffs, &mut out, &watch)
+            .unwrap();
         for (k, s) in seen.into_inner().unwrap().into_iter().enumerate() {
             let s = s.unwrap_or_else(|| panic!("B={b}: slice {k} not shown"));
             assert!(
@@ -219,7 +221,8 @@ fn watched_inverse_shows_every_slice_once() {
             assert!(old.is_none(), "B={b}: real slice {k} twice");
         };
         let mut out = vec![0.0; plan.num_samples()];
-        plan.inverse_real_watched(&coeffs, &mut out, &watch)
+        plan.engine()
+            .inverse_real_watched(&coeffs, &mut out, &watch)
             .unwrap();
         for (k, s) in seen.into_inner().unwrap().into_iter().enumerate() {
             let s = s.unwrap_or_else(|| panic!("B={b}: real slice {k} not shown"));

@@ -63,7 +63,8 @@ pub unsafe extern "C" fn softFFTWCor2(
             let mut out = vec![0.0; so3.num_samples()];
             // The argmax taken slice by slice while the inverse computes them.
             let seen = SliceArgmax::new(b);
-            so3.inverse_real_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
+            so3.engine()
+                .inverse_real_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
             seen.peak()
         } else {
             // SAFETY: as above, 2 (2bw)^2 doubles each, read as (2bw)^2 complex values
@@ -79,7 +80,8 @@ pub unsafe extern "C" fn softFFTWCor2(
             combine((&sig_hat, &pat_hat), b, b - 1, b, &mut so3_hat)?;
             let mut out = vec![Complex64::default(); so3.num_samples()];
             let seen = SliceArgmax::new(b);
-            so3.inverse_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
+            so3.engine()
+                .inverse_watched(&so3_hat, &mut out, &|k, s| seen.watch(k, s))?;
             seen.peak()
         };
         // SAFETY: non-NULL (checked); single doubles the caller owns.

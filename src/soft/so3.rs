@@ -71,7 +71,7 @@ unsafe fn forward_core(
     }
     let run = |samples: &[Complex64], out: &mut [Complex64]| {
         if real {
-            plan.forward_real_parts(samples, out).map(|_| ())
+            plan.engine().forward_real_parts(samples, out).map(|_| ())
         } else {
             plan.forward(samples, out).map(|_| ())
         }
@@ -130,7 +130,9 @@ unsafe fn inverse_core(
         if real_symmetric(&plan, b, input) {
             note_real_path(true);
             return plan
+                .engine()
                 .inverse_real_to_complex(input, out)
+                .map(|_| ())
                 .map_err(CallError::from);
         }
         return plan
@@ -139,9 +141,9 @@ unsafe fn inverse_core(
             .map_err(CallError::from);
     }
     let expanded = expand_real(b, input)?;
-    let res = plan.inverse_real_to_complex(&expanded, out);
+    let res = plan.engine().inverse_real_to_complex(&expanded, out);
     release_real_buf(b, expanded);
-    res.map_err(CallError::from)
+    res.map(|_| ()).map_err(CallError::from)
 }
 
 // soft_fftw.h
