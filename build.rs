@@ -34,9 +34,9 @@ fn main() {
     }
 }
 
-/// Compiles `src/partial/mpi_shim.c` with the include and link flags `mpicc` reports.
+/// Compiles `src/distributed/mpi_shim.c` with the include and link flags `mpicc` reports.
 fn build_mpi_shim() {
-    let shim = "src/partial/mpi_shim.c";
+    let shim = "src/distributed/mpi_shim.c";
     println!("cargo:rerun-if-changed={shim}");
     let showme = |what: &str| -> Vec<String> {
         let out = std::process::Command::new("mpicc")

@@ -23,8 +23,11 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 #![deny(clippy::undocumented_unsafe_blocks)]
 
+mod batch;
 pub mod capi;
+pub mod distributed;
 mod dwt;
+mod engine;
 mod error;
 mod ffi;
 mod fft;
@@ -38,6 +41,7 @@ mod options;
 pub mod partial;
 mod plan;
 pub mod s2;
+mod shape;
 mod simd;
 pub mod soft;
 mod symmetry;
@@ -46,6 +50,8 @@ mod transform;
 pub mod wigner;
 mod workers;
 
+pub use batch::Batch;
+pub use distributed::{DistributedPlan, Exchange, ThreadExchange};
 pub use error::{Error, Result};
 pub use fft::{wisdom, Rigor};
 pub use grid::MAX_BANDWIDTH;
@@ -54,7 +60,8 @@ pub use grid::{
 };
 pub use num_complex::Complex64;
 pub use options::{Betas, Direction, FftThreading, Options};
-pub use partial::{Batch, DistributedPlan, Exchange, PartialPlan, Shape, ThreadExchange};
+pub use partial::PartialPlan;
 pub use plan::Plan;
+pub use shape::Shape;
 pub use simd::{Isa, ISA_VARIABLE};
 pub use transform::{Scratch, StageTimes, Transform};

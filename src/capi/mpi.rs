@@ -1,14 +1,14 @@
 //! Distributed plans over MPI (feature `mpi`): the C entry points declared in the
 //! hand-written `include/so3fft_mpi.h` (not in the generated `so3fft.h`). The planner taking
-//! an `MPI_Comm` is in `src/partial/mpi_shim.c`; it passes the communicator's Fortran handle
+//! an `MPI_Comm` is in `src/distributed/mpi_shim.c`; it passes the communicator's Fortran handle
 //! here. Planners and executes are collective: a rank whose arguments are bad still takes
 //! part, so that every rank returns the same error and none waits.
 
 use super::partial::{checked_shape, options_of, so3fft_partial_options, so3fft_shape};
 use super::{guarded, guarded_code, guarded_count, so3fft_complex};
+use crate::distributed::{DistributedPlan, MpiExchange};
 use crate::ffi::{CallError, ErrorKind};
 use crate::options::Betas;
-use crate::partial::{DistributedPlan, MpiExchange};
 use crate::Complex64;
 use std::ffi::{c_int, c_uint};
 

@@ -5,8 +5,8 @@ use super::{so3fft_complex, SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
 use crate::ffi::checks::{input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
 use crate::options::{Betas, Direction, Options};
-use crate::partial::{Batch, PartialPlan, Shape};
 use crate::Complex64;
+use crate::{Batch, PartialPlan, Shape};
 use std::ffi::{c_int, c_uint};
 
 /// What a partial plan computes: degrees `L0 <= l < L`, orders `|m| <= m_max`,

@@ -85,7 +85,7 @@ pub struct Lanes<'a> {
     /// With `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`, side by
     /// side). Far larger in the half-major and split layouts of `plan/blocks.rs`, where
     /// the low-beta rows and the mirror rows are in two separate halves, and in a partial
-    /// plan's lane-major chunks (`partial/dwt_stage.rs`).
+    /// plan's lane-major chunks (`engine/dwt_stage.rs`).
     pub row_gap: usize,
 }
 

@@ -5,12 +5,13 @@
 use super::combine::{add_combined, Combine};
 use super::peaks::{Peak, SliceArgmax};
 use super::series::SeriesTables;
+use crate::engine::SliceRef;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
 use crate::options::{Betas, Direction, Options};
-use crate::partial::SliceRef;
-use crate::partial::{PartialPlan, Shape};
+use crate::partial::PartialPlan;
 use crate::s2::{S2Limits, S2Plan};
+use crate::shape::Shape;
 use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
 use num_complex::Complex64;
@@ -443,7 +444,7 @@ impl Correlation {
         })
     }
 
-    /// [`Correlation::correlate`] and the grid's largest `|C|^2` ([`grid_argmax`]: the
+    /// [`Correlation::correlate`] and the grid's largest `|C|^2` ([`grid_argmax`](super::grid_argmax): the
     /// same point, value and tie rule), found while the inverse computes each slice of the
     /// grid instead of in a second pass over it.
     pub fn correlate_argmax(
@@ -464,7 +465,7 @@ impl Correlation {
     }
 
     /// [`Correlation::correlate_real`] and the grid's largest `C^2`
-    /// ([`grid_argmax_real`]), as [`Correlation::correlate_argmax`].
+    /// ([`grid_argmax_real`](super::grid_argmax_real)), as [`Correlation::correlate_argmax`].
     pub fn correlate_real_argmax(
         &self,
         signal: &[f64],

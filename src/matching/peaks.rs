@@ -138,8 +138,8 @@ impl SliceArgmax {
     }
 
     /// Scans beta slice `k` (`|C|^2`: `|z|^2` of complex values, `x^2` of real ones).
-    pub(crate) fn watch(&self, k: usize, slice: crate::partial::SliceRef) {
-        use crate::partial::SliceRef;
+    pub(crate) fn watch(&self, k: usize, slice: crate::engine::SliceRef) {
+        use crate::engine::SliceRef;
         let n = 2 * self.b;
         let base = k * n * n;
         let found = match slice {
@@ -429,7 +429,7 @@ mod tests {
     /// point: ties within a row, across rows and across slices go to the lowest index.
     #[test]
     fn slice_watch_takes_the_first_largest_value() {
-        use crate::partial::SliceRef;
+        use crate::engine::SliceRef;
         let b = 6;
         let (n, stride) = (2 * b, 2 * b + 3);
         let mut state = 7u64;

@@ -1,13 +1,11 @@
 //! [`PartialPlan`]: the public face of the engine: construction, the argument checks and
 //! the transforms, single and batched.
 
-use super::betas::LanePairs;
-use super::fft_stage::SliceWatch;
-use super::general::{Data, Footprint, General};
-use super::options::Batch;
-use super::shape::Shape;
+use crate::batch::Batch;
+use crate::engine::{Data, Engine, Footprint, LanePairs, SliceWatch};
 use crate::error::{Error, Result};
 use crate::options::{Betas, Direction, Options};
+use crate::shape::Shape;
 use crate::simd::Isa;
 use crate::system::{mem_available, mem_total};
 use crate::transform::{Scratch, StageTimes, Transform};
@@ -28,7 +26,7 @@ pub struct PartialPlan {
     threads: usize,
     n_slices: usize,
     isa: Isa,
-    engine: Box<General>,
+    engine: Box<Engine>,
 }
 
 /// What [`PartialPlan::new`] checks and resolves before it builds anything.
@@ -55,7 +53,7 @@ impl PartialPlan {
     ) -> Result<PartialPlan> {
         let c = PartialPlan::validate(shape, options)?;
         let n_slices = c.pairs.n_slices;
-        let engine = Box::new(General::new(
+        let engine = Box::new(Engine::new(
             shape,
             c.pairs,
             (c.isa, c.skip, c.threads),

@@ -10,7 +10,8 @@ mod transform;
 use crate::error::{Error, Result};
 use crate::grid::{num_coeffs, num_samples, MAX_BANDWIDTH};
 use crate::options::{Direction, FftThreading, Options};
-use crate::partial::{PartialPlan, Shape};
+use crate::partial::PartialPlan;
+use crate::shape::Shape;
 use crate::simd::Isa;
 use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
@@ -125,7 +126,7 @@ impl Plan {
     /// half-spectrum buffers and a slice of reals), and the tables (`O(B^2)`). A transform needs the
     /// caller's arrays on top (`(2B)^3` and `(4B^3-B)/3` complex values) and nothing else
     /// large. [`Plan::memory_needed`] gives the same number before planning. [`Plan::new`]
-    /// fails with [`Error::OutOfMemory`](crate::Error::OutOfMemory) when this exceeds the
+    /// fails with [`Error::OutOfMemory`] when this exceeds the
     /// available memory.
     pub fn memory_bytes(&self) -> usize {
         self.engine.memory_bytes()

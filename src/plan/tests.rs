@@ -167,7 +167,7 @@ fn real_inverse_into_complex_matches_real_samples() {
 /// real: the output slice), complex and real, with one chunk and with several.
 #[test]
 fn watched_inverse_shows_every_slice_once() {
-    use crate::partial::SliceRef;
+    use crate::engine::SliceRef;
     use num_complex::Complex64;
     use std::sync::Mutex;
     for (b, cap) in [(12usize, None), (36, Some(1usize))] {

@@ -20,7 +20,7 @@ use num_complex::Complex64;
 use std::ffi::c_int;
 
 /// Complex values of padding after each row of a work buffer.
-pub(super) const ROW_PAD: usize = 4;
+pub(crate) const ROW_PAD: usize = 4;
 
 /// One output slice of an inverse, handed to a [`SliceWatch`] right after it is
 /// computed (while in the cache): the real slice as written, or a complex slice in a work
@@ -42,7 +42,7 @@ pub(crate) enum SliceRef<'a> {
 pub(crate) type SliceWatch<'a> = &'a (dyn Fn(usize, SliceRef) + Sync);
 
 /// A [`SliceWatch`] bound to one slice, for the FFT stage.
-pub(super) type Seen<'a> = Option<&'a dyn Fn(SliceRef)>;
+pub(crate) type Seen<'a> = Option<&'a dyn Fn(SliceRef)>;
 
 /// A batch of 1-D DFTs: `howmany` transforms of `n` points, `stride` apart within one,
 /// `dist` from one to the next, on the input and the output side.
@@ -176,7 +176,7 @@ impl TwoWay {
 /// A worker's buffers, each made on first use: the inverse's (whose columns outside
 /// `|M'| <= N` stay zero), the forward's, and the real transforms' half spectra.
 /// The work buffers of a slice and its mirror.
-pub(super) type BufPair<'a> = (&'a mut [Complex64], &'a mut [Complex64]);
+pub(crate) type BufPair<'a> = (&'a mut [Complex64], &'a mut [Complex64]);
 
 /// `len` values of two buffers, made on first use.
 fn buf_pair<'a>(
@@ -194,11 +194,11 @@ fn buf_pair<'a>(
     ))
 }
 
-/// A worker's buffers, each made on first use (a plan makes them, `General::reserve`):
+/// A worker's buffers, each made on first use (a plan makes them, `Engine::reserve`):
 /// two complex work buffers (a slice and its mirror in one task) that the forward and the
 /// inverse share, two half-spectrum buffers of the real transforms, and a slice of reals.
 #[derive(Default)]
-pub(super) struct Work {
+pub(crate) struct Work {
     pub inv: Option<AlignedBuf>,
     pub inv2: Option<AlignedBuf>,
     pub half: Option<AlignedBuf>,
@@ -211,7 +211,7 @@ pub(super) struct Work {
 }
 
 /// The slice DFTs of one shape.
-pub(super) struct FftStage {
+pub(crate) struct FftStage {
     na: usize,
     ng: usize,
     n: usize,
@@ -464,7 +464,7 @@ impl FftStage {
     /// buffer), then the columns `|M'| <= N` over alpha, in place.
     ///
     /// # Safety
-    /// `inp` is valid for reads of `na ng` values; `w` is [`FftStage::fwd_buf`]'s.
+    /// `inp` is valid for reads of `na ng` values; `w` is one of [`FftStage::fwd_pair`]'s buffers.
     pub unsafe fn forward(&self, w: &mut [Complex64], inp: *const Complex64) {
         let w = w.as_mut_ptr();
         // SAFETY: `inp` holds the slice's `na` rows of `ng` values and is only read; the

@@ -2,16 +2,16 @@
 //! of a beta and its mirror `pi - beta` ([`LanePairs`]), since a cluster's "reversed"
 //! members (see `symmetry.rs`) at one beta are its base function at the mirror.
 
-use super::shape::Shape;
 use crate::error::{Error, Result};
 use crate::numeric::{sin_cos_dd, Dd, PI_DD};
 use crate::options::Betas;
+use crate::shape::Shape;
 use crate::wigner::BetaTables;
 use std::f64::consts::PI;
 
 /// Kernel lanes in pairs: point `j` (`j < pairs`) is a beta `<= pi/2` and point
 /// `pairs + j` its mirror. Each output slice is one point of a pair.
-pub(super) struct LanePairs {
+pub(crate) struct LanePairs {
     /// Recurrence arguments and starting-value tables of the `2 pairs` points.
     pub tables: BetaTables,
     pub pairs: usize,

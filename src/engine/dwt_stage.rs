@@ -13,9 +13,9 @@
 
 use super::betas::LanePairs;
 use super::coeffs::{self, DegreeFactors};
-use super::shape::CoefLayout;
 use crate::dwt::{self, BatchRows, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
+use crate::shape::CoefLayout;
 use crate::simd::Isa;
 use crate::symmetry::{Cluster, Member};
 use crate::wigner::{big, start_norm, RecCoeffs, RecTables};
@@ -27,11 +27,11 @@ use std::sync::Mutex;
 /// Transforms of a batch per kernel call: they share the cluster's recurrence values
 /// (enough to make the recurrence a small part of the call), and their kernel inputs or
 /// sums stay in L2.
-pub(super) const KERNEL_BATCH: usize = 8;
+pub(crate) const KERNEL_BATCH: usize = 8;
 
 /// One order pair of a cluster that the shape holds.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Slot {
+pub(crate) struct Slot {
     pub member: Member,
     /// Index of `(M, M')` in a work buffer of `n_alpha` rows of `n_gamma` values, rows
     /// `row_stride` apart.
@@ -48,7 +48,7 @@ pub(super) struct Slot {
 
 /// A cluster of the shape: base pair, starting-value norm, its slots and its block.
 #[derive(Clone, Debug)]
-pub(super) struct ClusterPlan {
+pub(crate) struct ClusterPlan {
     pub m: usize,
     pub mp: usize,
     norm: Ext,
@@ -63,7 +63,7 @@ pub(super) struct ClusterPlan {
 /// `len` padded to an odd number of cache lines, so that a cluster's values in all rows
 /// fall in different cache sets (rows of a multiple of 4 KiB put them all in one); empty
 /// rows stay empty.
-pub(super) fn padded_row(len: usize) -> usize {
+pub(crate) fn padded_row(len: usize) -> usize {
     len + if len > 0 && (len / 8).is_multiple_of(2) {
         8
     } else {
@@ -73,7 +73,7 @@ pub(super) fn padded_row(len: usize) -> usize {
 
 /// What one kernel call of a cluster works on: the lanes of a chunk.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct ChunkLanes {
+pub(crate) struct ChunkLanes {
     /// First pair and number of pairs.
     pub j0: usize,
     pub h: usize,
@@ -85,7 +85,7 @@ pub(super) struct ChunkLanes {
     /// Doubles from the first lower lane row to the first upper one (`hp row_len` in a
     /// buffer in one piece; an inverse's chained buffer has its halves apart).
     pub upper_gap: usize,
-    /// Split chunks (see [`crate::partial::betas::LanePairs::first_upper_pair`]): pairs
+    /// Split chunks (see [`super::betas::LanePairs::first_upper_pair`]): pairs
     /// `0..k` write their lower point (or nothing: padding, also the chunk's pairs
     /// `h..hp`), pairs `k..hp` their upper one; `k` is a multiple of the vector width.
     pub first_upper_pair: Option<usize>,
@@ -99,7 +99,7 @@ impl ChunkLanes {
 
 /// How a cluster's inverse splits over a split chunk (see [`ChunkLanes::first_upper_pair`]).
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Split {
+pub(crate) struct Split {
     /// The chunk's first pair writing its upper point.
     first_upper: usize,
     /// Direct members (the first slots) and the width of their kernel call.
@@ -147,7 +147,7 @@ struct SplitCall<'a> {
 }
 
 /// Per-worker scratch.
-pub(super) struct Scratch {
+pub(crate) struct Scratch {
     rec: RecCoeffs,
     tau: Vec<f64>,
     start: Vec<f64>,
@@ -172,7 +172,7 @@ impl Scratch {
 }
 
 /// The DWT stage of a partial plan.
-pub(super) struct DwtStage {
+pub(crate) struct DwtStage {
     isa: Isa,
     /// Degree limit `L`.
     l: usize,

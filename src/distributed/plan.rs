@@ -19,19 +19,16 @@
 //!   group's lanes are one contiguous run.
 //! - In one group (the default whenever the rows fit in the workspace cap) each lane is one
 //!   kernel lane and a cluster's kernel call covers all betas, as in a single-process
-//!   [`PartialPlan`](super::PartialPlan) whose chunk holds every beta: the results are
+//!   [`PartialPlan`](crate::PartialPlan) whose chunk holds every beta: the results are
 //!   bitwise equal. With several groups the forward adds the same terms in another order.
 
-use super::betas::LanePairs;
-use super::dwt_stage::{padded_row, ChunkLanes, ClusterPlan};
 use super::exchange::Exchange;
-use super::general::General;
-use super::shape::Shape;
-use super::slots::LaneRows;
 use crate::dwt::Prefetch;
+use crate::engine::{padded_row, ChunkLanes, ClusterPlan, Engine, LanePairs, LaneRows};
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::{Betas, Direction, Options};
+use crate::shape::Shape;
 use crate::simd::Isa;
 use crate::transform::StageTimes;
 use crate::transform::{Scratch, Transform};
@@ -80,7 +77,7 @@ struct Share {
 }
 
 /// The lane rows of one member set (every member, or the real transforms' `M' >= 0`, see
-/// `General::members`): where each rank's clusters are in a lane row, and this rank's
+/// `Engine::members`): where each rank's clusters are in a lane row, and this rank's
 /// clusters.
 struct RankView {
     /// Per rank, its clusters' doubles in a lane row: `offset(c0) .. offset(c1)`.
@@ -208,7 +205,7 @@ struct Parts {
     shape: Shape,
     real: bool,
     direction: Direction,
-    general: General,
+    general: Engine,
     shares: Vec<Share>,
     /// The lane rows of every member, and with `real` those of the real transforms.
     views: Vec<RankView>,
@@ -286,7 +283,7 @@ impl<X: Exchange> DistributedPlan<X> {
             max_workspace_bytes: Some(usize::MAX / 4),
             ..options.clone()
         };
-        let mut general = General::new(shape, pairs, (isa, skip, threads), &opts, None)?;
+        let mut general = Engine::new(shape, pairs, (isa, skip, threads), &opts, None)?;
         let p = comm.size();
         let clusters = &general.dwt.clusters;
         // A cluster's DWT work: its degrees times its columns, plus what each cluster costs
@@ -543,7 +540,7 @@ impl<X: Exchange> DistributedPlan<X> {
     }
 
     /// Inverse to real samples (collective; reads the representatives as
-    /// [`PartialPlan::inverse_real`](super::PartialPlan::inverse_real)).
+    /// [`PartialPlan::inverse_real`](crate::PartialPlan::inverse_real)).
     pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
         let out = (SendPtr(samples.as_mut_ptr()), samples.len());
         self.inverse_impl(coeffs, out, (true, None))

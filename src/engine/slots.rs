@@ -9,16 +9,16 @@ use crate::error::{Error, Result};
 /// clusters.1`; cluster `c`'s slots start `offset(c)` doubles after the pointers (which may
 /// point before the rows when they hold only a later part of the clusters).
 #[derive(Clone, Copy)]
-pub(super) struct LaneRows {
-    pub(super) own: *mut f64,
-    pub(super) mirror: *mut f64,
-    pub(super) clusters: (usize, usize),
+pub(crate) struct LaneRows {
+    pub(crate) own: *mut f64,
+    pub(crate) mirror: *mut f64,
+    pub(crate) clusters: (usize, usize),
 }
 
 impl LaneRows {
     /// Rows that hold the clusters `clusters` only, the first of which at offset `first`
     /// of the full lane row: their slots at `own` and `mirror` onwards.
-    pub(super) fn part(
+    pub(crate) fn part(
         (own, mirror): (*mut f64, *mut f64),
         clusters: (usize, usize),
         first: usize,
@@ -32,7 +32,7 @@ impl LaneRows {
 
     /// Where a slot of a [`SlotTable`] entry is.
     #[inline(always)]
-    pub(super) fn at(&self, at: u32) -> *mut f64 {
+    pub(crate) fn at(&self, at: u32) -> *mut f64 {
         let row = if at & SlotTable::MIRROR != 0 {
             self.mirror
         } else {
@@ -46,7 +46,7 @@ impl LaneRows {
 /// read 8 bytes a slot here (one table for the complex layout, one for the real) instead of
 /// each cluster's list of slots (a heap allocation per cluster, 64 bytes a slot: at
 /// B = 128 about 4 MB read per slice).
-pub(super) struct SlotTable {
+pub(crate) struct SlotTable {
     /// `(offset in the lane row, or'ed with MIRROR for a reversed member, whose value is in
     /// the mirror's row; index in the FFT stage's work buffer)`.
     entries: Vec<(u32, u32)>,
@@ -59,12 +59,12 @@ pub(super) struct SlotTable {
 }
 
 impl SlotTable {
-    pub(super) const MIRROR: u32 = 1 << 31;
-    pub(super) const CONJ: u32 = 1 << 31;
+    pub(crate) const MIRROR: u32 = 1 << 31;
+    pub(crate) const CONJ: u32 = 1 << 31;
 
     /// The table of `dwt`'s clusters; the real entries for a half buffer of `na` rows `hs`
     /// apart.
-    pub(super) fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
+    pub(crate) fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
         let too_large =
             || Error::InvalidArgument("shape too large for the engine's slot table".into());
         let fits = |x: usize| u32::try_from(x).ok().filter(|a| a & (1 << 31) == 0);
@@ -100,7 +100,7 @@ impl SlotTable {
     /// The positions of a work buffer (`rows` rows `stride` apart) in the columns `cols` of
     /// each row that no entry fills: of the complex table, or with `real` of the real one
     /// (its entries `M' >= 0`).
-    pub(super) fn holes(
+    pub(crate) fn holes(
         &self,
         real: bool,
         (rows, stride): (usize, usize),
@@ -123,19 +123,19 @@ impl SlotTable {
     }
 
     /// The entries of clusters `a..b`.
-    pub(super) fn of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+    pub(crate) fn of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
         &self.entries[self.start[a]..self.start[b]]
     }
 
     /// The real entries of clusters `a..b`.
-    pub(super) fn real_of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
+    pub(crate) fn real_of(&self, (a, b): (usize, usize)) -> &[(u32, u32)] {
         &self.real[self.start[a]..self.start[b]]
     }
 }
 
 /// What the inverse zeroes in a worker's buffer before a slice's values go in: the
 /// positions the previous slice's transforms wrote that no slot fills.
-pub(super) enum Clear {
+pub(crate) enum Clear {
     /// Few positions (the full shape: the Nyquist row and column), one by one.
     Holes(Vec<usize>),
     /// These columns of every row (`rows` rows `stride` apart).
@@ -149,7 +149,7 @@ pub(super) enum Clear {
 impl Clear {
     /// The clear of the columns `cols` of a buffer of `rows` rows `stride` apart, of which
     /// the slots of `table` (complex, or `real`) fill all but `holes`.
-    pub(super) fn new(
+    pub(crate) fn new(
         table: &SlotTable,
         real: bool,
         (rows, stride): (usize, usize),
@@ -169,7 +169,7 @@ impl Clear {
     }
 
     /// Zeroes them in `w`.
-    pub(super) fn apply(&self, w: &mut [num_complex::Complex64]) {
+    pub(crate) fn apply(&self, w: &mut [num_complex::Complex64]) {
         let zero = num_complex::Complex64::default();
         match self {
             Clear::Holes(h) => h.iter().for_each(|&i| w[i] = zero),
