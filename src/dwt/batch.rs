@@ -1,21 +1,18 @@
-//! Batched kernels: the transforms of a batch share each cluster's recurrence.
+//! The batched inverse: the transforms of a batch share each cluster's recurrence.
 //!
 //! The single kernels fuse the recurrence with one transform's multiply-adds. Here the
-//! Wigner-d values are computed once into a small buffer (inverse: every degree of two
-//! vectors of betas, their recurrences run together, `2 n W` doubles, in L1 up to a few
-//! hundred degrees; forward: one block of degrees of every vector of a group), and each
-//! transform of the batch runs only the multiply-adds against it:
-//! - inverse: `y_t[row(s)][q] = sum_i dt_{l0+i}(beta_s) fin_t[i][q]`, with the sums held
-//!   as vectors over the columns of one lane (no transposes on the way out), each d value
-//!   a broadcast feeding `16 / W` multiply-adds (two transforms at once for 8 columns);
-//! - forward: `ft_t[i][q] = sum_s dt_{l0+i}(beta_s) x_t[row(s)][q]`, the forward kernel's
-//!   block multiply-adds without the interleaved steps.
+//! Wigner-d values of every degree of two vectors of betas are computed once into a small
+//! buffer (their recurrences run together, `2 n W` doubles, in L1 up to a few hundred
+//! degrees), and each transform of the batch runs only the multiply-adds against it:
+//! `y_t[row(s)][q] = sum_i dt_{l0+i}(beta_s) fin_t[i][q]`, with the sums held as vectors
+//! over the columns of one lane (no transposes on the way out), each d value a broadcast
+//! feeding `16 / W` multiply-adds (two transforms at once for 8 columns).
 //!
 //! Every output value is the same chain of fused multiply-adds in the same order as in
-//! the single kernels (`inverse`, `forward`): a batch gives bitwise the results of single
-//! calls.
+//! the single kernel (`inverse`): a batch gives bitwise the results of single calls.
+//! (A batch's forward runs the single forward kernel per transform: with the next
+//! transform's rows prefetched it was faster than a shared recurrence.)
 
-use super::forward::{assert_block, block_fmas, degree_block, FWD_VECTORS};
 use super::inverse::INV_VECTORS;
 use super::lanes::{Lanes, Prefetch, Rec};
 use super::state::{prefix_states, State};
@@ -97,11 +94,6 @@ pub struct BatchRows<T> {
 /// Doubles of the inverse's d-value buffer for `n` degrees and vectors of `w` lanes.
 pub fn inverse_tile_len(n: usize, w: usize) -> usize {
     CHAINS * n * w
-}
-
-/// Doubles of the forward's d-value buffer for vectors of `w` lanes.
-pub fn forward_tile_len(w: usize) -> usize {
-    FWD_VECTORS * w * w
 }
 
 /// The multiply-adds of one vector of lanes for transforms `t .. t + K` from degree `lo`:
@@ -256,119 +248,10 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
     }
 }
 
-/// Forward of a batch (see [`crate::dwt::forward_batch_raw`]); returns the lowest degree
-/// index any lane reached active (every transform's rows below it are zero).
-///
-/// # Safety
-/// The CPU supports `S`'s instruction set; every input row of every transform is valid
-/// for reads; `ft` holds `count` outputs of `(n + W) P` values `ft.dist` apart; `tile`
-/// holds [`forward_tile_len`] values.
-#[inline(always)]
-unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
-    rec: &Rec,
-    lanes: &Lanes,
-    x: BatchRows<*const f64>,
-    tile: *mut f64,
-    ft: BatchRows<*mut f64>,
-) -> usize {
-    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
-    unsafe {
-        const { assert_block::<W, P, DB>() };
-        let (n, nb) = (rec.len(), lanes.tau.len());
-        let cv = P / W;
-        let pair = super::forward::paired(W, P);
-        let data_rows = |xin: *const f64, s0: usize| {
-            let (at, stride) = lanes.vector_rows(s0, P);
-            (xin.add(at), stride)
-        };
-        let mut lo = n;
-        let mut v0 = 0;
-        while v0 < nb {
-            let vectors = ((nb - v0) / W).min(FWD_VECTORS);
-            let mut state_mem = [const { MaybeUninit::<State<S>>::uninit() }; FWD_VECTORS];
-            let (first, states) =
-                prefix_states::<S, W>(rec, lanes, v0, n, &mut state_mem[..vectors]);
-            lo = lo.min(first);
-            let mut i0 = first - first % DB;
-            let assign = v0 == 0;
-            if assign {
-                for t in 0..ft.count {
-                    std::ptr::write_bytes(ft.base.add(t * ft.dist), 0, i0 * P);
-                }
-            }
-            // The vectors of a block in the single kernel's order: those that start inside
-            // the block or still have inactive lanes, then the fully active ones.
-            let mut order = [0usize; FWD_VECTORS];
-            while i0 < n {
-                let mut used = 0;
-                for (v, s) in states.iter_mut().enumerate() {
-                    if s.i >= n || s.i >= i0 + DB || (s.i == i0 && s.all_active()) {
-                        continue;
-                    }
-                    let d = s.masked_block::<DB>(i0, n);
-                    let db = tile.add(used * DB * W);
-                    for (j, dj) in d.iter().enumerate() {
-                        S::store(db.add(j * W), *dj);
-                    }
-                    order[used] = v;
-                    used += 1;
-                }
-                for (v, s) in states.iter_mut().enumerate() {
-                    if !(s.i == i0 && s.i < n && s.all_active()) {
-                        continue;
-                    }
-                    let db = tile.add(used * DB * W);
-                    let (mut p0, mut p1) = (s.p0, s.p1);
-                    for j in 0..DB {
-                        S::store(db.add(j * W), p1);
-                        let p2 = S::fence(s.step(p0, p1, i0 + j));
-                        (p0, p1) = (p1, p2);
-                    }
-                    (s.p0, s.p1, s.i) = (p0, p1, i0 + DB);
-                    order[used] = v;
-                    used += 1;
-                }
-                for t in 0..ft.count {
-                    let sums = ft.base.add(t * ft.dist);
-                    let xin = x.base.add(t * x.dist);
-                    let mut acc = [S::zero(); super::forward::ACC];
-                    if !assign && !pair {
-                        for j in 0..DB {
-                            for h in 0..cv {
-                                acc[j * cv + h] = S::load(sums.add((i0 + j) * P + h * W));
-                            }
-                        }
-                    }
-                    for (k, &v) in order[..used].iter().enumerate() {
-                        let (xr, xs) = data_rows(xin, v0 + v * W);
-                        block_fmas::<S, W, P, DB>(&mut acc, tile.add(k * DB * W), xr, xs);
-                    }
-                    if pair {
-                        for j in 0..DB {
-                            let r = sums.add((i0 + j) * P);
-                            let v = super::forward::fold_pair::<S>(&acc, j);
-                            S::store(r, if assign { v } else { S::add(S::load(r), v) });
-                        }
-                    } else {
-                        for j in 0..DB {
-                            for h in 0..cv {
-                                S::store(sums.add((i0 + j) * P + h * W), acc[j * cv + h]);
-                            }
-                        }
-                    }
-                }
-                i0 += DB;
-            }
-            v0 += vectors * W;
-        }
-        lo
-    }
-}
-
-/// `#[target_feature]` entry points: [`inverse_body`] and [`forward_body`] for one
-/// instruction set, vector width and column count.
+/// `#[target_feature]` entry points: [`inverse_body`] for one instruction set, vector
+/// width and column count.
 macro_rules! entry {
-    ($inv:ident, $fwd:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:tt) => {
+    ($inv:ident, $feat:literal, $S:ty, $W:literal, $N:literal) => {
         /// # Safety
         /// As [`inverse_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
@@ -383,21 +266,6 @@ macro_rules! entry {
             // SAFETY: the caller upholds `inverse_body`'s contract.
             unsafe { inverse_body::<$S, $W, $N, NT>(rec, lanes, fin, tile, y) }
         }
-
-        /// # Safety
-        /// As [`forward_body`], for the instruction set of `$S`.
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feat)]
-        unsafe fn $fwd(
-            rec: &Rec,
-            lanes: &Lanes,
-            x: BatchRows<*const f64>,
-            tile: *mut f64,
-            ft: BatchRows<*mut f64>,
-        ) -> usize {
-            // SAFETY: the caller upholds `forward_body`'s contract.
-            unsafe { forward_body::<$S, $W, $N, $DB>(rec, lanes, x, tile, ft) }
-        }
     };
 }
 
@@ -405,18 +273,10 @@ macro_rules! entry {
 use crate::simd::{avx2::Avx2, avx512::Avx512};
 use crate::simd::{scalar::Scalar, Isa};
 
-entry!(
-    inv_avx512_16,
-    fwd_avx512_16,
-    "avx512f,fma",
-    Avx512,
-    8,
-    16,
-    8
-);
-entry!(inv_avx512_8, fwd_avx512_8, "avx512f,fma", Avx512, 8, 8, 8);
-entry!(inv_avx2_16, fwd_avx2_16, "avx2,fma", Avx2, 4, 16, 2);
-entry!(inv_avx2_8, fwd_avx2_8, "avx2,fma", Avx2, 4, 8, 4);
+entry!(inv_avx512_16, "avx512f,fma", Avx512, 8, 16);
+entry!(inv_avx512_8, "avx512f,fma", Avx512, 8, 8);
+entry!(inv_avx2_16, "avx2,fma", Avx2, 4, 16);
+entry!(inv_avx2_8, "avx2,fma", Avx2, 4, 8);
 
 /// The batched inverse for `isa` and `p` columns (8 or 16).
 ///
@@ -457,37 +317,4 @@ pub(super) unsafe fn run_inverse(
         }
     }
     crate::simd::sfence();
-}
-
-/// The batched forward for `isa` and `p` columns (8 or 16).
-///
-/// # Safety
-/// As [`forward_body`]; `isa` is supported by this CPU.
-pub(super) unsafe fn run_forward(
-    isa: Isa,
-    p: usize,
-    (rec, lanes): (&Rec, &Lanes),
-    x: BatchRows<*const f64>,
-    tile: *mut f64,
-    ft: BatchRows<*mut f64>,
-) -> usize {
-    // SAFETY: the caller's contract covers every kernel's (`forward_body`'s) and the
-    // instruction set of the one chosen.
-    unsafe {
-        match (isa, p) {
-            #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 16) => fwd_avx512_16(rec, lanes, x, tile, ft),
-            #[cfg(target_arch = "x86_64")]
-            (Isa::Avx512, 8) => fwd_avx512_8(rec, lanes, x, tile, ft),
-            #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, x, tile, ft),
-            #[cfg(target_arch = "x86_64")]
-            (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, x, tile, ft),
-            (_, 16) => {
-                forward_body::<Scalar, 1, 16, { degree_block(1, 16) }>(rec, lanes, x, tile, ft)
-            }
-            (_, 8) => forward_body::<Scalar, 1, 8, { degree_block(1, 8) }>(rec, lanes, x, tile, ft),
-            _ => unreachable!("P must be 8 or 16"),
-        }
-    }
 }

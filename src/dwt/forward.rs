@@ -51,8 +51,7 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     }
 }
 
-/// Degrees per block of the forward kernels for vectors of `w` lanes and `p` columns (the
-/// batched forward must use the same: the block decides the order of the sums).
+/// Degrees per block of the forward kernels for vectors of `w` lanes and `p` columns.
 pub(super) const fn degree_block(w: usize, p: usize) -> usize {
     match (w, p) {
         (8, _) => 8,

@@ -33,7 +33,7 @@ mod tests;
 
 use crate::simd::Isa;
 
-pub(crate) use batch::{forward_tile_len, inverse_tile_len, BatchFill, BatchRows};
+pub(crate) use batch::{inverse_tile_len, BatchFill, BatchRows};
 pub(crate) use inverse::Fill;
 pub(crate) use lanes::{Lanes, Prefetch, Rec};
 
@@ -220,28 +220,4 @@ pub(crate) unsafe fn inverse_batch_raw(
             y,
         )
     }
-}
-
-/// [`forward_raw`] for a batch of `x.count` transforms sharing the recurrence: transform
-/// `t` reads its rows from `x.base + t x.dist` and writes its sums to `ft.base + t ft.dist`
-/// (`(rec.len() + isa.lanes()) p` values each). `tile` is scratch of
-/// [`forward_tile_len`] values. Returns `lo` as [`forward_raw`] does (the same for every
-/// transform); bitwise the results of `x.count` calls of [`forward_raw`].
-///
-/// # Safety
-/// Every row of every transform is valid for reads and written by no one meanwhile; `ft`
-/// holds `ft.count` arrays `ft.dist` apart, nobody else's.
-pub(crate) unsafe fn forward_batch_raw(
-    isa: Isa,
-    p: usize,
-    (rec, lanes): (&Rec, &Lanes),
-    x: BatchRows<*const f64>,
-    tile: &mut [f64],
-    ft: BatchRows<*mut f64>,
-) -> usize {
-    check_shared(isa, p, rec, lanes);
-    assert!(x.count == ft.count && ft.dist >= (rec.len() + isa.lanes()) * p);
-    assert!(tile.len() >= forward_tile_len(isa.lanes()));
-    // SAFETY: lengths checked above, rows by the caller, instruction set by `check_shared`.
-    unsafe { batch::run_forward(isa, p, (rec, lanes), x, tile.as_mut_ptr(), ft) }
 }

@@ -645,11 +645,10 @@ fn forward_parity_kernel_sums_each_degree_over_its_parity() {
     });
 }
 
-/// The batched kernels against single calls, bit for bit, for `counts` transforms: every
-/// output row of the inverse (both store modes) and every sum of the forward, with its
-/// lowest active degree.
+/// The batched inverse against single calls, bit for bit, for `counts` transforms: every
+/// output row (both store modes).
 fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
-    use super::{forward_batch_raw, forward_tile_len, inverse_batch_raw, inverse_tile_len};
+    use super::{inverse_batch_raw, inverse_tile_len};
     use super::{BatchRows, Prefetch};
     let (n, nbs, w) = (rec.len(), lanes.tau.len(), isa.lanes());
     for count in [1usize, 2, 3] {
@@ -703,40 +702,6 @@ fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
                     u.to_bits(),
                     v.to_bits(),
                     "{isa:?} P={pw} inverse x{count} at {i}"
-                );
-            }
-        }
-        let xs: Vec<f64> = pseudo(count * nbs * pw, seed + 100);
-        let stride = (n + 8) * pw;
-        let mut want = vec![0.0; count * stride];
-        let mut lo_single = n;
-        for t in 0..count {
-            let x = &xs[t * nbs * pw..][..nbs * pw];
-            lo_single = forward(isa, pw, rec, lanes, x, &mut want[t * stride..][..stride]);
-        }
-        let mut ft = vec![f64::NAN; count * stride];
-        let mut tile = vec![f64::NAN; forward_tile_len(w)];
-        let x = BatchRows {
-            base: xs.as_ptr(),
-            dist: nbs * pw,
-            count,
-        };
-        let sums = BatchRows {
-            base: ft.as_mut_ptr(),
-            dist: stride,
-            count,
-        };
-        // SAFETY: `xs` holds `count` inputs of `nbs` consecutive rows, `ft` the `count`
-        // outputs of `(n + 8) pw` values.
-        let lo = unsafe { forward_batch_raw(isa, pw, (rec, lanes), x, &mut tile, sums) };
-        assert_eq!(lo, lo_single, "{isa:?} P={pw} forward x{count}");
-        for t in 0..count {
-            let (got, exp) = (&ft[t * stride..][..n * pw], &want[t * stride..][..n * pw]);
-            for (i, (u, v)) in got.iter().zip(exp).enumerate() {
-                assert_eq!(
-                    u.to_bits(),
-                    v.to_bits(),
-                    "{isa:?} P={pw} forward x{count} t={t} at {i}"
                 );
             }
         }

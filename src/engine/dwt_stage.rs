@@ -549,11 +549,9 @@ impl DwtStage {
         }
     }
 
-    /// Doubles of the batched kernels' scratch (either direction: a worker's scratch
-    /// serves both).
+    /// Doubles of the batched inverse's scratch.
     fn tile_len(&self) -> usize {
-        let w = self.isa.lanes();
-        dwt::inverse_tile_len(self.l, w).max(dwt::forward_tile_len(w))
+        dwt::inverse_tile_len(self.l, self.isa.lanes())
     }
 
     /// The scratch's kernel inputs or sums for `count` transforms and the batched kernels'
@@ -844,53 +842,6 @@ impl DwtStage {
         // SAFETY: `data` holds the kernel's sums; the blocks are the caller's.
         unsafe { self.scatter_sums(cl, (n, lo), &sc.rec.s, data.as_ptr(), (coef, first)) };
         sc.data = data;
-    }
-
-    /// [`DwtStage::forward`] for a batch sharing the recurrence: transform `t` from the
-    /// lane rows at `block.base + t block.dist` into the coefficients at
-    /// `coef.base + t coef.dist`. Bitwise the results of single calls.
-    ///
-    /// # Safety
-    /// As for [`DwtStage::forward`], for every transform of the batch.
-    #[allow(clippy::too_many_arguments)]
-    pub unsafe fn forward_many(
-        &self,
-        sc: &mut Scratch,
-        cl: &ClusterPlan,
-        ch: ChunkLanes,
-        n: usize,
-        block: BatchRows<*const f64>,
-        coef: BatchRows<*mut Complex64>,
-        first: bool,
-    ) {
-        let (p, dist) = (cl.p, self.data_len());
-        let (mut data, mut tile) = self.batch_buffers(sc, block.count);
-        let rec = Rec::new(&sc.rec, n);
-        let lanes = self.lanes(sc, ch, false);
-        let sums = BatchRows {
-            base: data.as_mut_ptr(),
-            dist,
-            count: block.count,
-        };
-        // SAFETY: every transform's `2 hp` rows of `p` doubles, read only (caller's
-        // contract); `data` holds `count` arrays of `dist >= (n + W) p` doubles.
-        let lo =
-            unsafe { dwt::forward_batch_raw(self.isa, p, (&rec, &lanes), block, &mut tile, sums) }
-                .min(n);
-        for t in 0..block.count {
-            // SAFETY: sums `t` of the kernel; the blocks of transform `t` are the caller's.
-            unsafe {
-                self.scatter_sums(
-                    cl,
-                    (n, lo),
-                    &sc.rec.s,
-                    data.as_ptr().add(t * dist),
-                    (coef.base.add(t * coef.dist), first),
-                )
-            };
-        }
-        sc.data = data;
-        sc.tile = tile;
     }
 
     /// Adds the forward kernel's sums of `cl` (`n` rows of `cl.p`, rows below `lo` zero),

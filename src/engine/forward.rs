@@ -2,10 +2,9 @@
 //! the DWT stage adding each chunk into the coefficients.
 
 use super::chunks::{Data, Engine, Members};
-use super::dwt_stage::KERNEL_BATCH;
 use super::fft_stage::{BufPair, Work};
 use crate::batch::Batch;
-use crate::dwt::{BatchRows, Prefetch};
+use crate::dwt::Prefetch;
 use crate::error::Result;
 use crate::transform::Scratch;
 use crate::transform::StageTimes;
@@ -126,49 +125,35 @@ impl Engine {
                     let clusters = &m.dwt.clusters;
                     m.dwt.for_each_cluster(|sc, i, cl| {
                         let n = m.dwt.setup(sc, cl, &self.pairs, ch);
-                        for t0 in (0..batch.count).step_by(KERNEL_BATCH) {
-                            let count = KERNEL_BATCH.min(batch.count - t0);
-                            let block = buf.get().wrapping_add(t0 * per_t + cl.offset);
-                            let c = coef.get().wrapping_add(t0 * batch.out_dist);
-                            // What the next cluster (likely this task's next one)
-                            // reads and writes.
-                            let next = match clusters.get(i + 1) {
-                                Some(nc) if count == 1 => m.dwt.forward_hints(
+                        // Transform by transform (the cluster's set-up shared), each
+                        // kernel prefetching what the next one reads: the next
+                        // transform's rows of this cluster, after the last the next
+                        // cluster's (likely this task's next one) of the first.
+                        for t in 0..batch.count {
+                            let block = buf.get().wrapping_add(t * per_t + cl.offset);
+                            let c = coef.get().wrapping_add(t * batch.out_dist);
+                            let next = if t + 1 < batch.count {
+                                m.dwt.forward_hints(
+                                    cl,
+                                    ch,
+                                    buf.get().wrapping_add((t + 1) * per_t + cl.offset),
+                                    coef.get().wrapping_add((t + 1) * batch.out_dist),
+                                )
+                            } else if let Some(nc) = clusters.get(i + 1) {
+                                m.dwt.forward_hints(
                                     nc,
                                     ch,
-                                    buf.get().wrapping_add(t0 * per_t + nc.offset),
-                                    c,
-                                ),
-                                _ => Prefetch::none(),
+                                    buf.get().wrapping_add(nc.offset),
+                                    coef.get(),
+                                )
+                            } else {
+                                Prefetch::none()
                             };
-                            // SAFETY: this cluster's slots of the lane rows of
-                            // transforms `t0..t0 + count` (written by the FFT stage or
-                            // zeroed above, finished); their coefficient arrays are
-                            // inside the checked output, and this cluster's slots'
-                            // blocks are this task's.
-                            unsafe {
-                                if count == 1 {
-                                    m.dwt.forward(sc, cl, (ch, n), block, (c, first, next))
-                                } else {
-                                    m.dwt.forward_many(
-                                        sc,
-                                        cl,
-                                        ch,
-                                        n,
-                                        BatchRows {
-                                            base: block.cast_const(),
-                                            dist: per_t,
-                                            count,
-                                        },
-                                        BatchRows {
-                                            base: c,
-                                            dist: batch.out_dist,
-                                            count,
-                                        },
-                                        first,
-                                    )
-                                }
-                            }
+                            // SAFETY: this cluster's slots of transform `t`'s lane rows
+                            // (written by the FFT stage or zeroed above, finished); its
+                            // coefficient array is inside the checked output, and this
+                            // cluster's slots' blocks are this task's.
+                            unsafe { m.dwt.forward(sc, cl, (ch, n), block, (c, first, next)) };
                         }
                     });
                     times.dwt += t1.elapsed().as_secs_f64();
