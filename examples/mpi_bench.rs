@@ -6,7 +6,7 @@
 //! `cargo build --release --features mpi --example mpi_bench`
 //! `mpirun --bind-to none -np 2 target/release/examples/mpi_bench B THREADS RUNS`
 
-use so3fft::partial::{mpi_finalize, mpi_init, MpiExchange};
+use so3fft::distributed::{mpi_finalize, mpi_init, MpiExchange};
 use so3fft::{Complex64, DistributedPlan, Exchange, Options, Shape};
 
 fn rnd(state: &mut u64) -> f64 {
