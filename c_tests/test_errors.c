@@ -4,9 +4,6 @@
 
 #include "test_util.h"
 
-/* Test hook exported by the library but kept out of the public header. */
-int so3fft_internal_test_panic(void);
-
 #define SENTINEL 4242.0
 
 static void fill_sentinel(so3fft_complex *a, size_t n) {
@@ -232,17 +229,6 @@ static void bad_arrays(void) {
     free(raw);
 }
 
-static void panics_are_caught(void) {
-    so3fft_plan p;
-    CHECK(so3fft_internal_test_panic() == SO3FFT_EPANIC);
-    CHECK_ERR(SO3FFT_EPANIC);
-    CHECK(strstr(so3fft_last_error(), "panic") != NULL);
-    p = so3fft_plan_both(2, 0);
-    CHECK(p != NULL);
-    CHECK_NO_ERR();
-    so3fft_destroy_plan(p);
-}
-
 int main(void) {
     CHECK(so3fft_last_error_code() == SO3FFT_OK);
     CHECK(so3fft_last_error() != NULL && so3fft_last_error()[0] == '\0');
@@ -250,6 +236,5 @@ int main(void) {
     bad_indices();
     bad_flags_threads_direction();
     bad_arrays();
-    panics_are_caught();
     return finish("test_errors");
 }

@@ -24,7 +24,7 @@
 #![deny(clippy::undocumented_unsafe_blocks)]
 
 mod batch;
-pub mod capi;
+mod capi;
 pub mod distributed;
 mod dwt;
 mod engine;
@@ -43,7 +43,7 @@ mod plan;
 pub mod s2;
 mod shape;
 mod simd;
-pub mod soft;
+mod soft;
 mod symmetry;
 mod system;
 mod transform;

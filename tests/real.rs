@@ -120,7 +120,29 @@ fn real_needs_the_option() {
 /// Checked against the complex path's inverse of the same coefficients.
 #[test]
 fn real_inverse_into_complex_at_odd_b() {
-    use so3fft::capi::*;
+    // The C API as a C program sees it (`include/so3fft.h`); it is not part of the Rust API.
+    #[allow(non_camel_case_types)]
+    type so3fft_complex = [f64; 2];
+    type Plan = *mut std::ffi::c_void;
+    const SO3FFT_BOTH: i32 = 3;
+    const SO3FFT_REAL: u32 = 32;
+    const SO3FFT_OK: i32 = 0;
+    extern "C" {
+        fn so3fft_plan_general(
+            b: i32,
+            direction: i32,
+            input: *mut so3fft_complex,
+            output: *mut so3fft_complex,
+            flags: u32,
+            nthreads: i32,
+        ) -> Plan;
+        fn so3fft_execute_inverse(
+            p: Plan,
+            input: *mut so3fft_complex,
+            out: *mut so3fft_complex,
+        ) -> i32;
+        fn so3fft_destroy_plan(p: Plan);
+    }
     for (b, threads) in [(41usize, 2), (43, 3)] {
         let mut rng = Rng::new(4100 + b as u64);
         let c = random_real_signal_coefs(b, &mut rng);

@@ -1,8 +1,8 @@
 //! Version, the thread-local error state and error descriptions.
 
 use super::{
-    error_code, guarded_code, SO3FFT_EBANDWIDTH, SO3FFT_EDIRECTION, SO3FFT_EFFTW, SO3FFT_EINVAL,
-    SO3FFT_ENOMEM, SO3FFT_ENULL, SO3FFT_EPANIC, SO3FFT_OK,
+    error_code, SO3FFT_EBANDWIDTH, SO3FFT_EDIRECTION, SO3FFT_EFFTW, SO3FFT_EINVAL, SO3FFT_ENOMEM,
+    SO3FFT_ENULL, SO3FFT_EPANIC, SO3FFT_OK,
 };
 use crate::ffi::last_error;
 use std::ffi::{c_char, c_int};
@@ -44,10 +44,26 @@ pub extern "C" fn so3fft_strerror(code: c_int) -> *const c_char {
     s.as_ptr() as *const c_char
 }
 
-/// Test hook (not in the public header): panics inside the boundary, so the C tests can
-/// check that panics become `SO3FFT_EPANIC` instead of crossing into C.
-#[doc(hidden)]
-#[no_mangle]
-pub extern "C" fn so3fft_internal_test_panic() -> c_int {
-    guarded_code(|| panic!("test panic requested by so3fft_internal_test_panic"))
+#[cfg(test)]
+mod tests {
+    use super::super::{guarded_code, SO3FFT_EPANIC, SO3FFT_OK};
+    use super::{so3fft_last_error, so3fft_last_error_code};
+    use std::ffi::CStr;
+
+    /// A panic inside the boundary becomes `SO3FFT_EPANIC` with a message naming it, and
+    /// the next call on the same thread starts clean (the C tests cannot reach this: the
+    /// library has no way to make itself panic on purpose).
+    #[test]
+    fn panics_become_an_error_code() {
+        let code = guarded_code(|| panic!("a test panic"));
+        assert_eq!(code, SO3FFT_EPANIC);
+        assert_eq!(so3fft_last_error_code(), SO3FFT_EPANIC);
+        // SAFETY: the library's error message is a NUL-terminated static or thread-local string.
+        let msg = unsafe { CStr::from_ptr(so3fft_last_error()) }
+            .to_string_lossy()
+            .into_owned();
+        assert!(msg.contains("panic"), "message: {msg}");
+        assert_eq!(guarded_code(|| Ok(())), SO3FFT_OK);
+        assert_eq!(so3fft_last_error_code(), SO3FFT_OK);
+    }
 }

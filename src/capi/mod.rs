@@ -51,51 +51,6 @@ mod wisdom;
 // Version and errors.
 mod errors;
 
-#[doc(hidden)]
-pub use errors::so3fft_internal_test_panic;
-pub use errors::{so3fft_last_error, so3fft_last_error_code, so3fft_strerror, so3fft_version};
-pub use execute::{so3fft_execute, so3fft_execute_forward, so3fft_execute_inverse};
-pub use grid::{
-    so3fft_alpha, so3fft_beta, so3fft_coef_index, so3fft_gamma, so3fft_max_bandwidth,
-    so3fft_num_coeffs, so3fft_num_samples, so3fft_sample_index, so3fft_weights,
-};
-pub use matching::{
-    so3fft_correlate, so3fft_correlate_real, so3fft_correlation, so3fft_correlation_grid_size,
-    so3fft_correlation_refine, so3fft_correlation_s, so3fft_destroy_correlation,
-    so3fft_grid_argmax, so3fft_grid_argmax_real, so3fft_plan_correlation, SO3FFT_NORMALIZED,
-};
-pub use partial::{
-    so3fft_destroy_partial, so3fft_partial, so3fft_partial_forward, so3fft_partial_forward_many,
-    so3fft_partial_forward_real, so3fft_partial_forward_real_many, so3fft_partial_inverse,
-    so3fft_partial_inverse_many, so3fft_partial_inverse_real, so3fft_partial_inverse_real_many,
-    so3fft_partial_num_coeffs, so3fft_partial_num_samples, so3fft_partial_options,
-    so3fft_partial_s, so3fft_plan_partial, so3fft_shape, so3fft_shape_check,
-    so3fft_shape_coef_index, so3fft_shape_default, so3fft_shape_num_coeffs,
-    so3fft_shape_num_samples,
-};
-pub use planner::{
-    so3fft_destroy_plan, so3fft_plan_both, so3fft_plan_forward, so3fft_plan_general,
-    so3fft_plan_inverse, so3fft_plan_with_fft_threading, so3fft_plan_with_max_workspace,
-    so3fft_plan_with_nthreads, so3fft_planner_fft_threading, so3fft_planner_max_workspace,
-    so3fft_planner_nthreads,
-};
-pub use query::{
-    so3fft_get_bandwidth, so3fft_get_fft_threading, so3fft_get_memory, so3fft_get_nthreads,
-    so3fft_plan_memory,
-};
-pub use s2::{
-    so3fft_destroy_s2_plan, so3fft_plan_s2, so3fft_plan_s2_limited, so3fft_s2_coef_index,
-    so3fft_s2_execute_forward, so3fft_s2_execute_forward_many, so3fft_s2_execute_forward_real,
-    so3fft_s2_execute_forward_real_many, so3fft_s2_execute_inverse, so3fft_s2_execute_inverse_many,
-    so3fft_s2_execute_inverse_real, so3fft_s2_execute_inverse_real_many, so3fft_s2_get_bandwidth,
-    so3fft_s2_num_coeffs, so3fft_s2_num_samples, so3fft_s2_plan, so3fft_s2_plan_s,
-    SO3FFT_S2_MAX_BANDWIDTH,
-};
-pub use wisdom::{
-    so3fft_export_wisdom_to_filename, so3fft_export_wisdom_to_string, so3fft_forget_wisdom,
-    so3fft_import_wisdom_from_filename, so3fft_import_wisdom_from_string,
-};
-
 use crate::ffi::last_error::LastErrorSink;
 use crate::ffi::{boundary, CallError, ErrorKind};
 use crate::{Direction, Plan, Rigor, MAX_BANDWIDTH};
@@ -128,6 +83,7 @@ pub const SO3FFT_MAX_BANDWIDTH: c_int = 2048;
 const _: () = assert!(SO3FFT_MAX_BANDWIDTH as usize == MAX_BANDWIDTH);
 
 /// Planner flag: heuristic FFTW plans, no measurement (the default, 0).
+#[allow(dead_code)] // for the header: the default is the absence of the other flags
 pub const SO3FFT_ESTIMATE: c_uint = 0;
 /// Planner flag: FFTW measures a few candidate plans (on so3fft's own scratch memory).
 pub const SO3FFT_MEASURE: c_uint = 1;

@@ -52,27 +52,6 @@ mod s2;
 mod so3;
 mod tables;
 
-pub use correlate::{seanindex, seanindex2, so3CombineCoef_fftw};
-pub use index::{
-    coefLoc_so3, howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3,
-};
-pub use matching::softFFTWCor2;
-pub use rotate::{rotateCoefAll, rotateFctFFTW, rotateFctFFTWS, rotateFctFFTWS_mem, s2RotateFFTW};
-pub use s2::{
-    transpose, vec_add, vec_mul, vec_pt_mul, ArcCosEvalPts, CosPmlTableGen, EvalPts, FST_semi_fly,
-    FST_semi_memo, InvFST_semi_fly, InvFST_semi_memo, L2_an, L2_cn, Naive_AnalysisX,
-    Naive_SynthesizeX, NewTableOffset, PmlTableGen, Pmm_L2, Reduced_Naive_TableSize,
-    Reduced_SpharmonicTableSize, RowSize, SemiNaive_Naive_Pml_Table, Spharmonic_Pml_Table,
-    Spharmonic_TableSize, TableSize, Transpose_CosPmlTableGen, Transpose_RowSize,
-    Transpose_SemiNaive_Naive_Pml_Table, Transpose_Spharmonic_Pml_Table,
-};
-pub use so3::{
-    Forward_SO3_Naive_fftw, Forward_SO3_Naive_fftw_W, Forward_SO3_Naive_fftw_nt,
-    Forward_SO3_Naive_fftw_pc, Inverse_SO3_Naive_fftw, Inverse_SO3_Naive_fftw_W,
-    Inverse_SO3_Naive_fftw_nt, Inverse_SO3_Naive_fftw_pc,
-};
-pub use tables::{genWigAll, genWigAllTrans, makeweights, makeweights2};
-
 use crate::ffi::{boundary, CallError, ErrorSink};
 use std::ffi::{c_double, c_int};
 use std::io::Write;
@@ -138,7 +117,8 @@ pub extern "C" fn csecond() -> c_double {
 
 #[cfg(test)]
 mod tests {
-    use super::{howMany_so3, numCoeffs_so3, sampLoc_so3, seanindex, so3CoefLoc, totalCoeffs_so3};
+    use super::correlate::seanindex;
+    use super::index::{howMany_so3, numCoeffs_so3, sampLoc_so3, so3CoefLoc, totalCoeffs_so3};
 
     #[test]
     fn index_functions() {

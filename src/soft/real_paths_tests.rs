@@ -5,7 +5,14 @@
 //! per-thread counter of the real paths taken ([`REAL_PATHS`]) and by results only the
 //! complex transform gives.
 
+use super::correlate::so3CombineCoef_fftw;
 use super::real::{parity, real_primary_pairs, REAL_PATHS};
+use super::s2::FST_semi_memo;
+use super::so3::{
+    Forward_SO3_Naive_fftw, Forward_SO3_Naive_fftw_W, Forward_SO3_Naive_fftw_nt,
+    Forward_SO3_Naive_fftw_pc, Inverse_SO3_Naive_fftw, Inverse_SO3_Naive_fftw_W,
+    Inverse_SO3_Naive_fftw_nt, Inverse_SO3_Naive_fftw_pc,
+};
 use super::*;
 use crate::grid::{block_start, coef_index};
 use crate::s2::s2_coef_index;

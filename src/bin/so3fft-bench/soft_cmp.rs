@@ -7,8 +7,8 @@
 //! allocated at the sizes SOFT documents (the layer does not touch them).
 
 use crate::workload::{median, random_coeffs};
-use so3fft::soft;
 use so3fft::{Complex64, Options, Plan, Rigor};
+use std::ffi::c_void;
 use std::fmt::Write as _;
 use std::os::raw::c_int;
 use std::time::Instant;
@@ -35,6 +35,34 @@ fn time_median(runs: usize, mut call: impl FnMut()) -> f64 {
 
 /// SOFT's complex type, `double[2]`.
 type SoftComplex = [f64; 2];
+
+// The SOFT entry points the library exports, called as a SOFT client calls them (they are
+// not part of the Rust API).
+extern "C" {
+    fn makeweights2(bw: c_int, w: *mut f64);
+    #[allow(clippy::too_many_arguments)]
+    fn Forward_SO3_Naive_fftw(
+        bw: c_int,
+        data: *mut SoftComplex,
+        coeffs: *mut SoftComplex,
+        workspace_cx: *mut SoftComplex,
+        workspace_cx2: *mut SoftComplex,
+        workspace_re: *mut f64,
+        weights: *mut f64,
+        p1: *mut c_void,
+        flag: c_int,
+    );
+    fn Inverse_SO3_Naive_fftw(
+        bw: c_int,
+        coeffs: *mut SoftComplex,
+        data: *mut SoftComplex,
+        workspace_cx: *mut SoftComplex,
+        workspace_cx2: *mut SoftComplex,
+        workspace_re: *mut f64,
+        p1: *mut c_void,
+        flag: c_int,
+    );
+}
 
 /// `v` as a SOFT complex array (`Complex64` has the same layout).
 fn as_soft(v: &mut [Complex64]) -> *mut SoftComplex {
@@ -79,9 +107,9 @@ pub fn compare(b: usize, runs: usize) -> Result<Vec<SoftRow>, so3fft::Error> {
     // SAFETY: every array has the size SOFT documents; the plan argument may be NULL
     // for this layer (it never executes client plans).
     unsafe {
-        soft::makeweights2(bandwidth, weights.as_mut_ptr());
+        makeweights2(bandwidth, weights.as_mut_ptr());
         let mut fwd = |flag: c_int| {
-            soft::Forward_SO3_Naive_fftw(
+            Forward_SO3_Naive_fftw(
                 bandwidth,
                 as_soft(&mut samples),
                 as_soft(&mut coeffs_out),
@@ -97,7 +125,7 @@ pub fn compare(b: usize, runs: usize) -> Result<Vec<SoftRow>, so3fft::Error> {
         let forward_complex = time_median(runs, || fwd(0));
         let forward_real = time_median(runs, || fwd(1));
         let mut inv = |flag: c_int| {
-            soft::Inverse_SO3_Naive_fftw(
+            Inverse_SO3_Naive_fftw(
                 bandwidth,
                 as_soft(&mut coeffs),
                 as_soft(&mut samples_out),

@@ -15,15 +15,6 @@ mod primitive;
 mod tables;
 mod transforms;
 
-pub use primitive::{
-    transpose, vec_add, vec_mul, vec_pt_mul, ArcCosEvalPts, EvalPts, L2_an, L2_cn, Naive_AnalysisX,
-    Naive_SynthesizeX, Pmm_L2,
-};
-pub use tables::{
-    CosPmlTableGen, NewTableOffset, PmlTableGen, Reduced_Naive_TableSize,
-    Reduced_SpharmonicTableSize, RowSize, SemiNaive_Naive_Pml_Table, Spharmonic_Pml_Table,
-    Spharmonic_TableSize, TableSize, Transpose_CosPmlTableGen, Transpose_RowSize,
-    Transpose_SemiNaive_Naive_Pml_Table, Transpose_Spharmonic_Pml_Table,
-};
 pub(in crate::soft) use transforms::s2_plan_for;
-pub use transforms::{FST_semi_fly, FST_semi_memo, InvFST_semi_fly, InvFST_semi_memo};
+#[cfg(test)]
+pub(in crate::soft) use transforms::FST_semi_memo;
