@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every test: the Rust suite (unit, integration, doc tests), the C/C++ suite under CTest
+# Every test: the Rust suite (unit, integration, doc tests; the library and the tools), the C/C++ suite under CTest
 # (C API, SOFT compatibility layer, installed-package tests, valgrind runs, and the
 # distributed plans under mpirun on 1..4 ranks: label `mpi`), and the Rust MPI test
 # (tests/mpi.rs, feature `mpi`).
@@ -11,7 +11,7 @@ if ! command -v mpirun >/dev/null || ! command -v mpicc >/dev/null; then
        "(scripts/install-deps.sh installs Open MPI)" >&2
   exit 1
 fi
-cargo test --release
+cargo test --release --workspace
 if [ -f CMakeLists.txt ]; then
   # SO3FFT_MPI=ON: libso3fft is built with the feature `mpi` (into target/mpi, apart from
   # cargo test's target/release), every C test runs on that library, plus the mpi tests.

@@ -310,15 +310,24 @@ pub fn random_real_signal_coefs(b: usize, rng: &mut Rng) -> Vec<Complex64> {
 // ---------------------------------------------------------------------------------------------
 // Test data
 // ---------------------------------------------------------------------------------------------
+/// The repository's root: this module is compiled into the library's tests and into the
+/// tools package's (`tools/`), whose manifest directory is one level down.
+pub fn repository_dir() -> PathBuf {
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    if manifest.join("tests").join("data").is_dir() {
+        manifest
+    } else {
+        manifest.join("..")
+    }
+}
+
 pub fn testdata_dir() -> PathBuf {
     if let Ok(d) = std::env::var("SO3FFT_TESTDATA") {
         if !d.is_empty() {
             return PathBuf::from(d);
         }
     }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests")
-        .join("data")
+    repository_dir().join("tests").join("data")
 }
 
 fn num<T: std::str::FromStr>(tok: &str, path: &std::path::Path, lineno: usize, line: &str) -> T {
@@ -494,7 +503,7 @@ impl std::ops::Index<&str> for S2Reference {
 
 /// Reads `tests/data/s2/<name>`.
 pub fn read_s2_reference(name: &str) -> S2Reference {
-    let path = format!("{}/tests/data/s2/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/tests/data/s2/{name}", repository_dir().display());
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let mut out = S2Reference {
         scalars: Default::default(),

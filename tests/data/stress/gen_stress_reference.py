@@ -4,7 +4,7 @@
 Everything is computed from the definitions in docs/conventions.md with mpmath at 40 digits,
 independently of so3fft, then rounded once to double. Inputs (coefficients or samples) are not
 stored: both sides draw them from the same tiny PRNG (splitmix64, below; the Rust side is
-src/bin/so3fft-stress/rng.rs), so the files hold only outputs and stay small.
+tools/src/bin/so3fft-stress/rng.rs), so the files hold only outputs and stay small.
 
 Usage: python3 gen_stress_reference.py [outdir]     (deterministic; about 4 minutes on one core)
 

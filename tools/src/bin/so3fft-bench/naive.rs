@@ -295,7 +295,7 @@ mod tests {
     fn matches_reference_csv() {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/tests/data/wigner_d_reference.csv"
+            "/../tests/data/wigner_d_reference.csv"
         );
         let Ok(text) = std::fs::read_to_string(path) else {
             eprintln!("{path} not found: skipped");

@@ -17,7 +17,7 @@ pub const POLES_BANDWIDTHS: [usize; 3] = [4, 8, 16];
 
 /// The reference data directory of the source tree.
 pub fn default_data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/stress")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/stress")
 }
 
 /// Every instruction set this CPU runs, best first.

@@ -1,6 +1,7 @@
 //! The `so3fft-match` tool: a reference correlation recovered from sample files, and bad
 //! files rejected with the file and line named and exit status 2.
 
+#[path = "../../tests/common/mod.rs"]
 mod common;
 
 use std::path::PathBuf;
