@@ -1,5 +1,5 @@
 //! The quick subset of the stress suite (`so3fft-stress`, docs/stability.md) as assertions:
-//! exact reference values, round trips and Parseval against the targets of issue 23, exact
+//! exact reference values, round trips and Parseval against the accuracy targets, exact
 //! scaling by powers of two, subnormal and NaN / Inf inputs, determinism across thread
 //! counts, and every instruction set. The suite's modules are compiled in from the binary.
 

@@ -239,7 +239,7 @@ impl Lean<'_> {
         let error = seeded::compare_complex(self.seed(), coeffs);
         let row = self.row(variant, plan, RoundTrip { inverse, forward }, error);
         eprintln!(
-            "  ({}: compared in {:.1} s; {}; issue limit 1.05)",
+            "  ({}: compared in {:.1} s; {}; target 1.05)",
             variant.name(),
             t.elapsed().as_secs_f64(),
             memory_summary(

@@ -1,4 +1,4 @@
-//! `so3fft-stress`: the numerical stress suite of so3fft (issue 23).
+//! `so3fft-stress`: the numerical stress suite of so3fft.
 //!
 //! Tests, each a module:
 //! - (a) `reference`: transforms against exact values (40-digit sums in
@@ -48,7 +48,7 @@ usage: so3fft-stress [--quick] [--big] [--threads N] [--only LIST] [--data DIR]
   --time-svg FILE  write the time-against-error plot
   --docs DIR   write DIR/stability.csv, stability.svg, time-vs-error.svg and the tables of
                DIR/stability.md (between its stress-table markers)
-exit status: 0 if every target of issue 23 that the run covers is met, 1 if one is missed,
+exit status: 0 if every accuracy target that the run covers is met, 1 if one is missed,
 2 on bad arguments or a failed transform";
 
 /// Command-line options.
@@ -246,7 +246,7 @@ fn main() -> ExitCode {
         record::growth_table(&growths)
     );
     let summary = targets::evaluate(&report.rows, o.big);
-    println!("targets of issue 23:\n{}", summary.text());
+    println!("accuracy targets:\n{}", summary.text());
     println!("total {:.1} s", start.elapsed().as_secs_f64());
     if let Err(msg) = write_outputs(&o, &report, &summary) {
         eprintln!("so3fft-stress: {msg}");

@@ -1,5 +1,5 @@
-//! The targets of issue 23, checked against the rows of a run, and the Markdown tables of
-//! `docs/stability.md`.
+//! The stress suite's accuracy targets, checked against the rows of a run, and the Markdown
+//! tables of `docs/stability.md`.
 
 use crate::record::{Growth, Report, Row};
 use std::fmt::Write as _;
@@ -241,7 +241,7 @@ fn fmt_value(v: f64) -> String {
 /// The Markdown of the targets, the growth exponents and every row.
 pub fn markdown(report: &Report, growths: &[Growth], summary: &Summary) -> String {
     let mut out =
-        String::from("### Targets of issue 23\n\n| target | status | measured |\n|---|---|---|\n");
+        String::from("### Accuracy targets\n\n| target | status | measured |\n|---|---|---|\n");
     for t in &summary.targets {
         let _ = writeln!(
             out,
