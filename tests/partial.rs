@@ -211,8 +211,9 @@ fn other_grids_against_direct_summation() {
     }
 }
 
-/// A batch gives bitwise the results of single executes (the batched kernels share each
-/// cluster's recurrence among the transforms of a group).
+/// A batch gives bitwise the results of single executes (the batched inverse kernel shares
+/// each cluster's recurrence among the transforms of a group; the forward runs the single
+/// kernel per transform with the next one's rows prefetched), and round trips.
 #[test]
 fn batches_equal_single_executes() {
     // A small cap: chunks of one pair, groups of one transform; the default: one of each.

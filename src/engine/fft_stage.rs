@@ -173,8 +173,6 @@ impl TwoWay {
     }
 }
 
-/// A worker's buffers, each made on first use: the inverse's (whose columns outside
-/// `|M'| <= N` stay zero), the forward's, and the real transforms' half spectra.
 /// The work buffers of a slice and its mirror.
 pub(crate) type BufPair<'a> = (&'a mut [Complex64], &'a mut [Complex64]);
 
@@ -536,12 +534,6 @@ impl FftStage {
         }
     }
 
-    /// Real forward of the `na ng` reals at `inp`: rows `r2c` into `w` (the half buffer),
-    /// then its columns `0..=N` over alpha with sign -1.
-    ///
-    /// # Safety
-    /// `inp` valid for reads of `na ng` doubles; the plan is real; `w` is
-    /// [`FftStage::half_buf`]'s.
     /// [`FftStage::forward_real`] of the real parts of the `na ng` complex values at `inp`
     /// (the imaginary parts are not read), through `reals` (`na ng` doubles, page-aligned).
     ///
@@ -561,6 +553,12 @@ impl FftStage {
         unsafe { self.forward_real(w, reals.as_ptr()) };
     }
 
+    /// Real forward of the `na ng` reals at `inp`: rows `r2c` into `w` (the half buffer),
+    /// then its columns `0..=N` over alpha with sign -1.
+    ///
+    /// # Safety
+    /// `inp` valid for reads of `na ng` doubles; the plan is real; `w` is
+    /// [`FftStage::half_buf`]'s.
     pub unsafe fn forward_real(&self, w: &mut [Complex64], inp: *const f64) {
         let r = self.real.as_ref().expect("real plans");
         let w = w.as_mut_ptr();

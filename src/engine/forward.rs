@@ -24,27 +24,22 @@ impl Engine {
         work: &'a mut Work,
         inp: &[Data],
     ) -> Result<BufPair<'a>> {
-        let (w0, w1) = match inp[0] {
-            Data::Complex(_) => self.fft.fwd_pair(work)?,
-            Data::Real(_) => self.fft.half_pair(work)?,
+        let ((w0, w1), mut reals) = match inp[0] {
+            Data::Complex(_) => (self.fft.fwd_pair(work)?, None),
+            Data::Real(_) => (self.fft.half_pair(work)?, None),
             Data::RealParts(_) => {
-                let ((w0, w1), reals) = self.fft.half_pair_reals(work)?;
-                for (w, i) in [&mut *w0, &mut *w1].into_iter().zip(inp) {
-                    if let Data::RealParts(i) = i {
-                        // SAFETY: the caller's contract; the buffers are this worker's.
-                        unsafe { self.fft.forward_real_parts((w, &mut *reals), i.get()) };
-                    }
-                }
-                return Ok((w0, w1));
+                let (pair, reals) = self.fft.half_pair_reals(work)?;
+                (pair, Some(reals))
             }
         };
         for (w, i) in [&mut *w0, &mut *w1].into_iter().zip(inp) {
             // SAFETY: the caller's contract; the buffers are this worker's.
             unsafe {
-                match i {
-                    Data::Complex(i) => self.fft.forward(w, i.get()),
-                    Data::Real(i) => self.fft.forward_real(w, i.get()),
-                    Data::RealParts(_) => unreachable!("one kind per call"),
+                match (i, reals.as_deref_mut()) {
+                    (Data::Complex(i), _) => self.fft.forward(w, i.get()),
+                    (Data::Real(i), _) => self.fft.forward_real(w, i.get()),
+                    (Data::RealParts(i), Some(r)) => self.fft.forward_real_parts((w, r), i.get()),
+                    (Data::RealParts(_), None) => unreachable!("one kind per call"),
                 }
             }
         }

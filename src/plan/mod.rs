@@ -8,7 +8,7 @@ mod tests;
 mod transform;
 
 use crate::error::{Error, Result};
-use crate::grid::{num_coeffs, num_samples, MAX_BANDWIDTH};
+use crate::grid::MAX_BANDWIDTH;
 use crate::options::{Direction, FftThreading, Options};
 use crate::partial::PartialPlan;
 use crate::shape::Shape;
@@ -24,8 +24,6 @@ use num_complex::Complex64;
 /// on different arrays (a concurrent call that finds the chunk buffer busy allocates its
 /// own; the `*_with_scratch` calls of [`Transform`](crate::Transform) never do).
 pub struct Plan {
-    /// The bandwidth `B`.
-    b: usize,
     /// The engine's full shape of `B`.
     engine: PartialPlan,
 }
@@ -44,7 +42,6 @@ impl Plan {
     ) -> Result<Plan> {
         let shape = Plan::shape(bandwidth)?;
         Ok(Plan {
-            b: bandwidth,
             engine: PartialPlan::new_on(&shape, &Plan::engine_options(options), shared)?,
         })
     }
@@ -86,7 +83,7 @@ impl Plan {
 
     /// The bandwidth `B`.
     pub fn bandwidth(&self) -> usize {
-        self.b
+        self.engine.shape().degree_limit
     }
 
     /// Number of worker threads.
@@ -112,12 +109,12 @@ impl Plan {
 
     /// `(2B)^3`.
     pub fn num_samples(&self) -> usize {
-        num_samples(self.b)
+        self.engine.num_samples()
     }
 
     /// `(4B^3 - B)/3`.
     pub fn num_coeffs(&self) -> usize {
-        num_coeffs(self.b)
+        self.engine.num_coeffs()
     }
 
     /// Bytes of memory the plan holds, all made with the plan: the chunk buffer
