@@ -1,9 +1,17 @@
-/* A minimal downstream program: inverse and forward transform of one coefficient. */
+/* A minimal downstream program: inverse and forward transform of one coefficient. It defines
+ * functions named like SOFT's (transpose, csecond), as numerical codes often do: libso3fft must
+ * neither clash with them in a static link nor replace them. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include <so3fft.h>
+
+/* Not SOFT's signatures: the program's own functions that happen to share the names. */
+int transpose(int x);
+double csecond(void);
+int transpose(int x) { return 7 * x; }
+double csecond(void) { return 42.0; }
 
 int main(void) {
     const int B = 8;
@@ -15,6 +23,10 @@ int main(void) {
     double err = 0.0;
     ptrdiff_t k = so3fft_coef_index(B, 3, -1, 2);
 
+    if (transpose(3) != 21 || csecond() != 42.0) {
+        fprintf(stderr, "the program's own transpose or csecond was replaced\n");
+        return EXIT_FAILURE;
+    }
     if (!coeffs || !samples || !back || k < 0) return EXIT_FAILURE;
     for (i = 0; i < nc; i++) coeffs[i][0] = coeffs[i][1] = 0.0;
     coeffs[k][0] = 1.0;

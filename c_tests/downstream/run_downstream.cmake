@@ -8,7 +8,8 @@
 #                   soft/... and as soft20/...
 #   KIND=pkgconfig  `pkg-config --cflags --libs so3fft` (shared) and
 #                   `pkg-config --static --cflags --libs so3fft` with -static (fully static;
-#                   with MPI only libso3fft.a is static: Debian ships no static libmpi).
+#                   with MPI only libso3fft.a is static: Debian ships no static libmpi); the
+#                   same for a SOFT client with so3fft-soft.
 #   KIND=mpi        an MPI program (mpi/main.c) built by a CMake project linking so3fft::mpi
 #                   and with `pkg-config --cflags --libs so3fft-mpi`, each run on 2 ranks.
 # Inputs: KIND, BUILD_DIR, WORK_DIR, SOURCE_DIR, C_COMPILER, GENERATOR; for a build with
@@ -78,6 +79,10 @@ elseif(KIND STREQUAL "soft20")
       -DCMAKE_BUILD_TYPE=Release)
   run("${CMAKE_COMMAND}" --build "${WORK_DIR}/build")
   run("${CMAKE_CTEST_COMMAND}" --test-dir "${WORK_DIR}/build" --output-on-failure)
+  # The static programs do not need the installed tree any more.
+  file(RENAME "${prefix}" "${WORK_DIR}/gone")
+  run("${WORK_DIR}/build/soft20_client_static")
+  run("${WORK_DIR}/build/both_static")
   message(STATUS "downstream soft20 client: OK")
 elseif(KIND STREQUAL "pkgconfig")
   find_program(PKG_CONFIG pkg-config REQUIRED)
@@ -95,6 +100,18 @@ elseif(KIND STREQUAL "pkgconfig")
       ${flags} -lm "-Wl,-rpath,${pc_libdir}")
   run("${WORK_DIR}/use_pc_shared")
 
+  # A SOFT client on the SOFT library alone: the linker and the loader find libso3fft.so.0
+  # next to libso3fft_soft.so (its RUNPATH), with nothing about it on the link line.
+  capture(soft_flags "${PKG_CONFIG}" --cflags --libs so3fft-soft)
+  message(STATUS "pkg-config --cflags --libs so3fft-soft: ${soft_flags}")
+  separate_arguments(soft_flags UNIX_COMMAND "${soft_flags}")
+  run("${C_COMPILER}" -Wall -Wextra -Werror "${SOURCE_DIR}/soft20/main.c"
+      -o "${WORK_DIR}/use_pc_soft_shared" ${soft_flags} "-Wl,-rpath,${pc_libdir}")
+  run("${WORK_DIR}/use_pc_soft_shared")
+  capture(soft_sflags "${PKG_CONFIG}" --static --cflags --libs so3fft-soft)
+  message(STATUS "pkg-config --static --cflags --libs so3fft-soft: ${soft_sflags}")
+  separate_arguments(soft_sflags UNIX_COMMAND "${soft_sflags}")
+
   # Fully static program: -static makes the linker take libso3fft.a and the static FFTW.
   capture(sflags "${PKG_CONFIG}" --static --cflags --libs so3fft)
   message(STATUS "pkg-config --static --cflags --libs so3fft: ${sflags}")
@@ -107,8 +124,11 @@ elseif(KIND STREQUAL "pkgconfig")
   endif()
   run("${C_COMPILER}" -Wall -Wextra -Werror ${static} "${SOURCE_DIR}/main.c"
       -o "${WORK_DIR}/use_pc_static" ${sflags} -lm)
+  run("${C_COMPILER}" -Wall -Wextra -Werror ${static} "${SOURCE_DIR}/soft20/main.c"
+      -o "${WORK_DIR}/use_pc_soft_static" ${soft_sflags})
   file(RENAME "${prefix}" "${WORK_DIR}/gone")
   run("${WORK_DIR}/use_pc_static")
+  run("${WORK_DIR}/use_pc_soft_static")
   message(STATUS "pkg-config: OK")
 elseif(KIND STREQUAL "mpi")
   file(GLOB_RECURSE mpi_pcfile "${prefix}/*/so3fft-mpi.pc")

@@ -7,7 +7,7 @@
  * authors.
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
- * Link with so3fft (pkg-config so3fft-soft, or CMake target so3fft::soft).
+ * Link with libso3fft_soft (-lso3fft_soft; pkg-config so3fft-soft; CMake so3fft::soft).
  *
  * The sizes are SOFT's. The transforms of so3fft never read a table (any table, or NULL, may
  * be passed to them). Naive tables (orders m >= cutoff, and PmlTableGen) hold the normalised

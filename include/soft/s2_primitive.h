@@ -6,7 +6,7 @@
  * authors.
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
- * Link with so3fft (pkg-config so3fft-soft, or CMake target so3fft::soft).
+ * Link with libso3fft_soft (-lso3fft_soft; pkg-config so3fft-soft; CMake so3fft::soft).
  * Nodes are computed with the exact pi (SOFT's library uses a 15-digit one).
  */
 #ifndef SO3FFT_SOFT_S2_PRIMITIVE_H

@@ -6,7 +6,7 @@
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
  * Include <fftw3.h> before this header, as with SOFT (it is included here if it was not).
- * Link with so3fft (pkg-config so3fft-soft, or CMake target so3fft::soft).
+ * Link with libso3fft_soft (-lso3fft_soft; pkg-config so3fft-soft; CMake so3fft::soft).
  */
 #ifndef SO3FFT_SOFT_SOFT_FFTW_H
 #define SO3FFT_SOFT_SOFT_FFTW_H

@@ -33,7 +33,7 @@ fn negative_order_index(m: i64, l: i64, b: i64) -> i64 {
 /// spherical harmonics); -1 if `|m| > l` or `l >= bw`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_seanindex"]
 pub extern "C" fn seanindex(m: c_int, l: c_int, bw: c_int) -> c_int {
     guarded("seanindex", -1, || {
         soft_bandwidth(bw.into())?;
@@ -52,7 +52,7 @@ pub extern "C" fn seanindex(m: c_int, l: c_int, bw: c_int) -> c_int {
 /// the end of the array). Nothing is written if `|m| > l`, `l >= bw` or `loc` is NULL.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_seanindex2"]
 pub unsafe extern "C" fn seanindex2(m: c_int, l: c_int, bw: c_int, loc: *mut c_int) {
     guarded("seanindex2", (), || {
         soft_bandwidth(bw.into())?;
@@ -90,7 +90,7 @@ pub unsafe extern "C" fn seanindex2(m: c_int, l: c_int, bw: c_int, loc: *mut c_i
 /// order pairs and fill the others by the SO(3) symmetry: the same numbers.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_so3CombineCoef_fftw"]
 pub unsafe extern "C" fn so3CombineCoef_fftw(
     bwIn: c_int,
     bwOut: c_int,

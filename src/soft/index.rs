@@ -10,7 +10,7 @@ use std::ffi::c_int;
 /// `1..=2048` or the value does not fit in an `int`, from `bw = 1173`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_totalCoeffs_so3"]
 pub extern "C" fn totalCoeffs_so3(bw: c_int) -> c_int {
     guarded("totalCoeffs_so3", -1, || {
         let b = i128::from(soft_bandwidth(bw.into())?);
@@ -24,7 +24,7 @@ pub extern "C" fn totalCoeffs_so3(bw: c_int) -> c_int {
 /// bandwidth is outside `1..=2048` or the order's magnitude exceeds it.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_numCoeffs_so3"]
 pub extern "C" fn numCoeffs_so3(bw: c_int, m1: c_int) -> c_int {
     guarded("numCoeffs_so3", -1, || {
         let (x, y) = (i64::from(bw), i64::from(m1));
@@ -42,7 +42,7 @@ pub extern "C" fn numCoeffs_so3(bw: c_int, m1: c_int) -> c_int {
 /// is outside `1..=2048` or `max(|m1|, |m2|) >= bw` (no such block).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_howMany_so3"]
 pub extern "C" fn howMany_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
     guarded("howMany_so3", -1, || {
         let b = soft_bandwidth(bw.into())?;
@@ -63,7 +63,7 @@ pub extern "C" fn howMany_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
 /// fit in an `int` (orders `(-1, -1)` from `bw = 646`, `(bw-1, bw-1)` from `bw = 813`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_sampLoc_so3"]
 pub extern "C" fn sampLoc_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
     guarded("sampLoc_so3", -1, || {
         let n = 2 * i128::from(soft_bandwidth(bw.into())?);
@@ -94,7 +94,7 @@ fn coef_loc(m: c_int, mp: c_int, l: c_int, bw: c_int) -> SoftResult<i64> {
 /// -1 if `max(|m1|,|m2|) >= bw`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_coefLoc_so3"]
 pub extern "C" fn coefLoc_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
     guarded("coefLoc_so3", -1, || {
         let l = (m1 as i64).abs().max((m2 as i64).abs());
@@ -108,7 +108,7 @@ pub extern "C" fn coefLoc_so3(m1: c_int, m2: c_int, bw: c_int) -> c_int {
 /// array of bandwidth `bw` (docs/conventions.md, sample and coefficient layout); -1 if the coefficient does not exist.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_so3CoefLoc"]
 pub extern "C" fn so3CoefLoc(m: c_int, mp: c_int, l: c_int, bw: c_int) -> c_int {
     guarded("so3CoefLoc", -1, || to_int(coef_loc(m, mp, l, bw)?))
 }

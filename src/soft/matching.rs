@@ -17,7 +17,7 @@ use std::ffi::{c_double, c_int};
 /// modified; on invalid input one line is printed and the angles are not written.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_softFFTWCor2"]
 pub unsafe extern "C" fn softFFTWCor2(
     bw: c_int,
     sig: *mut c_double,

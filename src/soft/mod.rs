@@ -7,6 +7,12 @@
 //! `s2_primitive.h`, `s2_legendreTransforms.h`); none of these
 //! functions belongs to the native API in `so3fft.h` (every item carries `cbindgen:ignore`).
 //!
+//! **Symbol names.** Each function is exported as `so3fft_soft_<SOFT name>`, a private name
+//! declared in no header, so libso3fft defines nothing but `so3fft_*`. SOFT's own names live in
+//! libso3fft_soft: `soft_names.c` in this directory, one forwarder per function, compiled by
+//! CMake against the headers. A new entry point needs its line there and in
+//! `c_tests/soft/soft_symbols.txt` (the symbol test checks both lists).
+//!
 //! Behaviour shared by all transform entry points:
 //!
 //! - **Plans.** One [`Plan`](crate::Plan) per bandwidth is created on first use and cached for the life of
@@ -107,7 +113,7 @@ fn soft_bandwidth(bw: i64) -> SoftResult<i64> {
 /// meaningful measure.)
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_csecond"]
 pub extern "C" fn csecond() -> c_double {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)

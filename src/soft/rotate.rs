@@ -101,7 +101,7 @@ unsafe fn split(values: &[Complex64], re: *mut c_double, im: *mut c_double) {
 /// into `sigOut`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_s2RotateFFTW"]
 pub unsafe extern "C" fn s2RotateFFTW(
     bw: c_int,
     sigIn: *mut c_double,
@@ -150,7 +150,7 @@ pub unsafe extern "C" fn s2RotateFFTW(
 /// not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_rotateFctFFTW"]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn rotateFctFFTW(
     bwIn: c_int,
@@ -184,7 +184,7 @@ pub unsafe extern "C" fn rotateFctFFTW(
 /// [`rotateFctFFTW`] without scratch and tables.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_rotateFctFFTWS"]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn rotateFctFFTWS(
     bwIn: c_int,
@@ -215,7 +215,7 @@ pub unsafe extern "C" fn rotateFctFFTWS(
 /// [`rotateFctFFTW`] in place at bandwidth `bw` (`sigR/I`, `(2bw)^2` each).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_rotateFctFFTWS_mem"]
 pub unsafe extern "C" fn rotateFctFFTWS_mem(
     bw: c_int,
     degOut: c_int,
@@ -273,7 +273,7 @@ unsafe fn rotate_split(
 /// `scratch` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_rotateCoefAll"]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn rotateCoefAll(
     bwIn: c_int,

@@ -162,7 +162,7 @@ unsafe fn inverse_core(
 /// The workspaces and the plan `p1` are accepted and not used; `data` is not modified.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Forward_SO3_Naive_fftw"]
 pub unsafe extern "C" fn Forward_SO3_Naive_fftw(
     bw: c_int,
     data: *mut FftwComplex,
@@ -191,7 +191,7 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw(
 /// accepted and not used; `coeffs` is not modified.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Inverse_SO3_Naive_fftw"]
 pub unsafe extern "C" fn Inverse_SO3_Naive_fftw(
     bw: c_int,
     coeffs: *mut FftwComplex,
@@ -214,7 +214,7 @@ pub unsafe extern "C" fn Inverse_SO3_Naive_fftw(
 /// [`Forward_SO3_Naive_fftw`]; the table `wigners` (from [`genWigAll`](super::genWigAll)) is not read.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Forward_SO3_Naive_fftw_pc"]
 pub unsafe extern "C" fn Forward_SO3_Naive_fftw_pc(
     bw: c_int,
     data: *mut FftwComplex,
@@ -237,7 +237,7 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw_pc(
 /// [`Inverse_SO3_Naive_fftw`]; the table `wignersTrans` (from [`genWigAllTrans`](super::genWigAllTrans)) is not read.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Inverse_SO3_Naive_fftw_pc"]
 pub unsafe extern "C" fn Inverse_SO3_Naive_fftw_pc(
     bw: c_int,
     coeffs: *mut FftwComplex,
@@ -261,7 +261,7 @@ pub unsafe extern "C" fn Inverse_SO3_Naive_fftw_pc(
 /// [`Forward_SO3_Naive_fftw`]; unlike SOFT's, it does not overwrite `data`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Forward_SO3_Naive_fftw_nt"]
 pub unsafe extern "C" fn Forward_SO3_Naive_fftw_nt(
     bw: c_int,
     data: *mut FftwComplex,
@@ -282,7 +282,7 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw_nt(
 /// [`Inverse_SO3_Naive_fftw`]; `coeffs` is not modified.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Inverse_SO3_Naive_fftw_nt"]
 pub unsafe extern "C" fn Inverse_SO3_Naive_fftw_nt(
     bw: c_int,
     coeffs: *mut FftwComplex,
@@ -303,7 +303,7 @@ pub unsafe extern "C" fn Inverse_SO3_Naive_fftw_nt(
 /// Forward transform that manages its own workspaces and weights (`wrap_fftw.h`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Forward_SO3_Naive_fftw_W"]
 pub unsafe extern "C" fn Forward_SO3_Naive_fftw_W(
     bw: c_int,
     signal: *mut FftwComplex,
@@ -319,7 +319,7 @@ pub unsafe extern "C" fn Forward_SO3_Naive_fftw_W(
 /// Inverse transform that manages its own workspaces (`wrap_fftw.h`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Inverse_SO3_Naive_fftw_W"]
 pub unsafe extern "C" fn Inverse_SO3_Naive_fftw_W(
     bw: c_int,
     coeffs: *mut FftwComplex,

@@ -12,7 +12,7 @@ use std::ffi::{c_double, c_int};
 /// for `j < 2bw` (docs/conventions.md, sample and coefficient layout).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_makeweights"]
 pub unsafe extern "C" fn makeweights(bw: c_int, w: *mut c_double) {
     guarded("makeweights", (), || {
         let b = checks::bandwidth(bw)?;
@@ -33,7 +33,7 @@ pub unsafe extern "C" fn makeweights(bw: c_int, w: *mut c_double) {
 /// forward transforms).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_makeweights2"]
 pub unsafe extern "C" fn makeweights2(bw: c_int, w: *mut c_double) {
     guarded("makeweights2", (), || {
         let b = checks::bandwidth(bw)?;
@@ -113,7 +113,7 @@ unsafe fn gen_wig(bw: c_int, table: *mut c_double, transposed: bool) -> SoftResu
 /// `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_genWigAll"]
 pub unsafe extern "C" fn genWigAll(bw: c_int, wigners: *mut c_double, _workspace: *mut c_double) {
     // SAFETY: `wigners` holds SOFT's table size (the module's safety contract).
     guarded("genWigAll", (), || unsafe { gen_wig(bw, wigners, false) })
@@ -123,7 +123,7 @@ pub unsafe extern "C" fn genWigAll(bw: c_int, wigners: *mut c_double, _workspace
 /// [`genWigAll`], each block transposed (rows `k`, columns `l`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_genWigAllTrans"]
 pub unsafe extern "C" fn genWigAllTrans(
     bw: c_int,
     wigners: *mut c_double,

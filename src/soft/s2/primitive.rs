@@ -13,7 +13,7 @@ use std::ffi::{c_double, c_int};
 /// three-term recurrence `Pt_{l+1}^m(x) = a(m,l) x Pt_l^m(x) + c(m,l) Pt_{l-1}^m(x)`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_L2_an"]
 pub extern "C" fn L2_an(m: c_int, l: c_int) -> c_double {
     let (m, l) = (f64::from(m), f64::from(l));
     ((2.0 * l + 1.0) * (2.0 * l + 3.0) / ((l + 1.0 - m) * (l + 1.0 + m))).sqrt()
@@ -23,7 +23,7 @@ pub extern "C" fn L2_an(m: c_int, l: c_int) -> c_double {
 /// normalised recurrence (see [`L2_an`]); 0 for `l = 0`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_L2_cn"]
 pub extern "C" fn L2_cn(m: c_int, l: c_int) -> c_double {
     if l == 0 {
         return 0.0;
@@ -66,7 +66,7 @@ unsafe fn elementwise(n: usize, result: *mut f64, op: impl Fn(usize) -> f64) {
 /// `result[i] = data1[i] + data2[i]`, `i < n` (`result` may be either input).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_vec_add"]
 pub unsafe extern "C" fn vec_add(
     data1: *mut c_double,
     data2: *mut c_double,
@@ -86,7 +86,7 @@ pub unsafe extern "C" fn vec_add(
 /// `result[i] = scalar data1[i]`, `i < n` (`result` may be `data1`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_vec_mul"]
 pub unsafe extern "C" fn vec_mul(
     scalar: c_double,
     data1: *mut c_double,
@@ -105,7 +105,7 @@ pub unsafe extern "C" fn vec_mul(
 /// `result[i] = data1[i] data2[i]`, `i < n` (`result` may be either input).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_vec_pt_mul"]
 pub unsafe extern "C" fn vec_pt_mul(
     data1: *mut c_double,
     data2: *mut c_double,
@@ -129,7 +129,7 @@ fn node(i: usize, n: usize) -> f64 {
 /// `eval_pts[i] = (2i+1) pi / (2n)`, `i < n` (the colatitudes `theta_j` for `n = 2bw`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_ArcCosEvalPts"]
 pub unsafe extern "C" fn ArcCosEvalPts(n: c_int, eval_pts: *mut c_double) {
     guarded("ArcCosEvalPts", (), || {
         let n = length(n)?;
@@ -143,7 +143,7 @@ pub unsafe extern "C" fn ArcCosEvalPts(n: c_int, eval_pts: *mut c_double) {
 /// `eval_pts[i] = cos((2i+1) pi / (2n))`, `i < n`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_EvalPts"]
 pub unsafe extern "C" fn EvalPts(n: c_int, eval_pts: *mut c_double) {
     guarded("EvalPts", (), || {
         let n = length(n)?;
@@ -166,7 +166,7 @@ fn pmm_norm(m: usize) -> f64 {
 /// angles `t_i = eval_pts[i]`, `i < n` (`result` may be `eval_pts`).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Pmm_L2"]
 pub unsafe extern "C" fn Pmm_L2(
     m: c_int,
     eval_pts: *mut c_double,
@@ -189,7 +189,7 @@ pub unsafe extern "C" fn Pmm_L2(
 /// Transposes the `size x size` matrix `array` in place.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_transpose"]
 pub unsafe extern "C" fn transpose(array: *mut c_double, size: c_int) {
     guarded("transpose", (), || {
         let n = length(size)?;
@@ -227,7 +227,7 @@ fn bw_and_order(bw: c_int, m: c_int) -> SoftResult<(usize, usize)> {
 /// of `SemiNaive_Naive_Pml_Table`). `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Naive_AnalysisX"]
 pub unsafe extern "C" fn Naive_AnalysisX(
     data: *mut c_double,
     bw: c_int,
@@ -271,7 +271,7 @@ pub unsafe extern "C" fn Naive_AnalysisX(
 /// plmtable[(l - m) 2bw + j]` for `j < 2bw` (`plmtable` as for [`Naive_AnalysisX`]).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Naive_SynthesizeX"]
 pub unsafe extern "C" fn Naive_SynthesizeX(
     coeffs: *mut c_double,
     bw: c_int,

@@ -83,7 +83,7 @@ fn bw_and_order(bw: c_int, m: c_int, what: &str) -> SoftResult<(i64, i64)> {
 /// (`sum_{l=m}^{bw-1} RowSize(m, l)`); -1 on invalid arguments.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_TableSize"]
 pub extern "C" fn TableSize(m: c_int, bw: c_int) -> c_int {
     guarded("TableSize", -1, || {
         let (b, m) = bw_and_order(bw, m, "order")?;
@@ -96,7 +96,7 @@ pub extern "C" fn TableSize(m: c_int, bw: c_int) -> c_int {
 /// invalid arguments or when it does not fit in an `int`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Spharmonic_TableSize"]
 pub extern "C" fn Spharmonic_TableSize(bw: c_int) -> c_int {
     guarded("Spharmonic_TableSize", -1, || {
         to_int(spharmonic_size(soft_bandwidth(bw.into())?))
@@ -107,7 +107,7 @@ pub extern "C" fn Spharmonic_TableSize(bw: c_int) -> c_int {
 /// `sum_{i<m} TableSize(i, bw)`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Reduced_SpharmonicTableSize"]
 pub extern "C" fn Reduced_SpharmonicTableSize(bw: c_int, m: c_int) -> c_int {
     guarded("Reduced_SpharmonicTableSize", -1, || {
         let (b, m) = bw_and_order(bw, m, "cutoff")?;
@@ -119,7 +119,7 @@ pub extern "C" fn Reduced_SpharmonicTableSize(bw: c_int, m: c_int) -> c_int {
 /// invalid arguments or when it does not fit in an `int`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Reduced_Naive_TableSize"]
 pub extern "C" fn Reduced_Naive_TableSize(bw: c_int, m: c_int) -> c_int {
     guarded("Reduced_Naive_TableSize", -1, || {
         let (b, m) = bw_and_order(bw, m, "cutoff")?;
@@ -131,7 +131,7 @@ pub extern "C" fn Reduced_Naive_TableSize(bw: c_int, m: c_int) -> c_int {
 /// `sum_{i=m}^{l-1} RowSize(m, i)`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_NewTableOffset"]
 pub extern "C" fn NewTableOffset(m: c_int, l: c_int) -> c_int {
     guarded("NewTableOffset", -1, || {
         let max = crate::MAX_BANDWIDTH as i64;
@@ -144,7 +144,7 @@ pub extern "C" fn NewTableOffset(m: c_int, l: c_int) -> c_int {
 /// `floor(l/2) + 1` for even `m`, `floor((l-1)/2) + 1` for odd `m`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_RowSize"]
 pub extern "C" fn RowSize(m: c_int, l: c_int) -> c_int {
     guarded("RowSize", -1, || {
         let max = crate::MAX_BANDWIDTH as i64;
@@ -158,7 +158,7 @@ pub extern "C" fn RowSize(m: c_int, l: c_int) -> c_int {
 /// (0 for `row >= bw`). The rows sum to `TableSize(m, bw)`.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Transpose_RowSize"]
 pub extern "C" fn Transpose_RowSize(row: c_int, m: c_int, bw: c_int) -> c_int {
     guarded("Transpose_RowSize", -1, || {
         let (b, m) = bw_and_order(bw, m, "order")?;
@@ -199,7 +199,7 @@ fn naive_table(b: usize, m: usize, out: &mut [f64]) {
 /// (`l = m..bw-1`, `j < 2bw`). `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_PmlTableGen"]
 pub unsafe extern "C" fn PmlTableGen(
     bw: c_int,
     m: c_int,
@@ -219,7 +219,7 @@ pub unsafe extern "C" fn PmlTableGen(
 /// transforms of this layer do not read it). `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_CosPmlTableGen"]
 pub unsafe extern "C" fn CosPmlTableGen(
     bw: c_int,
     m: c_int,
@@ -239,7 +239,7 @@ pub unsafe extern "C" fn CosPmlTableGen(
 /// `result` (zeros, as [`CosPmlTableGen`]); `cos_pml_table` is not read.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Transpose_CosPmlTableGen"]
 pub unsafe extern "C" fn Transpose_CosPmlTableGen(
     bw: c_int,
     m: c_int,
@@ -324,7 +324,7 @@ unsafe fn build_table(
 /// NULL on invalid arguments. `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Spharmonic_Pml_Table"]
 pub unsafe extern "C" fn Spharmonic_Pml_Table(
     bw: c_int,
     resultspace: *mut c_double,
@@ -341,7 +341,7 @@ pub unsafe extern "C" fn Spharmonic_Pml_Table(
 /// `spharmonic_pml_table` is not read.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Transpose_Spharmonic_Pml_Table"]
 pub unsafe extern "C" fn Transpose_Spharmonic_Pml_Table(
     _spharmonic_pml_table: *mut *mut c_double,
     bw: c_int,
@@ -367,7 +367,7 @@ pub unsafe extern "C" fn Transpose_Spharmonic_Pml_Table(
 /// arguments. `workspace` is not used.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_SemiNaive_Naive_Pml_Table"]
 pub unsafe extern "C" fn SemiNaive_Naive_Pml_Table(
     bw: c_int,
     cutoff: c_int,
@@ -385,7 +385,7 @@ pub unsafe extern "C" fn SemiNaive_Naive_Pml_Table(
 /// [`SemiNaive_Naive_Pml_Table`] (`seminaive_naive_pml_table` is not read).
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_Transpose_SemiNaive_Naive_Pml_Table"]
 pub unsafe extern "C" fn Transpose_SemiNaive_Naive_Pml_Table(
     _seminaive_naive_pml_table: *mut *mut c_double,
     bw: c_int,

@@ -361,7 +361,7 @@ unsafe fn transform(
 /// `weights` (those of `makeweights`) are accepted and not read; the inputs are not modified.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_FST_semi_memo"]
 pub unsafe extern "C" fn FST_semi_memo(
     rdata: *mut c_double,
     idata: *mut c_double,
@@ -394,7 +394,7 @@ pub unsafe extern "C" fn FST_semi_memo(
 /// result; the table, `workspace` and the plans are accepted and not read.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_InvFST_semi_memo"]
 pub unsafe extern "C" fn InvFST_semi_memo(
     rcoeffs: *mut c_double,
     icoeffs: *mut c_double,
@@ -421,7 +421,7 @@ pub unsafe extern "C" fn InvFST_semi_memo(
 /// same as [`FST_semi_memo`] without a table.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_FST_semi_fly"]
 pub unsafe extern "C" fn FST_semi_fly(
     rdata: *mut c_double,
     idata: *mut c_double,
@@ -446,7 +446,7 @@ pub unsafe extern "C" fn FST_semi_fly(
 /// same as [`InvFST_semi_memo`] without a table.
 ///
 /// cbindgen:ignore
-#[no_mangle]
+#[export_name = "so3fft_soft_InvFST_semi_fly"]
 pub unsafe extern "C" fn InvFST_semi_fly(
     rcoeffs: *mut c_double,
     icoeffs: *mut c_double,

@@ -36,11 +36,14 @@ fn time_median(runs: usize, mut call: impl FnMut()) -> f64 {
 /// SOFT's complex type, `double[2]`.
 type SoftComplex = [f64; 2];
 
-// The SOFT entry points the library exports, called as a SOFT client calls them (they are
-// not part of the Rust API).
+// The SOFT entry points, called as a SOFT client calls them through libso3fft_soft. They are
+// not part of the Rust API: the library exports them under private `so3fft_soft_` names,
+// which the SOFT library's one-line wrappers forward to.
 extern "C" {
+    #[link_name = "so3fft_soft_makeweights2"]
     fn makeweights2(bw: c_int, w: *mut f64);
     #[allow(clippy::too_many_arguments)]
+    #[link_name = "so3fft_soft_Forward_SO3_Naive_fftw"]
     fn Forward_SO3_Naive_fftw(
         bw: c_int,
         data: *mut SoftComplex,
@@ -52,6 +55,7 @@ extern "C" {
         p1: *mut c_void,
         flag: c_int,
     );
+    #[link_name = "so3fft_soft_Inverse_SO3_Naive_fftw"]
     fn Inverse_SO3_Naive_fftw(
         bw: c_int,
         coeffs: *mut SoftComplex,
