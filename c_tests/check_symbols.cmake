@@ -1,13 +1,14 @@
 # Checks the names a built library defines for its users (cmake -P; CTest label `symbols`):
 #
-#   cmake -DREADELF=readelf -DLIBRARY=<file> [-DNATIVE=ON] [-DNAMES=<file of names>]
-#         [-DNEEDED=<soname>] [-DNOT_NEEDED=<regex>] -P check_symbols.cmake
+#   cmake -DREADELF=readelf -DLIBRARY=<file> [-DPATTERN=<regex>] [-DDENY=<regex>]
+#         [-DNAMES=<file of names>] [-DNEEDED=<soname>] [-DNOT_NEEDED=<regex>]
+#         -P check_symbols.cmake
 #
 # The names checked are the dynamic symbols a shared library defines, or every global or weak
 # symbol an archive's members define (hidden ones too: they collide in a static link as well).
-# Each must start with so3fft_ (NATIVE=ON) or be one of the lines of NAMES; with both, either.
-# Every line of NAMES must be defined. NEEDED names a library that must be in DT_NEEDED,
-# NOT_NEEDED a pattern that none may match.
+# Each must match PATTERN or be one of the lines of NAMES, and none may match DENY. Every line
+# of NAMES must be defined. NEEDED names a library that must be in DT_NEEDED, NOT_NEEDED a
+# pattern that none may match.
 cmake_minimum_required(VERSION 3.21)
 if(NOT READELF OR NOT LIBRARY)
   message(FATAL_ERROR "check_symbols.cmake: -DREADELF=... and -DLIBRARY=... are required")
@@ -49,7 +50,11 @@ if(NAMES)
 endif()
 set(_stray)
 foreach(_name IN LISTS _defined)
-  if(NATIVE AND _name MATCHES "^so3fft_")
+  if(DENY AND _name MATCHES "${DENY}")
+    list(APPEND _stray "${_name}")
+    continue()
+  endif()
+  if(PATTERN AND _name MATCHES "${PATTERN}")
     continue()
   endif()
   if(NOT _name IN_LIST _expected)

@@ -1,5 +1,5 @@
 /*
- * so3fft: distributed plans over MPI -- C API (library built with the Cargo feature `mpi`).
+ * so3fft: distributed plans over MPI -- C API of libso3fft_mpi (-lso3fft_mpi -lso3fft, and MPI).
  *
  * Copyright (C) the so3fft authors.
  * SPDX-License-Identifier: GPL-2.0-or-later

@@ -13,16 +13,17 @@ if ! command -v mpirun >/dev/null || ! command -v mpicc >/dev/null; then
 fi
 cargo test --release --workspace
 if [ -f CMakeLists.txt ]; then
-  # SO3FFT_MPI=ON: libso3fft is built with the feature `mpi` (into target/mpi, apart from
-  # cargo test's target/release), every C test runs on that library, plus the mpi tests.
+  # SO3FFT_MPI=ON adds libso3fft_mpi and its tests to every other C test; libso3fft is the
+  # same with or without MPI (cargo test's target/release).
   cmake -S . -B build/ci -DCMAKE_BUILD_TYPE=Release -DSO3FFT_MPI=ON >/dev/null
   cmake --build build/ci -j2
   ctest --test-dir build/ci --output-on-failure
-  # The default build (no MPI) too, on cargo test's library: C API and installed package.
+  # The default configuration (no MPI) too: C API and installed package.
   cmake -S . -B build/ci-nompi -DCMAKE_BUILD_TYPE=Release -DSO3FFT_VALGRIND_TESTS=OFF \
         -DSO3FFT_ATTACK_TESTS=OFF >/dev/null
   cmake --build build/ci-nompi -j2
   ctest --test-dir build/ci-nompi -L '^(c|downstream)$' --output-on-failure
 fi
-# In the CMake build's target directory: reuses its MPI-enabled library.
+# The Rust crate with its feature `mpi` (MpiExchange), in its own target directory: cargo keeps
+# one libso3fft per target directory whatever the features.
 CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi

@@ -7,9 +7,8 @@
 #   KIND=soft20     a SOFT 2.0 client project: find_package(soft20), headers included bare, as
 #                   soft/... and as soft20/...
 #   KIND=pkgconfig  `pkg-config --cflags --libs so3fft` (shared) and
-#                   `pkg-config --static --cflags --libs so3fft` with -static (fully static;
-#                   with MPI only libso3fft.a is static: Debian ships no static libmpi); the
-#                   same for a SOFT client with so3fft-soft.
+#                   `pkg-config --static --cflags --libs so3fft` with -static (fully static);
+#                   the same for a SOFT client with so3fft-soft.
 #   KIND=mpi        an MPI program (mpi/main.c) built by a CMake project linking so3fft::mpi
 #                   and with `pkg-config --cflags --libs so3fft-mpi`, each run on 2 ranks.
 # Inputs: KIND, BUILD_DIR, WORK_DIR, SOURCE_DIR, C_COMPILER, GENERATOR; for a build with
@@ -116,15 +115,9 @@ elseif(KIND STREQUAL "pkgconfig")
   capture(sflags "${PKG_CONFIG}" --static --cflags --libs so3fft)
   message(STATUS "pkg-config --static --cflags --libs so3fft: ${sflags}")
   separate_arguments(sflags UNIX_COMMAND "${sflags}")
-  set(static -static)
-  if(MPI)
-    # libso3fft.a by name, the rest (libmpi through Requires.private) shared.
-    list(TRANSFORM sflags REPLACE "^-lso3fft$" "-l:libso3fft.a")
-    set(static)
-  endif()
-  run("${C_COMPILER}" -Wall -Wextra -Werror ${static} "${SOURCE_DIR}/main.c"
+  run("${C_COMPILER}" -Wall -Wextra -Werror -static "${SOURCE_DIR}/main.c"
       -o "${WORK_DIR}/use_pc_static" ${sflags} -lm)
-  run("${C_COMPILER}" -Wall -Wextra -Werror ${static} "${SOURCE_DIR}/soft20/main.c"
+  run("${C_COMPILER}" -Wall -Wextra -Werror -static "${SOURCE_DIR}/soft20/main.c"
       -o "${WORK_DIR}/use_pc_soft_static" ${soft_sflags})
   file(RENAME "${prefix}" "${WORK_DIR}/gone")
   run("${WORK_DIR}/use_pc_static")

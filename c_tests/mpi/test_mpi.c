@@ -26,6 +26,13 @@ int main(int argc, char **argv) {
     so3fft_mpi_plan p;
     ptrdiff_t nc, ns, sl, lnc, lns, i;
     so3fft_complex *c, *x, *lc, *lx, *back;
+    /* Before MPI_Init: a clear error, not a crash inside MPI (the Fortran-handle planner: the
+     * header's one converts the communicator, which MPI forbids before MPI_Init). */
+    s = so3fft_shape_default(4);
+    CHECK(so3fft_mpi_plan_partial_fortran(&s, NULL, SO3FFT_ESTIMATE, 0) == NULL);
+    CHECK(so3fft_last_error_code() == SO3FFT_EINVAL);
+    CHECK(strstr(so3fft_last_error(), "MPI is not initialised") != NULL);
+
     MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);

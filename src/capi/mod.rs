@@ -39,9 +39,8 @@ mod query;
 mod grid;
 // Partial plans (guru interface).
 mod partial;
-// Distributed plans over MPI (feature `mpi`; declared in include/so3fft_mpi.h).
-#[cfg(feature = "mpi")]
-mod mpi;
+// Distributed plans for libso3fft_mpi (private so3fft_dist_* entry points).
+mod distributed;
 // Spherical-harmonic transforms.
 mod s2;
 // Rotational matching.

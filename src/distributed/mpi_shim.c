@@ -1,9 +1,8 @@
-/* The few MPI calls of so3fft's MPI exchange (feature `mpi`), compiled against the MPI
- * installation's own header, so Rust sees only plain C types: communicators cross as their
- * Fortran handles (MPI_Comm_c2f / MPI_Comm_f2c), results as MPI error codes. */
-#include <mpi.h>
-#include <stddef.h>
-#include <stdint.h>
+/* The few MPI calls of so3fft's MPI exchange, compiled against the MPI installation's own
+ * header, so their callers see only plain C types: communicators cross as their Fortran handles
+ * (MPI_Comm_c2f / MPI_Comm_f2c), results as MPI error codes. Part of libso3fft_mpi, and of the
+ * Rust crate with the feature `mpi`. */
+#include "mpi_shim.h"
 
 /* Doubles per MPI message: counts are `int`, so large blocks go in pieces of 1 GiB. */
 #define SO3FFT_MPI_PIECE ((size_t)1 << 27)
@@ -26,7 +25,6 @@ int so3fft_mpi_max_u64(MPI_Fint comm, uint64_t *value) {
     return MPI_Allreduce(MPI_IN_PLACE, value, 1, MPI_UINT64_T, MPI_MAX, MPI_Comm_f2c(comm));
 }
 
-/* Sends `ns` doubles to `dest` while receiving `nr` from `src`, in pieces. */
 int so3fft_mpi_sendrecv(MPI_Fint comm, const double *send, size_t ns, int dest, double *recv,
                         size_t nr, int src) {
     MPI_Comm c = MPI_Comm_f2c(comm);
