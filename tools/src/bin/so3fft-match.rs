@@ -5,21 +5,13 @@
 //! with `signal(x) ~ pattern(g^-1 x)`: the grid peak, the peak refined off the grid, the
 //! correlation value and the time of each stage.
 
+use clap::Parser;
 use so3fft::matching::{
     grid_argmax, grid_argmax_real, top_peaks, Correlation, CorrelationOptions, Peak,
 };
 use so3fft::Complex64;
 use std::process::ExitCode;
 use std::time::Instant;
-
-const USAGE: &str = "usage: so3fft-match SIGNAL PATTERN [--bout B] [--top K] [--threads N]
-
-SIGNAL, PATTERN: S^2 samples, one number per line: (2B)^2 real values, or 2(2B)^2 numbers
-(real and imaginary parts interleaved) for complex data; both files of the same kind and B.
-  --bout B     bandwidth of the SO(3) grid searched (default: B; larger is finer)
-  --top K      also list the K largest separated grid peaks, each refined (default 1)
-  --threads N  worker threads (default 0 = all cores)
-Exit status: 0 success, 2 bad arguments or input files, 1 other errors.";
 
 /// Reads a sample file: the numbers, or a message naming the file and the line.
 fn read_samples(path: &str) -> Result<Vec<f64>, String> {
@@ -57,42 +49,33 @@ fn shape(count: usize) -> Option<(usize, bool)> {
         .map(|b| (b, false))
 }
 
+/// Rotational matching of two functions on the sphere given as S^2 sample files.
+///
+/// Prints the rotation g = Rz(alpha) Ry(beta) Rz(gamma) with signal(x) ~ pattern(g^-1 x):
+/// the grid peak, the peak refined off the grid, the correlation value and the time of each
+/// stage.
+#[derive(Parser, Debug)]
+#[command(
+    name = "so3fft-match",
+    version,
+    args_override_self = true,
+    after_help = "Exit status: 0 success, 2 bad arguments or input files, 1 other errors."
+)]
 struct Args {
+    /// S^2 samples, one number per line: (2B)^2 real values, or 2(2B)^2 numbers (real and
+    /// imaginary parts interleaved) for complex data
     signal: String,
+    /// Samples of the pattern, of the same kind and B as SIGNAL
     pattern: String,
+    /// Bandwidth of the SO(3) grid searched [default: B; larger is finer]
+    #[arg(long = "bout", value_name = "B")]
     b_out: Option<usize>,
+    /// Also list the K largest separated grid peaks, each refined
+    #[arg(long, value_name = "K", default_value_t = 1)]
     top: usize,
+    /// Worker threads (0 = all cores)
+    #[arg(long, value_name = "N", default_value_t = 0)]
     threads: usize,
-}
-
-fn parse_args() -> Result<Args, String> {
-    let mut args = std::env::args().skip(1);
-    let mut files = Vec::new();
-    let (mut b_out, mut top, mut threads) = (None, 1, 0);
-    while let Some(a) = args.next() {
-        let mut number = |name: &str| -> Result<usize, String> {
-            let v = args.next().ok_or(format!("{name} needs a value"))?;
-            v.parse()
-                .map_err(|_| format!("{name}: '{v}' is not a count"))
-        };
-        match a.as_str() {
-            "-h" | "--help" => return Err(String::new()),
-            "--bout" => b_out = Some(number("--bout")?),
-            "--top" => top = number("--top")?.max(1),
-            "--threads" => threads = number("--threads")?,
-            _ if a.starts_with("--") => return Err(format!("unknown option {a}")),
-            _ => files.push(a),
-        }
-    }
-    let [signal, pattern] =
-        <[String; 2]>::try_from(files).map_err(|_| "two sample files are needed".to_string())?;
-    Ok(Args {
-        signal,
-        pattern,
-        b_out,
-        top,
-        threads,
-    })
 }
 
 fn show(p: &Peak) -> String {
@@ -219,17 +202,9 @@ fn run(args: &Args) -> Result<(), (u8, String)> {
 }
 
 fn main() -> ExitCode {
-    let args = match parse_args() {
-        Ok(a) => a,
-        Err(m) => {
-            if m.is_empty() {
-                println!("{USAGE}");
-                return ExitCode::SUCCESS;
-            }
-            eprintln!("so3fft-match: {m}\n{USAGE}");
-            return ExitCode::from(2);
-        }
-    };
+    // Usage errors exit with status 2, --help and --version with 0 (clap).
+    let mut args = Args::parse();
+    args.top = args.top.max(1);
     match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err((code, m)) => {

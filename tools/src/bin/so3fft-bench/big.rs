@@ -30,6 +30,7 @@ use crate::timing::{self, Timed};
 use crate::workload::{self, RoundTripError};
 use rayon::prelude::*;
 use so3fft::{Complex64, Direction, Plan, StageTimes};
+use so3fft_tools::{bar_eprintln, bar_println};
 use std::time::Instant;
 
 /// Memory left over for everything else when a step is admitted.
@@ -45,7 +46,7 @@ pub struct Outcome {
 
 /// Runs the three steps at bandwidth `b` with `threads` workers.
 pub fn run(b: usize, threads: usize, opts: &Options, peak_1core: f64) -> Outcome {
-    eprintln!(
+    bar_eprintln!(
         "  (B = {b}: memory-lean run, {threads} threads, each transform once; grid {:.2} GB, \
          coefficients {:.2} GB)",
         gb(16 * so3fft::num_samples(b)),
@@ -120,7 +121,7 @@ impl Lean<'_> {
         let need = grid_bytes + coef_bytes + plan.memory_bytes();
         match workload::mem_available_bytes() {
             Some(avail) if need + MARGIN_BYTES > avail => {
-                eprintln!(
+                bar_eprintln!(
                     "so3fft-bench: B = {}: skipping the {what}: it needs {:.2} GB more \
                      (arrays and plan) plus {:.1} GB margin, MemAvailable is {:.2} GB",
                     self.b,
@@ -132,7 +133,7 @@ impl Lean<'_> {
             }
             Some(_) => true,
             None => {
-                eprintln!(
+                bar_eprintln!(
                     "so3fft-bench: cannot read MemAvailable; running B = {} unchecked",
                     self.b
                 );
@@ -153,7 +154,7 @@ impl Lean<'_> {
         let plan = match self.plan(None, false, None) {
             Ok(p) => p,
             Err(e) => {
-                eprintln!("so3fft-bench: B = {b}: complex plan failed: {e}");
+                bar_eprintln!("so3fft-bench: B = {b}: complex plan failed: {e}");
                 return Some(format!("complex plan failed: {e}"));
             }
         };
@@ -163,7 +164,7 @@ impl Lean<'_> {
         let mut coeffs = self.take_coeffs();
         let t = Instant::now();
         let mut grid = filled(so3fft::num_samples(b), Complex64::new(0.0, 0.0));
-        eprintln!(
+        bar_eprintln!(
             "  (grid allocated and faulted in: {:.1} s)",
             t.elapsed().as_secs_f64()
         );
@@ -179,7 +180,7 @@ impl Lean<'_> {
                     self.destroy_complex = Some(destroying.timed.wall);
                     print_destroying("complex", &destroying, error, row.fwd_median, arrays);
                 }
-                Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
+                Err(e) => bar_eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
             }
         }
         // The no-skip plan gets the same chunk buffer: the default depends on MemAvailable,
@@ -206,10 +207,10 @@ impl Lean<'_> {
         };
         match skip {
             Ok(row) => self.rows.insert(0, row),
-            Err(e) => eprintln!("so3fft-bench: B = {b}: complex round trip failed: {e}"),
+            Err(e) => bar_eprintln!("so3fft-bench: B = {b}: complex round trip failed: {e}"),
         }
         if let Some(why) = &missing {
-            eprintln!("  (B = {b}: no-skip step n/a: {why})");
+            bar_eprintln!("  (B = {b}: no-skip step n/a: {why})");
         }
         drop(grid);
         self.coeffs = Some(coeffs);
@@ -228,7 +229,7 @@ impl Lean<'_> {
         let b = self.b;
         let t = Instant::now();
         seeded::fill_complex(self.seed(), coeffs);
-        eprintln!(
+        bar_eprintln!(
             "  ({}: coefficients generated in {:.1} s)",
             variant.name(),
             t.elapsed().as_secs_f64()
@@ -238,7 +239,7 @@ impl Lean<'_> {
         let t = Instant::now();
         let error = seeded::compare_complex(self.seed(), coeffs);
         let row = self.row(variant, plan, RoundTrip { inverse, forward }, error);
-        eprintln!(
+        bar_eprintln!(
             "  ({}: compared in {:.1} s; {}; target 1.05)",
             variant.name(),
             t.elapsed().as_secs_f64(),
@@ -250,7 +251,7 @@ impl Lean<'_> {
             ),
         );
         if variant == Variant::Complex {
-            println!("{}", report::table_line(&row));
+            bar_println!("{}", report::table_line(&row));
         }
         Ok(row)
     }
@@ -259,16 +260,16 @@ impl Lean<'_> {
     fn real_step(&mut self) {
         let b = self.b;
         match seeded::real_symmetry_check(SYMMETRY_CHECK_B, self.real_seed()) {
-            Ok((im, abs)) => eprintln!(
+            Ok((im, abs)) => bar_eprintln!(
                 "  (real-signal coefficients fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M')): \
                  complex inverse at B = {SYMMETRY_CHECK_B} gives max |Im f| = {im:.2e}, max |f| = {abs:.2e})"
             ),
-            Err(e) => eprintln!("so3fft-bench: real symmetry check failed: {e}"),
+            Err(e) => bar_eprintln!("so3fft-bench: real symmetry check failed: {e}"),
         }
         let plan = match self.plan(None, true, None) {
             Ok(p) => p,
             Err(e) => {
-                eprintln!("so3fft-bench: B = {b}: real plan failed: {e}");
+                bar_eprintln!("so3fft-bench: B = {b}: real plan failed: {e}");
                 return;
             }
         };
@@ -278,7 +279,7 @@ impl Lean<'_> {
         let mut coeffs = self.take_coeffs();
         let t = Instant::now();
         let mut grid = filled(so3fft::num_samples(b), 0.0f64);
-        eprintln!(
+        bar_eprintln!(
             "  (real grid allocated and faulted in: {:.1} s)",
             t.elapsed().as_secs_f64()
         );
@@ -292,17 +293,19 @@ impl Lean<'_> {
                         let error = seeded::compare_real(self.real_seed(), b, &coeffs);
                         print_destroying("real", &destroying, error, row.fwd_median, arrays);
                         if let Some(complex) = self.destroy_complex {
-                            println!(
+                            bar_println!(
                                 "  destroying forwards, real over complex: {:.3}",
                                 destroying.timed.wall / complex
                             );
                         }
                     }
-                    Err(e) => eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}"),
+                    Err(e) => {
+                        bar_eprintln!("so3fft-bench: B = {b}: destroying forward failed: {e}")
+                    }
                 }
                 self.rows.push(row)
             }
-            Err(e) => eprintln!("so3fft-bench: B = {b}: real round trip failed: {e}"),
+            Err(e) => bar_eprintln!("so3fft-bench: B = {b}: real round trip failed: {e}"),
         }
         self.coeffs = Some(coeffs);
     }
@@ -325,7 +328,7 @@ impl Lean<'_> {
             .iter()
             .find(|r| r.variant == Variant::Complex)
             .map(|c| (row.fwd_median / c.fwd_median, row.inv_median / c.inv_median));
-        eprintln!(
+        bar_eprintln!(
             "  (real: {})",
             memory_summary(inverse.phase, forward.phase, arrays, plan)
         );
@@ -385,7 +388,7 @@ fn print_destroying(
         format!("{:.4}", p.peak as f64 / arrays as f64)
     });
     let Timed { wall, stages, .. } = destroying.timed;
-    println!(
+    bar_println!(
         "  {what} forward destroying its input: {wall:.3e} s (FFT {:.3e} / DWT {:.3e}), \
          {:.3} x the preserving forward; errors {:.2e} / {:.2e}; peak {peak} x (input + output)",
         stages.fft,

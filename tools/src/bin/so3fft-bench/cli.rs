@@ -1,8 +1,6 @@
-//! Command-line options of `so3fft-bench`.
-//!
-//! Hand-written parser: the binary may only depend on std and the crate's own dependencies,
-//! so no argument-parsing crate is available.
+//! Command-line options of `so3fft-bench` (clap), and the defaults each tool fills in.
 
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use so3fft::Rigor;
 use std::path::PathBuf;
 
@@ -22,64 +20,150 @@ const DEFAULT_NAIVE_MAX: usize = 128;
 /// ... and under `--quick`.
 const QUICK_NAIVE_MAX: usize = 16;
 
-pub const USAGE: &str = "\
-usage: so3fft-bench [TOOL] [options]
-TOOL (default: the full benchmark described below):
-  stages              stage times of repeated transforms, one line per transform on stderr,
-                      for profiling (perf record) and for comparing two builds run
-                      alternately; defaults --bandwidths 256 --threads 1 --runs 3
-  scaling             thread scaling on a shared machine: windows of inverse + forward pairs
-                      (at least 0.3 s each) that count only while other processes use under
-                      3% of the machine, thread counts alternating; medians of --runs clean
-                      windows (default 5); defaults --bandwidths 64,128,256 --threads 1,2
-  real                only the real-signal transforms against the complex ones (round trips
-                      interleaved, last thread count); default --bandwidths 64,128,256
-  s2 (or --s2)        the S^2 transforms: real and complex synthesis and analysis, medians,
-                      GFLOP/s against the peak, round-trip errors; B up to 4096 allowed
-  match (or --match)  rotational matching: a rotated random function recovered; pipeline
-                      medians (complex, real), one refinement and ten peaks refined
-                      together, grid and refined angle errors; the pipeline against its
-                      floor (FFTW alone on the grid's slices + the DWT at its in-cache kernel
-                      rate; the DWT part needs --features internals); eight patterns against
-                      one signal (per pattern) and four shells against one correlation
-  mpi-model (or --mpi-model)  distributed plans at B = 1024, 2048 on 8..256 nodes: memory
-                      per rank, bytes exchanged, expected time, from one-core rates measured here
-                      --runs 7
-  partial (or --partial)  partial plans against the transforms they replace: degree-limited
-                      on a finer grid, order-limited (B = 128, and 1024, 2048), batches of 8,
-                      1/16 of the betas, skip thresholds 2^-24 and 2^-34 (ratios in one run)
-options:
-  --bandwidths LIST   comma-separated bandwidths B, 1..=256, above 256 only with --big
-                      (default 16,32,64,128,256)
-  --threads LIST      comma-separated thread counts, 0 = all cores (default 1,2)
-  --runs N            timed runs per configuration (default 5; 3 at B = 256; B > 256: always 1)
-  --csv PATH          CSV output file (default bench.csv)
-  --plot PATH         SVG plot of time and error against B (default: the CSV path with
-                      extension .svg, i.e. bench.svg)
-  --rigor R           FFTW planner rigour: estimate | measure | patient | exhaustive (default
-                      measure: with estimate the FFT stage is 10-20% slower at B = 128 and 256)
-  --naive-max B       largest B of the plain one-thread DWT timed for comparison (default 128,
-                      0 = none; about 1 s per direction at 128)
-  --big               also run B = 512 (added unless the list has a B above 256): needs minutes
-                      and about 22 GB. B > 256 runs once, with the largest thread count only:
-                      complex inverse then forward (peak memory of the forward against input +
-                      output), the same without skipping, and a real-signal round trip; random
-                      coefficients are regenerated from a seed instead of being stored. Skipped
-                      with a message when MemAvailable is too small.
-  --quick             CI smoke test: only B <= 64, 3 runs, plain DWT at B = 16 only
-  --soft              also time the SOFT 2.0 entry points against the native plan (each B)
-  --mode M            stages: inv | fwd | both | dfwd (the forward that may overwrite its
-                      input) | rinv | rfwd | rboth (real signals); default both
-  --isa I             kernels' instruction set: avx512 | avx2 | scalar (default: the best this
-                      CPU has); sets SO3FFT_ISA for every plan, SOFT call and the FMA peak, so
-                      a host with AVX-512 can measure the AVX2 kernels
-  --workspace-mib N   stages: cap on the plan's chunk buffer (default: the plan's default)
-  -h, --help          print this help
+/// Timing, accuracy and efficiency of the SO(3) FFT.
+///
+/// Without a TOOL, the full benchmark: each B <= 256 and thread count, inverse then forward
+/// on random coefficients, stage times (medians), DWT GFLOP/s against the FMA peak measured
+/// in the same run, round-trip errors, peak memory. Per B also: the transforms without
+/// skipping of negligible Wigner-d prefixes (first thread count) and the plain DWT. Writes a
+/// CSV file and an SVG plot. Columns and formulas: docs/benchmark.md.
+#[derive(Parser, Debug)]
+#[command(
+    name = "so3fft-bench",
+    version,
+    args_override_self = true,
+    disable_help_subcommand = true
+)]
+pub struct Cli {
+    /// The narrower measurement to run instead of the full benchmark.
+    #[command(subcommand)]
+    pub tool: Option<ToolCommand>,
+    #[command(flatten)]
+    pub args: Args,
+}
 
-Each B <= 256 and thread count: inverse then forward on random coefficients, stage times
-(medians), DWT GFLOP/s against the FMA peak measured in the same run, round-trip errors, peak
-memory. Per B also: the transforms without skipping of negligible Wigner-d prefixes (first
-thread count) and the plain DWT. Columns and formulas: notes/bench.md.";
+/// The tools other than the full benchmark (they take the same options).
+#[derive(Subcommand, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolCommand {
+    /// Stage times of repeated transforms, one line per transform on stderr, for profiling
+    /// (perf record) and for comparing two builds run alternately; defaults --bandwidths 256
+    /// --threads 1 --runs 3.
+    Stages,
+    /// Thread scaling on a shared machine: windows of inverse + forward pairs (at least
+    /// 0.3 s each) that count only while other processes use under 3% of the machine, thread
+    /// counts alternating; medians of --runs clean windows (default 5); defaults --bandwidths
+    /// 64,128,256 --threads 1,2.
+    Scaling,
+    /// Only the real-signal transforms against the complex ones (round trips interleaved,
+    /// last thread count); default --bandwidths 64,128,256.
+    Real,
+    /// The S^2 transforms: real and complex synthesis and analysis, medians, GFLOP/s against
+    /// the peak, round-trip errors; B up to 4096 allowed.
+    #[command(long_flag = "s2")]
+    S2,
+    /// Rotational matching: a rotated random function recovered; pipeline medians (complex,
+    /// real), one refinement and ten peaks refined together, grid and refined angle errors;
+    /// the pipeline against its floor (FFTW alone on the grid's slices + the DWT at its
+    /// in-cache kernel rate; the DWT part needs --features internals); eight patterns against
+    /// one signal (per pattern) and four shells against one correlation.
+    #[command(long_flag = "match")]
+    Match,
+    /// Distributed plans at B = 1024, 2048 on 8..256 nodes: memory per rank, bytes exchanged,
+    /// expected time, from one-core rates measured here.
+    #[command(long_flag = "mpi-model")]
+    MpiModel,
+    /// Partial plans against the transforms they replace: degree-limited on a finer grid,
+    /// order-limited (B = 128, and 1024, 2048), batches of 8, 1/16 of the betas, skip
+    /// thresholds 2^-24 and 2^-34 (ratios in one run).
+    #[command(long_flag = "partial")]
+    Partial,
+}
+
+/// The options every tool takes (before or after the tool's name).
+#[derive(clap::Args, Debug, Clone)]
+pub struct Args {
+    /// Comma-separated bandwidths B, 1..=256, above 256 only with --big [default:
+    /// 16,32,64,128,256; each tool has its own]
+    #[arg(long, value_name = "LIST", value_parser = parse_list, global = true)]
+    pub bandwidths: Option<CountList>,
+    /// Comma-separated thread counts, 0 = all cores [default: 1,2]
+    #[arg(long, value_name = "LIST", value_parser = parse_list, global = true)]
+    pub threads: Option<CountList>,
+    /// Timed runs per configuration [default: 5; 3 at B = 256; B > 256: always 1]
+    #[arg(long, value_name = "N", value_parser = parse_positive, global = true)]
+    pub runs: Option<usize>,
+    /// CSV output file
+    #[arg(long, value_name = "PATH", default_value = "bench.csv", global = true)]
+    pub csv: PathBuf,
+    /// SVG plot of time and error against B [default: the CSV path with extension .svg,
+    /// i.e. bench.svg]
+    #[arg(long, value_name = "PATH", global = true)]
+    pub plot: Option<PathBuf>,
+    /// FFTW planner rigour (measure: with estimate the FFT stage is 10-20% slower at B = 128
+    /// and 256)
+    #[arg(long, value_name = "R", value_enum, ignore_case = true, default_value_t = RigorArg::Measure, global = true)]
+    pub rigor: RigorArg,
+    /// Largest B of the plain one-thread DWT timed for comparison (0 = none; about 1 s per
+    /// direction at 128) [default: 128]
+    #[arg(long, value_name = "B", global = true)]
+    pub naive_max: Option<usize>,
+    /// Also run B = 512 (added unless the list has a B above 256): needs minutes and about
+    /// 22 GB. B > 256 runs once, with the largest thread count only: complex inverse then
+    /// forward (peak memory of the forward against input + output), the same without
+    /// skipping, and a real-signal round trip; random coefficients are regenerated from a
+    /// seed instead of being stored. Skipped with a message when MemAvailable is too small.
+    #[arg(long, global = true)]
+    pub big: bool,
+    /// CI smoke test: only B <= 64, 3 runs, plain DWT at B = 16 only
+    #[arg(long, global = true)]
+    pub quick: bool,
+    /// Also time the SOFT 2.0 entry points against the native plan (each B)
+    #[arg(long, global = true)]
+    pub soft: bool,
+    /// Transforms of the stages tool (dfwd: the forward that may overwrite its input;
+    /// r...: real signals)
+    #[arg(long, value_name = "M", value_enum, default_value_t = StageMode::Both, global = true)]
+    pub mode: StageMode,
+    /// Kernels' instruction set [default: the best this CPU has]; sets SO3FFT_ISA for every
+    /// plan, SOFT call and the FMA peak, so a host with AVX-512 can measure the AVX2 kernels
+    #[arg(long, value_name = "I", value_enum, ignore_case = true, global = true)]
+    pub isa: Option<IsaArg>,
+    /// Stages: cap on the plan's chunk buffer, MiB [default: the plan's default]
+    #[arg(long, value_name = "N", global = true)]
+    pub workspace_mib: Option<usize>,
+}
+
+/// A comma-separated list of counts (`--bandwidths`, `--threads`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CountList(pub Vec<usize>);
+
+/// FFTW planner rigour as named on the command line.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RigorArg {
+    Estimate,
+    Measure,
+    Patient,
+    Exhaustive,
+}
+
+impl From<RigorArg> for Rigor {
+    fn from(r: RigorArg) -> Rigor {
+        match r {
+            RigorArg::Estimate => Rigor::Estimate,
+            RigorArg::Measure => Rigor::Measure,
+            RigorArg::Patient => Rigor::Patient,
+            RigorArg::Exhaustive => Rigor::Exhaustive,
+        }
+    }
+}
+
+/// Kernel instruction sets `--isa` accepts.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IsaArg {
+    Avx512,
+    Avx2,
+    Scalar,
+}
 
 /// Which measurement the command line asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,15 +187,22 @@ pub enum Tool {
 }
 
 /// Transforms the `stages` tool repeats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StageMode {
+    #[value(name = "inv")]
     Inverse,
+    #[value(name = "fwd")]
     Forward,
+    #[value(name = "both")]
     Both,
     /// The forward that may overwrite its input.
+    #[value(name = "dfwd")]
     ForwardDestroying,
+    #[value(name = "rinv")]
     RealInverse,
+    #[value(name = "rfwd")]
     RealForward,
+    #[value(name = "rboth")]
     RealBoth,
 }
 
@@ -206,101 +297,68 @@ impl Options {
     }
 }
 
-/// What the command line asks for.
-pub enum Command {
-    Run(Options),
-    Help,
+impl Cli {
+    /// The options of the run, each tool's defaults filled in; a usage error (exit status 2)
+    /// for bandwidths that cannot run.
+    pub fn into_options(self) -> Result<Options, clap::Error> {
+        let a = self.args;
+        let mut opts = Options {
+            tool: self.tool.map_or(Tool::Full, Tool::from),
+            runs: a.runs,
+            csv: a.csv.clone(),
+            rigor: a.rigor.into(),
+            quick: a.quick,
+            soft: a.soft,
+            big: a.big,
+            plot: a.plot.unwrap_or_else(|| a.csv.with_extension("svg")),
+            naive_max: a.naive_max.unwrap_or(DEFAULT_NAIVE_MAX),
+            stage_mode: a.mode,
+            workspace_bytes: a.workspace_mib.map(|mib| mib << 20),
+            isa: a.isa.map(|isa| {
+                isa.to_possible_value()
+                    .expect("no skipped values")
+                    .get_name()
+                    .to_string()
+            }),
+            ..Options::default()
+        };
+        let bandwidths_given = a.bandwidths.is_some();
+        if let Some(CountList(list)) = a.bandwidths {
+            opts.bandwidths = list;
+        }
+        let threads_given = a.threads.is_some();
+        if let Some(CountList(list)) = a.threads {
+            opts.threads = list;
+        }
+        apply_tool_defaults(&mut opts, bandwidths_given, threads_given);
+        if opts.big && !opts.bandwidths.iter().any(|&b| b > MAX_REGULAR_BANDWIDTH) {
+            opts.bandwidths.push(BIG_BANDWIDTH);
+        }
+        if opts.quick {
+            apply_quick(&mut opts, bandwidths_given, a.naive_max.is_some());
+        }
+        check(&opts)
+            .map_err(|msg| Cli::command().error(clap::error::ErrorKind::ValueValidation, msg))?;
+        Ok(opts)
+    }
 }
 
-/// Parses the arguments after the program name. Accepts `--opt value` and `--opt=value`.
-pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String> {
-    let mut opts = Options::default();
-    let mut bandwidths_given = false;
-    let mut plot_given = false;
-    let mut naive_given = false;
-    let mut threads_given = false;
-    let mut args = args.into_iter().peekable();
-    opts.tool = match args.peek().map(String::as_str) {
-        Some("stages") => Tool::Stages,
-        Some("scaling") => Tool::Scaling,
-        Some("real") => Tool::Real,
-        Some("s2" | "--s2") => Tool::S2,
-        Some("match" | "--match") => Tool::Match,
-        Some("partial" | "--partial") => Tool::Partial,
-        Some("mpi-model" | "--mpi-model") => Tool::MpiModel,
-        _ => Tool::Full,
-    };
-    if opts.tool != Tool::Full {
-        args.next();
-    }
-    while let Some(arg) = args.next() {
-        let (name, inline) = match arg.split_once('=') {
-            Some((n, v)) if n.starts_with("--") => (n.to_string(), Some(v.to_string())),
-            _ => (arg.clone(), None),
-        };
-        let mut value = || {
-            inline
-                .clone()
-                .or_else(|| args.next())
-                .ok_or_else(|| format!("{name} needs a value"))
-        };
-        match name.as_str() {
-            "-h" | "--help" => return Ok(Command::Help),
-            "--quick" => opts.quick = true,
-            "--soft" => opts.soft = true,
-            "--big" => opts.big = true,
-            "--plot" => {
-                opts.plot = PathBuf::from(value()?);
-                plot_given = true;
-            }
-            "--naive-max" => {
-                let text = value()?;
-                opts.naive_max = text
-                    .trim()
-                    .parse()
-                    .map_err(|e| format!("--naive-max: '{text}': {e}"))?;
-                naive_given = true;
-            }
-            "--bandwidths" => {
-                opts.bandwidths = parse_list(&value()?, "--bandwidths")?;
-                bandwidths_given = true;
-            }
-            "--threads" => {
-                opts.threads = parse_list(&value()?, "--threads")?;
-                threads_given = true;
-            }
-            "--mode" => opts.stage_mode = parse_stage_mode(&value()?)?,
-            "--workspace-mib" => {
-                let text = value()?;
-                let mib: usize = text
-                    .trim()
-                    .parse()
-                    .map_err(|e| format!("--workspace-mib: '{text}': {e}"))?;
-                opts.workspace_bytes = Some(mib << 20);
-            }
-            "--runs" => opts.runs = Some(parse_positive(&value()?, "--runs")?),
-            "--csv" => opts.csv = PathBuf::from(value()?),
-            "--rigor" => opts.rigor = parse_rigor(&value()?)?,
-            "--isa" => {
-                let text = value()?.trim().to_ascii_lowercase();
-                if !matches!(text.as_str(), "avx512" | "avx2" | "scalar") {
-                    return Err(format!("--isa: '{text}' is not avx512, avx2 or scalar"));
-                }
-                opts.isa = Some(text);
-            }
-            _ => return Err(format!("unknown option '{arg}'")),
+impl From<ToolCommand> for Tool {
+    fn from(t: ToolCommand) -> Tool {
+        match t {
+            ToolCommand::Stages => Tool::Stages,
+            ToolCommand::Scaling => Tool::Scaling,
+            ToolCommand::Real => Tool::Real,
+            ToolCommand::S2 => Tool::S2,
+            ToolCommand::Match => Tool::Match,
+            ToolCommand::MpiModel => Tool::MpiModel,
+            ToolCommand::Partial => Tool::Partial,
         }
     }
-    apply_tool_defaults(&mut opts, bandwidths_given, threads_given);
-    if !plot_given {
-        opts.plot = opts.csv.with_extension("svg");
-    }
-    if opts.big && !opts.bandwidths.iter().any(|&b| b > MAX_REGULAR_BANDWIDTH) {
-        opts.bandwidths.push(BIG_BANDWIDTH);
-    }
-    if opts.quick {
-        apply_quick(&mut opts, bandwidths_given, naive_given);
-    }
+}
+
+/// Refuses bandwidths and thread lists that cannot run.
+fn check(opts: &Options) -> Result<(), String> {
     if opts.bandwidths.is_empty() {
         return Err("no bandwidth left to run".into());
     }
@@ -323,7 +381,7 @@ pub fn parse<I: IntoIterator<Item = String>>(args: I) -> Result<Command, String>
     if opts.threads.is_empty() {
         return Err("--threads: no thread count given".into());
     }
-    Ok(Command::Run(opts))
+    Ok(())
 }
 
 /// Defaults of the tools other than the full benchmark, where not given.
@@ -366,49 +424,21 @@ fn apply_quick(opts: &mut Options, bandwidths_given: bool, naive_given: bool) {
     };
 }
 
-fn parse_list(text: &str, what: &str) -> Result<Vec<usize>, String> {
+/// A comma-separated list of counts; empty entries are skipped.
+fn parse_list(text: &str) -> Result<CountList, String> {
     text.split(',')
         .filter(|s| !s.trim().is_empty())
-        .map(|s| {
-            s.trim()
-                .parse::<usize>()
-                .map_err(|e| format!("{what}: '{s}': {e}"))
-        })
-        .collect()
+        .map(|s| s.trim().parse::<usize>().map_err(|e| format!("'{s}': {e}")))
+        .collect::<Result<_, _>>()
+        .map(CountList)
 }
 
-fn parse_positive(text: &str, what: &str) -> Result<usize, String> {
+/// A count of at least 1.
+fn parse_positive(text: &str) -> Result<usize, String> {
     match text.trim().parse::<usize>() {
-        Ok(0) => Err(format!("{what} must be at least 1")),
+        Ok(0) => Err("must be at least 1".into()),
         Ok(n) => Ok(n),
-        Err(e) => Err(format!("{what}: '{text}': {e}")),
-    }
-}
-
-fn parse_rigor(text: &str) -> Result<Rigor, String> {
-    match text.to_ascii_lowercase().as_str() {
-        "estimate" => Ok(Rigor::Estimate),
-        "measure" => Ok(Rigor::Measure),
-        "patient" => Ok(Rigor::Patient),
-        "exhaustive" => Ok(Rigor::Exhaustive),
-        _ => Err(format!(
-            "--rigor: '{text}' is not estimate, measure, patient or exhaustive"
-        )),
-    }
-}
-
-fn parse_stage_mode(text: &str) -> Result<StageMode, String> {
-    match text {
-        "inv" => Ok(StageMode::Inverse),
-        "fwd" => Ok(StageMode::Forward),
-        "both" => Ok(StageMode::Both),
-        "dfwd" => Ok(StageMode::ForwardDestroying),
-        "rinv" => Ok(StageMode::RealInverse),
-        "rfwd" => Ok(StageMode::RealForward),
-        "rboth" => Ok(StageMode::RealBoth),
-        _ => Err(format!(
-            "--mode: '{text}' is not inv, fwd, both, dfwd, rinv, rfwd or rboth"
-        )),
+        Err(e) => Err(format!("'{text}': {e}")),
     }
 }
 
@@ -424,13 +454,23 @@ pub fn rigor_name(rigor: Rigor) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::{parse, Command, StageMode, Tool};
+    use super::{Cli, Options, StageMode, Tool};
+    use clap::error::ErrorKind;
+    use clap::Parser;
 
-    fn options(args: &[&str]) -> super::Options {
-        match parse(args.iter().map(|a| a.to_string())) {
-            Ok(Command::Run(opts)) => opts,
-            Ok(Command::Help) => panic!("help"),
-            Err(e) => panic!("{e}"),
+    fn parse(args: &[&str]) -> Result<Options, clap::Error> {
+        let argv = std::iter::once("so3fft-bench").chain(args.iter().copied());
+        Cli::try_parse_from(argv)?.into_options()
+    }
+
+    fn options(args: &[&str]) -> Options {
+        parse(args).unwrap_or_else(|e| panic!("{args:?}: {e}"))
+    }
+
+    fn error_kind(args: &[&str]) -> ErrorKind {
+        match parse(args) {
+            Ok(o) => panic!("{args:?} accepted: {o:?}"),
+            Err(e) => e.kind(),
         }
     }
 
@@ -440,7 +480,26 @@ mod tests {
         assert_eq!(opts.tool, Tool::Full);
         assert_eq!(opts.bandwidths, [16, 32, 64]);
         assert_eq!(opts.runs, Some(3));
+        assert_eq!(opts.naive_max, 16);
         assert_eq!(opts.plot.to_str(), Some("target/x.svg"));
+    }
+
+    /// Without options: the documented defaults (B = 16..256, threads 1,2, measure,
+    /// bench.csv and bench.svg, plain DWT to 128, five runs to B = 128 and three at 256).
+    #[test]
+    fn full_run_defaults() {
+        let opts = options(&[]);
+        assert_eq!(opts.tool, Tool::Full);
+        assert_eq!(opts.bandwidths, [16, 32, 64, 128, 256]);
+        assert_eq!(opts.threads, [1, 2]);
+        assert_eq!(opts.rigor, so3fft::Rigor::Measure);
+        assert_eq!(opts.csv.to_str(), Some("bench.csv"));
+        assert_eq!(opts.plot.to_str(), Some("bench.svg"));
+        assert_eq!(opts.naive_max, 128);
+        assert_eq!((opts.runs_for(128), opts.runs_for(256)), (5, 3));
+        assert_eq!(opts.stage_mode, StageMode::Both);
+        assert!(!opts.quick && !opts.soft && !opts.big);
+        assert_eq!((opts.isa, opts.workspace_bytes), (None, None));
     }
 
     #[test]
@@ -457,6 +516,130 @@ mod tests {
         let opts = options(&["real"]);
         assert_eq!((opts.tool, opts.runs), (Tool::Real, None));
         assert_eq!(opts.bandwidths, [64, 128, 256]);
-        assert!(parse(["stages", "--mode", "sideways"].map(String::from)).is_err());
+        assert_eq!(
+            error_kind(&["stages", "--mode", "sideways"]),
+            ErrorKind::InvalidValue
+        );
+    }
+
+    /// Each tool by name and, where documented, as a flag.
+    #[test]
+    fn tool_names_and_flags() {
+        for (args, tool) in [
+            (&["s2"][..], Tool::S2),
+            (&["--s2"], Tool::S2),
+            (&["match"], Tool::Match),
+            (&["--match", "--runs", "7"], Tool::Match),
+            (&["partial"], Tool::Partial),
+            (&["--partial"], Tool::Partial),
+            (&["mpi-model"], Tool::MpiModel),
+            (&["--mpi-model"], Tool::MpiModel),
+        ] {
+            assert_eq!(options(args).tool, tool, "{args:?}");
+        }
+        assert_eq!(options(&["s2"]).bandwidths, [128, 256, 512, 1024]);
+        assert_eq!(options(&["match"]).threads, [2]);
+        // S^2 bandwidths above 256 need no --big.
+        assert_eq!(options(&["s2", "--bandwidths", "4096"]).bandwidths, [4096]);
+    }
+
+    /// The documented invocations of README.md and docs/*.md parse to what they say.
+    #[test]
+    fn documented_command_lines() {
+        let opts = options(&[
+            "--bandwidths",
+            "64,128,256",
+            "--threads",
+            "1,2",
+            "--rigor",
+            "measure",
+        ]);
+        assert_eq!(
+            (opts.bandwidths, opts.threads),
+            (vec![64, 128, 256], vec![1, 2])
+        );
+        let opts = options(&["--bandwidths", "512", "--big", "--threads", "2"]);
+        assert_eq!(opts.runs_for(512), 1);
+        assert_eq!((opts.bandwidths, opts.threads), (vec![512], vec![2]));
+        assert!(options(&["--soft"]).soft);
+        let opts = options(&[
+            "stages",
+            "--isa",
+            "avx2",
+            "--bandwidths",
+            "64,128,256",
+            "--threads",
+            "2",
+            "--mode",
+            "both",
+            "--runs",
+            "7",
+        ]);
+        assert_eq!(
+            (opts.tool, opts.isa.as_deref(), opts.runs),
+            (Tool::Stages, Some("avx2"), Some(7))
+        );
+        assert_eq!(
+            options(&["stages", "--mode", "inv"]).stage_mode,
+            StageMode::Inverse
+        );
+        assert_eq!(
+            options(&["s2", "--isa", "AVX512"]).isa.as_deref(),
+            Some("avx512")
+        );
+        assert_eq!(options(&["--rigor=Patient"]).rigor, so3fft::Rigor::Patient);
+        assert_eq!(
+            options(&["stages", "--workspace-mib", "3"]).workspace_bytes,
+            Some(3 << 20)
+        );
+    }
+
+    /// `--big` adds B = 512 unless a B above 256 is listed; the last of a repeated option wins;
+    /// empty list entries are skipped.
+    #[test]
+    fn big_repeats_and_lists() {
+        assert_eq!(options(&["--big"]).bandwidths, [16, 32, 64, 128, 256, 512]);
+        assert_eq!(
+            options(&["--big", "--bandwidths", "1024"]).bandwidths,
+            [1024]
+        );
+        assert_eq!(options(&["--runs", "2", "--runs", "4"]).runs, Some(4));
+        assert_eq!(options(&["--threads", "1,,2,"]).threads, [1, 2]);
+        let opts = options(&["--quick", "--bandwidths", "16,128", "--naive-max", "100"]);
+        assert_eq!((opts.bandwidths, opts.naive_max), (vec![16], 64));
+    }
+
+    /// Bad usage is a clap error (exit status 2): unknown options, bad values, bandwidths out
+    /// of range or above 256 without --big, nothing left to run; --help is not a failure.
+    #[test]
+    fn bad_usage_is_refused() {
+        assert_eq!(error_kind(&["--frobnicate"]), ErrorKind::UnknownArgument);
+        assert_eq!(error_kind(&["--runs", "0"]), ErrorKind::ValueValidation);
+        assert_eq!(error_kind(&["--runs"]), ErrorKind::InvalidValue);
+        assert_eq!(
+            error_kind(&["--bandwidths", "16,x"]),
+            ErrorKind::ValueValidation
+        );
+        assert_eq!(error_kind(&["--rigor", "sloppy"]), ErrorKind::InvalidValue);
+        assert_eq!(error_kind(&["--isa", "sse2"]), ErrorKind::InvalidValue);
+        assert_eq!(
+            error_kind(&["--bandwidths", "512"]),
+            ErrorKind::ValueValidation
+        );
+        assert_eq!(
+            error_kind(&["--bandwidths", "0"]),
+            ErrorKind::ValueValidation
+        );
+        assert_eq!(
+            error_kind(&["--quick", "--bandwidths", "128"]),
+            ErrorKind::ValueValidation
+        );
+        assert_eq!(error_kind(&["--threads", ","]), ErrorKind::ValueValidation);
+        assert_eq!(error_kind(&["--help"]), ErrorKind::DisplayHelp);
+        assert_eq!(error_kind(&["stages", "-h"]), ErrorKind::DisplayHelp);
+        for args in [&["--frobnicate"][..], &["--bandwidths", "512"]] {
+            assert_eq!(parse(args).unwrap_err().exit_code(), 2, "{args:?}");
+        }
+        assert_eq!(parse(&["--help"]).unwrap_err().exit_code(), 0);
     }
 }

@@ -39,33 +39,28 @@ mod stages;
 mod timing;
 mod workload;
 
-use cli::{Command, Options, Tool};
+use clap::Parser;
+use cli::{Options, Tool};
 use regular::{Results, Setup};
 use report::{Row, Variant};
+use so3fft_tools::progress::Steps;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    match cli::parse(std::env::args().skip(1)) {
-        Ok(Command::Help) => {
-            println!("{}", cli::USAGE);
-            ExitCode::SUCCESS
-        }
-        Ok(Command::Run(opts)) => {
-            if let Some(isa) = &opts.isa {
-                // Before any thread exists: every plan, SOFT call and the peak follow it.
-                std::env::set_var(so3fft::ISA_VARIABLE, isa);
-            }
-            if let Err(e) = so3fft::Isa::selected() {
-                eprintln!("so3fft-bench: {e}");
-                return ExitCode::from(2);
-            }
-            run_tool(&opts)
-        }
-        Err(msg) => {
-            eprintln!("so3fft-bench: {msg}\n{}", cli::USAGE);
-            ExitCode::from(2)
-        }
+    // Usage errors exit with status 2, --help and --version with 0 (clap).
+    let opts = match cli::Cli::parse().into_options() {
+        Ok(opts) => opts,
+        Err(e) => e.exit(),
+    };
+    if let Some(isa) = &opts.isa {
+        // Before any thread exists: every plan, SOFT call and the peak follow it.
+        std::env::set_var(so3fft::ISA_VARIABLE, isa);
     }
+    if let Err(e) = so3fft::Isa::selected() {
+        eprintln!("so3fft-bench: {e}");
+        return ExitCode::from(2);
+    }
+    run_tool(&opts)
 }
 
 /// Runs the tool `opts` names.
@@ -123,7 +118,9 @@ fn run_full(opts: &Options) -> ExitCode {
         rows: Vec::new(),
         noskip_missing: Vec::new(),
     };
+    let bar = Steps::new(opts.bandwidths.len() as u64, "bandwidths");
     for &b in &opts.bandwidths {
+        bar.message(format!("(B = {b})"));
         if b > cli::MAX_REGULAR_BANDWIDTH {
             let threads = big_threads(opts, cores);
             let out = big::run(b, threads, opts, peak.one_core);
@@ -139,7 +136,9 @@ fn run_full(opts: &Options) -> ExitCode {
             };
             regular::bench_bandwidth(setup, &mut results);
         }
+        bar.step();
     }
+    drop(bar);
     let rows = results.rows;
     print_summaries(&rows, &results.noskip_missing);
     if opts.soft {
@@ -151,7 +150,9 @@ fn run_full(opts: &Options) -> ExitCode {
     }
     println!("CSV written to {}", opts.csv.display());
     if !rows.is_empty() {
-        match std::fs::write(&opts.plot, plot::svg(&rows)) {
+        let written = plot::svg(&rows)
+            .and_then(|svg| std::fs::write(&opts.plot, svg).map_err(|e| e.to_string()));
+        match written {
             Ok(()) => println!("Plot written to {}", opts.plot.display()),
             Err(e) => eprintln!("so3fft-bench: cannot write {}: {e}", opts.plot.display()),
         }

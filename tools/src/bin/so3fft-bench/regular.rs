@@ -9,6 +9,7 @@ use crate::seeded;
 use crate::timing::{median_of, RunTimes};
 use crate::workload::{self, RoundTripError};
 use so3fft::{Complex64, Direction, Plan};
+use so3fft_tools::{bar_eprintln, bar_println};
 use std::time::Instant;
 
 /// Share of `MemAvailable` a configuration may use before it is skipped: the machine has no
@@ -44,17 +45,17 @@ pub fn bench_bandwidth(setup: Setup, results: &mut Results) {
     for &threads in &opts.threads {
         match complex_row(setup, threads, &coeffs) {
             Ok(row) => {
-                println!("{}", report::table_line(&row));
+                bar_println!("{}", report::table_line(&row));
                 results.rows.push(row);
             }
-            Err(e) => eprintln!("so3fft-bench: B = {b}, threads = {threads}: skipped: {e}"),
+            Err(e) => bar_eprintln!("so3fft-bench: B = {b}, threads = {threads}: skipped: {e}"),
         }
     }
 
     match noskip_row(setup, opts.threads[0], &coeffs) {
         Ok(row) => results.rows.push(row),
         Err(e) => {
-            eprintln!("  (B = {b}: no-skip run n/a: {e})");
+            bar_eprintln!("  (B = {b}: no-skip run n/a: {e})");
             results.noskip_missing.push((b, e.to_string()));
         }
     }
@@ -62,7 +63,7 @@ pub fn bench_bandwidth(setup: Setup, results: &mut Results) {
     let real_threads = *opts.threads.last().expect("at least one thread count");
     match real_row(setup, real_threads) {
         Ok(row) => results.rows.push(row),
-        Err(e) => eprintln!("so3fft-bench: B = {b}: real-signal run skipped: {e}"),
+        Err(e) => bar_eprintln!("so3fft-bench: B = {b}: real-signal run skipped: {e}"),
     }
 
     if b <= opts.naive_max {
@@ -70,13 +71,15 @@ pub fn bench_bandwidth(setup: Setup, results: &mut Results) {
         let library = match report::find(&results.rows, Variant::Complex, b, 1) {
             Some(r) => Ok(r.clone()),
             None => {
-                eprintln!("  (B = {b}: library one-thread DWT measured for the plain-DWT ratio)");
+                bar_eprintln!(
+                    "  (B = {b}: library one-thread DWT measured for the plain-DWT ratio)"
+                );
                 complex_row(setup, 1, &coeffs)
             }
         };
         match library {
             Ok(lib) => row.ratio = Some((lib.fwd.dwt / row.fwd.dwt, lib.inv.dwt / row.inv.dwt)),
-            Err(e) => eprintln!("so3fft-bench: B = {b}: one-thread plan failed: {e}"),
+            Err(e) => bar_eprintln!("so3fft-bench: B = {b}: one-thread plan failed: {e}"),
         }
         results.rows.push(row);
     }
@@ -114,7 +117,7 @@ fn naive_row(setup: Setup, coeffs: &[Complex64]) -> Row {
     });
     let forward = median_of(&times.forward, |t| t.wall);
     let inverse = median_of(&times.inverse, |t| t.wall);
-    eprintln!(
+    bar_eprintln!(
         "  (B = {b}: plain DWT, {runs} run(s): forward {forward:.3e} s, inverse {inverse:.3e} s)"
     );
     let not_applicable = Stages {
@@ -153,12 +156,12 @@ fn naive_row(setup: Setup, coeffs: &[Complex64]) -> Row {
 fn fits_in_memory(b: usize) -> bool {
     let need = workload::estimated_bytes(b);
     let Some(available) = workload::mem_available_bytes() else {
-        eprintln!("so3fft-bench: cannot read MemAvailable; running B = {b} unchecked");
+        bar_eprintln!("so3fft-bench: cannot read MemAvailable; running B = {b} unchecked");
         return true;
     };
     let fits = (need as f64) <= MEMORY_FRACTION * available as f64;
     if !fits {
-        eprintln!(
+        bar_eprintln!(
             "so3fft-bench: warning: skipping B = {b}: needs about {:.2} GiB, more than {:.0}% of \
              MemAvailable ({:.2} GiB)",
             gib(need),
@@ -193,7 +196,7 @@ fn bench_plan(setup: Setup, threads: usize, variant: Variant) -> Result<Plan, so
         Variant::Real => ", real signal",
         _ => "",
     };
-    eprintln!(
+    bar_eprintln!(
         "  (B = {b}, threads = {}{what}: plan created in {:.3} s)",
         plan.threads(),
         plan_start.elapsed().as_secs_f64(),

@@ -4,7 +4,6 @@
 //! row, "n/a" in the tables and an empty field in the CSV.
 
 use std::fmt::Write as _;
-use std::io;
 use std::path::Path;
 
 /// Median stage times of one direction, in seconds.
@@ -364,12 +363,42 @@ pub fn real_table(rows: &[Row]) -> String {
     out
 }
 
-const CSV_HEADER: &str = "bandwidth,threads,runs,fwd_median_s,inv_median_s,fwd_fft_s,fwd_dwt_s,\
-inv_fft_s,inv_dwt_s,dwt_flops,fwd_dwt_gflops,inv_dwt_gflops,peak_gflops_1core,fwd_dwt_frac_peak,\
-inv_dwt_frac_peak,roundtrip_max_abs_err,roundtrip_rel_l2_err,variant,peak_rss_bytes,\
-rss_growth_bytes,plan_memory_bytes,arrays_bytes,peak_over_arrays,lib_over_naive_fwd_dwt,\
-lib_over_naive_inv_dwt,noskip_over_skip_fwd_dwt,noskip_over_skip_inv_dwt,real_over_complex_fwd,\
-real_over_complex_inv,fwd_cpu_s,inv_cpu_s,utilisation";
+/// CSV columns; `docs/benchmark.md` describes each (new columns go at the end, so readers of
+/// the first ones keep working).
+const CSV_HEADER: [&str; 32] = [
+    "bandwidth",
+    "threads",
+    "runs",
+    "fwd_median_s",
+    "inv_median_s",
+    "fwd_fft_s",
+    "fwd_dwt_s",
+    "inv_fft_s",
+    "inv_dwt_s",
+    "dwt_flops",
+    "fwd_dwt_gflops",
+    "inv_dwt_gflops",
+    "peak_gflops_1core",
+    "fwd_dwt_frac_peak",
+    "inv_dwt_frac_peak",
+    "roundtrip_max_abs_err",
+    "roundtrip_rel_l2_err",
+    "variant",
+    "peak_rss_bytes",
+    "rss_growth_bytes",
+    "plan_memory_bytes",
+    "arrays_bytes",
+    "peak_over_arrays",
+    "lib_over_naive_fwd_dwt",
+    "lib_over_naive_inv_dwt",
+    "noskip_over_skip_fwd_dwt",
+    "noskip_over_skip_inv_dwt",
+    "real_over_complex_fwd",
+    "real_over_complex_inv",
+    "fwd_cpu_s",
+    "inv_cpu_s",
+    "utilisation",
+];
 
 /// A float field: Rust's shortest round-trip formatting in exponent form (`{:e}`), so nothing
 /// is lost and tiny errors stay readable; empty when NaN (does not apply).
@@ -381,58 +410,51 @@ fn num(x: f64) -> String {
     }
 }
 
-/// CSV text of all rows; `notes/bench.md` describes every column (new columns go at the end,
-/// so readers of the first ones keep working). Errors keep NaN (a NaN error is a result).
-pub fn csv(rows: &[Row]) -> String {
-    let mut out = String::from(CSV_HEADER);
-    out.push('\n');
-    for r in rows {
-        let mem = |f: fn(&Memory) -> String| r.memory.as_ref().map_or(String::new(), f);
-        let ratio = |v: Variant, fwd: bool| match (r.ratio, r.variant == v) {
-            (Some((f, i)), true) => num(if fwd { f } else { i }),
-            _ => String::new(),
-        };
-        let fields = [
-            r.bandwidth.to_string(),
-            r.threads.to_string(),
-            r.runs.to_string(),
-            num(r.fwd_median),
-            num(r.inv_median),
-            num(r.fwd.fft),
-            num(r.fwd.dwt),
-            num(r.inv.fft),
-            num(r.inv.dwt),
-            r.dwt_flops.to_string(),
-            num(r.fwd_dwt_gflops()),
-            num(r.inv_dwt_gflops()),
-            num(r.peak_1core),
-            num(r.fwd_frac_peak()),
-            num(r.inv_frac_peak()),
-            format!("{:e}", r.max_abs_err),
-            format!("{:e}", r.rel_l2_err),
-            r.variant.name().to_string(),
-            mem(|m| m.peak.to_string()),
-            mem(|m| m.growth().to_string()),
-            mem(|m| m.plan.to_string()),
-            mem(|m| m.arrays.to_string()),
-            mem(|m| num(m.peak_over_arrays())),
-            ratio(Variant::Naive, true),
-            ratio(Variant::Naive, false),
-            ratio(Variant::NoSkip, true),
-            ratio(Variant::NoSkip, false),
-            ratio(Variant::Real, true),
-            ratio(Variant::Real, false),
-            r.cpu.map_or(String::new(), |c| num(c.0)),
-            r.cpu.map_or(String::new(), |c| num(c.1)),
-            num(r.utilisation()),
-        ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
-    }
-    out
+/// The CSV fields of a row, in [`CSV_HEADER`]'s order. Errors keep NaN (a NaN error is a
+/// result).
+fn csv_record(r: &Row) -> [String; 32] {
+    let mem = |f: fn(&Memory) -> String| r.memory.as_ref().map_or(String::new(), f);
+    let ratio = |v: Variant, fwd: bool| match (r.ratio, r.variant == v) {
+        (Some((f, i)), true) => num(if fwd { f } else { i }),
+        _ => String::new(),
+    };
+    [
+        r.bandwidth.to_string(),
+        r.threads.to_string(),
+        r.runs.to_string(),
+        num(r.fwd_median),
+        num(r.inv_median),
+        num(r.fwd.fft),
+        num(r.fwd.dwt),
+        num(r.inv.fft),
+        num(r.inv.dwt),
+        r.dwt_flops.to_string(),
+        num(r.fwd_dwt_gflops()),
+        num(r.inv_dwt_gflops()),
+        num(r.peak_1core),
+        num(r.fwd_frac_peak()),
+        num(r.inv_frac_peak()),
+        format!("{:e}", r.max_abs_err),
+        format!("{:e}", r.rel_l2_err),
+        r.variant.name().to_string(),
+        mem(|m| m.peak.to_string()),
+        mem(|m| m.growth().to_string()),
+        mem(|m| m.plan.to_string()),
+        mem(|m| m.arrays.to_string()),
+        mem(|m| num(m.peak_over_arrays())),
+        ratio(Variant::Naive, true),
+        ratio(Variant::Naive, false),
+        ratio(Variant::NoSkip, true),
+        ratio(Variant::NoSkip, false),
+        ratio(Variant::Real, true),
+        ratio(Variant::Real, false),
+        r.cpu.map_or(String::new(), |c| num(c.0)),
+        r.cpu.map_or(String::new(), |c| num(c.1)),
+        num(r.utilisation()),
+    ]
 }
 
-/// Writes the CSV file.
-pub fn write_csv(path: &Path, rows: &[Row]) -> io::Result<()> {
-    std::fs::write(path, csv(rows))
+/// Writes the CSV file: the header, then one record per row.
+pub fn write_csv(path: &Path, rows: &[Row]) -> csv::Result<()> {
+    so3fft_tools::csv_out::write(path, &CSV_HEADER, rows.iter().map(csv_record))
 }

@@ -11,10 +11,10 @@
 //! - (d) `determinism`: bits across 1, 2, 4 threads and repeated executions;
 //! - `matching`: rotational matching's angle error and time (points of the time chart).
 //!
-//! Prints a table (a row per case as it is measured), the fitted exponents and the issue's
-//! targets; `--csv`, `--svg`,
-//! `--time-svg` write the results, `--docs DIR` all of them plus the tables in
-//! `DIR/stability.md`. See `docs/stability.md`.
+//! Prints a table (a row per case as it is measured), the fitted exponents and the accuracy
+//! targets; `--csv`, `--svg`, `--time-svg` write the results, `--docs DIR` all of them plus
+//! the tables in `DIR/stability.md`; `--from-csv` redraws charts and tables from an earlier
+//! run's CSV without running a test. See `docs/stability.md`.
 
 mod adversarial;
 mod determinism;
@@ -26,95 +26,98 @@ mod rng;
 mod roundtrip;
 mod targets;
 
-use record::Report;
-use std::path::PathBuf;
+use clap::{Parser, ValueEnum};
+use record::{Report, Row};
+use so3fft_tools::progress::Steps;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-const USAGE: &str = "\
-usage: so3fft-stress [--quick] [--big] [--threads N] [--only LIST] [--data DIR]
-                     [--csv FILE] [--svg FILE] [--time-svg FILE] [--docs DIR]
-
-  --quick      small bandwidths only (SO(3) round trips to 64, partial to 128, S^2 to 256;
-               about 5 s); default: the full run (SO(3) to 256, partial and S^2 to 2048;
-               a few minutes, under 6 GB)
-  --big        also B = 512 full-grid SO(3) round trips (needs about 24 GB)
-  --threads N  worker threads of the transforms (default 0 = all cores)
-  --only LIST  comma-separated tests among reference,roundtrip,adversarial,determinism,isa,
-               matching
-  --data DIR   reference data (default tests/data/stress of the source tree)
-  --csv FILE   write every row as CSV
-  --svg FILE   write the error-against-bandwidth plot
-  --time-svg FILE  write the time-against-error plot
-  --docs DIR   write DIR/stability.csv, stability.svg, time-vs-error.svg and the tables of
-               DIR/stability.md (between its stress-table markers)
-exit status: 0 if every accuracy target that the run covers is met, 1 if one is missed,
-2 on bad arguments or a failed transform";
-
-/// Command-line options.
+/// The numerical stress suite of so3fft: transforms against exact values, round trips over
+/// doubling bandwidths, adversarial inputs, determinism across threads, rotational matching
+/// and every instruction set. Prints a row per case as it is measured, the fitted growth
+/// exponents and the accuracy targets. See docs/stability.md.
+#[derive(Parser, Debug)]
+#[command(
+    name = "so3fft-stress",
+    version,
+    args_override_self = true,
+    after_help = "Exit status: 0 if every accuracy target that the run covers is met, 1 if one \
+                  is missed, 2 on bad arguments, a failed transform or an unwritable output."
+)]
 struct Options {
+    /// Small bandwidths only (SO(3) round trips to 64, partial to 128, S^2 to 256; about
+    /// 5 s); without it the full run (SO(3) to 256, partial and S^2 to 2048; a few minutes,
+    /// under 6 GB)
+    #[arg(long)]
     quick: bool,
+    /// Also B = 512 full-grid SO(3) round trips (needs about 24 GB)
+    #[arg(long)]
     big: bool,
+    /// Worker threads of the transforms (0 = all cores)
+    #[arg(long, value_name = "N", default_value_t = 0)]
     threads: usize,
-    only: Option<Vec<String>>,
-    data: PathBuf,
+    /// Comma-separated tests to run [default: all]
+    #[arg(long, value_name = "LIST", value_enum, value_delimiter = ',')]
+    only: Option<Vec<Test>>,
+    /// Reference data [default: tests/data/stress of the source tree]
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+    /// Write every row as CSV
+    #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
+    /// Write the error-against-bandwidth chart
+    #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
+    /// Write the time-against-error chart
+    #[arg(long, value_name = "FILE")]
     time_svg: Option<PathBuf>,
+    /// Write DIR/stability.csv, stability.svg, time-vs-error.svg and the tables of
+    /// DIR/stability.md (between its stress-table markers)
+    #[arg(long, value_name = "DIR")]
     docs: Option<PathBuf>,
+    /// Run no test: read the rows of an earlier run's CSV (as written by --csv or --docs)
+    /// and redraw the charts and tables from them (with --docs, the CSV is not rewritten)
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["quick", "big", "only", "threads"])]
+    from_csv: Option<PathBuf>,
 }
 
-fn parse(args: impl Iterator<Item = String>) -> Result<Option<Options>, String> {
-    let mut o = Options {
-        quick: false,
-        big: false,
-        threads: 0,
-        only: None,
-        data: reference::default_data_dir(),
-        csv: None,
-        svg: None,
-        time_svg: None,
-        docs: None,
-    };
-    let mut args = args.peekable();
-    while let Some(arg) = args.next() {
-        let mut value = || args.next().ok_or(format!("{arg} needs a value"));
-        match arg.as_str() {
-            "-h" | "--help" => return Ok(None),
-            "--quick" => o.quick = true,
-            "--big" => o.big = true,
-            "--threads" => {
-                o.threads = value()?
-                    .parse()
-                    .map_err(|_| "--threads needs a number".to_string())?
-            }
-            "--only" => o.only = Some(value()?.split(',').map(str::to_string).collect()),
-            "--data" => o.data = value()?.into(),
-            "--csv" => o.csv = Some(value()?.into()),
-            "--svg" => o.svg = Some(value()?.into()),
-            "--time-svg" => o.time_svg = Some(value()?.into()),
-            "--docs" => o.docs = Some(value()?.into()),
-            other => return Err(format!("unknown argument {other:?}")),
-        }
-    }
-    Ok(Some(o))
+/// The suite's tests, as `--only` names them.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+enum Test {
+    Reference,
+    Roundtrip,
+    Adversarial,
+    Determinism,
+    Isa,
+    Matching,
 }
 
 impl Options {
-    fn wants(&self, test: &str) -> bool {
-        self.only
-            .as_ref()
-            .is_none_or(|list| list.iter().any(|t| t == test))
+    fn wants(&self, test: Test) -> bool {
+        self.only.as_ref().is_none_or(|list| list.contains(&test))
+    }
+
+    /// Number of tests the run makes.
+    fn test_count(&self) -> usize {
+        Test::value_variants()
+            .iter()
+            .filter(|&&t| self.wants(t))
+            .count()
     }
 }
 
 /// Runs the selected tests into `report`.
 fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
     let t = o.threads;
-    if o.wants("reference") {
-        reference::run(&o.data, t, report)?;
+    let bar = Steps::new(o.test_count() as u64, "tests");
+    if o.wants(Test::Reference) {
+        bar.message("reference");
+        reference::run(&o.data_dir(), t, report)?;
+        bar.step();
     }
-    if o.wants("roundtrip") {
+    if o.wants(Test::Roundtrip) {
+        bar.message("roundtrip");
         let ranges = if o.quick {
             roundtrip::Ranges {
                 full_max: 64,
@@ -139,8 +142,10 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
             };
             roundtrip::full_complex(512, roundtrip::FULL_VARIANTS[0], run, report)?;
         }
+        bar.step();
     }
-    if o.wants("adversarial") {
+    if o.wants(Test::Adversarial) {
+        bar.message("adversarial");
         let bw = if o.quick {
             adversarial::Bandwidths {
                 top: &[16, 64],
@@ -155,19 +160,25 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
             }
         };
         adversarial::run(&bw, t, report)?;
+        bar.step();
     }
-    if o.wants("determinism") {
+    if o.wants(Test::Determinism) {
+        bar.message("determinism");
         determinism::run(if o.quick { 32 } else { 64 }, report)?;
+        bar.step();
     }
-    if o.wants("matching") {
+    if o.wants(Test::Matching) {
+        bar.message("matching");
         let ls: &[usize] = if o.quick {
             &[16, 32]
         } else {
             &[16, 32, 64, 128]
         };
         matching::run(ls, t, report)?;
+        bar.step();
     }
-    if o.wants("isa") {
+    if o.wants(Test::Isa) {
+        bar.message("isa");
         let bw = if o.quick {
             reference::IsaBandwidths {
                 so3: 32,
@@ -182,73 +193,98 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
             }
         };
         reference::isa_roundtrips(bw, t, report)?;
+        bar.step();
     }
     Ok(())
 }
 
-fn write(path: &PathBuf, text: &str) -> Result<(), String> {
+impl Options {
+    fn data_dir(&self) -> PathBuf {
+        self.data
+            .clone()
+            .unwrap_or_else(reference::default_data_dir)
+    }
+}
+
+fn write(path: &Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Writes the files the options ask for.
-fn write_outputs(o: &Options, report: &Report, summary: &targets::Summary) -> Result<(), String> {
-    let growths = record::growths(&report.rows, &roundtrip::GROWTH_TESTS);
+/// Writes the files the options ask for (`from_csv`: the rows came from that file, which
+/// `--docs` then does not rewrite).
+fn write_outputs(o: &Options, rows: &[Row], summary: &targets::Summary) -> Result<(), String> {
+    let growths = record::growths(rows, &roundtrip::GROWTH_TESTS);
     let mut csv = o.csv.clone();
     let mut svg = o.svg.clone();
     let mut time_svg = o.time_svg.clone();
     if let Some(dir) = &o.docs {
-        csv = Some(dir.join("stability.csv"));
+        if o.from_csv.is_none() || csv.is_some() {
+            csv = csv.or(Some(dir.join("stability.csv")));
+        }
         svg = Some(dir.join("stability.svg"));
         time_svg = Some(dir.join("time-vs-error.svg"));
         let md = dir.join("stability.md");
         let old = std::fs::read_to_string(&md).map_err(|e| format!("{}: {e}", md.display()))?;
-        let tables = targets::markdown(report, &growths, summary);
+        let tables = targets::markdown(rows, &growths, summary);
         write(&md, &targets::splice(&old, &tables)?)?;
     }
     if let Some(p) = csv {
-        write(&p, &report.csv())?;
+        record::write_csv(&p, rows).map_err(|e| format!("{}: {e}", p.display()))?;
     }
     if let Some(p) = svg {
-        write(&p, &plot::error_svg(&report.rows, &growths))?;
+        write(&p, &plot::error_svg(rows, &growths)?)?;
     }
     if let Some(p) = time_svg {
-        write(&p, &plot::time_svg(&report.rows))?;
+        write(&p, &plot::time_svg(rows)?)?;
     }
     Ok(())
 }
 
-fn main() -> ExitCode {
-    let o = match parse(std::env::args().skip(1)) {
-        Ok(Some(o)) => o,
-        Ok(None) => {
-            println!("{USAGE}");
-            return ExitCode::SUCCESS;
-        }
-        Err(msg) => {
-            eprintln!("so3fft-stress: {msg}\n{USAGE}");
-            return ExitCode::from(2);
-        }
-    };
+/// The rows: read from `--from-csv`, or measured now (printed as they come).
+fn collect_rows(o: &Options) -> Result<Vec<Row>, String> {
+    if let Some(path) = &o.from_csv {
+        return record::read_csv(path);
+    }
     let mut report = Report {
         verbose: true,
         ..Default::default()
     };
-    let start = Instant::now();
     println!("{}", Report::header());
-    if let Err(e) = run_tests(&o, &mut report) {
-        eprintln!("so3fft-stress: {e}");
-        return ExitCode::from(2);
-    }
+    run_tests(o, &mut report).map_err(|e| e.to_string())?;
+    Ok(report.rows)
+}
+
+fn main() -> ExitCode {
+    // Usage errors exit with status 2, --help and --version with 0 (clap).
+    let o = Options::parse();
+    let start = Instant::now();
+    let rows = match collect_rows(&o) {
+        Ok(rows) => rows,
+        Err(e) => {
+            eprintln!("so3fft-stress: {e}");
+            return ExitCode::from(2);
+        }
+    };
     println!();
-    let growths = record::growths(&report.rows, &roundtrip::GROWTH_TESTS);
+    let growths = record::growths(&rows, &roundtrip::GROWTH_TESTS);
     println!(
         "growth of the error with B (least squares on log-log):\n{}",
         record::growth_table(&growths)
     );
-    let summary = targets::evaluate(&report.rows, o.big);
+    // Read back, the rows tell whether the full-grid B = 512 round trips were run.
+    let big = o.big
+        || (o.from_csv.is_some()
+            && rows.iter().any(|r| {
+                r.test == "roundtrip"
+                    && r.b == 512
+                    && (r.variant == "complex" || r.variant == "real")
+            }));
+    let summary = targets::evaluate(&rows, big);
     println!("accuracy targets:\n{}", summary.text());
-    println!("total {:.1} s", start.elapsed().as_secs_f64());
-    if let Err(msg) = write_outputs(&o, &report, &summary) {
+    if o.from_csv.is_none() {
+        println!("total {:.1} s", start.elapsed().as_secs_f64());
+    }
+    if let Err(msg) = write_outputs(&o, &rows, &summary) {
         eprintln!("so3fft-stress: {msg}");
         return ExitCode::from(2);
     }

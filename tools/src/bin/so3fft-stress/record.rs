@@ -3,6 +3,7 @@
 
 use so3fft::Complex64;
 use std::fmt::Write as _;
+use std::path::Path;
 
 /// One measured case.
 #[derive(Clone, Debug)]
@@ -94,7 +95,8 @@ impl Report {
     /// Adds a row (and prints it when verbose).
     pub fn push(&mut self, row: Row) {
         if self.verbose {
-            println!("{}", format_row(&row));
+            so3fft_tools::bar_println!("{}", format_row(&row));
+            so3fft_tools::progress::message(format!("{} B = {}", row.test, row.b));
         }
         self.rows.push(row);
     }
@@ -110,25 +112,6 @@ impl Report {
             time_s,
             note: note.into(),
         });
-    }
-
-    /// The rows as CSV (header line first).
-    pub fn csv(&self) -> String {
-        let mut out = String::from("test,B,variant,rel_l2,max_abs,time_s,note\n");
-        for r in &self.rows {
-            let _ = writeln!(
-                out,
-                "{},{},{},{:.3e},{:.3e},{:.4e},\"{}\"",
-                r.test,
-                r.b,
-                r.variant,
-                r.rel_l2,
-                r.max_abs,
-                r.time_s,
-                r.note.replace('"', "'")
-            );
-        }
-        out
     }
 
     /// The table's header line (the rows print as they are measured).
@@ -253,4 +236,104 @@ pub fn growth_table(growths: &[Growth]) -> String {
         );
     }
     out
+}
+
+/// Columns of the CSV file.
+const CSV_HEADER: [&str; 7] = [
+    "test", "B", "variant", "rel_l2", "max_abs", "time_s", "note",
+];
+
+/// Writes the rows as CSV (header line first).
+pub fn write_csv(path: &Path, rows: &[Row]) -> csv::Result<()> {
+    let records = rows.iter().map(|r| {
+        [
+            r.test.clone(),
+            r.b.to_string(),
+            r.variant.clone(),
+            format!("{:.3e}", r.rel_l2),
+            format!("{:.3e}", r.max_abs),
+            format!("{:.4e}", r.time_s),
+            r.note.clone(),
+        ]
+    });
+    so3fft_tools::csv_out::write(path, &CSV_HEADER, records)
+}
+
+/// The rows of a CSV file written by [`write_csv`]. Files of earlier versions left a variant
+/// holding a comma (`M=B-1,M'=-(B-1)`) unquoted: its pieces are joined again.
+pub fn read_csv(path: &Path) -> Result<Vec<Row>, String> {
+    let records = so3fft_tools::csv_out::read(path, &CSV_HEADER)?;
+    records
+        .iter()
+        .enumerate()
+        .map(|(i, rec)| {
+            // Line i + 2: the header is line 1.
+            let bad = |what: &str| format!("{}: line {}: bad {what}", path.display(), i + 2);
+            let n = rec.len();
+            if n < CSV_HEADER.len() {
+                return Err(bad("record (too few fields)"));
+            }
+            // The four fields after the variant, counted from the end.
+            let number =
+                |k: usize, what: &str| rec[n - 4 + k].trim().parse::<f64>().map_err(|_| bad(what));
+            let variant: Vec<&str> = rec.iter().skip(2).take(n - 6).collect();
+            Ok(Row {
+                test: rec[0].to_string(),
+                b: rec[1].trim().parse().map_err(|_| bad("B"))?,
+                variant: variant.join(","),
+                rel_l2: number(0, "rel_l2")?,
+                max_abs: number(1, "max_abs")?,
+                time_s: number(2, "time_s")?,
+                note: rec[n - 1].to_string(),
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{read_csv, write_csv, Row};
+
+    fn row(variant: &str, rel_l2: f64, note: &str) -> Row {
+        Row {
+            test: "top-order-inverse".into(),
+            b: 16,
+            variant: variant.into(),
+            rel_l2,
+            max_abs: 4.578e-16,
+            time_s: 3.6345e-4,
+            note: note.into(),
+        }
+    }
+
+    /// Rows come back from the CSV as written (commas in variants and notes, NaN), and the
+    /// unquoted variants of older files are joined again.
+    #[test]
+    fn csv_round_trip_and_old_files() {
+        let dir = std::env::temp_dir();
+        let path = dir.join(format!("so3fft-stress-rows-{}.csv", std::process::id()));
+        let rows = [
+            row("M=B-1,M'=-(B-1)", 3.467e-16, "vs closed form, \"quoted\""),
+            row("complex", f64::NAN, ""),
+        ];
+        write_csv(&path, &rows).unwrap();
+        let back = read_csv(&path).unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!(back[0].variant, rows[0].variant);
+        assert_eq!(back[0].note, rows[0].note);
+        assert_eq!((back[0].rel_l2, back[0].b), (3.467e-16, 16));
+        assert!(back[1].rel_l2.is_nan());
+        let old = "test,B,variant,rel_l2,max_abs,time_s,note\n\
+                   top-order-inverse,16,M=B-1,M'=-(B-1),3.467e-16,4.578e-16,3.6345e-4,\"vs x\"\n";
+        std::fs::write(&path, old).unwrap();
+        let back = read_csv(&path).unwrap();
+        assert_eq!(back[0].variant, "M=B-1,M'=-(B-1)");
+        assert_eq!(
+            (back[0].max_abs, back[0].note.as_str()),
+            (4.578e-16, "vs x")
+        );
+        std::fs::write(&path, "test,B\n").unwrap();
+        assert!(read_csv(&path).is_err());
+        std::fs::remove_file(path).unwrap();
+    }
 }

@@ -1,7 +1,7 @@
 //! The stress suite's accuracy targets, checked against the rows of a run, and the Markdown
 //! tables of `docs/stability.md`.
 
-use crate::record::{Growth, Report, Row};
+use crate::record::{Growth, Row};
 use std::fmt::Write as _;
 
 /// Whether a target was met.
@@ -24,6 +24,8 @@ pub struct Target {
     pub status: Status,
     /// The measured figure(s).
     pub detail: String,
+    /// Kinds (see [`kind`]) of the rows it covers.
+    pub covers: Vec<String>,
 }
 
 /// Every target of a run.
@@ -60,6 +62,28 @@ fn status_word(s: Status) -> &'static str {
         Status::Missed => "MISSED",
         Status::NotRun => "not run",
     }
+}
+
+/// What a row is summarised under: its test, and for the round trips (whose variants have
+/// different targets and tolerances) the variant too.
+fn kind(r: &Row) -> String {
+    if r.test == "roundtrip" {
+        format!("roundtrip {}", r.variant)
+    } else {
+        r.test.clone()
+    }
+}
+
+/// Distinct kinds of `rows`, in order.
+fn kinds_of(rows: &[&Row]) -> Vec<String> {
+    let mut kinds: Vec<String> = Vec::new();
+    for r in rows {
+        let k = kind(r);
+        if !kinds.contains(&k) {
+            kinds.push(k);
+        }
+    }
+    kinds
 }
 
 /// Worst value of `field` over `rows`, with the row it came from.
@@ -111,6 +135,7 @@ fn bound(
         name: name.into(),
         status,
         detail,
+        covers: kinds_of(&picked),
     }
 }
 
@@ -138,6 +163,7 @@ fn every_note(
         name: name.into(),
         status,
         detail,
+        covers: kinds_of(&picked),
     }
 }
 
@@ -238,8 +264,9 @@ fn fmt_value(v: f64) -> String {
     }
 }
 
-/// The Markdown of the targets, the growth exponents and every row.
-pub fn markdown(report: &Report, growths: &[Growth], summary: &Summary) -> String {
+/// The Markdown of the targets, the growth exponents and a summary per test; the rows
+/// themselves are in stability.csv.
+pub fn markdown(rows: &[Row], growths: &[Growth], summary: &Summary) -> String {
     let mut out =
         String::from("### Accuracy targets\n\n| target | status | measured |\n|---|---|---|\n");
     for t in &summary.targets {
@@ -269,23 +296,88 @@ pub fn markdown(report: &Report, growths: &[Growth], summary: &Summary) -> Strin
             bs.join(", ")
         );
     }
-    out.push_str("\n### Every row\n\n<details><summary>The whole table (also in stability.csv)</summary>\n\n");
-    out.push_str("| test | B | variant | rel L2 | max abs | time s | note |\n|---|---|---|---|---|---|---|\n");
-    for r in &report.rows {
+    out.push_str("\n### Summary per test\n\n");
+    out.push_str(
+        "Worst errors over each test's rows (round trips: each variant's), with the variant \
+         and B where they occur (\"-\" where the rows carry no such error: bit checks, NaN \
+         counts), and the accuracy targets that cover them. Every row (test, B, variant, \
+         errors, time, note) is in [stability.csv](stability.csv).\n\n",
+    );
+    out.push_str(
+        "| test | rows | variants | B | worst rel L2 | worst max abs | targets |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    for k in kind_summaries(rows, summary) {
         let _ = writeln!(
             out,
             "| {} | {} | {} | {} | {} | {} | {} |",
-            r.test,
-            r.b,
-            r.variant,
-            fmt_value(r.rel_l2),
-            fmt_value(r.max_abs),
-            fmt_value(r.time_s),
-            r.note.replace('|', "/")
+            k.kind, k.rows, k.variants, k.bandwidths, k.worst_rel, k.worst_max, k.targets
         );
     }
-    out.push_str("\n</details>\n");
     out
+}
+
+/// One line of the per-test summary, formatted.
+struct KindSummary {
+    kind: String,
+    rows: usize,
+    variants: usize,
+    /// `lo..hi`, or the one bandwidth.
+    bandwidths: String,
+    worst_rel: String,
+    worst_max: String,
+    /// `met: name; MISSED: name`, or `-`.
+    targets: String,
+}
+
+/// Per kind, in the order the kinds first appear.
+fn kind_summaries(rows: &[Row], summary: &Summary) -> Vec<KindSummary> {
+    let all: Vec<&Row> = rows.iter().collect();
+    kinds_of(&all)
+        .into_iter()
+        .map(|kind_name| {
+            let mine: Vec<&Row> = rows.iter().filter(|r| kind(r) == kind_name).collect();
+            let mut variants: Vec<&str> = mine.iter().map(|r| r.variant.as_str()).collect();
+            variants.sort_unstable();
+            variants.dedup();
+            let lo = mine.iter().map(|r| r.b).min().unwrap_or(0);
+            let hi = mine.iter().map(|r| r.b).max().unwrap_or(0);
+            let bandwidths = if lo == hi {
+                lo.to_string()
+            } else {
+                format!("{lo}..{hi}")
+            };
+            let worst_of = |field: fn(&Row) -> f64| {
+                let with_values: Vec<&Row> = mine
+                    .iter()
+                    .copied()
+                    .filter(|r| !field(r).is_nan())
+                    .collect();
+                worst(&with_values, field).map_or("-".to_string(), |(v, r)| {
+                    format!("{} ({} B = {})", fmt_value(v), r.variant, r.b)
+                })
+            };
+            let targets: Vec<String> = summary
+                .targets
+                .iter()
+                .filter(|t| t.covers.contains(&kind_name))
+                .map(|t| format!("{}: {}", status_word(t.status), t.name))
+                .collect();
+            KindSummary {
+                rows: mine.len(),
+                variants: variants.len(),
+                bandwidths,
+                worst_rel: worst_of(rel),
+                worst_max: worst_of(max_abs),
+                targets: if targets.is_empty() {
+                    "-".into()
+                } else {
+                    targets.join("; ")
+                },
+                kind: kind_name,
+            }
+        })
+        .collect()
 }
 
 /// Marker lines of the generated part of docs/stability.md.
