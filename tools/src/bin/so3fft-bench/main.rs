@@ -248,15 +248,21 @@ fn print_summaries(rows: &[Row], noskip_missing: &[(usize, String)]) {
 fn print_soft_comparison(opts: &Options) {
     let mut soft_rows = Vec::new();
     // Not above 256: the SOFT entry points need several grid-sized workspaces.
-    for &b in opts
+    let bandwidths: Vec<usize> = opts
         .bandwidths
         .iter()
-        .filter(|&&b| b <= cli::MAX_REGULAR_BANDWIDTH)
-    {
+        .copied()
+        .filter(|&b| b <= cli::MAX_REGULAR_BANDWIDTH)
+        .collect();
+    let bar = Steps::new(bandwidths.len() as u64, "bandwidths (SOFT)");
+    for b in bandwidths {
+        bar.message(format!("(B = {b})"));
         match soft_cmp::compare(b, opts.runs_for(b)) {
             Ok(r) => soft_rows.extend(r),
-            Err(e) => eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
+            Err(e) => so3fft_tools::bar_eprintln!("so3fft-bench: SOFT comparison at B = {b}: {e}"),
         }
+        bar.step();
     }
+    drop(bar);
     print!("{}", soft_cmp::table(&soft_rows));
 }

@@ -10,6 +10,8 @@
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
 use so3fft::{Complex64, Plan, StageTimes};
+use so3fft_tools::bar_println;
+use so3fft_tools::progress::Steps;
 use std::time::{Duration, Instant};
 
 /// Shortest window, in seconds of the first thread count's round trip.
@@ -100,7 +102,7 @@ impl RoundTrip {
             if (others as f64) <= DISTURBANCE_LIMIT * all + 1.0 {
                 return Ok(window);
             }
-            eprintln!(
+            so3fft_tools::bar_eprintln!(
                 "window disturbed: other processes used {:.0}% of the machine",
                 100.0 * others as f64 / all
             );
@@ -117,7 +119,9 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
         "{:>5} {:>3} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}  fft threading",
         "B", "thr", "inv", "inv fft", "inv dwt", "fwd", "fwd fft", "fwd dwt"
     );
+    let bar = Steps::new(opts.bandwidths.len() as u64, "bandwidths");
     for &b in &opts.bandwidths {
+        bar.message(format!("(B = {b})"));
         let plans = opts
             .threads
             .iter()
@@ -131,6 +135,7 @@ pub fn run(opts: &Options) -> Result<(), so3fft::Error> {
             })
             .collect::<Result<Vec<_>, _>>()?;
         scale_bandwidth(b, &plans, runs)?;
+        bar.step();
     }
     Ok(())
 }
@@ -161,7 +166,7 @@ fn scale_bandwidth(b: usize, plans: &[Plan], runs: usize) -> Result<(), so3fft::
     let mut round_trip_medians = Vec::new();
     for (plan, windows) in plans.iter().zip(&windows) {
         let of = |f: fn(&Window) -> f64| median(&windows.iter().map(f).collect::<Vec<_>>());
-        println!(
+        bar_println!(
             "{:>5} {:>3} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e} {:>10.4e}",
             b,
             plan.threads(),
@@ -180,7 +185,7 @@ fn scale_bandwidth(b: usize, plans: &[Plan], runs: usize) -> Result<(), so3fft::
     // Speed-ups from the medians of per-window sums (inverse + forward).
     let (total_first, fft_first) = round_trip_medians[0];
     for (plan, (total, fft)) in plans.iter().zip(&round_trip_medians).skip(1) {
-        println!(
+        bar_println!(
             "B = {b}: {} threads over {}: whole transform {:.3}x, FFT stage {:.3}x",
             plan.threads(),
             plans[0].threads(),
