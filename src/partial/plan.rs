@@ -53,6 +53,15 @@ impl PartialPlan {
     ) -> Result<PartialPlan> {
         let c = PartialPlan::validate(shape, options)?;
         let n_slices = c.pairs.n_slices;
+        // Fail cleanly instead of meeting the OOM killer: the plan must fit in the available
+        // memory, and plan plus the caller's arrays in the machine. Checked on the estimate
+        // before the tables are built (they take minutes at the largest bandwidths), and on
+        // the plan's own count before its large buffers are made.
+        let arrays = (n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
+        let estimate = Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total();
+        if !fits_in_memory(estimate, arrays) {
+            return Err(Error::OutOfMemory { bytes: estimate });
+        }
         let engine = Box::new(Engine::new(
             shape,
             c.pairs,
@@ -60,16 +69,8 @@ impl PartialPlan {
             options,
             shared,
         )?);
-        // Fail cleanly instead of meeting the OOM killer before the large buffers are
-        // made: the plan must fit in the available memory, and plan plus the caller's
-        // arrays in the machine.
         let need = engine.memory_bytes();
-        let arrays = (n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
-        let too_big = match (mem_available(), mem_total()) {
-            (Some(avail), Some(total)) => need > avail || need.saturating_add(arrays) > total,
-            _ => false,
-        };
-        if too_big {
+        if !fits_in_memory(need, arrays) {
             return Err(Error::OutOfMemory { bytes: need });
         }
         engine.reserve()?;
@@ -534,5 +535,14 @@ impl Transform for PartialPlan {
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());
         self.inverse_real_in(b, coeffs, samples, Some(scratch))
+    }
+}
+
+/// Whether a plan of `need` bytes fits in the available memory, and with the caller's
+/// `arrays` in the machine (true where the system does not say).
+fn fits_in_memory(need: usize, arrays: usize) -> bool {
+    match (mem_available(), mem_total()) {
+        (Some(avail), Some(total)) => need <= avail && need.saturating_add(arrays) <= total,
+        _ => true,
     }
 }
