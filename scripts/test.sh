@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Every test: the Rust suite (unit, integration, doc tests; the library and the tools), the C/C++ suite under CTest
 # (C API, SOFT compatibility layer, installed-package tests, valgrind runs, and the
-# distributed plans under mpirun on 1..4 ranks: label `mpi`), and the Rust MPI test
-# (tests/mpi.rs, feature `mpi`).
+# distributed plans under mpirun on 1..4 ranks: label `mpi`), the Rust MPI test
+# (tests/mpi.rs, feature `mpi`), and the Python package (installed as a user would, into
+# the virtual environment target/pyenv, then pytest and the example).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -27,3 +28,9 @@ fi
 # The Rust crate with its feature `mpi` (MpiExchange), in its own target directory: cargo keeps
 # one libso3fft per target directory whatever the features.
 CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi
+# The Python package, installed the way the README says, with its test dependencies.
+python3 -m venv target/pyenv
+target/pyenv/bin/pip install -q numpy scipy pytest ducc0 matplotlib
+target/pyenv/bin/pip install -q ./python
+target/pyenv/bin/pytest -q python/tests
+target/pyenv/bin/python python/examples/match_rotation.py --out target/match_rotation.png

@@ -1,0 +1,72 @@
+"""Argument checks shared by the plans: inputs used in place when they already have the
+right dtype, layout and shape, copied when a safe conversion exists, rejected otherwise;
+outputs checked, never converted."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def as_input(x, dtype, shapes, what):
+    """`x` as a C-contiguous array of `dtype` with one of `shapes` (tuples; `None` in a
+    shape matches any length). Arrays that already fit are returned as they are."""
+    if (
+        type(x) is np.ndarray
+        and x.dtype == dtype
+        and x.flags.c_contiguous
+        and x.shape in shapes
+    ):
+        return x
+    a = np.asarray(x)
+    if a.dtype == object or not (
+        np.issubdtype(a.dtype, np.number) or a.dtype == np.bool_
+    ):
+        raise TypeError(f"{what}: expected numbers, got an array of {a.dtype}")
+    if not np.can_cast(a.dtype, dtype, casting="same_kind"):
+        raise TypeError(
+            f"{what}: cannot convert {a.dtype} to {np.dtype(dtype)} without losing "
+            "information (complex data for a real plan?)"
+        )
+    if not any(_fits(a.shape, s) for s in shapes):
+        expected = " or ".join(str(s) for s in shapes)
+        raise ValueError(f"{what}: shape {a.shape}, expected {expected}")
+    return np.ascontiguousarray(a, dtype=dtype)
+
+
+def _fits(shape, pattern):
+    return len(shape) == len(pattern) and all(
+        p is None or p == s for s, p in zip(shape, pattern)
+    )
+
+
+def check_output(out, dtype, shape, what="out"):
+    """`out` if it is a writeable C-contiguous array of `dtype` and `shape` (else an error:
+    outputs are written in place, so they cannot be converted)."""
+    if not isinstance(out, np.ndarray):
+        raise TypeError(f"{what} must be a numpy.ndarray, not {type(out).__name__}")
+    if out.dtype != dtype:
+        raise TypeError(f"{what} must have dtype {np.dtype(dtype)}, not {out.dtype}")
+    if out.shape != shape:
+        raise ValueError(f"{what} must have shape {shape}, not {out.shape}")
+    if not out.flags.c_contiguous:
+        raise ValueError(f"{what} must be C-contiguous")
+    if not out.flags.writeable:
+        raise ValueError(f"{what} is read-only")
+    return out
+
+
+def threads_arg(threads):
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
+        raise TypeError(f"threads must be an integer (0: all cores), not {threads!r}")
+    t = int(threads)
+    if t < 0:
+        raise ValueError(f"threads must be a non-negative integer (0: all cores), not {threads!r}")
+    return t
+
+
+def bandwidth_arg(b, name="B"):
+    if isinstance(b, (bool, np.bool_)) or not isinstance(b, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, not {type(b).__name__}")
+    if b < 1:
+        raise ValueError(f"{name} must be at least 1, not {b}")
+    return int(b)

@@ -1,0 +1,347 @@
+"""Rotational matching: rotations, the correlation plan, peaks, refinement off the grid."""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from . import _so3fft
+from ._arrays import as_input, bandwidth_arg, check_output, threads_arg
+from ._transforms import _rigor_arg
+
+
+class Rotation:
+    """A rotation ``g = Rz(alpha) Ry(beta) Rz(gamma)`` (z-y-z Euler angles in radians, SOFT's
+    convention), acting on column vectors.
+
+    It is SciPy's intrinsic ``"ZYZ"``: ``Rotation(a, b, c).to_scipy()`` is
+    ``scipy.spatial.transform.Rotation.from_euler("ZYZ", [a, b, c])``. Quaternions are
+    ``(w, x, y, z)`` here (SciPy's default order is ``(x, y, z, w)``).
+    """
+
+    __slots__ = ("alpha", "beta", "gamma")
+
+    def __init__(self, alpha, beta, gamma):
+        self.alpha = float(alpha)
+        self.beta = float(beta)
+        self.gamma = float(gamma)
+        if not all(map(math.isfinite, (self.alpha, self.beta, self.gamma))):
+            raise ValueError(f"Euler angles must be finite, not ({alpha}, {beta}, {gamma})")
+
+    def __repr__(self):
+        return f"so3fft.Rotation({self.alpha!r}, {self.beta!r}, {self.gamma!r})"
+
+    def __iter__(self):
+        return iter((self.alpha, self.beta, self.gamma))
+
+    def as_euler(self):
+        """``(alpha, beta, gamma)`` as an array."""
+        return np.array([self.alpha, self.beta, self.gamma])
+
+    def as_matrix(self):
+        """The 3x3 rotation matrix."""
+        return np.array(_so3fft.euler_to_matrix(self.alpha, self.beta, self.gamma))
+
+    def as_quaternion(self):
+        """The unit quaternion ``(w, x, y, z)`` with ``w >= 0``."""
+        return np.array(_so3fft.euler_to_quaternion(self.alpha, self.beta, self.gamma))
+
+    def angle_to(self, other):
+        """The angle (radians) of the rotation taking ``self`` to ``other``: the geodesic
+        distance on SO(3), accurate for small angles."""
+        p, q = self.as_quaternion(), Rotation._of(other).as_quaternion()
+        if np.dot(p, q) < 0:
+            q = -q
+        return 4.0 * math.atan2(np.linalg.norm(p - q), np.linalg.norm(p + q))
+
+    @classmethod
+    def from_matrix(cls, matrix):
+        """The Euler angles of a rotation matrix (``beta`` in ``[0, pi]``, the others in
+        ``(-pi, pi]``; ``gamma = 0`` where ``beta`` is 0 or ``pi``)."""
+        r = np.asarray(matrix, dtype=float)
+        if r.shape != (3, 3) or not np.all(np.isfinite(r)):
+            raise ValueError("a rotation matrix is a finite 3x3 array")
+        if not np.allclose(r @ r.T, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+            raise ValueError("the matrix is not a rotation (orthogonal, determinant 1)")
+        s = math.hypot(r[0, 2], r[1, 2])
+        beta = math.atan2(s, r[2, 2])
+        if s > 1e-12:
+            return cls(math.atan2(r[1, 2], r[0, 2]), beta, math.atan2(r[2, 1], -r[2, 0]))
+        if r[2, 2] > 0:
+            return cls(math.atan2(r[1, 0], r[0, 0]), 0.0, 0.0)
+        return cls(math.atan2(-r[1, 0], -r[0, 0]), math.pi, 0.0)
+
+    @classmethod
+    def from_quaternion(cls, q):
+        """The rotation of a quaternion ``(w, x, y, z)`` (normalised here)."""
+        q = np.asarray(q, dtype=float)
+        if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.any(q):
+            raise ValueError("a quaternion is four finite numbers (w, x, y, z), not all 0")
+        w, x, y, z = q / np.linalg.norm(q)
+        return cls.from_matrix(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+
+    @classmethod
+    def from_scipy(cls, rotation):
+        """The rotation of a single ``scipy.spatial.transform.Rotation``."""
+        return cls.from_matrix(rotation.as_matrix())
+
+    def to_scipy(self):
+        """This rotation as a ``scipy.spatial.transform.Rotation``."""
+        from scipy.spatial.transform import Rotation as ScipyRotation
+
+        return ScipyRotation.from_euler("ZYZ", [self.alpha, self.beta, self.gamma])
+
+    @staticmethod
+    def _of(x):
+        return x if isinstance(x, Rotation) else Rotation(*x)
+
+
+class Peak(NamedTuple):
+    """A grid point of a correlation: flat index ``k (2B)^2 + j 2B + i``, its Euler angles
+    and ``|C|^2`` there."""
+
+    index: int
+    alpha: float
+    beta: float
+    gamma: float
+    value: float
+
+    @property
+    def rotation(self):
+        """The peak's rotation."""
+        return Rotation(self.alpha, self.beta, self.gamma)
+
+
+def _rows(rotations):
+    """Rotations (``Rotation`` objects, angle triples or an ``(n, 3)`` array) as rows."""
+    if isinstance(rotations, Rotation):
+        rotations = [rotations]
+    a = np.array(
+        [tuple(g) for g in rotations] if not isinstance(rotations, np.ndarray) else rotations,
+        dtype=float,
+    )
+    if a.ndim == 1:
+        a = a.reshape(1, -1)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError("rotations are rows of three Euler angles (alpha, beta, gamma)")
+    return np.ascontiguousarray(a)
+
+
+class Correlation:
+    """The rotational correlation of two functions on the sphere over the SO(3) grid::
+
+        C(g) = integral over S^2 of f(x) conj(h(g^-1 x)) dx
+
+    for a signal ``f`` and a pattern ``h`` sampled on the S^2 grid of bandwidth ``B`` (see
+    :class:`S2Plan`), at every rotation ``g`` of the SO(3) grid of bandwidth ``b_out`` (a
+    ``(2 b_out)^3`` array laid out as SO(3) samples, see :class:`Plan`). ``C`` is largest
+    where the signal is the pattern rotated by ``g``: ``f(x) = h(g^-1 x)``.
+
+    Parameters
+    ----------
+    B : int
+        Bandwidth of the inputs.
+    b_out : int, optional
+        Bandwidth of the SO(3) grid (default ``B``; larger samples the correlation more
+        finely).
+    deg_lim : int, optional
+        Highest degree combined (default ``min(B, b_out) - 1``).
+    real : bool
+        Real inputs and a real correlation grid (about half the work).
+    normalized : bool
+        Normalised cross-correlation: the means left out and the result divided by the
+        norms, so ``|C| <= 1`` with 1 for an exact rotated, scaled and shifted copy.
+    threads, rigor
+        As for :class:`Plan`.
+    """
+
+    def __init__(
+        self, B, *, b_out=None, deg_lim=None, real=False, normalized=False, threads=0,
+        rigor="estimate",
+    ):
+        B = bandwidth_arg(B)
+        b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
+        if deg_lim is not None and (int(deg_lim) != deg_lim or deg_lim < 0):
+            raise ValueError(f"deg_lim must be a non-negative integer, not {deg_lim!r}")
+        self._plan = _so3fft.Correlation(
+            B, b_out, None if deg_lim is None else int(deg_lim), bool(real), bool(normalized),
+            threads_arg(threads), _rigor_arg(rigor),
+        )
+        self.B = B
+        self.b_out = self._plan.b_out
+        self.deg_lim = self._plan.deg_lim
+        self.real = bool(real)
+        self.normalized = bool(normalized)
+        n = 2 * self.b_out
+        #: Shape of the correlation grid.
+        self.grid_shape = (n, n, n)
+        self._in_dtype = np.float64 if self.real else np.complex128
+        self._s2_shapes = ((2 * B, 2 * B),)
+
+    def __repr__(self):
+        return (
+            f"so3fft.Correlation({self.B}, b_out={self.b_out}, deg_lim={self.deg_lim}, "
+            f"real={self.real}, normalized={self.normalized})"
+        )
+
+    def _inputs(self, signal, pattern):
+        return (
+            as_input(signal, self._in_dtype, self._s2_shapes, "signal"),
+            as_input(pattern, self._in_dtype, self._s2_shapes, "pattern"),
+        )
+
+    def _grid(self, out):
+        if out is None:
+            return np.empty(self.grid_shape, self._in_dtype)
+        return check_output(out, self._in_dtype, self.grid_shape)
+
+    def correlate(self, signal, pattern, out=None):
+        """The correlation grid (``(2 b_out)^3``; real for a real plan), into ``out`` if
+        given."""
+        s, p = self._inputs(signal, pattern)
+        out = self._grid(out)
+        run = self._plan.correlate_real if self.real else self._plan.correlate
+        run(s, p, out, False)
+        return out
+
+    def correlate_argmax(self, signal, pattern, out=None):
+        """The correlation grid and its largest ``|C|^2`` (a :class:`Peak`, found while the
+        grid is computed: ties go to the lowest index)."""
+        s, p = self._inputs(signal, pattern)
+        out = self._grid(out)
+        run = self._plan.correlate_real if self.real else self._plan.correlate
+        return out, Peak(*run(s, p, out, True))
+
+    def correlate_shells(self, shells, out=None):
+        """``sum_i w_i C_i``: the correlations of shells ``(signal_i, pattern_i, w_i)``
+        (functions on concentric spheres, e.g. of a 3-D map), in one inverse transform."""
+        arrays = [(*self._inputs(s, p), float(w)) for s, p, w in shells]
+        out = self._grid(out)
+        run = self._plan.correlate_shells_real if self.real else self._plan.correlate_shells
+        run(arrays, out)
+        return out
+
+    def coefficients(self, signal, pattern, out=None):
+        """The correlation's SO(3) coefficients (bandwidth ``b_out``; zero above
+        ``deg_lim``), the input of :meth:`refine`."""
+        s, p = self._inputs(signal, pattern)
+        n = _so3fft.num_coeffs(self.b_out)
+        if out is None:
+            out = np.empty(n, np.complex128)
+        else:
+            check_output(out, np.complex128, (n,))
+        run = self._plan.coefficients_real if self.real else self._plan.coefficients
+        run(s, p, out)
+        return out
+
+    def refine(self, coeffs, starts):
+        """From each start rotation, the nearest maximum of ``|C|^2`` of the band-limited
+        correlation with coefficients ``coeffs`` (from :meth:`coefficients`), off the grid:
+        a list of ``(Rotation, value)``."""
+        c = as_input(coeffs, np.complex128, ((_so3fft.num_coeffs(self.b_out),),), "coefficients")
+        angles, values = self._plan.refine(c, _rows(starts))
+        return [(Rotation(*a), float(v)) for a, v in zip(angles, values)]
+
+    def match(self, signal, pattern, k=1, min_angle=None):
+        """The rotations that best take the pattern to the signal: the ``k`` largest peaks of
+        the correlation grid (at least ``min_angle`` radians apart, default one grid step),
+        each refined off the grid; a list of ``(Rotation, value)``, best first."""
+        grid = self.correlate(signal, pattern)
+        peaks = top_peaks(grid, k, math.pi / self.b_out if min_angle is None else min_angle)
+        found = self.refine(self.coefficients(signal, pattern), [p.rotation for p in peaks])
+        return sorted(found, key=lambda gv: -gv[1])
+
+
+@functools.lru_cache(maxsize=4)
+def _cached_correlation(B, b_out, deg_lim, real, normalized, threads):
+    return Correlation(
+        B, b_out=b_out, deg_lim=deg_lim, real=real, normalized=normalized, threads=threads
+    )
+
+
+def correlate(signal, pattern, b_out=None, deg_lim=None, *, normalized=False, threads=0):
+    """The correlation grid of ``signal`` and ``pattern`` (S^2 samples, ``(2B, 2B)``): see
+    :class:`Correlation`. Real inputs (both ``float``) give a real grid. The plan is kept
+    for the next call with the same arguments (a :class:`Correlation` made once is faster
+    for many calls with different ones)."""
+    s, p = np.asarray(signal), np.asarray(pattern)
+    if s.ndim != 2 or s.shape[0] != s.shape[1] or s.shape[0] % 2:
+        raise ValueError(f"signal: shape {s.shape}, expected (2B, 2B)")
+    real = not (np.iscomplexobj(s) or np.iscomplexobj(p))
+    plan = _cached_correlation(
+        s.shape[0] // 2, b_out, deg_lim, real, bool(normalized), threads_arg(threads)
+    )
+    return plan.correlate(s, p)
+
+
+def _grid_bandwidth(n):
+    b = round((n / 8) ** (1 / 3))
+    if b < 1 or 8 * b**3 != n:
+        raise ValueError(f"a correlation grid holds (2B)^3 values, not {n}")
+    return b
+
+
+def top_peaks(grid, k=1, min_angle=0.0):
+    """The ``k`` largest local maxima of ``|C|^2`` on a correlation grid (``(2B)^3``, complex
+    or real), each at least ``min_angle`` radians (geodesic) from every larger one taken: a
+    list of :class:`Peak`, largest first."""
+    g = np.asarray(grid)
+    _grid_bandwidth(g.size)
+    if int(k) != k or k < 0:
+        raise ValueError(f"k must be a non-negative integer, not {k!r}")
+    if np.iscomplexobj(g):
+        g = as_input(g, np.complex128, (g.shape,), "grid")
+        found = _so3fft.top_peaks(g, int(k), float(min_angle))
+    else:
+        g = as_input(g, np.float64, (g.shape,), "grid")
+        found = _so3fft.top_peaks_real(g, int(k), float(min_angle))
+    return [Peak(*p) for p in found]
+
+
+def _coeffs_and_limit(coeffs, deg_lim):
+    c = np.asarray(coeffs)
+    from ._layout import _bandwidth_of
+
+    B = _bandwidth_of(c.size)
+    c = as_input(c, np.complex128, ((c.size,),), "coefficients")
+    if deg_lim is None:
+        return c, B, B - 1
+    if isinstance(deg_lim, (bool, np.bool_)) or int(deg_lim) != deg_lim or not 0 <= deg_lim < B:
+        raise ValueError(f"deg_lim must be an integer from 0 to B - 1 = {B - 1}, not {deg_lim!r}")
+    return c, B, int(deg_lim)
+
+
+def refine(coeffs, starts, deg_lim=None):
+    """From each start rotation, the nearest maximum of ``|f|^2`` of the band-limited SO(3)
+    function with coefficients ``coeffs`` (degrees up to ``deg_lim``, default all), by
+    damped Newton steps off the grid: a list of ``(Rotation, value)``."""
+    c, B, L = _coeffs_and_limit(coeffs, deg_lim)
+    angles, values = _so3fft.refine_series(B, L, c, _rows(starts))
+    return [(Rotation(*a), float(v)) for a, v in zip(angles, values)]
+
+
+def evaluate(coeffs, rotations, deg_lim=None):
+    """The band-limited SO(3) function with coefficients ``coeffs`` at any rotations
+    (``Rotation`` objects or rows of Euler angles), off the grid."""
+    c, B, L = _coeffs_and_limit(coeffs, deg_lim)
+    return _so3fft.evaluate_series(B, L, c, _rows(rotations))
+
+
+def rotate_s2_coeffs(coeffs, rotation):
+    """The S^2 coefficients of ``f(g^-1 x)``: the function of ``coeffs`` rotated by
+    ``rotation`` (a :class:`Rotation` or Euler angles)."""
+    c = np.asarray(coeffs)
+    B = math.isqrt(c.size)
+    if B * B != c.size or B < 1:
+        raise ValueError(f"S^2 coefficients number B^2, not {c.size}")
+    c = as_input(c, np.complex128, ((c.size,),), "coefficients")
+    return _so3fft.rotate_s2_coeffs(B, c, tuple(Rotation._of(rotation)))

@@ -1,0 +1,215 @@
+"""The SO(3) and S^2 transform plans."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _so3fft
+from ._arrays import as_input, bandwidth_arg, check_output, threads_arg
+
+_RIGORS = ("estimate", "measure", "patient", "exhaustive")
+
+
+def _rigor_arg(rigor):
+    if not isinstance(rigor, str) or rigor.lower() not in _RIGORS:
+        raise ValueError(f"rigor must be one of {_RIGORS}, not {rigor!r}")
+    return rigor.lower()
+
+
+class Plan:
+    """Forward and inverse FFT on SO(3) at bandwidth ``B`` (SOFT 2.0's conventions).
+
+    Samples are a ``(2B, 2B, 2B)`` array indexed ``[k, j, i]``: the function at
+    ``beta_k = pi (2k + 1) / (4B)``, ``alpha_j = pi j / B``, ``gamma_i = pi i / B`` (beta
+    slowest, gamma fastest; :func:`grid_angles`). A flat array of ``(2B)^3`` values in the
+    same order is accepted too.
+
+    Coefficients are a flat array of ``(4B^3 - B) / 3`` complex values in SOFT's order
+    (``so3CoefLoc``): ``fhat(l, m, m')`` is at :func:`coef_index` ``(B, l, m, m')``, with
+    ``m`` paired with alpha and ``m'`` with gamma. :func:`to_dense` and :func:`from_dense`
+    convert to and from an ``(l, m, m')`` array.
+
+    The inverse transform is, with Wigner's ``D^l_{m m'}(alpha, beta, gamma) =
+    e^{-i m alpha} d^l_{m m'}(beta) e^{-i m' gamma}`` normalised as in SOFT::
+
+        f(alpha, beta, gamma) = sum_{l < B} sum_{|m|, |m'| <= l} fhat(l, m, m')
+                                * sqrt((2l + 1) / 2) / (2 pi) * D^l_{m m'}(alpha, beta, gamma)
+
+    and the forward transform is its exact inverse on band-limited samples (the library's
+    docs/conventions.md has the details).
+
+    Inputs of another dtype are converted when no information is lost (``float32`` or
+    ``float64`` samples for a complex plan, for instance); C-contiguous arrays of the plan's
+    dtype are used as they are, without a copy.
+
+    Parameters
+    ----------
+    B : int
+        Bandwidth (degrees ``l < B``), 1 to ``MAX_BANDWIDTH``.
+    real : bool
+        Samples are real: ``forward`` takes ``float64`` samples, ``inverse`` returns them
+        (about half the work). The coefficients then satisfy
+        ``fhat(l, -m, -m') = (-1)^(m - m') conj(fhat(l, m, m'))``.
+    threads : int
+        Worker threads (0: all cores).
+    rigor : str
+        FFTW's planning rigour: ``"estimate"``, ``"measure"``, ``"patient"`` or
+        ``"exhaustive"`` (more planning time, sometimes faster transforms).
+
+    The transforms release the GIL: several threads may use one plan at once.
+    """
+
+    def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
+        B = bandwidth_arg(B)
+        self._plan = _so3fft.Plan(B, bool(real), threads_arg(threads), _rigor_arg(rigor))
+        self.B = B
+        self.real = bool(real)
+        n = 2 * B
+        #: Shape of a sample array.
+        self.sample_shape = (n, n, n)
+        self._sample_shapes = ((n, n, n), (n * n * n,))
+        self._sample_dtype = np.float64 if self.real else np.complex128
+        #: Number of coefficients, ``(4B^3 - B) / 3``.
+        self.num_coeffs = self._plan.num_coeffs
+
+    @property
+    def threads(self):
+        """Worker threads the plan runs on."""
+        return self._plan.threads
+
+    @property
+    def memory_bytes(self):
+        """Bytes the plan holds (tables and buffers)."""
+        return self._plan.memory_bytes
+
+    @property
+    def isa(self):
+        """The instruction set of the plan's kernels (``"avx512"``, ``"avx2"``, ...)."""
+        return self._plan.isa
+
+    def __repr__(self):
+        return f"so3fft.Plan({self.B}, real={self.real}, threads={self.threads})"
+
+    def forward(self, f, out=None, *, check_finite=True):
+        """Samples ``f`` (``(2B, 2B, 2B)``; ``float64`` for a real plan, else
+        ``complex128``) to coefficients, written into ``out`` if given (a ``complex128``
+        array of ``num_coeffs`` values) and returned.
+
+        With ``check_finite``, NaN or infinite samples raise ``ValueError`` (the check reads
+        the coefficients: a few percent of the transform's time)."""
+        f = as_input(f, self._sample_dtype, self._sample_shapes, "samples")
+        if out is None:
+            out = np.empty(self.num_coeffs, np.complex128)
+        else:
+            check_output(out, np.complex128, (self.num_coeffs,))
+        if self.real:
+            self._plan.forward_real(f, out, check_finite)
+        else:
+            self._plan.forward(f, out, check_finite)
+        return out
+
+    def inverse(self, fhat, out=None, *, check_finite=True):
+        """Coefficients ``fhat`` (``num_coeffs`` complex values) to samples, written into
+        ``out`` if given (``(2B, 2B, 2B)``, ``float64`` for a real plan, else
+        ``complex128``) and returned.
+
+        A real plan reads the coefficients with ``m >= 0`` and takes the others from the
+        real symmetry. With ``check_finite``, NaN or infinite coefficients raise
+        ``ValueError``."""
+        fhat = as_input(fhat, np.complex128, ((self.num_coeffs,),), "coefficients")
+        if out is None:
+            out = np.empty(self.sample_shape, self._sample_dtype)
+        else:
+            check_output(out, self._sample_dtype, self.sample_shape)
+        if self.real:
+            self._plan.inverse_real(fhat, out, check_finite)
+        else:
+            self._plan.inverse(fhat, out, check_finite)
+        return out
+
+
+class S2Plan:
+    """Spherical-harmonic transforms on the sphere at bandwidth ``B`` (SOFT 2.0's grid and
+    coefficient order), of one field or many.
+
+    Samples are a ``(2B, 2B)`` array indexed ``[j, k]``: the function at colatitude
+    ``theta_j = pi (2j + 1) / (4B)`` and longitude ``phi_k = pi k / B``; many fields are a
+    ``(n, 2B, 2B)`` array. Coefficients are ``B^2`` complex values per field (``(n, B^2)``
+    for many) in SOFT's ``seanindex`` order: :func:`s2_coef_index` ``(B, l, m)``.
+
+    ``Y_l^m`` is orthonormal with the Condon-Shortley phase, the convention of
+    ``scipy.special.sph_harm_y(l, m, theta, phi)``::
+
+        f(theta, phi) = sum_{l < B} sum_{|m| <= l} fhat(l, m) Y_l^m(theta, phi)
+
+    :mod:`so3fft.interop` converts to and from ducc0's and SciPy's layouts.
+
+    Parameters
+    ----------
+    B : int
+        Bandwidth, 1 to ``S2_MAX_BANDWIDTH``.
+    real : bool
+        ``forward`` takes ``float64`` samples and ``inverse`` returns them; the coefficients
+        (all ``B^2``) satisfy ``fhat(l, -m) = (-1)^m conj(fhat(l, m))``.
+    threads : int
+        Worker threads (0: all cores).
+    rigor : str
+        FFTW's planning rigour (see :class:`Plan`).
+    """
+
+    def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
+        B = bandwidth_arg(B)
+        self._plan = _so3fft.S2Plan(B, threads_arg(threads), _rigor_arg(rigor))
+        self.B = B
+        self.real = bool(real)
+        self.sample_shape = (2 * B, 2 * B)
+        self.num_coeffs = B * B
+        self._sample_dtype = np.float64 if self.real else np.complex128
+
+    @property
+    def threads(self):
+        """Worker threads the plan runs on."""
+        return self._plan.threads
+
+    def __repr__(self):
+        return f"so3fft.S2Plan({self.B}, real={self.real}, threads={self.threads})"
+
+    def forward(self, f, out=None, *, check_finite=True):
+        """Samples (``(2B, 2B)`` or ``(n, 2B, 2B)``) to coefficients (``(B^2,)`` or
+        ``(n, B^2)``, ``complex128``), into ``out`` if given."""
+        n = 2 * self.B
+        f = as_input(f, self._sample_dtype, ((n, n), (None, n, n)), "samples")
+        many = f.ndim == 3
+        howmany = f.shape[0] if many else 1
+        shape = (howmany, self.num_coeffs) if many else (self.num_coeffs,)
+        if out is None:
+            out = np.empty(shape, np.complex128)
+        else:
+            check_output(out, np.complex128, shape)
+        if howmany == 0:
+            return out
+        if self.real:
+            self._plan.forward_real(f, out, howmany, check_finite)
+        else:
+            self._plan.forward(f, out, howmany, check_finite)
+        return out
+
+    def inverse(self, fhat, out=None, *, check_finite=True):
+        """Coefficients (``(B^2,)`` or ``(n, B^2)``) to samples (``(2B, 2B)`` or
+        ``(n, 2B, 2B)``), into ``out`` if given."""
+        nc = self.num_coeffs
+        fhat = as_input(fhat, np.complex128, ((nc,), (None, nc)), "coefficients")
+        many = fhat.ndim == 2
+        howmany = fhat.shape[0] if many else 1
+        shape = (howmany,) + self.sample_shape if many else self.sample_shape
+        if out is None:
+            out = np.empty(shape, self._sample_dtype)
+        else:
+            check_output(out, self._sample_dtype, shape)
+        if howmany == 0:
+            return out
+        if self.real:
+            self._plan.inverse_real(fhat, out, howmany, check_finite)
+        else:
+            self._plan.inverse(fhat, out, howmany, check_finite)
+        return out

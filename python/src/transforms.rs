@@ -1,0 +1,332 @@
+//! `Plan` (the SO(3) transform) and `S2Plan` (the S^2 transform) over NumPy arrays. Each
+//! transform returns the seconds it took inside the library (for measuring the bindings'
+//! overhead).
+
+use crate::arrays::{all_finite, input, not_finite, output, readonly, readwrite};
+use crate::errors::{to_py, value_error};
+use numpy::PyArrayDyn;
+use pyo3::prelude::*;
+use so3fft::s2::S2Plan as RustS2Plan;
+use so3fft::{Complex64, Options, Rigor};
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Plan>()?;
+    m.add_class::<S2Plan>()?;
+    Ok(())
+}
+
+/// FFTW's planning rigour by name.
+pub fn rigor(name: &str) -> PyResult<Rigor> {
+    match name.to_ascii_lowercase().as_str() {
+        "estimate" => Ok(Rigor::Estimate),
+        "measure" => Ok(Rigor::Measure),
+        "patient" => Ok(Rigor::Patient),
+        "exhaustive" => Ok(Rigor::Exhaustive),
+        _ => Err(value_error(format!(
+            "rigor must be 'estimate', 'measure', 'patient' or 'exhaustive', not {name:?}"
+        ))),
+    }
+}
+
+/// The plans' options: `threads` workers (0: all cores), FFTW's `rigor`, real data or not.
+pub fn options(threads: usize, rigor_name: &str, real: bool) -> PyResult<Options> {
+    Ok(Options::default()
+        .with_threads(threads)
+        .with_rigor(rigor(rigor_name)?)
+        .with_real(real))
+}
+
+/// An SO(3) transform plan of one bandwidth (low level: exact arrays, no allocation).
+#[pyclass(frozen, module = "so3fft._so3fft")]
+pub struct Plan {
+    plan: so3fft::Plan,
+    real: bool,
+}
+
+#[pymethods]
+impl Plan {
+    #[new]
+    #[pyo3(signature = (bandwidth, real, threads, rigor))]
+    fn new(
+        py: Python<'_>,
+        bandwidth: usize,
+        real: bool,
+        threads: usize,
+        rigor: &str,
+    ) -> PyResult<Self> {
+        let o = options(threads, rigor, real)?;
+        let plan = py
+            .detach(|| so3fft::Plan::new(bandwidth, &o))
+            .map_err(to_py)?;
+        Ok(Plan { plan, real })
+    }
+
+    #[getter]
+    fn bandwidth(&self) -> usize {
+        self.plan.bandwidth()
+    }
+
+    #[getter]
+    fn real(&self) -> bool {
+        self.real
+    }
+
+    #[getter]
+    fn threads(&self) -> usize {
+        self.plan.threads()
+    }
+
+    #[getter]
+    fn num_samples(&self) -> usize {
+        self.plan.num_samples()
+    }
+
+    #[getter]
+    fn num_coeffs(&self) -> usize {
+        self.plan.num_coeffs()
+    }
+
+    #[getter]
+    fn memory_bytes(&self) -> usize {
+        self.plan.memory_bytes()
+    }
+
+    #[getter]
+    fn isa(&self) -> String {
+        format!("{:?}", self.plan.isa()).to_lowercase()
+    }
+
+    /// Complex samples to coefficients.
+    fn forward(
+        &self,
+        py: Python<'_>,
+        samples: Bound<'_, PyArrayDyn<Complex64>>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let samples = readonly(&samples)?;
+        let mut coeffs = readwrite(&coeffs)?;
+        let x = input(&samples, self.plan.num_samples(), "samples")?;
+        let c = output(&mut coeffs, self.plan.num_coeffs(), "out")?;
+        py.detach(|| {
+            let t = self.plan.forward(x, c)?;
+            Ok((t.total, check_finite && !all_finite(c)))
+        })
+        .map_err(to_py)
+        .and_then(|(t, bad)| {
+            if bad {
+                Err(not_finite("samples"))
+            } else {
+                Ok(t)
+            }
+        })
+    }
+
+    /// Real samples to coefficients.
+    fn forward_real(
+        &self,
+        py: Python<'_>,
+        samples: Bound<'_, PyArrayDyn<f64>>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let samples = readonly(&samples)?;
+        let mut coeffs = readwrite(&coeffs)?;
+        let x = input(&samples, self.plan.num_samples(), "samples")?;
+        let c = output(&mut coeffs, self.plan.num_coeffs(), "out")?;
+        py.detach(|| {
+            let t = self.plan.forward_real(x, c)?;
+            Ok((t.total, check_finite && !all_finite(c)))
+        })
+        .map_err(to_py)
+        .and_then(|(t, bad)| {
+            if bad {
+                Err(not_finite("samples"))
+            } else {
+                Ok(t)
+            }
+        })
+    }
+
+    /// Coefficients to complex samples.
+    fn inverse(
+        &self,
+        py: Python<'_>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        samples: Bound<'_, PyArrayDyn<Complex64>>,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let coeffs = readonly(&coeffs)?;
+        let mut samples = readwrite(&samples)?;
+        let c = input(&coeffs, self.plan.num_coeffs(), "coefficients")?;
+        let x = output(&mut samples, self.plan.num_samples(), "out")?;
+        py.detach(|| {
+            if check_finite && !all_finite(c) {
+                return Ok(None);
+            }
+            self.plan.inverse(c, x).map(|t| Some(t.total))
+        })
+        .map_err(to_py)?
+        .ok_or_else(|| not_finite("coefficients"))
+    }
+
+    /// Coefficients (of a real function) to real samples.
+    fn inverse_real(
+        &self,
+        py: Python<'_>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        samples: Bound<'_, PyArrayDyn<f64>>,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let coeffs = readonly(&coeffs)?;
+        let mut samples = readwrite(&samples)?;
+        let c = input(&coeffs, self.plan.num_coeffs(), "coefficients")?;
+        let x = output(&mut samples, self.plan.num_samples(), "out")?;
+        py.detach(|| {
+            if check_finite && !all_finite(c) {
+                return Ok(None);
+            }
+            self.plan.inverse_real(c, x).map(|t| Some(t.total))
+        })
+        .map_err(to_py)?
+        .ok_or_else(|| not_finite("coefficients"))
+    }
+}
+
+/// An S^2 transform plan of one bandwidth; every call takes `howmany` fields stored one
+/// after another.
+#[pyclass(frozen, module = "so3fft._so3fft")]
+pub struct S2Plan {
+    plan: RustS2Plan,
+}
+
+#[pymethods]
+impl S2Plan {
+    #[new]
+    #[pyo3(signature = (bandwidth, threads, rigor))]
+    fn new(py: Python<'_>, bandwidth: usize, threads: usize, rigor: &str) -> PyResult<Self> {
+        let o = options(threads, rigor, false)?;
+        let plan = py
+            .detach(|| RustS2Plan::new(bandwidth, &o))
+            .map_err(to_py)?;
+        Ok(S2Plan { plan })
+    }
+
+    #[getter]
+    fn bandwidth(&self) -> usize {
+        self.plan.bandwidth()
+    }
+
+    #[getter]
+    fn threads(&self) -> usize {
+        self.plan.threads()
+    }
+
+    #[getter]
+    fn num_samples(&self) -> usize {
+        self.plan.num_samples()
+    }
+
+    #[getter]
+    fn num_coeffs(&self) -> usize {
+        self.plan.num_coeffs()
+    }
+
+    fn forward(
+        &self,
+        py: Python<'_>,
+        samples: Bound<'_, PyArrayDyn<Complex64>>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        howmany: usize,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let samples = readonly(&samples)?;
+        let mut coeffs = readwrite(&coeffs)?;
+        let x = input(&samples, howmany * self.plan.num_samples(), "samples")?;
+        let c = output(&mut coeffs, howmany * self.plan.num_coeffs(), "out")?;
+        py.detach(|| {
+            let t = self.plan.forward_many(x, c, howmany)?;
+            Ok((t.total, check_finite && !all_finite(c)))
+        })
+        .map_err(to_py)
+        .and_then(|(t, bad)| {
+            if bad {
+                Err(not_finite("samples"))
+            } else {
+                Ok(t)
+            }
+        })
+    }
+
+    fn forward_real(
+        &self,
+        py: Python<'_>,
+        samples: Bound<'_, PyArrayDyn<f64>>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        howmany: usize,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let samples = readonly(&samples)?;
+        let mut coeffs = readwrite(&coeffs)?;
+        let x = input(&samples, howmany * self.plan.num_samples(), "samples")?;
+        let c = output(&mut coeffs, howmany * self.plan.num_coeffs(), "out")?;
+        py.detach(|| {
+            let t = self.plan.forward_real_many(x, c, howmany)?;
+            Ok((t.total, check_finite && !all_finite(c)))
+        })
+        .map_err(to_py)
+        .and_then(|(t, bad)| {
+            if bad {
+                Err(not_finite("samples"))
+            } else {
+                Ok(t)
+            }
+        })
+    }
+
+    fn inverse(
+        &self,
+        py: Python<'_>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        samples: Bound<'_, PyArrayDyn<Complex64>>,
+        howmany: usize,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let coeffs = readonly(&coeffs)?;
+        let mut samples = readwrite(&samples)?;
+        let c = input(&coeffs, howmany * self.plan.num_coeffs(), "coefficients")?;
+        let x = output(&mut samples, howmany * self.plan.num_samples(), "out")?;
+        py.detach(|| {
+            if check_finite && !all_finite(c) {
+                return Ok(None);
+            }
+            self.plan.inverse_many(c, x, howmany).map(|t| Some(t.total))
+        })
+        .map_err(to_py)?
+        .ok_or_else(|| not_finite("coefficients"))
+    }
+
+    fn inverse_real(
+        &self,
+        py: Python<'_>,
+        coeffs: Bound<'_, PyArrayDyn<Complex64>>,
+        samples: Bound<'_, PyArrayDyn<f64>>,
+        howmany: usize,
+        check_finite: bool,
+    ) -> PyResult<f64> {
+        let coeffs = readonly(&coeffs)?;
+        let mut samples = readwrite(&samples)?;
+        let c = input(&coeffs, howmany * self.plan.num_coeffs(), "coefficients")?;
+        let x = output(&mut samples, howmany * self.plan.num_samples(), "out")?;
+        py.detach(|| {
+            if check_finite && !all_finite(c) {
+                return Ok(None);
+            }
+            self.plan
+                .inverse_real_many(c, x, howmany)
+                .map(|t| Some(t.total))
+        })
+        .map_err(to_py)?
+        .ok_or_else(|| not_finite("coefficients"))
+    }
+}
