@@ -76,26 +76,26 @@ class Plan:
 
     def forward(
         self, samples: _ComplexArray, coeffs: _ComplexArray, check_finite: bool
-    ) -> None:
-        """Complex samples to coefficients, written into ``coeffs``."""
+    ) -> float:
+        """Complex samples to coefficients, written into ``coeffs``; the seconds the library spent."""
         ...
 
     def forward_real(
         self, samples: _RealArray, coeffs: _ComplexArray, check_finite: bool
-    ) -> None:
-        """Real samples to coefficients, written into ``coeffs``."""
+    ) -> float:
+        """Real samples to coefficients, written into ``coeffs``; the seconds the library spent."""
         ...
 
     def inverse(
         self, coeffs: _ComplexArray, samples: _ComplexArray, check_finite: bool
-    ) -> None:
-        """Coefficients to complex samples, written into ``samples``."""
+    ) -> float:
+        """Coefficients to complex samples, written into ``samples``; the seconds the library spent."""
         ...
 
     def inverse_real(
         self, coeffs: _ComplexArray, samples: _RealArray, check_finite: bool
-    ) -> None:
-        """Coefficients of a real function to real samples, written into ``samples``."""
+    ) -> float:
+        """Coefficients of a real function to real samples, written into ``samples``; the seconds the library spent."""
         ...
 
 
@@ -132,8 +132,8 @@ class S2Plan:
         coeffs: _ComplexArray,
         howmany: int,
         check_finite: bool,
-    ) -> None:
-        """Complex samples of ``howmany`` fields to their coefficients."""
+    ) -> float:
+        """Complex samples of ``howmany`` fields to their coefficients; the seconds the library spent."""
         ...
 
     def forward_real(
@@ -142,8 +142,8 @@ class S2Plan:
         coeffs: _ComplexArray,
         howmany: int,
         check_finite: bool,
-    ) -> None:
-        """Real samples of ``howmany`` fields to their coefficients."""
+    ) -> float:
+        """Real samples of ``howmany`` fields to their coefficients; the seconds the library spent."""
         ...
 
     def inverse(
@@ -152,8 +152,8 @@ class S2Plan:
         samples: _ComplexArray,
         howmany: int,
         check_finite: bool,
-    ) -> None:
-        """Coefficients of ``howmany`` fields to complex samples."""
+    ) -> float:
+        """Coefficients of ``howmany`` fields to complex samples; the seconds the library spent."""
         ...
 
     def inverse_real(
@@ -162,8 +162,8 @@ class S2Plan:
         samples: _RealArray,
         howmany: int,
         check_finite: bool,
-    ) -> None:
-        """Coefficients of ``howmany`` real fields to real samples."""
+    ) -> float:
+        """Coefficients of ``howmany`` real fields to real samples; the seconds the library spent."""
         ...
 
 
