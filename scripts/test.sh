@@ -30,7 +30,7 @@ fi
 CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi
 # The Python package, installed the way the README says, with its test dependencies.
 python3 -m venv target/pyenv
-target/pyenv/bin/pip install -q numpy scipy pytest ducc0 matplotlib
+target/pyenv/bin/pip install -q numpy "scipy>=1.15" pytest ducc0 matplotlib
 target/pyenv/bin/pip install -q ./python
 target/pyenv/bin/pytest -q python/tests
 target/pyenv/bin/python python/examples/match_rotation.py --out target/match_rotation.png

@@ -14,6 +14,7 @@ def as_input(x, dtype, shapes, what):
         type(x) is np.ndarray
         and x.dtype == dtype
         and x.flags.c_contiguous
+        and x.flags.aligned
         and x.shape in shapes
     ):
         return x
@@ -30,7 +31,7 @@ def as_input(x, dtype, shapes, what):
     if not any(_fits(a.shape, s) for s in shapes):
         expected = " or ".join(str(s) for s in shapes)
         raise ValueError(f"{what}: shape {a.shape}, expected {expected}")
-    return np.ascontiguousarray(a, dtype=dtype)
+    return np.require(a, dtype=dtype, requirements=["C", "A"])
 
 
 def _fits(shape, pattern):
@@ -48,25 +49,34 @@ def check_output(out, dtype, shape, what="out"):
         raise TypeError(f"{what} must have dtype {np.dtype(dtype)}, not {out.dtype}")
     if out.shape != shape:
         raise ValueError(f"{what} must have shape {shape}, not {out.shape}")
-    if not out.flags.c_contiguous:
-        raise ValueError(f"{what} must be C-contiguous")
+    if not (out.flags.c_contiguous and out.flags.aligned):
+        raise ValueError(f"{what} must be C-contiguous and aligned")
     if not out.flags.writeable:
         raise ValueError(f"{what} is read-only")
     return out
 
 
+def apart(x, out):
+    """`x`, copied if it shares memory with `out` (the transforms read all of their input
+    while they write their output)."""
+    return x.copy() if np.may_share_memory(x, out) else x
+
+
+def int_arg(x, name, low, high):
+    """`x` as an int in `low ..= high` (TypeError for non-integers and bools)."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, not {x!r}")
+    if x < low:
+        raise ValueError(f"{name} must be at least {low}, not {x}")
+    if x > high:
+        raise ValueError(f"{name} must be at most {high}, not {x}")
+    return int(x)
+
+
 def threads_arg(threads):
-    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)):
-        raise TypeError(f"threads must be an integer (0: all cores), not {threads!r}")
-    t = int(threads)
-    if t < 0:
-        raise ValueError(f"threads must be a non-negative integer (0: all cores), not {threads!r}")
-    return t
+    return int_arg(threads, "threads (0: all cores)", 0, 1 << 31)
 
 
 def bandwidth_arg(b, name="B"):
-    if isinstance(b, (bool, np.bool_)) or not isinstance(b, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer, not {type(b).__name__}")
-    if b < 1:
-        raise ValueError(f"{name} must be at least 1, not {b}")
-    return int(b)
+    # The library names its own limits (MAX_BANDWIDTH, S2_MAX_BANDWIDTH) in its errors.
+    return int_arg(b, name, 1, 1 << 31)

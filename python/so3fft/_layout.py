@@ -46,8 +46,8 @@ def _degrees_orders(B):
 
 def coef_degrees_orders(B):
     """``(l, m, mp)`` of every coefficient, in the flat array's order: an integer array of
-    shape ``(num_coeffs(B), 3)`` (read-only)."""
-    return _degrees_orders(bandwidth_arg(B))
+    shape ``(num_coeffs(B), 3)``."""
+    return _degrees_orders(bandwidth_arg(B)).copy()
 
 
 def to_dense(fhat, B=None):
@@ -57,8 +57,8 @@ def to_dense(fhat, B=None):
     fhat = np.asarray(fhat)
     if B is None:
         B = _bandwidth_of(fhat.size)
-    lmm = coef_degrees_orders(B)
-    fhat = as_input(fhat, np.complex128, ((len(lmm),),), "coefficients")
+    fhat = as_input(fhat, np.complex128, ((num_coeffs(B),),), "coefficients")
+    lmm = _degrees_orders(B)
     dense = np.zeros((B, 2 * B - 1, 2 * B - 1), np.complex128)
     dense[lmm[:, 0], lmm[:, 1] + B - 1, lmm[:, 2] + B - 1] = fhat
     return dense
@@ -71,7 +71,7 @@ def from_dense(dense):
     if dense.ndim != 3 or dense.shape[1] != dense.shape[2] or dense.shape[1] != 2 * dense.shape[0] - 1:
         raise ValueError(f"a dense array has shape (B, 2B - 1, 2B - 1), not {dense.shape}")
     B = dense.shape[0]
-    lmm = coef_degrees_orders(B)
+    lmm = _degrees_orders(bandwidth_arg(B))
     return np.ascontiguousarray(
         dense[lmm[:, 0], lmm[:, 1] + B - 1, lmm[:, 2] + B - 1], dtype=np.complex128
     )
@@ -119,7 +119,7 @@ def _s2_degrees_orders(B):
 
 def s2_coef_degrees_orders(B):
     """``(l, m)`` of every S^2 coefficient in the flat array's order: shape ``(B^2, 2)``."""
-    return _s2_degrees_orders(bandwidth_arg(B))
+    return _s2_degrees_orders(bandwidth_arg(B)).copy()
 
 
 def s2_grid_angles(B):

@@ -9,8 +9,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _so3fft
-from ._arrays import as_input, bandwidth_arg, check_output, threads_arg
-from ._transforms import _rigor_arg
+from ._arrays import apart, as_input, bandwidth_arg, check_output, int_arg, threads_arg
 
 
 class Rotation:
@@ -122,18 +121,23 @@ class Peak(NamedTuple):
 
 
 def _rows(rotations):
-    """Rotations (``Rotation`` objects, angle triples or an ``(n, 3)`` array) as rows."""
+    """Rotations (a ``Rotation``, an angle triple, a list of either, or an ``(n, 3)`` array)
+    as a C-contiguous ``(n, 3)`` array of Euler angles."""
     if isinstance(rotations, Rotation):
-        rotations = [rotations]
-    a = np.array(
-        [tuple(g) for g in rotations] if not isinstance(rotations, np.ndarray) else rotations,
-        dtype=float,
-    )
-    if a.ndim == 1:
-        a = a.reshape(1, -1)
+        rotations = [tuple(rotations)]
+    elif not isinstance(rotations, np.ndarray):
+        rotations = [tuple(g) if isinstance(g, Rotation) else g for g in rotations]
+    a = np.asarray(rotations)
+    if np.iscomplexobj(a) or not (a.size == 0 or np.issubdtype(a.dtype, np.number)):
+        raise TypeError("rotations are real Euler angles (alpha, beta, gamma)")
+    a = a.astype(float)
+    if a.ndim == 1 and a.size == 3:
+        a = a.reshape(1, 3)
+    if a.size == 0:
+        a = a.reshape(0, 3)
     if a.ndim != 2 or a.shape[1] != 3:
         raise ValueError("rotations are rows of three Euler angles (alpha, beta, gamma)")
-    return np.ascontiguousarray(a)
+    return np.require(a, requirements=["C", "A"])
 
 
 class Correlation:
@@ -170,22 +174,43 @@ class Correlation:
     ):
         B = bandwidth_arg(B)
         b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
-        if deg_lim is not None and (int(deg_lim) != deg_lim or deg_lim < 0):
-            raise ValueError(f"deg_lim must be a non-negative integer, not {deg_lim!r}")
+        deg_lim = None if deg_lim is None else int_arg(deg_lim, "deg_lim", 0, 1 << 31)
         self._plan = _so3fft.Correlation(
-            B, b_out, None if deg_lim is None else int(deg_lim), bool(real), bool(normalized),
-            threads_arg(threads), _rigor_arg(rigor),
+            B, b_out, deg_lim, bool(real), bool(normalized), threads_arg(threads), rigor
         )
-        self.B = B
-        self.b_out = self._plan.b_out
-        self.deg_lim = self._plan.deg_lim
-        self.real = bool(real)
-        self.normalized = bool(normalized)
-        n = 2 * self.b_out
-        #: Shape of the correlation grid.
-        self.grid_shape = (n, n, n)
+        self._normalized = bool(normalized)
         self._in_dtype = np.float64 if self.real else np.complex128
         self._s2_shapes = ((2 * B, 2 * B),)
+
+    @property
+    def B(self):
+        """Bandwidth of the inputs."""
+        return self._plan.b_in
+
+    @property
+    def b_out(self):
+        """Bandwidth of the correlation grid."""
+        return self._plan.b_out
+
+    @property
+    def deg_lim(self):
+        """Highest degree combined."""
+        return self._plan.deg_lim
+
+    @property
+    def real(self):
+        """Whether inputs and grid are real."""
+        return self._plan.real
+
+    @property
+    def normalized(self):
+        """Whether this is the normalised cross-correlation."""
+        return self._normalized
+
+    @property
+    def grid_shape(self):
+        """Shape of the correlation grid, ``(2 b_out,) * 3``."""
+        return (2 * self.b_out,) * 3
 
     def __repr__(self):
         return (
@@ -193,10 +218,11 @@ class Correlation:
             f"real={self.real}, normalized={self.normalized})"
         )
 
-    def _inputs(self, signal, pattern):
+    def _inputs(self, signal, pattern, out):
+        """The inputs as arrays, apart from `out` (the grid or coefficients written)."""
         return (
-            as_input(signal, self._in_dtype, self._s2_shapes, "signal"),
-            as_input(pattern, self._in_dtype, self._s2_shapes, "pattern"),
+            apart(as_input(signal, self._in_dtype, self._s2_shapes, "signal"), out),
+            apart(as_input(pattern, self._in_dtype, self._s2_shapes, "pattern"), out),
         )
 
     def _grid(self, out):
@@ -207,8 +233,8 @@ class Correlation:
     def correlate(self, signal, pattern, out=None):
         """The correlation grid (``(2 b_out)^3``; real for a real plan), into ``out`` if
         given."""
-        s, p = self._inputs(signal, pattern)
         out = self._grid(out)
+        s, p = self._inputs(signal, pattern, out)
         run = self._plan.correlate_real if self.real else self._plan.correlate
         run(s, p, out, False)
         return out
@@ -216,16 +242,16 @@ class Correlation:
     def correlate_argmax(self, signal, pattern, out=None):
         """The correlation grid and its largest ``|C|^2`` (a :class:`Peak`, found while the
         grid is computed: ties go to the lowest index)."""
-        s, p = self._inputs(signal, pattern)
         out = self._grid(out)
+        s, p = self._inputs(signal, pattern, out)
         run = self._plan.correlate_real if self.real else self._plan.correlate
         return out, Peak(*run(s, p, out, True))
 
     def correlate_shells(self, shells, out=None):
         """``sum_i w_i C_i``: the correlations of shells ``(signal_i, pattern_i, w_i)``
         (functions on concentric spheres, e.g. of a 3-D map), in one inverse transform."""
-        arrays = [(*self._inputs(s, p), float(w)) for s, p, w in shells]
         out = self._grid(out)
+        arrays = [(*self._inputs(s, p, out), float(w)) for s, p, w in shells]
         run = self._plan.correlate_shells_real if self.real else self._plan.correlate_shells
         run(arrays, out)
         return out
@@ -233,12 +259,12 @@ class Correlation:
     def coefficients(self, signal, pattern, out=None):
         """The correlation's SO(3) coefficients (bandwidth ``b_out``; zero above
         ``deg_lim``), the input of :meth:`refine`."""
-        s, p = self._inputs(signal, pattern)
         n = _so3fft.num_coeffs(self.b_out)
         if out is None:
             out = np.empty(n, np.complex128)
         else:
             check_output(out, np.complex128, (n,))
+        s, p = self._inputs(signal, pattern, out)
         run = self._plan.coefficients_real if self.real else self._plan.coefficients
         run(s, p, out)
         return out
@@ -254,11 +280,18 @@ class Correlation:
     def match(self, signal, pattern, k=1, min_angle=None):
         """The rotations that best take the pattern to the signal: the ``k`` largest peaks of
         the correlation grid (at least ``min_angle`` radians apart, default one grid step),
-        each refined off the grid; a list of ``(Rotation, value)``, best first."""
+        each refined off the grid; a list of ``(Rotation, value)``, best first. Peaks that
+        refine to the same maximum (within 1e-6 rad) are reported once."""
         grid = self.correlate(signal, pattern)
         peaks = top_peaks(grid, k, math.pi / self.b_out if min_angle is None else min_angle)
+        if not peaks:
+            return []
         found = self.refine(self.coefficients(signal, pattern), [p.rotation for p in peaks])
-        return sorted(found, key=lambda gv: -gv[1])
+        kept = []
+        for g, v in sorted(found, key=lambda gv: -gv[1]):
+            if all(g.angle_to(h) > 1e-6 for h, _ in kept):
+                kept.append((g, v))
+        return kept
 
 
 @functools.lru_cache(maxsize=4)
@@ -277,17 +310,12 @@ def correlate(signal, pattern, b_out=None, deg_lim=None, *, normalized=False, th
     if s.ndim != 2 or s.shape[0] != s.shape[1] or s.shape[0] % 2:
         raise ValueError(f"signal: shape {s.shape}, expected (2B, 2B)")
     real = not (np.iscomplexobj(s) or np.iscomplexobj(p))
+    b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
+    deg_lim = None if deg_lim is None else int_arg(deg_lim, "deg_lim", 0, 1 << 31)
     plan = _cached_correlation(
         s.shape[0] // 2, b_out, deg_lim, real, bool(normalized), threads_arg(threads)
     )
     return plan.correlate(s, p)
-
-
-def _grid_bandwidth(n):
-    b = round((n / 8) ** (1 / 3))
-    if b < 1 or 8 * b**3 != n:
-        raise ValueError(f"a correlation grid holds (2B)^3 values, not {n}")
-    return b
 
 
 def top_peaks(grid, k=1, min_angle=0.0):
@@ -295,15 +323,13 @@ def top_peaks(grid, k=1, min_angle=0.0):
     or real), each at least ``min_angle`` radians (geodesic) from every larger one taken: a
     list of :class:`Peak`, largest first."""
     g = np.asarray(grid)
-    _grid_bandwidth(g.size)
-    if int(k) != k or k < 0:
-        raise ValueError(f"k must be a non-negative integer, not {k!r}")
+    k = int_arg(k, "k", 0, 1 << 31)
     if np.iscomplexobj(g):
         g = as_input(g, np.complex128, (g.shape,), "grid")
-        found = _so3fft.top_peaks(g, int(k), float(min_angle))
+        found = _so3fft.top_peaks(g, k, float(min_angle))
     else:
         g = as_input(g, np.float64, (g.shape,), "grid")
-        found = _so3fft.top_peaks_real(g, int(k), float(min_angle))
+        found = _so3fft.top_peaks_real(g, k, float(min_angle))
     return [Peak(*p) for p in found]
 
 
@@ -315,9 +341,7 @@ def _coeffs_and_limit(coeffs, deg_lim):
     c = as_input(c, np.complex128, ((c.size,),), "coefficients")
     if deg_lim is None:
         return c, B, B - 1
-    if isinstance(deg_lim, (bool, np.bool_)) or int(deg_lim) != deg_lim or not 0 <= deg_lim < B:
-        raise ValueError(f"deg_lim must be an integer from 0 to B - 1 = {B - 1}, not {deg_lim!r}")
-    return c, B, int(deg_lim)
+    return c, B, int_arg(deg_lim, "deg_lim", 0, B - 1)
 
 
 def refine(coeffs, starts, deg_lim=None):

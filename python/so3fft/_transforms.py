@@ -5,15 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _so3fft
-from ._arrays import as_input, bandwidth_arg, check_output, threads_arg
-
-_RIGORS = ("estimate", "measure", "patient", "exhaustive")
-
-
-def _rigor_arg(rigor):
-    if not isinstance(rigor, str) or rigor.lower() not in _RIGORS:
-        raise ValueError(f"rigor must be one of {_RIGORS}, not {rigor!r}")
-    return rigor.lower()
+from ._arrays import apart, as_input, bandwidth_arg, check_output, threads_arg
 
 
 class Plan:
@@ -61,16 +53,33 @@ class Plan:
 
     def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
         B = bandwidth_arg(B)
-        self._plan = _so3fft.Plan(B, bool(real), threads_arg(threads), _rigor_arg(rigor))
-        self.B = B
-        self.real = bool(real)
+        self._plan = _so3fft.Plan(B, bool(real), threads_arg(threads), rigor)
+        self._real = bool(real)
         n = 2 * B
-        #: Shape of a sample array.
-        self.sample_shape = (n, n, n)
+        self._sample_shape = (n, n, n)
         self._sample_shapes = ((n, n, n), (n * n * n,))
-        self._sample_dtype = np.float64 if self.real else np.complex128
-        #: Number of coefficients, ``(4B^3 - B) / 3``.
-        self.num_coeffs = self._plan.num_coeffs
+        self._sample_dtype = np.float64 if self._real else np.complex128
+        self._num_coeffs = self._plan.num_coeffs
+
+    @property
+    def B(self):
+        """The bandwidth."""
+        return self._plan.bandwidth
+
+    @property
+    def real(self):
+        """Whether the samples are real."""
+        return self._real
+
+    @property
+    def sample_shape(self):
+        """Shape of a sample array, ``(2B, 2B, 2B)``."""
+        return self._sample_shape
+
+    @property
+    def num_coeffs(self):
+        """Number of coefficients, ``(4B^3 - B) / 3``."""
+        return self._num_coeffs
 
     @property
     def threads(self):
@@ -101,7 +110,7 @@ class Plan:
         if out is None:
             out = np.empty(self.num_coeffs, np.complex128)
         else:
-            check_output(out, np.complex128, (self.num_coeffs,))
+            f = apart(f, check_output(out, np.complex128, (self.num_coeffs,)))
         if self.real:
             self._plan.forward_real(f, out, check_finite)
         else:
@@ -120,7 +129,7 @@ class Plan:
         if out is None:
             out = np.empty(self.sample_shape, self._sample_dtype)
         else:
-            check_output(out, self._sample_dtype, self.sample_shape)
+            fhat = apart(fhat, check_output(out, self._sample_dtype, self.sample_shape))
         if self.real:
             self._plan.inverse_real(fhat, out, check_finite)
         else:
@@ -150,7 +159,8 @@ class S2Plan:
         Bandwidth, 1 to ``S2_MAX_BANDWIDTH``.
     real : bool
         ``forward`` takes ``float64`` samples and ``inverse`` returns them; the coefficients
-        (all ``B^2``) satisfy ``fhat(l, -m) = (-1)^m conj(fhat(l, m))``.
+        (all ``B^2``) satisfy ``fhat(l, -m) = (-1)^m conj(fhat(l, m))``, and ``inverse``
+        reads only the orders ``m >= 0``.
     threads : int
         Worker threads (0: all cores).
     rigor : str
@@ -159,12 +169,29 @@ class S2Plan:
 
     def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
         B = bandwidth_arg(B)
-        self._plan = _so3fft.S2Plan(B, threads_arg(threads), _rigor_arg(rigor))
-        self.B = B
-        self.real = bool(real)
-        self.sample_shape = (2 * B, 2 * B)
-        self.num_coeffs = B * B
-        self._sample_dtype = np.float64 if self.real else np.complex128
+        self._plan = _so3fft.S2Plan(B, threads_arg(threads), rigor)
+        self._real = bool(real)
+        self._sample_dtype = np.float64 if self._real else np.complex128
+
+    @property
+    def B(self):
+        """The bandwidth."""
+        return self._plan.bandwidth
+
+    @property
+    def real(self):
+        """Whether the samples are real."""
+        return self._real
+
+    @property
+    def sample_shape(self):
+        """Shape of one field's samples, ``(2B, 2B)``."""
+        return (2 * self.B, 2 * self.B)
+
+    @property
+    def num_coeffs(self):
+        """Coefficients per field, ``B^2``."""
+        return self._plan.num_coeffs
 
     @property
     def threads(self):
@@ -185,7 +212,7 @@ class S2Plan:
         if out is None:
             out = np.empty(shape, np.complex128)
         else:
-            check_output(out, np.complex128, shape)
+            f = apart(f, check_output(out, np.complex128, shape))
         if howmany == 0:
             return out
         if self.real:
@@ -205,7 +232,7 @@ class S2Plan:
         if out is None:
             out = np.empty(shape, self._sample_dtype)
         else:
-            check_output(out, self._sample_dtype, shape)
+            fhat = apart(fhat, check_output(out, self._sample_dtype, shape))
         if howmany == 0:
             return out
         if self.real:

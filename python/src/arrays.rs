@@ -21,8 +21,9 @@ pub fn readonly<'py, T: Element>(
 pub fn readwrite<'py, T: Element>(
     a: &Bound<'py, PyArrayDyn<T>>,
 ) -> PyResult<PyReadwriteArrayDyn<'py, T>> {
-    a.try_readwrite()
-        .map_err(|_| value_error("out overlaps an input array, or is read-only"))
+    a.try_readwrite().map_err(|_| {
+        value_error("out overlaps an input array, is read-only, or is in use by another call")
+    })
 }
 
 /// The values of a C-contiguous input array of `len` values.
@@ -33,7 +34,7 @@ pub fn input<'a, T: Element>(
 ) -> PyResult<&'a [T]> {
     let s = a
         .as_slice()
-        .map_err(|_| value_error(format!("{what} must be C-contiguous")))?;
+        .map_err(|_| value_error(format!("{what} must be C-contiguous and aligned")))?;
     if s.len() != len {
         return Err(value_error(format!(
             "{what} has {} values, the plan needs {len}",
@@ -52,7 +53,7 @@ pub fn output<'a, T: Element>(
     let got = a.len();
     let s = a
         .as_slice_mut()
-        .map_err(|_| value_error(format!("{what} must be C-contiguous")))?;
+        .map_err(|_| value_error(format!("{what} must be C-contiguous and aligned")))?;
     if got != len {
         return Err(value_error(format!(
             "{what} has {got} values, the plan needs {len}"

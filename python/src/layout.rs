@@ -21,7 +21,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 }
 
 /// `bandwidth` if it is in `1 ..= max`.
-fn checked(bandwidth: usize, max: usize) -> PyResult<usize> {
+pub fn checked(bandwidth: usize, max: usize) -> PyResult<usize> {
     if bandwidth == 0 || bandwidth > max {
         return Err(to_py(so3fft::Error::InvalidBandwidth { bandwidth, max }));
     }
@@ -56,7 +56,10 @@ fn coef_index(bandwidth: usize, l: isize, m: isize, mp: isize) -> PyResult<usize
 fn coef_degrees_orders(py: Python<'_>, bandwidth: usize) -> PyResult<Bound<'_, PyArray2<i64>>> {
     let b = checked(bandwidth, so3fft::MAX_BANDWIDTH)?;
     let n = so3fft::num_coeffs(b);
-    let mut lmm = vec![0i64; 3 * n];
+    let mut lmm: Vec<i64> = Vec::new();
+    lmm.try_reserve_exact(3 * n)
+        .map_err(|_| to_py(so3fft::Error::OutOfMemory { bytes: 24 * n }))?;
+    lmm.resize(3 * n, 0);
     let bi = b as isize;
     for m in 1 - bi..bi {
         for mp in 1 - bi..bi {
@@ -96,7 +99,10 @@ fn s2_coef_index(bandwidth: usize, l: isize, m: isize) -> PyResult<usize> {
 #[pyfunction]
 fn s2_coef_degrees_orders(py: Python<'_>, bandwidth: usize) -> PyResult<Bound<'_, PyArray2<i64>>> {
     let b = checked(bandwidth, so3fft::s2::S2_MAX_BANDWIDTH)?;
-    let mut lm = vec![0i64; 2 * b * b];
+    let mut lm: Vec<i64> = Vec::new();
+    lm.try_reserve_exact(2 * b * b)
+        .map_err(|_| to_py(so3fft::Error::OutOfMemory { bytes: 16 * b * b }))?;
+    lm.resize(2 * b * b, 0);
     for l in 0..b {
         let li = l as isize;
         for m in -li..=li {
@@ -108,7 +114,7 @@ fn s2_coef_degrees_orders(py: Python<'_>, bandwidth: usize) -> PyResult<Bound<'_
 }
 
 /// The grid's angles: `alpha_j = pi j / B`, `beta_k = pi (2k + 1) / (4B)`,
-/// `gamma_j = pi j / B` (each `2B` values).
+/// `gamma_j = pi j / B` (each `2B` values), up to the S^2 transforms' largest bandwidth.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
 fn grid_angles(
@@ -119,7 +125,7 @@ fn grid_angles(
     Bound<'_, PyArray1<f64>>,
     Bound<'_, PyArray1<f64>>,
 )> {
-    let b = checked(bandwidth, so3fft::MAX_BANDWIDTH)?;
+    let b = checked(bandwidth, so3fft::s2::S2_MAX_BANDWIDTH)?;
     let n = 2 * b;
     let a: Vec<f64> = (0..n).map(|j| so3fft::alpha(b, j)).collect();
     let be: Vec<f64> = (0..n).map(|k| so3fft::beta(b, k)).collect();
@@ -134,6 +140,6 @@ fn grid_angles(
 /// The quadrature weights of the beta grid (`2B` values).
 #[pyfunction]
 fn weights(py: Python<'_>, bandwidth: usize) -> PyResult<Bound<'_, PyArray1<f64>>> {
-    let b = checked(bandwidth, so3fft::MAX_BANDWIDTH)?;
+    let b = checked(bandwidth, so3fft::s2::S2_MAX_BANDWIDTH)?;
     Ok(PyArray1::from_vec(py, so3fft::weights(b)))
 }

@@ -11,8 +11,9 @@ mod layout;
 mod matching;
 mod transforms;
 
-/// so3fft's extension module (see the package `so3fft` for the documented API).
-#[pymodule]
+/// so3fft's extension module (see the package `so3fft` for the documented API). It keeps the
+/// GIL on free-threaded interpreters: the module has not been checked for running without it.
+#[pymodule(gil_used = true)]
 fn _so3fft(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     transforms::register(m)?;

@@ -5,8 +5,12 @@ use crate::arrays::{
     all_finite, all_finite_real, input, not_finite_always, output, readonly, readwrite,
 };
 use crate::errors::{to_py, value_error};
+use crate::layout::checked;
 use crate::transforms::options;
-use numpy::{PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn};
+use numpy::{
+    PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
+    PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use so3fft::matching::{self, CorrelationOptions, Peak, Rotation};
 use so3fft::Complex64;
@@ -282,15 +286,16 @@ impl Correlation {
 
 /// Rows of Euler angles as rotations (all finite).
 fn rotations(rows: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Rotation>> {
-    let rows = rows.as_array();
-    if rows.ncols() != 3 {
+    let values = rows
+        .as_slice()
+        .map_err(|_| value_error("the rotations must be a C-contiguous, aligned array"))?;
+    if rows.shape()[1] != 3 {
         return Err(value_error(
             "rotations must be rows of three Euler angles (alpha, beta, gamma)",
         ));
     }
-    let gs: Vec<Rotation> = rows
-        .rows()
-        .into_iter()
+    let gs: Vec<Rotation> = values
+        .chunks_exact(3)
         .map(|r| Rotation::new(r[0], r[1], r[2]))
         .collect();
     if gs.iter().any(|g| !g.is_finite()) {
@@ -318,12 +323,7 @@ fn found_arrays<'py>(
 
 /// The series of SO(3) coefficients of bandwidth `bandwidth`, degrees `<= deg_lim`.
 fn series(bandwidth: usize, deg_lim: usize, c: &[Complex64]) -> PyResult<matching::So3Series> {
-    if bandwidth == 0 || bandwidth > so3fft::MAX_BANDWIDTH {
-        return Err(to_py(so3fft::Error::InvalidBandwidth {
-            bandwidth,
-            max: so3fft::MAX_BANDWIDTH,
-        }));
-    }
+    checked(bandwidth, so3fft::MAX_BANDWIDTH)?;
     if deg_lim >= bandwidth {
         return Err(value_error(format!(
             "deg_lim = {deg_lim} must be below the bandwidth {bandwidth}"
@@ -406,6 +406,9 @@ fn top_peaks(
         .as_slice()
         .map_err(|_| value_error("the grid must be C-contiguous"))?;
     let b = peak_args(g.len(), min_angle)?;
+    if !py.detach(|| all_finite(g)) {
+        return Err(not_finite_always("the grid"));
+    }
     let peaks = py.detach(|| matching::top_peaks(b, g, k, min_angle));
     Ok(peaks.iter().map(peak_tuple).collect())
 }
@@ -422,6 +425,9 @@ fn top_peaks_real(
         .as_slice()
         .map_err(|_| value_error("the grid must be C-contiguous"))?;
     let b = peak_args(g.len(), min_angle)?;
+    if !py.detach(|| all_finite_real(g)) {
+        return Err(not_finite_always("the grid"));
+    }
     let peaks = py.detach(|| matching::top_peaks_real(b, g, k, min_angle));
     Ok(peaks.iter().map(peak_tuple).collect())
 }
@@ -446,6 +452,7 @@ fn rotate_s2_coeffs<'py>(
     coeffs: PyReadonlyArrayDyn<'_, Complex64>,
     angles: (f64, f64, f64),
 ) -> PyResult<Bound<'py, PyArray1<Complex64>>> {
+    let b = checked(bandwidth, so3fft::s2::S2_MAX_BANDWIDTH)?;
     let c = coeffs
         .as_slice()
         .map_err(|_| value_error("the coefficients must be C-contiguous"))?;
@@ -457,7 +464,7 @@ fn rotate_s2_coeffs<'py>(
         return Err(value_error("the rotation's angles must be finite"));
     }
     let out = py
-        .detach(|| matching::rotate_s2_coeffs(bandwidth, c, &g))
+        .detach(|| matching::rotate_s2_coeffs(b, c, &g))
         .map_err(to_py)?;
     Ok(PyArray1::from_vec(py, out))
 }

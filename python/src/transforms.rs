@@ -15,6 +15,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
+/// Values of `howmany` fields of `per_field` values each.
+fn fields(howmany: usize, per_field: usize) -> PyResult<usize> {
+    howmany
+        .checked_mul(per_field)
+        .ok_or_else(|| value_error(format!("{howmany} fields are too many")))
+}
+
 /// FFTW's planning rigour by name.
 pub fn rigor(name: &str) -> PyResult<Rigor> {
     match name.to_ascii_lowercase().as_str() {
@@ -242,8 +249,12 @@ impl S2Plan {
     ) -> PyResult<f64> {
         let samples = readonly(&samples)?;
         let mut coeffs = readwrite(&coeffs)?;
-        let x = input(&samples, howmany * self.plan.num_samples(), "samples")?;
-        let c = output(&mut coeffs, howmany * self.plan.num_coeffs(), "out")?;
+        let x = input(
+            &samples,
+            fields(howmany, self.plan.num_samples())?,
+            "samples",
+        )?;
+        let c = output(&mut coeffs, fields(howmany, self.plan.num_coeffs())?, "out")?;
         py.detach(|| {
             let t = self.plan.forward_many(x, c, howmany)?;
             Ok((t.total, check_finite && !all_finite(c)))
@@ -268,8 +279,12 @@ impl S2Plan {
     ) -> PyResult<f64> {
         let samples = readonly(&samples)?;
         let mut coeffs = readwrite(&coeffs)?;
-        let x = input(&samples, howmany * self.plan.num_samples(), "samples")?;
-        let c = output(&mut coeffs, howmany * self.plan.num_coeffs(), "out")?;
+        let x = input(
+            &samples,
+            fields(howmany, self.plan.num_samples())?,
+            "samples",
+        )?;
+        let c = output(&mut coeffs, fields(howmany, self.plan.num_coeffs())?, "out")?;
         py.detach(|| {
             let t = self.plan.forward_real_many(x, c, howmany)?;
             Ok((t.total, check_finite && !all_finite(c)))
@@ -294,8 +309,16 @@ impl S2Plan {
     ) -> PyResult<f64> {
         let coeffs = readonly(&coeffs)?;
         let mut samples = readwrite(&samples)?;
-        let c = input(&coeffs, howmany * self.plan.num_coeffs(), "coefficients")?;
-        let x = output(&mut samples, howmany * self.plan.num_samples(), "out")?;
+        let c = input(
+            &coeffs,
+            fields(howmany, self.plan.num_coeffs())?,
+            "coefficients",
+        )?;
+        let x = output(
+            &mut samples,
+            fields(howmany, self.plan.num_samples())?,
+            "out",
+        )?;
         py.detach(|| {
             if check_finite && !all_finite(c) {
                 return Ok(None);
@@ -316,8 +339,16 @@ impl S2Plan {
     ) -> PyResult<f64> {
         let coeffs = readonly(&coeffs)?;
         let mut samples = readwrite(&samples)?;
-        let c = input(&coeffs, howmany * self.plan.num_coeffs(), "coefficients")?;
-        let x = output(&mut samples, howmany * self.plan.num_samples(), "out")?;
+        let c = input(
+            &coeffs,
+            fields(howmany, self.plan.num_coeffs())?,
+            "coefficients",
+        )?;
+        let x = output(
+            &mut samples,
+            fields(howmany, self.plan.num_samples())?,
+            "out",
+        )?;
         py.detach(|| {
             if check_finite && !all_finite(c) {
                 return Ok(None);
