@@ -4,10 +4,10 @@
 
 use crate::arrays::{all_finite, input, not_finite, output, readonly, readwrite};
 use crate::errors::{to_py, value_error};
-use numpy::PyArrayDyn;
+use numpy::{Element, PyArrayDyn};
 use pyo3::prelude::*;
 use so3fft::s2::S2Plan as RustS2Plan;
-use so3fft::{Complex64, Options, Rigor};
+use so3fft::{Complex64, Options, Rigor, StageTimes};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Plan>()?;
@@ -41,6 +41,57 @@ pub fn options(threads: usize, rigor_name: &str, real: bool) -> PyResult<Options
         .with_threads(threads)
         .with_rigor(rigor(rigor_name)?)
         .with_real(real))
+}
+
+/// A library transform from `In` values to `Out` values.
+type Run<'a, In, Out> = &'a (dyn Fn(&[In], &mut [Out]) -> so3fft::Result<StageTimes> + Sync);
+
+/// Runs a forward transform `run` from `samples` into `coeffs` (sizes `(samples, coeffs)`)
+/// with the GIL released; with `check_finite`, non-finite samples (seen in the coefficients)
+/// are an error. The library's seconds.
+fn run_forward<X: Element + Sync>(
+    py: Python<'_>,
+    (samples, coeffs): (&Bound<'_, PyArrayDyn<X>>, &Bound<'_, PyArrayDyn<Complex64>>),
+    (ns, nc): (usize, usize),
+    check_finite: bool,
+    run: Run<'_, X, Complex64>,
+) -> PyResult<f64> {
+    let samples = readonly(samples)?;
+    let mut coeffs = readwrite(coeffs)?;
+    let x = input(&samples, ns, "samples")?;
+    let c = output(&mut coeffs, nc, "out")?;
+    let (t, finite) = py
+        .detach(|| run(x, c).map(|t| (t.total, !check_finite || all_finite(c))))
+        .map_err(to_py)?;
+    if finite {
+        Ok(t)
+    } else {
+        Err(not_finite("samples"))
+    }
+}
+
+/// Runs an inverse transform `run` from `coeffs` into `samples` (sizes `(coeffs, samples)`)
+/// with the GIL released, after checking with `check_finite` that the coefficients are
+/// finite. The library's seconds.
+fn run_inverse<X: Element + Send>(
+    py: Python<'_>,
+    (coeffs, samples): (&Bound<'_, PyArrayDyn<Complex64>>, &Bound<'_, PyArrayDyn<X>>),
+    (nc, ns): (usize, usize),
+    check_finite: bool,
+    run: Run<'_, Complex64, X>,
+) -> PyResult<f64> {
+    let coeffs = readonly(coeffs)?;
+    let mut samples = readwrite(samples)?;
+    let c = input(&coeffs, nc, "coefficients")?;
+    let x = output(&mut samples, ns, "out")?;
+    py.detach(|| {
+        if check_finite && !all_finite(c) {
+            return Ok(None);
+        }
+        run(c, x).map(|t| Some(t.total))
+    })
+    .map_err(to_py)?
+    .ok_or_else(|| not_finite("coefficients"))
 }
 
 /// An SO(3) transform plan of one bandwidth (low level: exact arrays, no allocation).
@@ -111,21 +162,9 @@ impl Plan {
         coeffs: Bound<'_, PyArrayDyn<Complex64>>,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let samples = readonly(&samples)?;
-        let mut coeffs = readwrite(&coeffs)?;
-        let x = input(&samples, self.plan.num_samples(), "samples")?;
-        let c = output(&mut coeffs, self.plan.num_coeffs(), "out")?;
-        py.detach(|| {
-            let t = self.plan.forward(x, c)?;
-            Ok((t.total, check_finite && !all_finite(c)))
-        })
-        .map_err(to_py)
-        .and_then(|(t, bad)| {
-            if bad {
-                Err(not_finite("samples"))
-            } else {
-                Ok(t)
-            }
+        let sizes = (self.plan.num_samples(), self.plan.num_coeffs());
+        run_forward(py, (&samples, &coeffs), sizes, check_finite, &|x, c| {
+            self.plan.forward(x, c)
         })
     }
 
@@ -137,21 +176,9 @@ impl Plan {
         coeffs: Bound<'_, PyArrayDyn<Complex64>>,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let samples = readonly(&samples)?;
-        let mut coeffs = readwrite(&coeffs)?;
-        let x = input(&samples, self.plan.num_samples(), "samples")?;
-        let c = output(&mut coeffs, self.plan.num_coeffs(), "out")?;
-        py.detach(|| {
-            let t = self.plan.forward_real(x, c)?;
-            Ok((t.total, check_finite && !all_finite(c)))
-        })
-        .map_err(to_py)
-        .and_then(|(t, bad)| {
-            if bad {
-                Err(not_finite("samples"))
-            } else {
-                Ok(t)
-            }
+        let sizes = (self.plan.num_samples(), self.plan.num_coeffs());
+        run_forward(py, (&samples, &coeffs), sizes, check_finite, &|x, c| {
+            self.plan.forward_real(x, c)
         })
     }
 
@@ -163,18 +190,10 @@ impl Plan {
         samples: Bound<'_, PyArrayDyn<Complex64>>,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let coeffs = readonly(&coeffs)?;
-        let mut samples = readwrite(&samples)?;
-        let c = input(&coeffs, self.plan.num_coeffs(), "coefficients")?;
-        let x = output(&mut samples, self.plan.num_samples(), "out")?;
-        py.detach(|| {
-            if check_finite && !all_finite(c) {
-                return Ok(None);
-            }
-            self.plan.inverse(c, x).map(|t| Some(t.total))
+        let sizes = (self.plan.num_coeffs(), self.plan.num_samples());
+        run_inverse(py, (&coeffs, &samples), sizes, check_finite, &|c, x| {
+            self.plan.inverse(c, x)
         })
-        .map_err(to_py)?
-        .ok_or_else(|| not_finite("coefficients"))
     }
 
     /// Coefficients (of a real function) to real samples.
@@ -185,18 +204,10 @@ impl Plan {
         samples: Bound<'_, PyArrayDyn<f64>>,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let coeffs = readonly(&coeffs)?;
-        let mut samples = readwrite(&samples)?;
-        let c = input(&coeffs, self.plan.num_coeffs(), "coefficients")?;
-        let x = output(&mut samples, self.plan.num_samples(), "out")?;
-        py.detach(|| {
-            if check_finite && !all_finite(c) {
-                return Ok(None);
-            }
-            self.plan.inverse_real(c, x).map(|t| Some(t.total))
+        let sizes = (self.plan.num_coeffs(), self.plan.num_samples());
+        run_inverse(py, (&coeffs, &samples), sizes, check_finite, &|c, x| {
+            self.plan.inverse_real(c, x)
         })
-        .map_err(to_py)?
-        .ok_or_else(|| not_finite("coefficients"))
     }
 }
 
@@ -247,25 +258,12 @@ impl S2Plan {
         howmany: usize,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let samples = readonly(&samples)?;
-        let mut coeffs = readwrite(&coeffs)?;
-        let x = input(
-            &samples,
+        let sizes = (
             fields(howmany, self.plan.num_samples())?,
-            "samples",
-        )?;
-        let c = output(&mut coeffs, fields(howmany, self.plan.num_coeffs())?, "out")?;
-        py.detach(|| {
-            let t = self.plan.forward_many(x, c, howmany)?;
-            Ok((t.total, check_finite && !all_finite(c)))
-        })
-        .map_err(to_py)
-        .and_then(|(t, bad)| {
-            if bad {
-                Err(not_finite("samples"))
-            } else {
-                Ok(t)
-            }
+            fields(howmany, self.plan.num_coeffs())?,
+        );
+        run_forward(py, (&samples, &coeffs), sizes, check_finite, &|x, c| {
+            self.plan.forward_many(x, c, howmany)
         })
     }
 
@@ -277,25 +275,12 @@ impl S2Plan {
         howmany: usize,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let samples = readonly(&samples)?;
-        let mut coeffs = readwrite(&coeffs)?;
-        let x = input(
-            &samples,
+        let sizes = (
             fields(howmany, self.plan.num_samples())?,
-            "samples",
-        )?;
-        let c = output(&mut coeffs, fields(howmany, self.plan.num_coeffs())?, "out")?;
-        py.detach(|| {
-            let t = self.plan.forward_real_many(x, c, howmany)?;
-            Ok((t.total, check_finite && !all_finite(c)))
-        })
-        .map_err(to_py)
-        .and_then(|(t, bad)| {
-            if bad {
-                Err(not_finite("samples"))
-            } else {
-                Ok(t)
-            }
+            fields(howmany, self.plan.num_coeffs())?,
+        );
+        run_forward(py, (&samples, &coeffs), sizes, check_finite, &|x, c| {
+            self.plan.forward_real_many(x, c, howmany)
         })
     }
 
@@ -307,26 +292,13 @@ impl S2Plan {
         howmany: usize,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let coeffs = readonly(&coeffs)?;
-        let mut samples = readwrite(&samples)?;
-        let c = input(
-            &coeffs,
+        let sizes = (
             fields(howmany, self.plan.num_coeffs())?,
-            "coefficients",
-        )?;
-        let x = output(
-            &mut samples,
             fields(howmany, self.plan.num_samples())?,
-            "out",
-        )?;
-        py.detach(|| {
-            if check_finite && !all_finite(c) {
-                return Ok(None);
-            }
-            self.plan.inverse_many(c, x, howmany).map(|t| Some(t.total))
+        );
+        run_inverse(py, (&coeffs, &samples), sizes, check_finite, &|c, x| {
+            self.plan.inverse_many(c, x, howmany)
         })
-        .map_err(to_py)?
-        .ok_or_else(|| not_finite("coefficients"))
     }
 
     fn inverse_real(
@@ -337,27 +309,12 @@ impl S2Plan {
         howmany: usize,
         check_finite: bool,
     ) -> PyResult<f64> {
-        let coeffs = readonly(&coeffs)?;
-        let mut samples = readwrite(&samples)?;
-        let c = input(
-            &coeffs,
+        let sizes = (
             fields(howmany, self.plan.num_coeffs())?,
-            "coefficients",
-        )?;
-        let x = output(
-            &mut samples,
             fields(howmany, self.plan.num_samples())?,
-            "out",
-        )?;
-        py.detach(|| {
-            if check_finite && !all_finite(c) {
-                return Ok(None);
-            }
-            self.plan
-                .inverse_real_many(c, x, howmany)
-                .map(|t| Some(t.total))
+        );
+        run_inverse(py, (&coeffs, &samples), sizes, check_finite, &|c, x| {
+            self.plan.inverse_real_many(c, x, howmany)
         })
-        .map_err(to_py)?
-        .ok_or_else(|| not_finite("coefficients"))
     }
 }
