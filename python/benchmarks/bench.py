@@ -101,6 +101,10 @@ class Timed:
     def inverse_real(self, *a):
         self.last = self.ext.inverse_real(*a)
 
+    def __getattr__(self, name):
+        # Everything else (sizes, bandwidth, ...) is the extension object's.
+        return getattr(self.ext, name)
+
 
 def timed(plan):
     """``plan`` with its extension object wrapped in :class:`Timed` (once); the wrapper."""
