@@ -30,7 +30,9 @@ fi
 CARGO_TARGET_DIR=target/mpi cargo test --release --features mpi --test mpi
 # The Python package, installed the way the README says, with its test dependencies.
 python3 -m venv target/pyenv
-target/pyenv/bin/pip install -q numpy "scipy>=1.15" pytest ducc0 matplotlib
+target/pyenv/bin/pip install -q numpy "scipy>=1.15" pytest ducc0 matplotlib mypy
 target/pyenv/bin/pip install -q ./python
 target/pyenv/bin/pytest -q python/tests
+# The package's annotations and the extension's stubs agree with its code.
+target/pyenv/bin/mypy --ignore-missing-imports python/so3fft
 target/pyenv/bin/python python/examples/match_rotation.py --out target/match_rotation.png

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def as_input(x, dtype, shapes, what):
+def as_input(x, dtype, shapes, what) -> np.ndarray:
     """`x` as a C-contiguous array of `dtype` with one of `shapes` (tuples; `None` in a
     shape matches any length). Arrays that already fit are returned as they are."""
     if (
@@ -40,7 +40,7 @@ def _fits(shape, pattern):
     )
 
 
-def check_output(out, dtype, shape, what="out"):
+def check_output(out, dtype, shape, what="out") -> np.ndarray:
     """`out` if it is a writeable C-contiguous array of `dtype` and `shape` (else an error:
     outputs are written in place, so they cannot be converted)."""
     if not isinstance(out, np.ndarray):
@@ -56,7 +56,7 @@ def check_output(out, dtype, shape, what="out"):
     return out
 
 
-def apart(x, out):
+def apart(x: np.ndarray, out: np.ndarray) -> np.ndarray:
     """`x`, copied if it shares memory with `out` (the transforms read all of their input
     while they write their output)."""
     return x.copy() if np.may_share_memory(x, out) else x

@@ -4,8 +4,10 @@ view of SO(3) coefficients."""
 from __future__ import annotations
 
 import functools
+from typing import Optional, Tuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _so3fft
 from ._arrays import as_input, bandwidth_arg
@@ -14,12 +16,12 @@ MAX_BANDWIDTH = _so3fft.MAX_BANDWIDTH
 S2_MAX_BANDWIDTH = _so3fft.S2_MAX_BANDWIDTH
 
 
-def num_coeffs(B):
+def num_coeffs(B: int) -> int:
     """Number of SO(3) coefficients at bandwidth ``B``: ``(4B^3 - B) / 3``."""
     return _so3fft.num_coeffs(bandwidth_arg(B))
 
 
-def num_samples(B):
+def num_samples(B: int) -> int:
     """Number of SO(3) samples at bandwidth ``B``: ``(2B)^3``."""
     return _so3fft.num_samples(bandwidth_arg(B))
 
@@ -31,7 +33,7 @@ def _index_args(*values):
     return [int(v) for v in values]
 
 
-def coef_index(B, l, m, mp):
+def coef_index(B: int, l: int, m: int, mp: int) -> int:
     """Index of ``fhat(l, m, mp)`` in the flat coefficient array (SOFT's ``so3CoefLoc``;
     ``m`` pairs with alpha, ``mp`` with gamma). ``ValueError`` if it does not exist."""
     return _so3fft.coef_index(bandwidth_arg(B), *_index_args(l, m, mp))
@@ -44,13 +46,13 @@ def _degrees_orders(B):
     return a
 
 
-def coef_degrees_orders(B):
+def coef_degrees_orders(B: int) -> np.ndarray:
     """``(l, m, mp)`` of every coefficient, in the flat array's order: an integer array of
     shape ``(num_coeffs(B), 3)``."""
     return _degrees_orders(bandwidth_arg(B)).copy()
 
 
-def to_dense(fhat, B=None):
+def to_dense(fhat: ArrayLike, B: Optional[int] = None) -> np.ndarray:
     """SO(3) coefficients as a dense array ``D[l, m + B - 1, mp + B - 1]`` of shape
     ``(B, 2B - 1, 2B - 1)`` (zero where ``|m|`` or ``|mp|`` exceeds ``l``), the ``(l, m,
     m')`` indexing many Python packages use. ``B`` is found from the length if not given."""
@@ -64,7 +66,7 @@ def to_dense(fhat, B=None):
     return dense
 
 
-def from_dense(dense):
+def from_dense(dense: ArrayLike) -> np.ndarray:
     """The flat coefficient array of a dense ``(B, 2B - 1, 2B - 1)`` array (see
     :func:`to_dense`); entries with ``|m| > l`` or ``|mp| > l`` are ignored."""
     dense = np.asarray(dense)
@@ -86,26 +88,26 @@ def _bandwidth_of(n):
     return B
 
 
-def grid_angles(B):
+def grid_angles(B: int) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The SO(3) grid's angles ``(alpha, beta, gamma)``, ``2B`` values each:
     ``alpha_j = pi j / B``, ``beta_k = pi (2k + 1) / (4B)``, ``gamma_i = pi i / B``. Sample
     ``[k, j, i]`` is the function at ``(alpha_j, beta_k, gamma_i)``."""
     return _so3fft.grid_angles(bandwidth_arg(B))
 
 
-def weights(B):
+def weights(B: int) -> np.ndarray:
     """Quadrature weights of the beta (or theta) grid, ``2B`` values; with them
     ``sum_k w_k g(beta_k)`` integrates ``g(beta) sin(beta) dbeta`` exactly for band-limited
     ``g``."""
     return _so3fft.weights(bandwidth_arg(B))
 
 
-def s2_num_coeffs(B):
+def s2_num_coeffs(B: int) -> int:
     """Number of S^2 coefficients at bandwidth ``B``: ``B^2``."""
     return _so3fft.s2_num_coeffs(bandwidth_arg(B))
 
 
-def s2_coef_index(B, l, m):
+def s2_coef_index(B: int, l: int, m: int) -> int:
     """Index of ``fhat(l, m)`` in the flat S^2 coefficient array (SOFT's ``seanindex``)."""
     return _so3fft.s2_coef_index(bandwidth_arg(B), *_index_args(l, m))
 
@@ -117,12 +119,12 @@ def _s2_degrees_orders(B):
     return a
 
 
-def s2_coef_degrees_orders(B):
+def s2_coef_degrees_orders(B: int) -> np.ndarray:
     """``(l, m)`` of every S^2 coefficient in the flat array's order: shape ``(B^2, 2)``."""
     return _s2_degrees_orders(bandwidth_arg(B)).copy()
 
 
-def s2_grid_angles(B):
+def s2_grid_angles(B: int) -> Tuple[np.ndarray, np.ndarray]:
     """The S^2 grid's angles ``(theta, phi)``, ``2B`` values each:
     ``theta_j = pi (2j + 1) / (4B)``, ``phi_k = pi k / B``; sample ``[j, k]`` is the function
     at ``(theta_j, phi_k)``."""

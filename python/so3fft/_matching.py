@@ -4,12 +4,19 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import NamedTuple
+from typing import Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _so3fft
 from ._arrays import apart, as_input, bandwidth_arg, check_output, int_arg, threads_arg
+
+
+#: A rotation: a :class:`Rotation` or Euler angles ``(alpha, beta, gamma)``.
+RotationLike = Union["Rotation", Sequence[float]]
+#: Rotations: one, several, or an ``(n, 3)`` array of Euler angles.
+Rotations = Union[RotationLike, Iterable[RotationLike], np.ndarray]
 
 
 class Rotation:
@@ -23,7 +30,7 @@ class Rotation:
 
     __slots__ = ("alpha", "beta", "gamma")
 
-    def __init__(self, alpha, beta, gamma):
+    def __init__(self, alpha: float, beta: float, gamma: float) -> None:
         self.alpha = float(alpha)
         self.beta = float(beta)
         self.gamma = float(gamma)
@@ -36,19 +43,19 @@ class Rotation:
     def __iter__(self):
         return iter((self.alpha, self.beta, self.gamma))
 
-    def as_euler(self):
+    def as_euler(self) -> np.ndarray:
         """``(alpha, beta, gamma)`` as an array."""
         return np.array([self.alpha, self.beta, self.gamma])
 
-    def as_matrix(self):
+    def as_matrix(self) -> np.ndarray:
         """The 3x3 rotation matrix."""
         return np.array(_so3fft.euler_to_matrix(self.alpha, self.beta, self.gamma))
 
-    def as_quaternion(self):
+    def as_quaternion(self) -> np.ndarray:
         """The unit quaternion ``(w, x, y, z)`` with ``w >= 0``."""
         return np.array(_so3fft.euler_to_quaternion(self.alpha, self.beta, self.gamma))
 
-    def angle_to(self, other):
+    def angle_to(self, other: RotationLike) -> float:
         """The angle (radians) of the rotation taking ``self`` to ``other``: the geodesic
         distance on SO(3), accurate for small angles."""
         p, q = self.as_quaternion(), Rotation._of(other).as_quaternion()
@@ -57,7 +64,7 @@ class Rotation:
         return 4.0 * math.atan2(np.linalg.norm(p - q), np.linalg.norm(p + q))
 
     @classmethod
-    def from_matrix(cls, matrix):
+    def from_matrix(cls, matrix: ArrayLike) -> "Rotation":
         """The Euler angles of a rotation matrix (``beta`` in ``[0, pi]``, the others in
         ``(-pi, pi]``; ``gamma = 0`` where ``beta`` is 0 or ``pi``)."""
         r = np.asarray(matrix, dtype=float)
@@ -74,7 +81,7 @@ class Rotation:
         return cls(math.atan2(-r[1, 0], -r[0, 0]), math.pi, 0.0)
 
     @classmethod
-    def from_quaternion(cls, q):
+    def from_quaternion(cls, q: ArrayLike) -> "Rotation":
         """The rotation of a quaternion ``(w, x, y, z)`` (normalised here)."""
         q = np.asarray(q, dtype=float)
         if q.shape != (4,) or not np.all(np.isfinite(q)) or not np.any(q):
@@ -89,7 +96,7 @@ class Rotation:
         )
 
     @classmethod
-    def from_scipy(cls, rotation):
+    def from_scipy(cls, rotation) -> "Rotation":
         """The rotation of a single ``scipy.spatial.transform.Rotation``."""
         return cls.from_matrix(rotation.as_matrix())
 
@@ -108,14 +115,14 @@ class Peak(NamedTuple):
     """A grid point of a correlation: flat index ``k (2B)^2 + j 2B + i``, its Euler angles
     and ``|C|^2`` there."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # shadows tuple.index on purpose
     alpha: float
     beta: float
     gamma: float
     value: float
 
     @property
-    def rotation(self):
+    def rotation(self) -> Rotation:
         """The peak's rotation."""
         return Rotation(self.alpha, self.beta, self.gamma)
 
@@ -169,9 +176,16 @@ class Correlation:
     """
 
     def __init__(
-        self, B, *, b_out=None, deg_lim=None, real=False, normalized=False, threads=0,
-        rigor="estimate",
-    ):
+        self,
+        B: int,
+        *,
+        b_out: Optional[int] = None,
+        deg_lim: Optional[int] = None,
+        real: bool = False,
+        normalized: bool = False,
+        threads: int = 0,
+        rigor: str = "estimate",
+    ) -> None:
         B = bandwidth_arg(B)
         b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
         deg_lim = None if deg_lim is None else int_arg(deg_lim, "deg_lim", 0, 1 << 31)
@@ -183,32 +197,32 @@ class Correlation:
         self._s2_shapes = ((2 * B, 2 * B),)
 
     @property
-    def B(self):
+    def B(self) -> int:
         """Bandwidth of the inputs."""
         return self._plan.b_in
 
     @property
-    def b_out(self):
+    def b_out(self) -> int:
         """Bandwidth of the correlation grid."""
         return self._plan.b_out
 
     @property
-    def deg_lim(self):
+    def deg_lim(self) -> int:
         """Highest degree combined."""
         return self._plan.deg_lim
 
     @property
-    def real(self):
+    def real(self) -> bool:
         """Whether inputs and grid are real."""
         return self._plan.real
 
     @property
-    def normalized(self):
+    def normalized(self) -> bool:
         """Whether this is the normalised cross-correlation."""
         return self._normalized
 
     @property
-    def grid_shape(self):
+    def grid_shape(self) -> Tuple[int, int, int]:
         """Shape of the correlation grid, ``(2 b_out,) * 3``."""
         return (2 * self.b_out,) * 3
 
@@ -230,7 +244,9 @@ class Correlation:
             return np.empty(self.grid_shape, self._in_dtype)
         return check_output(out, self._in_dtype, self.grid_shape)
 
-    def correlate(self, signal, pattern, out=None):
+    def correlate(
+        self, signal: ArrayLike, pattern: ArrayLike, out: Optional[np.ndarray] = None
+    ) -> np.ndarray:
         """The correlation grid (``(2 b_out)^3``; real for a real plan), into ``out`` if
         given."""
         out = self._grid(out)
@@ -239,15 +255,23 @@ class Correlation:
         run(s, p, out, False)
         return out
 
-    def correlate_argmax(self, signal, pattern, out=None):
+    def correlate_argmax(
+        self, signal: ArrayLike, pattern: ArrayLike, out: Optional[np.ndarray] = None
+    ) -> Tuple[np.ndarray, Peak]:
         """The correlation grid and its largest ``|C|^2`` (a :class:`Peak`, found while the
         grid is computed: ties go to the lowest index)."""
         out = self._grid(out)
         s, p = self._inputs(signal, pattern, out)
         run = self._plan.correlate_real if self.real else self._plan.correlate
-        return out, Peak(*run(s, p, out, True))
+        peak = run(s, p, out, True)
+        assert peak is not None  # the extension returns the peak when asked for it
+        return out, Peak(*peak)
 
-    def correlate_shells(self, shells, out=None):
+    def correlate_shells(
+        self,
+        shells: Iterable[Tuple[ArrayLike, ArrayLike, float]],
+        out: Optional[np.ndarray] = None,
+    ) -> np.ndarray:
         """``sum_i w_i C_i``: the correlations of shells ``(signal_i, pattern_i, w_i)``
         (functions on concentric spheres, e.g. of a 3-D map), in one inverse transform."""
         out = self._grid(out)
@@ -256,7 +280,9 @@ class Correlation:
         run(arrays, out)
         return out
 
-    def coefficients(self, signal, pattern, out=None):
+    def coefficients(
+        self, signal: ArrayLike, pattern: ArrayLike, out: Optional[np.ndarray] = None
+    ) -> np.ndarray:
         """The correlation's SO(3) coefficients (bandwidth ``b_out``; zero above
         ``deg_lim``), the input of :meth:`refine`."""
         n = _so3fft.num_coeffs(self.b_out)
@@ -269,7 +295,7 @@ class Correlation:
         run(s, p, out)
         return out
 
-    def refine(self, coeffs, starts):
+    def refine(self, coeffs: ArrayLike, starts: Rotations) -> List[Tuple[Rotation, float]]:
         """From each start rotation, the nearest maximum of ``|C|^2`` of the band-limited
         correlation with coefficients ``coeffs`` (from :meth:`coefficients`), off the grid:
         a list of ``(Rotation, value)``."""
@@ -277,7 +303,9 @@ class Correlation:
         angles, values = self._plan.refine(c, _rows(starts))
         return [(Rotation(*a), float(v)) for a, v in zip(angles, values)]
 
-    def match(self, signal, pattern, k=1, min_angle=None):
+    def match(
+        self, signal: ArrayLike, pattern: ArrayLike, k: int = 1, min_angle: Optional[float] = None
+    ) -> List[Tuple[Rotation, float]]:
         """The rotations that best take the pattern to the signal: the ``k`` largest peaks of
         the correlation grid (at least ``min_angle`` radians apart, default one grid step),
         each refined off the grid; a list of ``(Rotation, value)``, best first. Peaks that
@@ -287,7 +315,7 @@ class Correlation:
         if not peaks:
             return []
         found = self.refine(self.coefficients(signal, pattern), [p.rotation for p in peaks])
-        kept = []
+        kept: List[Tuple[Rotation, float]] = []
         for g, v in sorted(found, key=lambda gv: -gv[1]):
             if all(g.angle_to(h) > 1e-6 for h, _ in kept):
                 kept.append((g, v))
@@ -301,7 +329,15 @@ def _cached_correlation(B, b_out, deg_lim, real, normalized, threads):
     )
 
 
-def correlate(signal, pattern, b_out=None, deg_lim=None, *, normalized=False, threads=0):
+def correlate(
+    signal: ArrayLike,
+    pattern: ArrayLike,
+    b_out: Optional[int] = None,
+    deg_lim: Optional[int] = None,
+    *,
+    normalized: bool = False,
+    threads: int = 0,
+) -> np.ndarray:
     """The correlation grid of ``signal`` and ``pattern`` (S^2 samples, ``(2B, 2B)``): see
     :class:`Correlation`. Real inputs (both ``float``) give a real grid. The plan is kept
     for the next call with the same arguments (a :class:`Correlation` made once is faster
@@ -318,7 +354,7 @@ def correlate(signal, pattern, b_out=None, deg_lim=None, *, normalized=False, th
     return plan.correlate(s, p)
 
 
-def top_peaks(grid, k=1, min_angle=0.0):
+def top_peaks(grid: ArrayLike, k: int = 1, min_angle: float = 0.0) -> List[Peak]:
     """The ``k`` largest local maxima of ``|C|^2`` on a correlation grid (``(2B)^3``, complex
     or real), each at least ``min_angle`` radians (geodesic) from every larger one taken: a
     list of :class:`Peak`, largest first."""
@@ -344,7 +380,9 @@ def _coeffs_and_limit(coeffs, deg_lim):
     return c, B, int_arg(deg_lim, "deg_lim", 0, B - 1)
 
 
-def refine(coeffs, starts, deg_lim=None):
+def refine(
+    coeffs: ArrayLike, starts: Rotations, deg_lim: Optional[int] = None
+) -> List[Tuple[Rotation, float]]:
     """From each start rotation, the nearest maximum of ``|f|^2`` of the band-limited SO(3)
     function with coefficients ``coeffs`` (degrees up to ``deg_lim``, default all), by
     damped Newton steps off the grid: a list of ``(Rotation, value)``."""
@@ -353,14 +391,14 @@ def refine(coeffs, starts, deg_lim=None):
     return [(Rotation(*a), float(v)) for a, v in zip(angles, values)]
 
 
-def evaluate(coeffs, rotations, deg_lim=None):
+def evaluate(coeffs: ArrayLike, rotations: Rotations, deg_lim: Optional[int] = None) -> np.ndarray:
     """The band-limited SO(3) function with coefficients ``coeffs`` at any rotations
     (``Rotation`` objects or rows of Euler angles), off the grid."""
     c, B, L = _coeffs_and_limit(coeffs, deg_lim)
     return _so3fft.evaluate_series(B, L, c, _rows(rotations))
 
 
-def rotate_s2_coeffs(coeffs, rotation):
+def rotate_s2_coeffs(coeffs: ArrayLike, rotation: RotationLike) -> np.ndarray:
     """The S^2 coefficients of ``f(g^-1 x)``: the function of ``coeffs`` rotated by
     ``rotation`` (a :class:`Rotation` or Euler angles)."""
     c = np.asarray(coeffs)

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from typing import Optional, Tuple
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import _so3fft
 from ._arrays import apart, as_input, bandwidth_arg, check_output, threads_arg
@@ -51,7 +54,9 @@ class Plan:
     The transforms release the GIL: several threads may use one plan at once.
     """
 
-    def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
+    def __init__(
+        self, B: int, *, real: bool = False, threads: int = 0, rigor: str = "estimate"
+    ) -> None:
         B = bandwidth_arg(B)
         self._plan = _so3fft.Plan(B, bool(real), threads_arg(threads), rigor)
         self._real = bool(real)
@@ -62,62 +67,66 @@ class Plan:
         self._num_coeffs = self._plan.num_coeffs
 
     @property
-    def B(self):
+    def B(self) -> int:
         """The bandwidth."""
         return self._plan.bandwidth
 
     @property
-    def real(self):
+    def real(self) -> bool:
         """Whether the samples are real."""
         return self._real
 
     @property
-    def sample_shape(self):
+    def sample_shape(self) -> Tuple[int, ...]:
         """Shape of a sample array, ``(2B, 2B, 2B)``."""
         return self._sample_shape
 
     @property
-    def num_coeffs(self):
+    def num_coeffs(self) -> int:
         """Number of coefficients, ``(4B^3 - B) / 3``."""
         return self._num_coeffs
 
     @property
-    def threads(self):
+    def threads(self) -> int:
         """Worker threads the plan runs on."""
         return self._plan.threads
 
     @property
-    def memory_bytes(self):
+    def memory_bytes(self) -> int:
         """Bytes the plan holds (tables and buffers)."""
         return self._plan.memory_bytes
 
     @property
-    def isa(self):
+    def isa(self) -> str:
         """The instruction set of the plan's kernels (``"avx512"``, ``"avx2"``, ...)."""
         return self._plan.isa
 
     def __repr__(self):
         return f"so3fft.Plan({self.B}, real={self.real}, threads={self.threads})"
 
-    def forward(self, f, out=None, *, check_finite=True):
+    def forward(
+        self, f: ArrayLike, out: Optional[np.ndarray] = None, *, check_finite: bool = True
+    ) -> np.ndarray:
         """Samples ``f`` (``(2B, 2B, 2B)``; ``float64`` for a real plan, else
         ``complex128``) to coefficients, written into ``out`` if given (a ``complex128``
         array of ``num_coeffs`` values) and returned.
 
         With ``check_finite``, NaN or infinite samples raise ``ValueError`` (the check reads
         the coefficients: a few percent of the transform's time)."""
-        f = as_input(f, self._sample_dtype, self._sample_shapes, "samples")
+        x = as_input(f, self._sample_dtype, self._sample_shapes, "samples")
         if out is None:
             out = np.empty(self.num_coeffs, np.complex128)
         else:
-            f = apart(f, check_output(out, np.complex128, (self.num_coeffs,)))
+            x = apart(x, check_output(out, np.complex128, (self.num_coeffs,)))
         if self.real:
-            self._plan.forward_real(f, out, check_finite)
+            self._plan.forward_real(x, out, check_finite)
         else:
-            self._plan.forward(f, out, check_finite)
+            self._plan.forward(x, out, check_finite)
         return out
 
-    def inverse(self, fhat, out=None, *, check_finite=True):
+    def inverse(
+        self, fhat: ArrayLike, out: Optional[np.ndarray] = None, *, check_finite: bool = True
+    ) -> np.ndarray:
         """Coefficients ``fhat`` (``num_coeffs`` complex values) to samples, written into
         ``out`` if given (``(2B, 2B, 2B)``, ``float64`` for a real plan, else
         ``complex128``) and returned.
@@ -125,15 +134,15 @@ class Plan:
         A real plan reads the coefficients with ``m >= 0`` and takes the others from the
         real symmetry. With ``check_finite``, NaN or infinite coefficients raise
         ``ValueError``."""
-        fhat = as_input(fhat, np.complex128, ((self.num_coeffs,),), "coefficients")
+        c = as_input(fhat, np.complex128, ((self.num_coeffs,),), "coefficients")
         if out is None:
             out = np.empty(self.sample_shape, self._sample_dtype)
         else:
-            fhat = apart(fhat, check_output(out, self._sample_dtype, self.sample_shape))
+            c = apart(c, check_output(out, self._sample_dtype, self.sample_shape))
         if self.real:
-            self._plan.inverse_real(fhat, out, check_finite)
+            self._plan.inverse_real(c, out, check_finite)
         else:
-            self._plan.inverse(fhat, out, check_finite)
+            self._plan.inverse(c, out, check_finite)
         return out
 
 
@@ -167,76 +176,82 @@ class S2Plan:
         FFTW's planning rigour (see :class:`Plan`).
     """
 
-    def __init__(self, B, *, real=False, threads=0, rigor="estimate"):
+    def __init__(
+        self, B: int, *, real: bool = False, threads: int = 0, rigor: str = "estimate"
+    ) -> None:
         B = bandwidth_arg(B)
         self._plan = _so3fft.S2Plan(B, threads_arg(threads), rigor)
         self._real = bool(real)
         self._sample_dtype = np.float64 if self._real else np.complex128
 
     @property
-    def B(self):
+    def B(self) -> int:
         """The bandwidth."""
         return self._plan.bandwidth
 
     @property
-    def real(self):
+    def real(self) -> bool:
         """Whether the samples are real."""
         return self._real
 
     @property
-    def sample_shape(self):
+    def sample_shape(self) -> Tuple[int, ...]:
         """Shape of one field's samples, ``(2B, 2B)``."""
         return (2 * self.B, 2 * self.B)
 
     @property
-    def num_coeffs(self):
+    def num_coeffs(self) -> int:
         """Coefficients per field, ``B^2``."""
         return self._plan.num_coeffs
 
     @property
-    def threads(self):
+    def threads(self) -> int:
         """Worker threads the plan runs on."""
         return self._plan.threads
 
     def __repr__(self):
         return f"so3fft.S2Plan({self.B}, real={self.real}, threads={self.threads})"
 
-    def forward(self, f, out=None, *, check_finite=True):
+    def forward(
+        self, f: ArrayLike, out: Optional[np.ndarray] = None, *, check_finite: bool = True
+    ) -> np.ndarray:
         """Samples (``(2B, 2B)`` or ``(n, 2B, 2B)``) to coefficients (``(B^2,)`` or
         ``(n, B^2)``, ``complex128``), into ``out`` if given."""
         n = 2 * self.B
-        f = as_input(f, self._sample_dtype, ((n, n), (None, n, n)), "samples")
-        many = f.ndim == 3
-        howmany = f.shape[0] if many else 1
+        x = as_input(f, self._sample_dtype, ((n, n), (None, n, n)), "samples")
+        many = x.ndim == 3
+        howmany = x.shape[0] if many else 1
         shape = (howmany, self.num_coeffs) if many else (self.num_coeffs,)
         if out is None:
             out = np.empty(shape, np.complex128)
         else:
-            f = apart(f, check_output(out, np.complex128, shape))
+            x = apart(x, check_output(out, np.complex128, shape))
         if howmany == 0:
             return out
         if self.real:
-            self._plan.forward_real(f, out, howmany, check_finite)
+            self._plan.forward_real(x, out, howmany, check_finite)
         else:
-            self._plan.forward(f, out, howmany, check_finite)
+            self._plan.forward(x, out, howmany, check_finite)
         return out
 
-    def inverse(self, fhat, out=None, *, check_finite=True):
+    def inverse(
+        self, fhat: ArrayLike, out: Optional[np.ndarray] = None, *, check_finite: bool = True
+    ) -> np.ndarray:
         """Coefficients (``(B^2,)`` or ``(n, B^2)``) to samples (``(2B, 2B)`` or
         ``(n, 2B, 2B)``), into ``out`` if given."""
         nc = self.num_coeffs
-        fhat = as_input(fhat, np.complex128, ((nc,), (None, nc)), "coefficients")
-        many = fhat.ndim == 2
-        howmany = fhat.shape[0] if many else 1
+        c = as_input(fhat, np.complex128, ((nc,), (None, nc)), "coefficients")
+        many = c.ndim == 2
+        howmany = c.shape[0] if many else 1
         shape = (howmany,) + self.sample_shape if many else self.sample_shape
         if out is None:
             out = np.empty(shape, self._sample_dtype)
         else:
-            fhat = apart(fhat, check_output(out, self._sample_dtype, shape))
+            c = apart(c, check_output(out, self._sample_dtype, shape))
         if howmany == 0:
             return out
         if self.real:
-            self._plan.inverse_real(fhat, out, howmany, check_finite)
+            self._plan.inverse_real(c, out, howmany, check_finite)
         else:
-            self._plan.inverse(fhat, out, howmany, check_finite)
+            self._plan.inverse(c, out, howmany, check_finite)
         return out
