@@ -79,7 +79,9 @@ impl CallbackExchange {
         // valid.
         let e = unsafe { group(t.context, &mut rank, &mut size) };
         if e == GROUP_NOT_READY {
-            return Err(Error::InvalidArgument("MPI is not initialised".into()));
+            return Err(Error::InvalidArgument(
+                "MPI is not initialised (or already finalised)".into(),
+            ));
         }
         if e != 0 {
             return Err(transport_error("MPI_Comm_rank or MPI_Comm_size", e));

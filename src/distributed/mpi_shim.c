@@ -30,12 +30,22 @@ int so3fft_mpi_sendrecv(MPI_Fint comm, const double *send, size_t ns, int dest, 
     MPI_Comm c = MPI_Comm_f2c(comm);
     size_t at_s = 0, at_r = 0;
     int tag = 0;
+    /* Exactly ceil(n / piece) messages each way, none for an empty block: a side with nothing
+     * left talks to MPI_PROC_NULL, so no empty message is left queued for a later exchange,
+     * and both partners agree on the pieces (their lengths agree pairwise). */
     while (at_s < ns || at_r < nr) {
         size_t ks = ns - at_s < SO3FFT_MPI_PIECE ? ns - at_s : SO3FFT_MPI_PIECE;
         size_t kr = nr - at_r < SO3FFT_MPI_PIECE ? nr - at_r : SO3FFT_MPI_PIECE;
-        int err = MPI_Sendrecv(send + at_s, (int)ks, MPI_DOUBLE, dest, tag, recv + at_r, (int)kr,
-                               MPI_DOUBLE, src, tag, c, MPI_STATUS_IGNORE);
+        int to = ks > 0 ? dest : MPI_PROC_NULL, from = kr > 0 ? src : MPI_PROC_NULL, got = 0;
+        MPI_Status status;
+        int err = MPI_Sendrecv(send + at_s, (int)ks, MPI_DOUBLE, to, tag, recv + at_r, (int)kr,
+                               MPI_DOUBLE, from, tag, c, &status);
         if (err != MPI_SUCCESS) return err;
+        if (kr > 0) {
+            err = MPI_Get_count(&status, MPI_DOUBLE, &got);
+            if (err != MPI_SUCCESS) return err;
+            if ((size_t)got != kr) return MPI_ERR_TRUNCATE;
+        }
         at_s += ks;
         at_r += kr;
         tag = (tag + 1) % 32768;

@@ -46,9 +46,12 @@ int so3fft_dist_inverse_real(so3fft_mpi_plan p, so3fft_complex *coeffs, double *
 static MPI_Fint comm_of(void *context) { return (MPI_Fint)(intptr_t)context; }
 
 static int group(void *context, int *rank, int *size) {
-    int flag = 0, err = so3fft_mpi_initialized(&flag);
+    int flag = 0, finalized = 0, err = so3fft_mpi_initialized(&flag);
     if (err != MPI_SUCCESS) return err;
     if (!flag) return SO3FFT_DIST_NOT_READY;
+    err = MPI_Finalized(&finalized);
+    if (err != MPI_SUCCESS) return err;
+    if (finalized) return SO3FFT_DIST_NOT_READY;
     err = so3fft_mpi_rank(comm_of(context), rank);
     if (err != MPI_SUCCESS) return err;
     return so3fft_mpi_size(comm_of(context), size);
