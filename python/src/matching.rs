@@ -8,7 +8,7 @@ use crate::errors::{to_py, value_error};
 use crate::layout::checked;
 use crate::transforms::options;
 use numpy::{
-    PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
+    Element, PyArray1, PyArray2, PyArrayDyn, PyArrayMethods, PyReadonlyArray2, PyReadonlyArrayDyn,
     PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
@@ -49,6 +49,30 @@ type Shells<'a, T> = Vec<(&'a [T], &'a [T], f64)>;
 impl Correlation {
     fn s2_samples(&self) -> usize {
         so3fft::s2::s2_num_samples(self.plan.b_in())
+    }
+
+    /// Borrows `signal`, `pattern` (S^2 samples) and `out` (`out_len` values), checks the
+    /// inputs with `finite`, and runs `run` with the GIL released.
+    #[allow(clippy::type_complexity)]
+    fn run_pair<I: Element + Sync, O: Element + Send, R: Send>(
+        &self,
+        py: Python<'_>,
+        (signal, pattern, out): (
+            &Bound<'_, PyArrayDyn<I>>,
+            &Bound<'_, PyArrayDyn<I>>,
+            &Bound<'_, PyArrayDyn<O>>,
+        ),
+        (out_len, finite): (usize, fn(&[I]) -> bool),
+        run: &(dyn Fn(&[I], &[I], &mut [O]) -> so3fft::Result<R> + Sync),
+    ) -> PyResult<R> {
+        let signal = readonly(signal)?;
+        let pattern = readonly(pattern)?;
+        let mut out = readwrite(out)?;
+        let n = self.s2_samples();
+        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
+        self.check_inputs(py, &[s, p], finite)?;
+        let o = output(&mut out, out_len, "out")?;
+        py.detach(|| run(s, p, o)).map_err(to_py)
     }
 
     /// Checks, with the GIL released, that the inputs are finite.
@@ -127,14 +151,8 @@ impl Correlation {
         out: Bound<'_, PyArrayDyn<Complex64>>,
         argmax: bool,
     ) -> PyResult<Option<PeakTuple>> {
-        let signal = readonly(&signal)?;
-        let pattern = readonly(&pattern)?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
-        self.check_inputs(py, &[s, p], all_finite)?;
-        let g = output(&mut out, self.plan.num_grid(), "out")?;
-        py.detach(|| {
+        let grid = (self.plan.num_grid(), all_finite as fn(&[_]) -> bool);
+        self.run_pair(py, (&signal, &pattern, &out), grid, &|s, p, g| {
             if argmax {
                 self.plan
                     .correlate_argmax(s, p, g)
@@ -143,7 +161,6 @@ impl Correlation {
                 self.plan.correlate(s, p, g).map(|_| None)
             }
         })
-        .map_err(to_py)
     }
 
     /// The correlation grid of real inputs (a real plan); with `argmax`, also its peak.
@@ -155,14 +172,8 @@ impl Correlation {
         out: Bound<'_, PyArrayDyn<f64>>,
         argmax: bool,
     ) -> PyResult<Option<PeakTuple>> {
-        let signal = readonly(&signal)?;
-        let pattern = readonly(&pattern)?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
-        self.check_inputs(py, &[s, p], all_finite_real)?;
-        let g = output(&mut out, self.plan.num_grid(), "out")?;
-        py.detach(|| {
+        let grid = (self.plan.num_grid(), all_finite_real as fn(&[_]) -> bool);
+        self.run_pair(py, (&signal, &pattern, &out), grid, &|s, p, g| {
             if argmax {
                 self.plan
                     .correlate_real_argmax(s, p, g)
@@ -171,7 +182,6 @@ impl Correlation {
                 self.plan.correlate_real(s, p, g).map(|_| None)
             }
         })
-        .map_err(to_py)
     }
 
     /// The weighted sum of the correlations of shells `(signal, pattern, weight)`.
@@ -230,14 +240,13 @@ impl Correlation {
         pattern: Bound<'_, PyArrayDyn<Complex64>>,
         out: Bound<'_, PyArrayDyn<Complex64>>,
     ) -> PyResult<()> {
-        let signal = readonly(&signal)?;
-        let pattern = readonly(&pattern)?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
-        self.check_inputs(py, &[s, p], all_finite)?;
-        let c = output(&mut out, so3fft::num_coeffs(self.plan.b_out()), "out")?;
-        py.detach(|| self.plan.coefficients(s, p, c)).map_err(to_py)
+        let coeffs = (
+            so3fft::num_coeffs(self.plan.b_out()),
+            all_finite as fn(&[_]) -> bool,
+        );
+        self.run_pair(py, (&signal, &pattern, &out), coeffs, &|s, p, c| {
+            self.plan.coefficients(s, p, c)
+        })
     }
 
     /// [`Correlation::coefficients`] of real inputs.
@@ -248,15 +257,13 @@ impl Correlation {
         pattern: Bound<'_, PyArrayDyn<f64>>,
         out: Bound<'_, PyArrayDyn<Complex64>>,
     ) -> PyResult<()> {
-        let signal = readonly(&signal)?;
-        let pattern = readonly(&pattern)?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
-        self.check_inputs(py, &[s, p], all_finite_real)?;
-        let c = output(&mut out, so3fft::num_coeffs(self.plan.b_out()), "out")?;
-        py.detach(|| self.plan.coefficients_real(s, p, c))
-            .map_err(to_py)
+        let coeffs = (
+            so3fft::num_coeffs(self.plan.b_out()),
+            all_finite_real as fn(&[_]) -> bool,
+        );
+        self.run_pair(py, (&signal, &pattern, &out), coeffs, &|s, p, c| {
+            self.plan.coefficients_real(s, p, c)
+        })
     }
 
     /// Refines each start rotation (rows of Euler angles) to the nearest maximum of `|C|^2`
@@ -381,10 +388,12 @@ fn evaluate_series<'py>(
 
 /// Checks a grid and the peak-selection arguments; the grid's bandwidth.
 fn peak_args(len: usize, min_angle: f64) -> PyResult<usize> {
-    let b = (1..=so3fft::MAX_BANDWIDTH)
-        .find(|b| 8 * b * b * b >= len)
-        .filter(|b| 8 * b * b * b == len)
-        .ok_or_else(|| value_error(format!("a grid holds (2B)^3 values, not {len}")))?;
+    let b = ((len as f64 / 8.0).cbrt().round() as usize).max(1);
+    if 8 * (b as u128).pow(3) != len as u128 {
+        return Err(value_error(format!(
+            "a grid holds (2B)^3 values, not {len}"
+        )));
+    }
     if min_angle.is_nan() || min_angle < 0.0 {
         return Err(value_error(format!(
             "min_angle must be a non-negative number of radians, not {min_angle}"

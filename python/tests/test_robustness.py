@@ -120,6 +120,9 @@ def test_match_reports_each_maximum_once():
     rng = np.random.default_rng(3)
     f = s2.inverse(_real_coeffs(rng, B))
     found = so3fft.Correlation(B, real=True).match(f, f, k=10, min_angle=0.0)
+    # A function correlated with itself is best at the identity (|C| is largest where the
+    # pattern lies on the signal), so the best rotation found is the identity.
+    assert found and found[0][0].angle_to(so3fft.Rotation(0.0, 0.0, 0.0)) < 1e-6
     angles = [g for g, _ in found]
     for i, g in enumerate(angles):
         for h in angles[:i]:
