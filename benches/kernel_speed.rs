@@ -62,18 +62,25 @@ fn kernel_gflops(isa: Isa) {
     ] {
         let mp = m / 2;
         let n = b - m;
+        let inputs = cluster_setup(b, m, mp, nbs);
+        let ci = inputs.to_f32();
         let ClusterInputs {
             coeffs: rc,
             tau: x,
             p,
             sc,
-        } = cluster_setup(b, m, mp, nbs);
+        } = inputs;
         let rec = Rec::new(&rc, n);
         let lanes = grid_lanes(&x, &p, &sc, nbs / 2);
+        let (rec32, lanes32) = (ci.rec(n), ci.lanes(nbs / 2));
         let xbuf = vec![0.5; nbs * 16 + 8];
         let xin = aligned(&xbuf, nbs * 16);
+        let xbuf32 = vec![0.5f32; nbs * 16 + 16];
+        let xin32 = aligned(&xbuf32, nbs * 16);
         let mut f = vec![0.0; (n + 8) * 16];
         let mut y = vec![0.0; nbs * 16];
+        let mut f32s = vec![0.0f32; (n + 16) * 16];
+        let mut y32 = vec![0.0f32; nbs * 16];
         let batch = |f: &mut dyn FnMut()| {
             let t = std::time::Instant::now();
             for _ in 0..50 {
@@ -81,12 +88,13 @@ fn kernel_gflops(isa: Isa) {
             }
             t.elapsed().as_secs_f64() / 50.0
         };
-        let (mut tf, mut ti, mut peak) = (f64::INFINITY, f64::INFINITY, 0.0f64);
+        let mut best = [f64::INFINITY; 4];
+        let mut peak = 0.0f64;
         for _ in 0..7 {
-            tf = tf.min(batch(&mut || {
+            best[0] = best[0].min(batch(&mut || {
                 forward(isa, pw, &rec, &lanes, xin, &mut f);
             }));
-            ti = ti.min(batch(&mut || {
+            best[1] = best[1].min(batch(&mut || {
                 inverse(
                     isa,
                     pw,
@@ -97,14 +105,30 @@ fn kernel_gflops(isa: Isa) {
                     &mut y,
                 )
             }));
+            best[2] = best[2].min(batch(&mut || {
+                forward(isa, pw, &rec32, &lanes32, xin32, &mut f32s);
+            }));
+            best[3] = best[3].min(batch(&mut || {
+                inverse(
+                    isa,
+                    pw,
+                    &rec32,
+                    &lanes32,
+                    &mut f32s[..n * pw],
+                    &mut |_, _, _| {},
+                    &mut y32,
+                )
+            }));
             peak = peak.max(fma_peak(isa));
         }
         let flops = (n * nbs * pw * 2) as f64;
-        let (gf, gi) = (flops / tf / 1e9, flops / ti / 1e9);
+        let [gf, gi] = [flops / best[0] / 1e9, flops / best[1] / 1e9];
         println!(
-            "B={b} nb={nbs} L={n} P={pw} m={m}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}",
+            "B={b} nb={nbs} L={n} P={pw} m={m}: forward {gf:.1} GFLOP/s ({:.0}%), inverse {gi:.1} GFLOP/s ({:.0}%), peak {peak:.1}; f32/f64 time: forward {:.2}, inverse {:.2}",
             100.0 * gf / peak,
-            100.0 * gi / peak
+            100.0 * gi / peak,
+            best[2] / best[0],
+            best[3] / best[1]
         );
     }
 }

@@ -1,7 +1,9 @@
 //! Crate-internal kernels and stages, exposed for the measuring tools in `benches/`
 //! (feature `internals`). Not part of the public API: no stability promise.
 
-pub use crate::dwt::fixtures::{aligned, cluster_setup, grid_lanes, ClusterInputs, ClusterTables};
+pub use crate::dwt::fixtures::{
+    aligned, cluster_setup, grid_lanes, ClusterInputs, ClusterTables, FloatInputs,
+};
 pub use crate::dwt::lanes::Rec;
 pub use crate::dwt::{forward, inverse};
 pub use crate::numeric::Ext;

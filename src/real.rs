@@ -57,6 +57,8 @@ mod private {
         /// The largest accepted skip-threshold exponent (see `Options::skip_bits`): the
         /// scaled values `[2^(-bits-1), 2^(SCALE_STEP - bits))` stay normal.
         const MAX_SKIP_BITS: u32;
+        /// The rescaling factor `2^-SCALE_STEP`.
+        const TINY: Self;
         /// `x` rounded to this type (to nearest).
         fn from_f64(x: f64) -> Self;
         /// `self` as `f64` (exact).
@@ -78,6 +80,7 @@ mod private {
         const EPSILON: f64 = f64::EPSILON;
         const SCALE_STEP: i64 = 600;
         const MAX_SKIP_BITS: u32 = 560;
+        const TINY: f64 = f64::from_bits(((1023 - Self::SCALE_STEP) as u64) << 52);
         #[inline(always)]
         fn from_f64(x: f64) -> f64 {
             x
@@ -109,6 +112,7 @@ mod private {
         const EPSILON: f32 = f32::EPSILON;
         const SCALE_STEP: i64 = 96;
         const MAX_SKIP_BITS: u32 = 100;
+        const TINY: f32 = f32::from_bits(((127 - Self::SCALE_STEP) as u32) << 23);
         #[inline(always)]
         fn from_f64(x: f64) -> f32 {
             x as f32
@@ -141,6 +145,7 @@ mod tests {
     fn scaled_range_normal<E: Elem>() {
         let smallest = crate::numeric::ldexp(1.0, -(E::MAX_SKIP_BITS as i64) - 1);
         let tiny = crate::numeric::ldexp(1.0, -E::SCALE_STEP);
+        assert_eq!(E::TINY.to_f64(), tiny);
         for x in [smallest, tiny] {
             let v = E::from_f64(x);
             assert!(v >= E::MIN_POSITIVE && v.to_f64() == x, "{} {x}", E::NAME);

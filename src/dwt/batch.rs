@@ -35,7 +35,7 @@ unsafe fn fill_tiles<S: Simd, const W: usize, const K: usize>(
     st: &mut [State<S>; K],
     used: usize,
     n: usize,
-    tiles: [*mut f64; K],
+    tiles: [*mut S::E; K],
 ) -> [usize; K] {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -78,7 +78,7 @@ unsafe fn fill_tiles<S: Simd, const W: usize, const K: usize>(
 }
 
 /// Fills rows `from..to` of transform `t`'s input (see [`crate::dwt::inverse_batch_raw`]).
-pub type BatchFill<'a> = &'a mut dyn FnMut(usize, &mut [f64], usize, usize);
+pub type BatchFill<'a, E = f64> = &'a mut dyn FnMut(usize, &mut [E], usize, usize);
 
 /// The rows of a batch's transforms: transform `t`'s array at `base + t * dist`.
 #[derive(Clone, Copy)]
@@ -91,7 +91,7 @@ pub struct BatchRows<T> {
     pub count: usize,
 }
 
-/// Doubles of the inverse's d-value buffer for `n` degrees and vectors of `w` lanes.
+/// Values of the inverse's d-value buffer for `n` degrees and vectors of `w` lanes.
 pub fn inverse_tile_len(n: usize, w: usize) -> usize {
     CHAINS * n * w
 }
@@ -106,10 +106,10 @@ pub fn inverse_tile_len(n: usize, w: usize) -> usize {
 /// `rows(w)` are valid for `P` doubles each and nobody else's.
 #[inline(always)]
 unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, const NT: bool>(
-    tile: *const f64,
+    tile: *const S::E,
     (lo, n): (usize, usize),
-    fin: [*const f64; K],
-    out: [*mut f64; K],
+    fin: [*const S::E; K],
+    out: [*mut S::E; K],
     rows: &impl Fn(usize) -> usize,
     (hint, lines): (&mut Prefetch, usize),
 ) {
@@ -120,7 +120,7 @@ unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, con
         let cv = P / W;
         // Lanes per pass over the degrees: all of them where the sums fit the registers
         // beside the coefficients (AVX-512's 32), a part with AVX2's 16 (8 sums a pass).
-        let lanes_per_pass = if W == 4 {
+        let lanes_per_pass = if S::REGS == 16 {
             (8 / (K * cv)).clamp(1, W)
         } else {
             W
@@ -173,11 +173,11 @@ unsafe fn lane_sums<S: Simd, const W: usize, const P: usize, const K: usize, con
 /// transform is valid for writes and nobody else's.
 #[inline(always)]
 unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
-    rec: &Rec,
-    lanes: &Lanes,
-    (fin, fill, hints): (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
-    tile: *mut f64,
-    y: BatchRows<*mut f64>,
+    rec: &Rec<S::E>,
+    lanes: &Lanes<S::E>,
+    (fin, fill, hints): (BatchRows<*mut S::E>, BatchFill<S::E>, &mut [Prefetch]),
+    tile: *mut S::E,
+    y: BatchRows<*mut S::E>,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -206,9 +206,9 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                 for (k, s) in st.iter_mut().enumerate().take(used) {
                     *s = states[vector + k];
                 }
-                let tiles: [*mut f64; CHAINS] = std::array::from_fn(|k| tile.add(k * n * W));
+                let tiles: [*mut S::E; CHAINS] = std::array::from_fn(|k| tile.add(k * n * W));
                 let lo = fill_tiles::<S, W, CHAINS>(&mut st, used, n, tiles);
-                let at = |b: BatchRows<*mut f64>, t: usize| b.base.add(t * b.dist);
+                let at = |b: BatchRows<*mut S::E>, t: usize| b.base.add(t * b.dist);
                 let mut t = 0;
                 while t < count {
                     // Two transforms at once with 8 columns (16 sums), one with 16.
@@ -251,17 +251,17 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
 /// `#[target_feature]` entry points: [`inverse_body`] for one instruction set, vector
 /// width and column count.
 macro_rules! entry {
-    ($inv:ident, $feat:literal, $S:ty, $W:literal, $N:literal) => {
+    ($inv:ident, $feat:literal, $S:ty, $E:ty, $W:literal, $N:literal) => {
         /// # Safety
         /// As [`inverse_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
         unsafe fn $inv<const NT: bool>(
-            rec: &Rec,
-            lanes: &Lanes,
-            fin: (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
-            tile: *mut f64,
-            y: BatchRows<*mut f64>,
+            rec: &Rec<$E>,
+            lanes: &Lanes<$E>,
+            fin: (BatchRows<*mut $E>, BatchFill<$E>, &mut [Prefetch]),
+            tile: *mut $E,
+            y: BatchRows<*mut $E>,
         ) {
             // SAFETY: the caller upholds `inverse_body`'s contract.
             unsafe { inverse_body::<$S, $W, $N, NT>(rec, lanes, fin, tile, y) }
@@ -270,13 +270,19 @@ macro_rules! entry {
 }
 
 #[cfg(target_arch = "x86_64")]
-use crate::simd::{avx2::Avx2, avx512::Avx512};
-use crate::simd::{scalar::Scalar, Isa};
+use crate::simd::{avx2::Avx2, avx2_f32::Avx2F32, avx512::Avx512, avx512_f32::Avx512F32};
+use crate::simd::{
+    scalar::{Scalar, ScalarF32},
+    Isa,
+};
 
-entry!(inv_avx512_16, "avx512f,fma", Avx512, 8, 16);
-entry!(inv_avx512_8, "avx512f,fma", Avx512, 8, 8);
-entry!(inv_avx2_16, "avx2,fma", Avx2, 4, 16);
-entry!(inv_avx2_8, "avx2,fma", Avx2, 4, 8);
+entry!(inv_avx512_16, "avx512f,fma", Avx512, f64, 8, 16);
+entry!(inv_avx512_8, "avx512f,fma", Avx512, f64, 8, 8);
+entry!(inv_avx2_16, "avx2,fma", Avx2, f64, 4, 16);
+entry!(inv_avx2_8, "avx2,fma", Avx2, f64, 4, 8);
+entry!(inv_avx512_f32_16, "avx512f,fma", Avx512F32, f32, 16, 16);
+entry!(inv_avx2_f32_16, "avx2,fma", Avx2F32, f32, 8, 16);
+entry!(inv_avx2_f32_8, "avx2,fma", Avx2F32, f32, 8, 8);
 
 /// The batched inverse for `isa` and `p` columns (8 or 16).
 ///
@@ -313,6 +319,46 @@ pub(super) unsafe fn run_inverse(
             (Isa::Avx2, 8) => nt!(inv_avx2_8),
             (_, 16) => nt!(inverse_body::<Scalar, 1, 16>),
             (_, 8) => nt!(inverse_body::<Scalar, 1, 8>),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
+    crate::simd::sfence();
+}
+
+/// [`run_inverse`] for floats: 16-lane vectors for 16 columns with AVX-512, 8-lane
+/// vectors otherwise (a lane's 8 columns would fill half a 16-lane vector).
+///
+/// # Safety
+/// As [`run_inverse`].
+pub(super) unsafe fn run_inverse_f32(
+    isa: Isa,
+    p: usize,
+    (rec, lanes): (&Rec<f32>, &Lanes<f32>),
+    fin: (BatchRows<*mut f32>, BatchFill<f32>, &mut [Prefetch]),
+    tile: *mut f32,
+    y: BatchRows<*mut f32>,
+) {
+    // SAFETY: the caller's contract covers every kernel's (`inverse_body`'s) and the
+    // instruction set of the one chosen (every AVX-512 CPU has AVX2).
+    unsafe {
+        macro_rules! nt {
+            ($f:ident $(::<$($g:tt),*>)?) => {
+                if lanes.stream {
+                    $f::<$($($g,)*)? true>(rec, lanes, fin, tile, y)
+                } else {
+                    $f::<$($($g,)*)? false>(rec, lanes, fin, tile, y)
+                }
+            };
+        }
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => nt!(inv_avx512_f32_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => nt!(inv_avx2_f32_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512 | Isa::Avx2, 8) => nt!(inv_avx2_f32_8),
+            (_, 16) => nt!(inverse_body::<ScalarF32, 1, 16>),
+            (_, 8) => nt!(inverse_body::<ScalarF32, 1, 8>),
             _ => unreachable!("P must be 8 or 16"),
         }
     }

@@ -1,7 +1,9 @@
 //! Kernel inputs for one cluster on the sample grid: shared by the kernel tests and the
 //! measuring tools in `benches/` (feature `internals`).
 
-use super::lanes::{Lanes, Prefetch};
+use super::lanes::{Lanes, Prefetch, Rec};
+use crate::numeric::{frexp, ldexp};
+use crate::real::Elem;
 use crate::wigner::starts::{big, start_norm, BaseStart, BetaTables, DEFAULT_SKIP_BITS};
 use crate::wigner::{RecCoeffs, RecTables};
 
@@ -88,9 +90,9 @@ impl ClusterTables {
 }
 
 /// `len` values of `buf` from its first 64-byte boundary (as the plan's chunk
-/// buffers); `buf` holds at least `len + 7`.
+/// buffers); `buf` holds at least `len + 64 / size_of::<T>() - 1`.
 #[cfg(feature = "internals")]
-pub fn aligned(buf: &[f64], len: usize) -> &[f64] {
+pub fn aligned<T>(buf: &[T], len: usize) -> &[T] {
     &buf[buf.as_ptr().align_offset(64)..][..len]
 }
 
@@ -108,5 +110,74 @@ pub fn grid_lanes<'a>(tau: &'a [f64], p: &'a [f64], sc: &'a [f64], upper_from: u
         stream: true,
         pair_stride: 0,
         row_gap: 0,
+    }
+}
+
+/// A cluster's kernel inputs in floats (see [`ClusterInputs::to_f32`]).
+pub struct FloatInputs {
+    coeffs: [Vec<f32>; 4],
+    /// Recurrence argument of each beta.
+    pub tau: Vec<f32>,
+    /// Scaled starting value of each beta, in the float scaled form.
+    pub p: Vec<f32>,
+    /// Scale index of each beta, in the float scaled form.
+    pub sc: Vec<f32>,
+}
+
+impl ClusterInputs {
+    /// The inputs rounded to floats: the coefficients and arguments to nearest, each start
+    /// moved from the double scaled form (step `f64::SCALE_STEP`) to the float one.
+    pub fn to_f32(&self) -> FloatInputs {
+        let r = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+        let c = &self.coeffs;
+        let bits = test_skip_bits() as i64;
+        let (mut p, mut sc) = (vec![0.0f32; self.p.len()], vec![0.0f32; self.p.len()]);
+        for (s, (&v, &k)) in self.p.iter().zip(&self.sc).enumerate() {
+            if v == 0.0 {
+                continue;
+            }
+            // The true value is v 2^(step k), |.| in [2^(e-1), 2^e).
+            let (mant, e0) = frexp(v);
+            let e = e0 + f64::SCALE_STEP * k as i64;
+            let step = f32::SCALE_STEP;
+            let j = if e > -bits {
+                0
+            } else {
+                (-bits - e + step) / step
+            };
+            (p[s], sc[s]) = (ldexp(mant, e + step * j) as f32, -(j as f32));
+        }
+        FloatInputs {
+            coeffs: [r(&c.a), r(&c.neg_a), r(&c.a_plus_c), r(&c.c_minus_a)],
+            tau: r(&self.tau),
+            p,
+            sc,
+        }
+    }
+}
+
+impl FloatInputs {
+    /// The coefficients of the first `n` degrees.
+    pub fn rec(&self, n: usize) -> Rec<'_, f32> {
+        let c = &self.coeffs;
+        Rec::from_slices([&c[0], &c[1], &c[2], &c[3]], n)
+    }
+
+    /// Kernel lanes as [`grid_lanes`] gives them.
+    pub fn lanes(&self, upper_from: usize) -> Lanes<'_, f32> {
+        let l = grid_lanes(&[], &[], &[], upper_from);
+        Lanes {
+            tau: &self.tau,
+            p: &self.p,
+            sc: &self.sc,
+            upper_from,
+            big: ldexp(1.0, f32::SCALE_STEP - test_skip_bits() as i64) as f32,
+            skip: l.skip,
+            interleaved: l.interleaved,
+            prefetch: l.prefetch,
+            stream: l.stream,
+            pair_stride: l.pair_stride,
+            row_gap: l.row_gap,
+        }
     }
 }

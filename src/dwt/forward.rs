@@ -3,7 +3,8 @@
 
 use super::lanes::{Lanes, Rec};
 use super::state::{prefix_states, State};
-use crate::simd::Simd;
+use crate::real::Elem;
+use crate::simd::{group_of, Simd};
 use crate::wigner::REC_PAD;
 use std::mem::MaybeUninit;
 
@@ -17,7 +18,7 @@ pub(super) const ACC: usize = 16;
 /// broadcasts.
 #[repr(C, align(64))]
 #[derive(Clone, Copy)]
-struct DBlock([f64; 128]);
+struct DBlock<E>([E; 128]);
 
 /// The multiply-adds of one beta lane `w` of a stored d block: for each degree `j` of the
 /// block, `acc[j][h] += d[j][w] * x[h]` with `x` the `P / W` vectors of the beta's data
@@ -29,9 +30,9 @@ struct DBlock([f64; 128]);
 #[inline(always)]
 unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
-    db: *const f64,
+    db: *const S::E,
     w: usize,
-    xw: *const f64,
+    xw: *const S::E,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -51,79 +52,74 @@ unsafe fn beta_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     }
 }
 
-/// Degrees per block of the forward kernels for vectors of `w` lanes and `p` columns.
-pub(super) const fn degree_block(w: usize, p: usize) -> usize {
-    match (w, p) {
-        (8, _) => 8,
-        (4, 16) => 2,
-        (4, _) => 4,
-        _ => 1,
+/// Degrees per block of the forward kernels for vectors of `w` lanes, `p` columns and
+/// `regs` vector registers: 8 with 32 registers (16 sums with paired betas), with 16
+/// registers as many as keep 8 sums.
+pub(super) const fn degree_block(w: usize, p: usize, regs: usize) -> usize {
+    if w == 1 {
+        1
+    } else if regs >= 32 {
+        if w < 8 {
+            w
+        } else {
+            8
+        }
+    } else if p <= w {
+        // Grouped (two sums per degree, see `grouped`).
+        4
+    } else {
+        8 / (p / w)
     }
 }
 
 /// Compile-time checks of a forward block shape: the sums fit the registers, the d block
 /// its buffer, and the last block's steps the coefficients' padding.
-pub(super) const fn assert_block<const W: usize, const P: usize, const DB: usize>() {
-    assert!(DB <= W && DB * W <= 128 && DB * (P / W) <= ACC && P.is_multiple_of(W));
-    assert!(DB <= REC_PAD);
-    assert!(!paired(W, P) || (2 * DB <= ACC && W.is_multiple_of(2)));
+pub(super) const fn assert_block<S: Simd, const W: usize, const P: usize, const DB: usize>() {
+    assert!(DB <= W && DB * W <= 128 && DB <= REC_PAD);
+    if grouped::<S>(P) {
+        assert!(2 * DB <= ACC && W * 2 == P * group_of::<S>(P));
+    } else {
+        assert!(DB * (P / W) <= ACC && P.is_multiple_of(W));
+    }
 }
 
-/// Whether the forward kernel pairs betas ([`pair_fmas`]): with one vector of columns
-/// (`P == W`) a broadcast d value would feed a single multiply-add.
-pub(super) const fn paired(w: usize, p: usize) -> bool {
-    p == w && w >= 2
+/// Whether the forward kernel groups betas ([`group_fmas`]): with one vector of columns
+/// or less (`P <= W`) a broadcast d value would feed a single multiply-add.
+pub(super) const fn grouped<S: Simd>(p: usize) -> bool {
+    group_of::<S>(p) > 1
 }
 
-/// [`beta_fmas`] for the neighbouring lanes `w` and `w + 1` when `P == W`: one broadcast
-/// of the pair `(d[j][w], d[j][w + 1])` feeds two multiply-adds, with the two beta rows
-/// interleaved column by column: `acc[2j]` holds columns `0, 2, 4, ...` and `acc[2j + 1]`
-/// columns `1, 3, 5, ...`, alternate lanes summing the even and the odd betas
-/// ([`fold_pair`] adds them). Half as many broadcasts per multiply-add leave more of the
-/// load ports to the data.
+/// [`beta_fmas`] for the `G` neighbouring lanes from `w` when `G P = 2 W` (`G` = 2 or 4,
+/// [`group_of`]): one broadcast of the group's d values `d[j][w..w + G]` feeds two
+/// multiply-adds with the group's rows arranged by [`Simd::group_rows`], lane `k` of the
+/// sums holding beta `k % G`'s share ([`Simd::fold_group`] adds them). Fewer broadcasts
+/// per multiply-add leave more of the load ports to the data.
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
 /// entries read or written (`P` values a data row, `DB x W` a d block).
 #[inline(always)]
-unsafe fn pair_fmas<S: Simd, const W: usize, const DB: usize>(
+unsafe fn group_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
-    db: *const f64,
+    db: *const S::E,
     w: usize,
-    x0: *const f64,
-    x1: *const f64,
+    x0: *const S::E,
+    xs: usize,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        let (a, b) = (S::load(x0), S::load(x1));
-        let (even, odd) = (S::unpack_even(a, b), S::unpack_odd(a, b));
+        let [lo, hi] = S::group_rows::<P>(x0, xs);
         for j in 0..DB {
-            let e = S::splat2(db.add(j * W + w));
-            acc[2 * j] = S::fence(S::fma(e, even, acc[2 * j]));
-            acc[2 * j + 1] = S::fence(S::fma(e, odd, acc[2 * j + 1]));
+            let e = S::splat_group::<P>(db.add(j * W + w));
+            acc[2 * j] = S::fence(S::fma(e, lo, acc[2 * j]));
+            acc[2 * j + 1] = S::fence(S::fma(e, hi, acc[2 * j + 1]));
         }
     }
 }
 
-/// The column sums of degree `j` from [`pair_fmas`]'s accumulators: lane `2k` of
-/// `acc[2j]` and `acc[2j + 1]` holds the even betas' sums of columns `2k` and `2k + 1`,
-/// lane `2k + 1` the odd betas'.
-///
-/// # Safety
-/// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
-/// entries read or written (`P` values a data row, `DB x W` a d block).
-#[inline(always)]
-pub(super) unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
-    // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
-    unsafe {
-        let (a, b) = (acc[2 * j], acc[2 * j + 1]);
-        S::add(S::unpack_even(a, b), S::unpack_odd(a, b))
-    }
-}
-
 /// Lane `w`'s share of the multiply-adds of a stored d block: [`beta_fmas`], or with
-/// paired betas [`pair_fmas`] for lanes `w - 1` and `w` at each odd `w` (nothing at even
-/// `w`). `x` is lane 0's data row, `xs` the stride between rows.
+/// grouped betas [`group_fmas`] for lanes `w + 1 - G ..= w` at each `w = G - 1 (mod G)`
+/// (nothing at the others). `x` is lane 0's data row, `xs` the stride between rows.
 ///
 /// # Safety
 /// The CPU supports `S`'s instruction set; `db` holds a `DB x W` d block and the data
@@ -131,17 +127,19 @@ pub(super) unsafe fn fold_pair<S: Simd>(acc: &[S::V; ACC], j: usize) -> S::V {
 #[inline(always)]
 unsafe fn lane_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
-    db: *const f64,
+    db: *const S::E,
     w: usize,
-    x: *const f64,
+    x: *const S::E,
     xs: usize,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        if !paired(W, P) {
+        let g = group_of::<S>(P);
+        if g == 1 {
             beta_fmas::<S, W, P, DB>(acc, db, w, x.add(w * xs));
-        } else if w % 2 == 1 {
-            pair_fmas::<S, W, DB>(acc, db, w - 1, x.add((w - 1) * xs), x.add(w * xs));
+        } else if w % g == g - 1 {
+            let w0 = w + 1 - g;
+            group_fmas::<S, W, P, DB>(acc, db, w0, x.add(w0 * xs), xs);
         }
     }
 }
@@ -154,14 +152,14 @@ unsafe fn lane_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
 #[inline(always)]
 pub(super) unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const DB: usize>(
     acc: &mut [S::V; ACC],
-    db: *const f64,
-    x: *const f64,
+    db: *const S::E,
+    x: *const S::E,
     xs: usize,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
-        // Only the lanes that do work (each pair at its odd lane), so the loop unrolls.
-        let step = if paired(W, P) { 2 } else { 1 };
+        // Only the lanes that do work (each group at its last lane), so the loop unrolls.
+        let step = group_of::<S>(P);
         for w in (step - 1..W).step_by(step) {
             lane_fmas::<S, W, P, DB>(acc, db, w, x, xs);
         }
@@ -195,18 +193,18 @@ pub(super) unsafe fn block_fmas<S: Simd, const W: usize, const P: usize, const D
 /// entries read or written (`P` values a data row, `DB x W` a d block).
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>(
-    rec: &Rec,
-    lanes: &Lanes,
-    xin: *const f64,
-    ft: &mut [f64],
+    rec: &Rec<S::E>,
+    lanes: &Lanes<S::E>,
+    xin: *const S::E,
+    ft: &mut [S::E],
 ) -> usize {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
         let n = rec.len();
         let nb = lanes.tau.len();
         let col_vectors = P / W;
-        const { assert_block::<W, P, DB>() };
-        let pair = paired(W, P);
+        const { assert_block::<S, W, P, DB>() };
+        let pair = grouped::<S>(P);
         debug_assert!(nb.is_multiple_of(W));
         debug_assert!(ft.len() >= n.next_multiple_of(DB) * P);
         let sums = ft.as_mut_ptr();
@@ -218,7 +216,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
         let prefetch_per_vector = prefetch.lines().div_ceil((n / DB).max(1) * (nb / W).max(1));
         // Every vector's rows are the same distance apart (`Lanes::vector_rows`).
         let xs = lanes.vector_rows(0, P).1;
-        let mut d_blocks = [DBlock([0.0; 128]); 2];
+        let mut d_blocks = [DBlock([S::E::ZERO; 128]); 2];
         let mut lo = n;
         let mut v0 = 0;
         while v0 < nb {
@@ -348,6 +346,14 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                         lane!(5);
                         lane!(6);
                         lane!(7);
+                        lane!(8);
+                        lane!(9);
+                        lane!(10);
+                        lane!(11);
+                        lane!(12);
+                        lane!(13);
+                        lane!(14);
+                        lane!(15);
                         (s.p0, s.p1, s.i) = (p0, p1, base + DB);
                         cur = 1 - cur;
                         fma_vector = v;
@@ -363,8 +369,15 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
                 if pair {
                     for j in 0..DB {
                         let r = sums.add((i0 + j) * P);
-                        let v = fold_pair::<S>(&acc, j);
-                        S::store(r, if assign { v } else { S::add(S::load(r), v) });
+                        let v = S::fold_group::<P>(acc[2 * j], acc[2 * j + 1]);
+                        // With P < W the load reads the next row too (`ft` holds `n + W`
+                        // rows), of which nothing is stored.
+                        let v = if assign { v } else { S::add(S::load(r), v) };
+                        if P < W {
+                            S::store_first(r, v, P);
+                        } else {
+                            S::store(r, v);
+                        }
                     }
                 } else {
                     for j in 0..DB {
@@ -384,32 +397,34 @@ unsafe fn forward_body<S: Simd, const W: usize, const P: usize, const DB: usize>
 /// A `#[target_feature]` entry point: [`forward_body`] for one instruction set, vector
 /// width, column count and degree block.
 macro_rules! entry {
-    ($name:ident, $feat:literal, $S:ty, $W:literal, $N:literal, $DB:tt) => {
+    ($name:ident, $feat:literal, $S:ty, $E:ty, $W:literal, $N:literal) => {
         /// # Safety
         /// As [`forward_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, xin: *const f64, ft: &mut [f64]) -> usize {
+        unsafe fn $name(rec: &Rec<$E>, lanes: &Lanes<$E>, xin: *const $E, ft: &mut [$E]) -> usize {
+            const DB: usize = degree_block($W, $N, <$S as Simd>::REGS);
             // SAFETY: the caller upholds `forward_body`'s contract.
-            unsafe { forward_body::<$S, $W, $N, $DB>(rec, lanes, xin, ft) }
+            unsafe { forward_body::<$S, $W, $N, DB>(rec, lanes, xin, ft) }
         }
     };
 }
 
 #[cfg(target_arch = "x86_64")]
-use crate::simd::{avx2::Avx2, avx512::Avx512};
-use crate::simd::{scalar::Scalar, Isa};
+use crate::simd::{avx2::Avx2, avx2_f32::Avx2F32, avx512::Avx512, avx512_f32::Avx512F32};
+use crate::simd::{
+    scalar::{Scalar, ScalarF32},
+    Isa,
+};
 
-entry!(fwd_avx512_16, "avx512f,fma", Avx512, 8, 16, {
-    degree_block(8, 16)
-});
-entry!(fwd_avx512_8, "avx512f,fma", Avx512, 8, 8, {
-    degree_block(8, 8)
-});
-entry!(fwd_avx2_16, "avx2,fma", Avx2, 4, 16, {
-    degree_block(4, 16)
-});
-entry!(fwd_avx2_8, "avx2,fma", Avx2, 4, 8, { degree_block(4, 8) });
+entry!(fwd_avx512_16, "avx512f,fma", Avx512, f64, 8, 16);
+entry!(fwd_avx512_8, "avx512f,fma", Avx512, f64, 8, 8);
+entry!(fwd_avx2_16, "avx2,fma", Avx2, f64, 4, 16);
+entry!(fwd_avx2_8, "avx2,fma", Avx2, f64, 4, 8);
+entry!(fwd_avx512_f32_16, "avx512f,fma", Avx512F32, f32, 16, 16);
+entry!(fwd_avx512_f32_8, "avx512f,fma", Avx512F32, f32, 16, 8);
+entry!(fwd_avx2_f32_16, "avx2,fma", Avx2F32, f32, 8, 16);
+entry!(fwd_avx2_f32_8, "avx2,fma", Avx2F32, f32, 8, 8);
 
 /// The forward kernel for `isa` and `p` columns (8 or 16).
 ///
@@ -437,8 +452,39 @@ pub(super) unsafe fn run(
             (Isa::Avx2, 16) => fwd_avx2_16(rec, lanes, xin, ft),
             #[cfg(target_arch = "x86_64")]
             (Isa::Avx2, 8) => fwd_avx2_8(rec, lanes, xin, ft),
-            (_, 16) => forward_body::<Scalar, 1, 16, { degree_block(1, 16) }>(rec, lanes, xin, ft),
-            (_, 8) => forward_body::<Scalar, 1, 8, { degree_block(1, 8) }>(rec, lanes, xin, ft),
+            (_, 16) => forward_body::<Scalar, 1, 16, 1>(rec, lanes, xin, ft),
+            (_, 8) => forward_body::<Scalar, 1, 8, 1>(rec, lanes, xin, ft),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
+}
+
+/// [`run`] for floats: 16-lane vectors with AVX-512, 8-lane vectors with AVX2.
+///
+/// # Safety
+/// As [`run`], with `ft` holding `(n + isa.lanes_of::<f32>()) * p` values.
+pub(super) unsafe fn run_f32(
+    isa: Isa,
+    p: usize,
+    rec: &Rec<f32>,
+    lanes: &Lanes<f32>,
+    xin: *const f32,
+    ft: &mut [f32],
+) -> usize {
+    // SAFETY: the caller's contract covers every kernel's (`forward_body`'s) and the
+    // instruction set of the one chosen (every AVX-512 CPU has AVX2).
+    unsafe {
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => fwd_avx512_f32_16(rec, lanes, xin, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 8) => fwd_avx512_f32_8(rec, lanes, xin, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => fwd_avx2_f32_16(rec, lanes, xin, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 8) => fwd_avx2_f32_8(rec, lanes, xin, ft),
+            (_, 16) => forward_body::<ScalarF32, 1, 16, 1>(rec, lanes, xin, ft),
+            (_, 8) => forward_body::<ScalarF32, 1, 8, 1>(rec, lanes, xin, ft),
             _ => unreachable!("P must be 8 or 16"),
         }
     }

@@ -11,7 +11,7 @@ use std::mem::MaybeUninit;
 /// The CPU supports `S`'s instruction set; the pointers are valid for the rows and
 /// entries read or written (`P` values an input row, the output rows of the lanes).
 #[inline(always)]
-unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *const f64) {
+unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *const S::E) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
         for (q, a) in acc.iter_mut().enumerate() {
@@ -21,15 +21,15 @@ unsafe fn acc_row<S: Simd, const P: usize>(acc: &mut [S::V; P], v: S::V, row: *c
 }
 
 /// Whether the 8-column kernel runs two vectors of betas together (16 sums in registers:
-/// AVX-512 and scalar code; AVX2's 16 registers would spill the sums).
-const fn paired_vectors(w: usize, p: usize) -> bool {
-    p <= 8 && w != 4
+/// AVX-512 and scalar code; `regs` = 16 (AVX2) would spill the sums).
+const fn paired_vectors(regs: usize, p: usize) -> bool {
+    p <= 8 && regs >= 32
 }
 
 /// Passes over the columns per vector of betas: with AVX2's 16 registers, 16 sums do not
 /// fit beside the recurrence, so the columns go in two halves of 8 (see [`two_passes`]).
-const fn column_passes(w: usize, p: usize) -> usize {
-    if w == 4 && p == 16 {
+const fn column_passes(regs: usize, p: usize) -> usize {
+    if regs == 16 && p == 16 {
         2
     } else {
         1
@@ -51,7 +51,7 @@ const PASS_BLOCK: usize = 64;
 unsafe fn two_passes<S: Simd, const P: usize>(
     s: &mut State<S>,
     n: usize,
-    fin: *const f64,
+    fin: *const S::E,
     acc: &mut [S::V; P],
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller; the
@@ -98,7 +98,7 @@ unsafe fn two_passes<S: Simd, const P: usize>(
 }
 
 /// Fills rows `from..to` of the inverse kernel's input (see [`crate::dwt::inverse_raw`]).
-pub type Fill<'a> = &'a mut dyn FnMut(&mut [f64], usize, usize);
+pub type Fill<'a, E = f64> = &'a mut dyn FnMut(&mut [E], usize, usize);
 
 /// Vectors of betas whose states the inverse kernel sets up before it needs their input
 /// rows.
@@ -109,11 +109,11 @@ pub(super) const INV_VECTORS: usize = 16;
 /// entries read or written (`P` values an input row, the output rows of the lanes).
 #[inline(always)]
 unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
-    rec: &Rec,
-    lanes: &Lanes,
-    fin: &mut [f64],
-    fill: Fill,
-    y: *mut f64,
+    rec: &Rec<S::E>,
+    lanes: &Lanes<S::E>,
+    fin: &mut [S::E],
+    fill: Fill<S::E>,
+    y: *mut S::E,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -144,7 +144,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                 // data broadcast then feeds two multiply-adds, and the two recurrences are
                 // independent chains (one vector's step and 8 multiply-adds per degree leave
                 // the pipes half idle).
-                let pair = paired_vectors(W, P) && vector + 1 < vectors;
+                let pair = paired_vectors(S::REGS, P) && vector + 1 < vectors;
                 let mut run_states = [states[vector], states[(vector + 1).min(vectors - 1)]];
                 let mut acc = [[S::zero(); P]; 2];
                 prefetch.issue(prefetch_per_vector * (1 + pair as usize));
@@ -172,7 +172,7 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                             a1[q] = S::fma(u, c, a1[q]);
                         }
                     }
-                } else if column_passes(W, P) == 2 {
+                } else if column_passes(S::REGS, P) == 2 {
                     let mut s = run_states[0];
                     two_passes::<S, P>(&mut s, n, fin_rows, &mut acc[0]);
                 } else {
@@ -194,7 +194,8 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
                         if step == 2 { pair_stride } else { P },
                     );
                     for q0 in (0..P).step_by(W) {
-                        S::store_transposed(&a[q0..q0 + W], y.add(at + q0), stride, NT);
+                        let cols = &a[q0..(q0 + W).min(P)];
+                        S::store_transposed::<W>(cols, y.add(at + q0), stride, NT);
                     }
                 }
                 vector += 1 + pair as usize;
@@ -207,17 +208,17 @@ unsafe fn inverse_body<S: Simd, const W: usize, const P: usize, const NT: bool>(
 /// A `#[target_feature]` entry point: [`inverse_body`] for one instruction set, vector
 /// width and column count.
 macro_rules! entry {
-    ($name:ident, $feat:literal, $S:ty, $W:literal, $N:literal) => {
+    ($name:ident, $feat:literal, $S:ty, $E:ty, $W:literal, $N:literal) => {
         /// # Safety
         /// As [`inverse_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
         unsafe fn $name<const NT: bool>(
-            rec: &Rec,
-            lanes: &Lanes,
-            fin: &mut [f64],
-            fill: Fill,
-            y: *mut f64,
+            rec: &Rec<$E>,
+            lanes: &Lanes<$E>,
+            fin: &mut [$E],
+            fill: Fill<$E>,
+            y: *mut $E,
         ) {
             // SAFETY: the caller upholds `inverse_body`'s contract.
             unsafe { inverse_body::<$S, $W, $N, NT>(rec, lanes, fin, fill, y) }
@@ -226,13 +227,20 @@ macro_rules! entry {
 }
 
 #[cfg(target_arch = "x86_64")]
-use crate::simd::{avx2::Avx2, avx512::Avx512};
-use crate::simd::{scalar::Scalar, Isa};
+use crate::simd::{avx2::Avx2, avx2_f32::Avx2F32, avx512::Avx512, avx512_f32::Avx512F32};
+use crate::simd::{
+    scalar::{Scalar, ScalarF32},
+    Isa,
+};
 
-entry!(inv_avx512_16, "avx512f,fma", Avx512, 8, 16);
-entry!(inv_avx512_8, "avx512f,fma", Avx512, 8, 8);
-entry!(inv_avx2_16, "avx2,fma", Avx2, 4, 16);
-entry!(inv_avx2_8, "avx2,fma", Avx2, 4, 8);
+entry!(inv_avx512_16, "avx512f,fma", Avx512, f64, 8, 16);
+entry!(inv_avx512_8, "avx512f,fma", Avx512, f64, 8, 8);
+entry!(inv_avx2_16, "avx2,fma", Avx2, f64, 4, 16);
+entry!(inv_avx2_8, "avx2,fma", Avx2, f64, 4, 8);
+entry!(inv_avx512_f32_16, "avx512f,fma", Avx512F32, f32, 16, 16);
+entry!(inv_avx512_f32_8, "avx512f,fma", Avx512F32, f32, 16, 8);
+entry!(inv_avx2_f32_16, "avx2,fma", Avx2F32, f32, 8, 16);
+entry!(inv_avx2_f32_8, "avx2,fma", Avx2F32, f32, 8, 8);
 
 /// The inverse kernel for `isa` and `p` columns (8 or 16).
 ///
@@ -278,5 +286,47 @@ pub(super) unsafe fn run(
         }
     }
     // The output rows may have been written with non-temporal stores.
+    crate::simd::sfence();
+}
+
+/// [`run`] for floats: 16-lane vectors with AVX-512, 8-lane vectors with AVX2.
+///
+/// # Safety
+/// As [`run`]; the lane arrays hold a multiple of `isa.lanes_of::<f32>()` entries.
+pub(super) unsafe fn run_f32(
+    isa: Isa,
+    p: usize,
+    rec: &Rec<f32>,
+    lanes: &Lanes<f32>,
+    fin: &mut [f32],
+    fill: Fill<f32>,
+    y: *mut f32,
+) {
+    // SAFETY: the caller's contract covers every kernel's (`inverse_body`'s) and the
+    // instruction set of the one chosen (every AVX-512 CPU has AVX2).
+    unsafe {
+        macro_rules! nt {
+            ($f:ident $(::<$($g:tt),*>)?) => {
+                if lanes.stream {
+                    $f::<$($($g,)*)? true>(rec, lanes, fin, fill, y)
+                } else {
+                    $f::<$($($g,)*)? false>(rec, lanes, fin, fill, y)
+                }
+            };
+        }
+        match (isa, p) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 16) => nt!(inv_avx512_f32_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 8) => nt!(inv_avx512_f32_8),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 16) => nt!(inv_avx2_f32_16),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 8) => nt!(inv_avx2_f32_8),
+            (_, 16) => nt!(inverse_body::<ScalarF32, 1, 16>),
+            (_, 8) => nt!(inverse_body::<ScalarF32, 1, 8>),
+            _ => unreachable!("P must be 8 or 16"),
+        }
+    }
     crate::simd::sfence();
 }

@@ -1,21 +1,22 @@
 //! The kernels' inputs besides the data: recurrence coefficients ([`Rec`]), per-lane
 //! inputs and the data layout ([`Lanes`]), prefetch hints ([`Prefetch`]).
 
+use crate::real::Elem;
 use crate::wigner::{RecCoeffs, REC_PAD};
 
 /// Recurrence coefficients of one cluster, index `i = l - l0`, for the scaled values
 /// `e_i` of `RecTables::coeffs`: `e_{i+1} = (A'_i x + C'_i) e_i - e_{i-1}`. Each slice
 /// holds [`REC_PAD`] finite values past the `n` degrees (what the forward kernel's last
 /// block steps through).
-pub struct Rec<'a> {
+pub struct Rec<'a, E = f64> {
     /// `A'_i`
-    pub a: &'a [f64],
+    pub a: &'a [E],
     /// `-A'_i`
-    pub neg_a: &'a [f64],
+    pub neg_a: &'a [E],
     /// `A'_i + C'_i`
-    pub a_plus_c: &'a [f64],
+    pub a_plus_c: &'a [E],
     /// `C'_i - A'_i`
-    pub c_minus_a: &'a [f64],
+    pub c_minus_a: &'a [E],
     n: usize,
 }
 
@@ -29,6 +30,21 @@ impl<'a> Rec<'a> {
             neg_a: &r.neg_a[..end],
             a_plus_c: &r.a_plus_c[..end],
             c_minus_a: &r.c_minus_a[..end],
+            n,
+        }
+    }
+}
+
+impl<'a, E: Elem> Rec<'a, E> {
+    /// The first `n` degrees of the four coefficient arrays `[a, neg_a, a_plus_c,
+    /// c_minus_a]` (each padded by [`REC_PAD`] entries).
+    pub fn from_slices(c: [&'a [E]; 4], n: usize) -> Rec<'a, E> {
+        let end = n + REC_PAD;
+        Rec {
+            a: &c[0][..end],
+            neg_a: &c[1][..end],
+            a_plus_c: &c[2][..end],
+            c_minus_a: &c[3][..end],
             n,
         }
     }
@@ -53,17 +69,17 @@ impl<'a> Rec<'a> {
 /// the upper half (`tau = 1 + cos beta`): the recurrence multiplier `A cos(beta) + C` is
 /// formed as `(A + C) - A tau` or `A tau + (C - A)`, never from a rounded `cos(beta)`,
 /// which near the poles would shift beta and move `d^l` by up to `l^2 eps`.
-pub struct Lanes<'a> {
+pub struct Lanes<'a, E = f64> {
     /// Recurrence argument `1 - cos beta` (lower half) or `1 + cos beta` (upper half).
-    pub tau: &'a [f64],
+    pub tau: &'a [E],
     /// Scaled starting value (`wigner::starts::to_scaled`).
-    pub p: &'a [f64],
+    pub p: &'a [E],
     /// Scale index of the starting value (`<= 0`).
-    pub sc: &'a [f64],
+    pub sc: &'a [E],
     /// First lane of the upper half.
     pub upper_from: usize,
     /// Rescale threshold of the scaled values, `wigner::big(skip bits)`.
-    pub big: f64,
+    pub big: E,
     /// Skip the degrees where no lane of a vector is active yet (`false` only to measure
     /// what skipping saves: inactive lanes then accumulate exact zeros).
     pub skip: bool,
@@ -78,11 +94,11 @@ pub struct Lanes<'a> {
     /// Inverse: write the output with non-temporal stores (for outputs far larger than
     /// the caches, read back only later; ordinary stores would first read every line).
     pub stream: bool,
-    /// Interleaved only: doubles from one pair of rows (`2j`, `2j + 1`) of the inverse's
+    /// Interleaved only: values from one pair of rows (`2j`, `2j + 1`) of the inverse's
     /// output or the forward's input (`forward_raw`) to the next; row `r` is at
     /// `(r / 2) * pair_stride + (r % 2) * row_gap`. 0 means `2P`, rows one after another.
     pub pair_stride: usize,
-    /// With `pair_stride`: doubles from row `2j` to row `2j + 1` (0 means `P`, side by
+    /// With `pair_stride`: values from row `2j` to row `2j + 1` (0 means `P`, side by
     /// side). Far larger in the half-major and split layouts of `plan/blocks.rs`, where
     /// the low-beta rows and the mirror rows are in two separate halves, and in a partial
     /// plan's lane-major chunks (`engine/dwt_stage.rs`).
@@ -112,16 +128,22 @@ impl Prefetch {
         }
     }
 
-    /// Add `len` doubles from `p` (ignored beyond [`Prefetch::MAX`] ranges).
-    pub fn push(&mut self, p: *const f64, len: usize) {
+    /// Add `len` values from `p` (ignored beyond [`Prefetch::MAX`] ranges).
+    pub fn push<T>(&mut self, p: *const T, len: usize) {
         self.push_rows(p, len, (0, 1));
     }
 
-    /// Add `rows` runs of `len` doubles, the first at `p`, each `stride` doubles after the
+    /// Add `rows` runs of `len` values, the first at `p`, each `stride` values after the
     /// one before (ignored beyond [`Prefetch::MAX`] ranges).
-    pub fn push_rows(&mut self, p: *const f64, len: usize, (stride, rows): (usize, usize)) {
+    pub fn push_rows<T>(&mut self, p: *const T, len: usize, (stride, rows): (usize, usize)) {
+        let size = std::mem::size_of::<T>();
         if self.n < Prefetch::MAX && len > 0 && rows > 0 {
-            self.ranges[self.n] = (p as *const u8, (len * 8).div_ceil(64), 8 * stride, rows);
+            self.ranges[self.n] = (
+                p as *const u8,
+                (len * size).div_ceil(64),
+                size * stride,
+                rows,
+            );
             self.n += 1;
         }
     }
@@ -159,9 +181,9 @@ impl Prefetch {
     }
 }
 
-impl Lanes<'_> {
-    /// Interleaved rows: doubles from one pair of rows to the next and from row `2j` to
-    /// row `2j + 1` (`pair_stride`, `row_gap` with their defaults for `P` doubles a row).
+impl<E> Lanes<'_, E> {
+    /// Interleaved rows: values from one pair of rows to the next and from row `2j` to
+    /// row `2j + 1` (`pair_stride`, `row_gap` with their defaults for `P` values a row).
     #[inline(always)]
     pub(crate) fn pair_layout(&self, p: usize) -> (usize, usize) {
         let ps = if self.pair_stride == 0 {
@@ -172,7 +194,7 @@ impl Lanes<'_> {
         (ps, if self.row_gap == 0 { p } else { self.row_gap })
     }
 
-    /// Panics unless the rows of the `tau.len()` lanes (`p` doubles each) cannot overlap:
+    /// Panics unless the rows of the `tau.len()` lanes (`p` values each) cannot overlap:
     /// consecutive, the two rows of a pair side by side, or the second rows of all pairs
     /// after the first rows (the split layouts of `plan/blocks.rs`).
     pub(crate) fn assert_rows_apart(&self, p: usize) {
@@ -186,8 +208,8 @@ impl Lanes<'_> {
         assert!(gap != p || ps >= 2 * p);
     }
 
-    /// Offset (in doubles) of the first row of the vector of lanes starting at `s0`, rows of
-    /// `p` doubles addressed as the data layout says, and the offset from one of its rows
+    /// Offset (in values) of the first row of the vector of lanes starting at `s0`, rows of
+    /// `p` values addressed as the data layout says, and the offset from one of its rows
     /// to the next.
     #[inline(always)]
     pub(crate) fn vector_rows(&self, s0: usize, p: usize) -> (usize, usize) {

@@ -30,7 +30,10 @@ mod parity;
 mod state;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_f32;
 
+use crate::real::Elem;
 use crate::simd::Isa;
 
 pub(crate) use batch::{inverse_tile_len, BatchFill, BatchRows};
@@ -49,7 +52,14 @@ pub(crate) use lanes::{Lanes, Prefetch, Rec};
 /// `isa` must be supported by this CPU ([`Isa::is_supported`]), and the lane arrays'
 /// length a multiple of `isa.lanes()`.
 #[cfg(any(test, feature = "internals"))]
-pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &mut [f64]) -> usize {
+pub fn forward<E: DwtElem>(
+    isa: Isa,
+    p: usize,
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    xin: &[E],
+    ft: &mut [E],
+) -> usize {
     assert!(lanes.pair_stride == 0 && lanes.row_gap == 0);
     assert!(xin.len() >= lanes.tau.len() * p);
     // SAFETY: the rows are consecutive, within `xin`.
@@ -60,14 +70,21 @@ pub fn forward(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes, xin: &[f64], ft: &m
 /// S^2 Legendre stage): `y[(par c + q) nb + s] = sum_{i % 2 = par} dt_{l0+i}(beta_s)
 /// fin[i c + q]` for `c` = 2 or 4 columns, `nb = lanes.tau.len()` lanes, all in the lower
 /// half and not interleaved. Rows `0..rec.len()` of `fin` are read.
-pub fn inverse_parity(isa: Isa, c: usize, rec: &Rec, lanes: &Lanes, fin: &[f64], y: &mut [f64]) {
+pub fn inverse_parity<E: DwtElem>(
+    isa: Isa,
+    c: usize,
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    fin: &[E],
+    y: &mut [E],
+) {
     check_shared(isa, c, rec, lanes);
     let nb = lanes.tau.len();
     assert!(c == 2 || c == 4);
     assert!(!lanes.interleaved && lanes.upper_from >= nb);
     assert!(fin.len() >= rec.len() * c && y.len() >= 2 * c * nb);
     // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
-    unsafe { parity::run(isa, c, rec, lanes, fin.as_ptr(), y.as_mut_ptr()) }
+    unsafe { E::inverse_parity_kernel(isa, c, rec, lanes, fin.as_ptr(), y.as_mut_ptr()) }
 }
 
 /// Values of the forward parity kernel's partial sums for `n` degrees, `c` columns and
@@ -81,23 +98,23 @@ pub fn parity_partial_len(n: usize, c: usize, w: usize) -> usize {
 /// `nb = lanes.tau.len()` values (the even combinations, then the odd ones), lanes as for
 /// [`inverse_parity`]. `part` is scratch of [`parity_partial_len`] values; `ft` holds at
 /// least `(n c).next_multiple_of(isa.lanes())` values, rows from `n` on are scratch.
-pub fn forward_parity(
+pub fn forward_parity<E: DwtElem>(
     isa: Isa,
     c: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    x: &[f64],
-    (part, ft): (&mut [f64], &mut [f64]),
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    x: &[E],
+    (part, ft): (&mut [E], &mut [E]),
 ) {
     check_shared(isa, c, rec, lanes);
-    let (nb, n, w) = (lanes.tau.len(), rec.len(), isa.lanes());
+    let (nb, n, w) = (lanes.tau.len(), rec.len(), isa.lanes_of::<E>());
     assert!(c == 2 || c == 4);
     assert!(!lanes.interleaved && lanes.upper_from >= nb);
     assert!(x.len() >= 2 * c * nb && part.len() >= parity_partial_len(n, c, w));
     assert!(ft.len() >= (n * c).next_multiple_of(w));
     // SAFETY: lengths and lanes checked above, instruction set by `check_shared`.
     unsafe {
-        parity::run_forward(
+        E::forward_parity_kernel(
             isa,
             c,
             rec,
@@ -111,11 +128,14 @@ pub fn forward_parity(
 /// Panics unless the arguments every kernel takes are consistent: `isa` supported, the
 /// coefficients padded, every lane array of the same length (a multiple of the vector
 /// width), and rows of `p` values that cannot overlap.
-fn check_shared(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes) {
+fn check_shared<E: Elem>(isa: Isa, p: usize, rec: &Rec<E>, lanes: &Lanes<E>) {
     let nb = lanes.tau.len();
     assert!(isa.is_supported());
     assert!(rec.padded());
-    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(isa.lanes()));
+    let w = isa.lanes_of::<E>();
+    assert!(lanes.p.len() == nb && lanes.sc.len() == nb && nb.is_multiple_of(w));
+    // A vector of lanes lies in one half.
+    assert!(lanes.upper_from >= nb || lanes.upper_from.is_multiple_of(w));
     lanes.assert_rows_apart(p);
 }
 
@@ -126,31 +146,31 @@ fn check_shared(isa: Isa, p: usize, rec: &Rec, lanes: &Lanes) {
 /// # Safety
 /// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for reads and
 /// written by no one meanwhile.
-pub(crate) unsafe fn forward_raw(
+pub(crate) unsafe fn forward_raw<E: DwtElem>(
     isa: Isa,
     p: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    xin: *const f64,
-    ft: &mut [f64],
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    xin: *const E,
+    ft: &mut [E],
 ) -> usize {
     check_shared(isa, p, rec, lanes);
-    assert!(ft.len() >= (rec.len() + isa.lanes()) * p);
+    assert!(ft.len() >= (rec.len() + isa.lanes_of::<E>()) * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
-    unsafe { forward::run(isa, p, rec, lanes, xin, ft) }
+    unsafe { E::forward_kernel(isa, p, rec, lanes, xin, ft) }
 }
 
 /// [`inverse_raw`] into consecutive rows of `y` (bounds checked).
 #[cfg(any(test, feature = "internals"))]
-pub fn inverse(
+pub fn inverse<E: DwtElem>(
     isa: Isa,
     p: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    fin: &mut [f64],
-    fill: Fill,
-    y: &mut [f64],
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    fin: &mut [E],
+    fill: Fill<E>,
+    y: &mut [E],
 ) {
     assert!(lanes.pair_stride == 0 && y.len() >= lanes.tau.len() * p);
     // SAFETY: `y` holds every row (consecutive rows of `p` values).
@@ -171,20 +191,20 @@ pub fn inverse(
 /// # Safety
 /// Every row of the lanes (`lanes.tau.len()` rows of `p` values) is valid for writes and
 /// written by no one else meanwhile; a nonzero `pair_stride` needs interleaved lanes.
-pub(crate) unsafe fn inverse_raw(
+pub(crate) unsafe fn inverse_raw<E: DwtElem>(
     isa: Isa,
     p: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    fin: &mut [f64],
-    fill: Fill,
-    y: *mut f64,
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    fin: &mut [E],
+    fill: Fill<E>,
+    y: *mut E,
 ) {
     check_shared(isa, p, rec, lanes);
     assert!(fin.len() >= rec.len() * p);
     // SAFETY: lengths checked above, rows by the caller, instruction set checked by
     // is_supported.
-    unsafe { inverse::run(isa, p, rec, lanes, fin, fill, y) }
+    unsafe { E::inverse_kernel(isa, p, rec, lanes, fin, fill, y) }
 }
 
 /// [`inverse_raw`] for a batch of `fin.count` transforms sharing the recurrence: transform
@@ -198,20 +218,20 @@ pub(crate) unsafe fn inverse_raw(
 /// # Safety
 /// `fin` holds `fin.count` arrays of `rec.len() p` values `fin.dist` apart, nobody else's;
 /// every output row of every transform is valid for writes and nobody else's.
-pub(crate) unsafe fn inverse_batch_raw(
+pub(crate) unsafe fn inverse_batch_raw<E: DwtElem>(
     isa: Isa,
     p: usize,
-    (rec, lanes): (&Rec, &Lanes),
-    (fin, fill, hints): (BatchRows<*mut f64>, BatchFill, &mut [Prefetch]),
-    tile: &mut [f64],
-    y: BatchRows<*mut f64>,
+    (rec, lanes): (&Rec<E>, &Lanes<E>),
+    (fin, fill, hints): (BatchRows<*mut E>, BatchFill<E>, &mut [Prefetch]),
+    tile: &mut [E],
+    y: BatchRows<*mut E>,
 ) {
     check_shared(isa, p, rec, lanes);
     assert!(fin.count == y.count && fin.dist >= rec.len() * p && hints.len() == fin.count);
-    assert!(tile.len() >= inverse_tile_len(rec.len(), isa.lanes()));
+    assert!(tile.len() >= inverse_tile_len(rec.len(), isa.lanes_of::<E>()));
     // SAFETY: lengths checked above, rows by the caller, instruction set by `check_shared`.
     unsafe {
-        batch::run_inverse(
+        E::inverse_batch_kernel(
             isa,
             p,
             (rec, lanes),
@@ -221,3 +241,139 @@ pub(crate) unsafe fn inverse_batch_raw(
         )
     }
 }
+
+/// The element types the kernels are instantiated for: each names its kernels per
+/// instruction set (the `run` functions of the kernel files).
+///
+/// # Safety
+/// Every method has the contract of the kernel file's function it forwards to.
+pub trait DwtElem: Elem {
+    /// `forward::run`
+    unsafe fn forward_kernel(
+        isa: Isa,
+        p: usize,
+        rec: &Rec<Self>,
+        lanes: &Lanes<Self>,
+        xin: *const Self,
+        ft: &mut [Self],
+    ) -> usize;
+    /// `inverse::run`
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn inverse_kernel(
+        isa: Isa,
+        p: usize,
+        rec: &Rec<Self>,
+        lanes: &Lanes<Self>,
+        fin: &mut [Self],
+        fill: Fill<Self>,
+        y: *mut Self,
+    );
+    /// `batch::run_inverse`
+    unsafe fn inverse_batch_kernel(
+        isa: Isa,
+        p: usize,
+        rl: (&Rec<Self>, &Lanes<Self>),
+        fin: (BatchRows<*mut Self>, BatchFill<Self>, &mut [Prefetch]),
+        tile: *mut Self,
+        y: BatchRows<*mut Self>,
+    );
+    /// `parity::run`
+    unsafe fn inverse_parity_kernel(
+        isa: Isa,
+        c: usize,
+        rec: &Rec<Self>,
+        lanes: &Lanes<Self>,
+        fin: *const Self,
+        y: *mut Self,
+    );
+    /// `parity::run_forward`
+    unsafe fn forward_parity_kernel(
+        isa: Isa,
+        c: usize,
+        rec: &Rec<Self>,
+        lanes: &Lanes<Self>,
+        x: *const Self,
+        out: (*mut Self, *mut Self),
+    );
+}
+
+/// Forwards each [`DwtElem`] method to the kernel files' functions for one element type.
+macro_rules! dwt_elem {
+    ($E:ty, $fwd:path, $inv:path, $batch:path, $par:path, $par_fwd:path) => {
+        impl DwtElem for $E {
+            unsafe fn forward_kernel(
+                isa: Isa,
+                p: usize,
+                rec: &Rec<$E>,
+                lanes: &Lanes<$E>,
+                xin: *const $E,
+                ft: &mut [$E],
+            ) -> usize {
+                // SAFETY: the trait's contract.
+                unsafe { $fwd(isa, p, rec, lanes, xin, ft) }
+            }
+            unsafe fn inverse_kernel(
+                isa: Isa,
+                p: usize,
+                rec: &Rec<$E>,
+                lanes: &Lanes<$E>,
+                fin: &mut [$E],
+                fill: Fill<$E>,
+                y: *mut $E,
+            ) {
+                // SAFETY: the trait's contract.
+                unsafe { $inv(isa, p, rec, lanes, fin, fill, y) }
+            }
+            unsafe fn inverse_batch_kernel(
+                isa: Isa,
+                p: usize,
+                rl: (&Rec<$E>, &Lanes<$E>),
+                fin: (BatchRows<*mut $E>, BatchFill<$E>, &mut [Prefetch]),
+                tile: *mut $E,
+                y: BatchRows<*mut $E>,
+            ) {
+                // SAFETY: the trait's contract.
+                unsafe { $batch(isa, p, rl, fin, tile, y) }
+            }
+            unsafe fn inverse_parity_kernel(
+                isa: Isa,
+                c: usize,
+                rec: &Rec<$E>,
+                lanes: &Lanes<$E>,
+                fin: *const $E,
+                y: *mut $E,
+            ) {
+                // SAFETY: the trait's contract.
+                unsafe { $par(isa, c, rec, lanes, fin, y) }
+            }
+            unsafe fn forward_parity_kernel(
+                isa: Isa,
+                c: usize,
+                rec: &Rec<$E>,
+                lanes: &Lanes<$E>,
+                x: *const $E,
+                out: (*mut $E, *mut $E),
+            ) {
+                // SAFETY: the trait's contract.
+                unsafe { $par_fwd(isa, c, rec, lanes, x, out) }
+            }
+        }
+    };
+}
+
+dwt_elem!(
+    f64,
+    forward::run,
+    inverse::run,
+    batch::run_inverse,
+    parity::run,
+    parity::run_forward
+);
+dwt_elem!(
+    f32,
+    forward::run_f32,
+    inverse::run_f32,
+    batch::run_inverse_f32,
+    parity::run_f32,
+    parity::run_forward_f32
+);

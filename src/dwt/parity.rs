@@ -13,7 +13,7 @@
 
 use super::lanes::{Lanes, Rec};
 use super::state::{prefix_states, State};
-use crate::simd::Simd;
+use crate::simd::{Simd, MAX_LANES};
 use std::mem::MaybeUninit;
 
 /// Vectors of betas whose states are set up together (through their negligible prefixes).
@@ -43,8 +43,8 @@ trait Sink<S: Simd, const K: usize>: Copy {
 /// The CPU supports `S`'s instruction set; the lane arrays hold a multiple of `W` entries.
 #[inline(always)]
 unsafe fn chain_groups<'r, S: Simd, const W: usize, const K: usize>(
-    rec: &Rec<'r>,
-    lanes: &Lanes,
+    rec: &Rec<'r, S::E>,
+    lanes: &Lanes<S::E>,
     mut group: impl FnMut(&mut [State<'r, S>; K], usize, usize),
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
@@ -79,7 +79,7 @@ unsafe fn chain_groups<'r, S: Simd, const W: usize, const K: usize>(
 #[inline(always)]
 unsafe fn run_chains<S: Simd, const K: usize>(
     st: &mut [State<S>; K],
-    rec: &Rec,
+    rec: &Rec<S::E>,
     sink: &mut impl Sink<S, K>,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
@@ -99,7 +99,7 @@ unsafe fn run_chains<S: Simd, const K: usize>(
         let mut p0 = [S::zero(); K];
         let mut p1 = [S::zero(); K];
         let mut tau = [S::zero(); K];
-        let narrow = std::mem::size_of::<S::V>() == 32;
+        let narrow = S::REGS == 16;
         for c in 0..K {
             (p0[c], p1[c], tau[c]) = (st[c].p0, st[c].p1, st[c].tau);
         }
@@ -147,7 +147,7 @@ unsafe fn run_chains<S: Simd, const K: usize>(
 #[derive(Clone, Copy)]
 struct InverseSums<S: Simd, const C: usize, const K: usize> {
     sums: [[S::V; 8]; K],
-    fin: *const f64,
+    fin: *const S::E,
 }
 
 impl<S: Simd, const C: usize, const K: usize> Sink<S, K> for InverseSums<S, C, K> {
@@ -184,10 +184,10 @@ impl<S: Simd, const C: usize, const K: usize> Sink<S, K> for InverseSums<S, C, K
 /// the lower half (`lanes.upper_from >= lanes.tau.len()`).
 #[inline(always)]
 unsafe fn body<S: Simd, const W: usize, const C: usize, const K: usize>(
-    rec: &Rec,
-    lanes: &Lanes,
-    fin: *const f64,
-    y: *mut f64,
+    rec: &Rec<S::E>,
+    lanes: &Lanes<S::E>,
+    fin: *const S::E,
+    y: *mut S::E,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -213,7 +213,7 @@ unsafe fn body<S: Simd, const W: usize, const C: usize, const K: usize>(
 #[derive(Clone, Copy)]
 struct ForwardSums<S: Simd, const W: usize, const C: usize, const K: usize> {
     data: [[S::V; 8]; K],
-    part: *mut f64,
+    part: *mut S::E,
 }
 
 impl<S: Simd, const W: usize, const C: usize, const K: usize> ForwardSums<S, W, C, K> {
@@ -269,11 +269,11 @@ impl<S: Simd, const W: usize, const C: usize, const K: usize> Sink<S, K>
 /// `ft` for `(rec.len() C).next_multiple_of(W)` values; every lane is in the lower half.
 #[inline(always)]
 unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
-    rec: &Rec,
-    lanes: &Lanes,
-    x: *const f64,
-    part: *mut f64,
-    ft: *mut f64,
+    rec: &Rec<S::E>,
+    lanes: &Lanes<S::E>,
+    x: *const S::E,
+    part: *mut S::E,
+    ft: *mut S::E,
 ) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
@@ -296,7 +296,7 @@ unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
         // Lane sums: W rows of partial sums transposed, then added.
         let mut r = 0;
         while r < rows {
-            let mut t = [S::zero(); 8];
+            let mut t = [S::zero(); MAX_LANES];
             for (w, v) in t.iter_mut().enumerate().take(W) {
                 *v = S::load(part.add((r + w) * W));
             }
@@ -314,12 +314,12 @@ unsafe fn forward_body<S: Simd, const W: usize, const C: usize, const K: usize>(
 /// A `#[target_feature]` entry point: [`body`] for one instruction set, vector width,
 /// column count and number of chains.
 macro_rules! entry {
-    ($name:ident, $feat:literal, $S:ty, $W:literal, $C:literal, $K:literal) => {
+    ($name:ident, $feat:literal, $S:ty, $E:ty, $W:literal, $C:literal, $K:literal) => {
         /// # Safety
         /// As [`body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, fin: *const f64, y: *mut f64) {
+        unsafe fn $name(rec: &Rec<$E>, lanes: &Lanes<$E>, fin: *const $E, y: *mut $E) {
             // SAFETY: the caller upholds `body`'s contract.
             unsafe { body::<$S, $W, $C, $K>(rec, lanes, fin, y) }
         }
@@ -329,12 +329,18 @@ macro_rules! entry {
 /// A `#[target_feature]` entry point: [`forward_body`] for one instruction set, vector
 /// width, column count and number of chains.
 macro_rules! forward_entry {
-    ($name:ident, $feat:literal, $S:ty, $W:literal, $C:literal, $K:literal) => {
+    ($name:ident, $feat:literal, $S:ty, $E:ty, $W:literal, $C:literal, $K:literal) => {
         /// # Safety
         /// As [`forward_body`], for the instruction set of `$S`.
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = $feat)]
-        unsafe fn $name(rec: &Rec, lanes: &Lanes, x: *const f64, part: *mut f64, ft: *mut f64) {
+        unsafe fn $name(
+            rec: &Rec<$E>,
+            lanes: &Lanes<$E>,
+            x: *const $E,
+            part: *mut $E,
+            ft: *mut $E,
+        ) {
             // SAFETY: the caller upholds `forward_body`'s contract.
             unsafe { forward_body::<$S, $W, $C, $K>(rec, lanes, x, part, ft) }
         }
@@ -342,13 +348,20 @@ macro_rules! forward_entry {
 }
 
 #[cfg(target_arch = "x86_64")]
-use crate::simd::{avx2::Avx2, avx512::Avx512};
-use crate::simd::{scalar::Scalar, Isa};
+use crate::simd::{avx2::Avx2, avx2_f32::Avx2F32, avx512::Avx512, avx512_f32::Avx512F32};
+use crate::simd::{
+    scalar::{Scalar, ScalarF32},
+    Isa,
+};
 
-entry!(avx512_2, "avx512f,fma", Avx512, 8, 2, 4);
-entry!(avx512_4, "avx512f,fma", Avx512, 8, 4, 2);
-entry!(avx2_2, "avx2,fma", Avx2, 4, 2, 2);
-entry!(avx2_4, "avx2,fma", Avx2, 4, 4, 2);
+entry!(avx512_2, "avx512f,fma", Avx512, f64, 8, 2, 4);
+entry!(avx512_4, "avx512f,fma", Avx512, f64, 8, 4, 2);
+entry!(avx2_2, "avx2,fma", Avx2, f64, 4, 2, 2);
+entry!(avx2_4, "avx2,fma", Avx2, f64, 4, 4, 2);
+entry!(avx512_f32_2, "avx512f,fma", Avx512F32, f32, 16, 2, 4);
+entry!(avx512_f32_4, "avx512f,fma", Avx512F32, f32, 16, 4, 2);
+entry!(avx2_f32_2, "avx2,fma", Avx2F32, f32, 8, 2, 2);
+entry!(avx2_f32_4, "avx2,fma", Avx2F32, f32, 8, 4, 2);
 
 /// The kernel for `isa` and `c` columns (2 or 4).
 ///
@@ -381,10 +394,14 @@ pub(super) unsafe fn run(
     }
 }
 
-forward_entry!(fwd_avx512_2, "avx512f,fma", Avx512, 8, 2, 4);
-forward_entry!(fwd_avx512_4, "avx512f,fma", Avx512, 8, 4, 2);
-forward_entry!(fwd_avx2_2, "avx2,fma", Avx2, 4, 2, 2);
-forward_entry!(fwd_avx2_4, "avx2,fma", Avx2, 4, 4, 2);
+forward_entry!(fwd_avx512_2, "avx512f,fma", Avx512, f64, 8, 2, 4);
+forward_entry!(fwd_avx512_4, "avx512f,fma", Avx512, f64, 8, 4, 2);
+forward_entry!(fwd_avx2_2, "avx2,fma", Avx2, f64, 4, 2, 2);
+forward_entry!(fwd_avx2_4, "avx2,fma", Avx2, f64, 4, 4, 2);
+forward_entry!(fwd_avx512_f32_2, "avx512f,fma", Avx512F32, f32, 16, 2, 4);
+forward_entry!(fwd_avx512_f32_4, "avx512f,fma", Avx512F32, f32, 16, 4, 2);
+forward_entry!(fwd_avx2_f32_2, "avx2,fma", Avx2F32, f32, 8, 2, 2);
+forward_entry!(fwd_avx2_f32_4, "avx2,fma", Avx2F32, f32, 8, 4, 2);
 
 /// The forward kernel for `isa` and `c` columns (2 or 4).
 ///
@@ -412,6 +429,68 @@ pub(super) unsafe fn run_forward(
             (Isa::Avx2, 4) => fwd_avx2_4(rec, lanes, x, part, ft),
             (_, 2) => forward_body::<Scalar, 1, 2, 2>(rec, lanes, x, part, ft),
             (_, 4) => forward_body::<Scalar, 1, 4, 2>(rec, lanes, x, part, ft),
+            _ => unreachable!("C must be 2 or 4"),
+        }
+    }
+}
+
+/// [`run`] for floats.
+///
+/// # Safety
+/// As [`run`]; the lane arrays hold a multiple of `isa.lanes_of::<f32>()` entries.
+pub(super) unsafe fn run_f32(
+    isa: Isa,
+    c: usize,
+    rec: &Rec<f32>,
+    lanes: &Lanes<f32>,
+    fin: *const f32,
+    y: *mut f32,
+) {
+    // SAFETY: the caller's contract covers every kernel's and the instruction set of the
+    // one chosen.
+    unsafe {
+        match (isa, c) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 2) => avx512_f32_2(rec, lanes, fin, y),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 4) => avx512_f32_4(rec, lanes, fin, y),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 2) => avx2_f32_2(rec, lanes, fin, y),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 4) => avx2_f32_4(rec, lanes, fin, y),
+            (_, 2) => body::<ScalarF32, 1, 2, 2>(rec, lanes, fin, y),
+            (_, 4) => body::<ScalarF32, 1, 4, 2>(rec, lanes, fin, y),
+            _ => unreachable!("C must be 2 or 4"),
+        }
+    }
+}
+
+/// [`run_forward`] for floats.
+///
+/// # Safety
+/// As [`run_forward`]; the lane arrays hold a multiple of `isa.lanes_of::<f32>()` entries.
+pub(super) unsafe fn run_forward_f32(
+    isa: Isa,
+    c: usize,
+    rec: &Rec<f32>,
+    lanes: &Lanes<f32>,
+    x: *const f32,
+    (part, ft): (*mut f32, *mut f32),
+) {
+    // SAFETY: the caller's contract covers every kernel's and the instruction set of the
+    // one chosen.
+    unsafe {
+        match (isa, c) {
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 2) => fwd_avx512_f32_2(rec, lanes, x, part, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx512, 4) => fwd_avx512_f32_4(rec, lanes, x, part, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 2) => fwd_avx2_f32_2(rec, lanes, x, part, ft),
+            #[cfg(target_arch = "x86_64")]
+            (Isa::Avx2, 4) => fwd_avx2_f32_4(rec, lanes, x, part, ft),
+            (_, 2) => forward_body::<ScalarF32, 1, 2, 2>(rec, lanes, x, part, ft),
+            (_, 4) => forward_body::<ScalarF32, 1, 4, 2>(rec, lanes, x, part, ft),
             _ => unreachable!("C must be 2 or 4"),
         }
     }

@@ -2,8 +2,8 @@
 //! in `l`, shared by the kernels.
 
 use super::lanes::{Lanes, Rec};
+use crate::real::Elem;
 use crate::simd::Simd;
-use crate::wigner::starts::TINY;
 use std::mem::MaybeUninit;
 
 /// Recurrence state of one vector of betas.
@@ -12,9 +12,9 @@ pub(crate) struct State<'r, S: Simd> {
     /// Recurrence argument of each lane (see [`Lanes`]).
     pub(crate) tau: S::V,
     /// `-A` (lower half) or `A` (upper half).
-    pub(crate) slope: &'r [f64],
+    pub(crate) slope: &'r [S::E],
     /// `A + C` (lower half) or `C - A` (upper half).
-    pub(crate) offset: &'r [f64],
+    pub(crate) offset: &'r [S::E],
     /// The (scaled) values of the degree before the next one.
     pub(crate) p0: S::V,
     /// The (scaled) values of the next degree `i`.
@@ -36,7 +36,7 @@ impl<'r, S: Simd> State<'r, S> {
     /// The CPU supports `S`'s instruction set; the lanes from the vector's first one hold `W`
     /// entries each; degree indices stay below the padded length of the coefficients.
     #[inline(always)]
-    pub(crate) unsafe fn new(rec: &Rec<'r>, lanes: &Lanes, s0: usize) -> Self {
+    pub(crate) unsafe fn new(rec: &Rec<'r, S::E>, lanes: &Lanes<S::E>, s0: usize) -> Self {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
         unsafe {
             let scale_index = S::load(lanes.sc.as_ptr().add(s0));
@@ -57,11 +57,11 @@ impl<'r, S: Simd> State<'r, S> {
                 // are neither active nor scaled down: they never hold back the skipping of
                 // their vector's prefix, nor its fast phase.
                 mask: S::mul(
-                    S::blend_ge(scale_index, S::zero(), S::splat(1.0), S::zero()),
+                    S::blend_ge(scale_index, S::zero(), S::splat(S::E::ONE), S::zero()),
                     S::blend_ge(
                         S::abs(p1),
-                        S::splat(f64::MIN_POSITIVE),
-                        S::splat(1.0),
+                        S::splat(S::E::MIN_POSITIVE),
+                        S::splat(S::E::ONE),
                         S::zero(),
                     ),
                 ),
@@ -80,7 +80,7 @@ impl<'r, S: Simd> State<'r, S> {
     #[inline(always)]
     pub(crate) unsafe fn none_active(&self) -> bool {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
-        unsafe { !S::any_ge(self.mask, S::splat(0.5)) }
+        unsafe { !S::any_ge(self.mask, S::splat(S::E::from_f64(0.5))) }
     }
 
     /// Whether every lane is active.
@@ -90,7 +90,7 @@ impl<'r, S: Simd> State<'r, S> {
     #[inline(always)]
     pub(crate) unsafe fn all_active(&self) -> bool {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
-        unsafe { !S::any_ge(S::splat(-0.5), self.scale_index) }
+        unsafe { !S::any_ge(S::splat(S::E::from_f64(-0.5)), self.scale_index) }
     }
 
     /// Rescale the scaled-down lanes of `(p0, p1)` that grew past `big` by `2^-SCALE_STEP`
@@ -105,10 +105,10 @@ impl<'r, S: Simd> State<'r, S> {
     pub(crate) unsafe fn rescale(&mut self, p0: &mut S::V, p1: &mut S::V) {
         // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
         unsafe {
-            let (zero, one) = (S::zero(), S::splat(1.0));
+            let (zero, one) = (S::zero(), S::splat(S::E::ONE));
             // |p1| of the scaled-down lanes, 0 for the active ones.
             let a = S::blend_ge(self.scale_index, zero, zero, S::abs(*p1));
-            let f = S::blend_ge(a, self.big, S::splat(TINY), one);
+            let f = S::blend_ge(a, self.big, S::splat(S::E::TINY), one);
             *p0 = S::mul(*p0, f);
             *p1 = S::mul(*p1, f);
             let hit = S::blend_ge(a, self.big, one, zero);
@@ -285,7 +285,11 @@ const GROUP: usize = 4;
 /// The CPU supports `S`'s instruction set; the lanes from the vector's first one hold `W`
 /// entries each; degree indices stay below the padded length of the coefficients.
 #[inline(always)]
-pub(crate) unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec: &Rec, n: usize) {
+pub(crate) unsafe fn skip_inactive<S: Simd>(
+    st: &mut [State<'_, S>; GROUP],
+    rec: &Rec<S::E>,
+    n: usize,
+) {
     // SAFETY: this function's contract (see `# Safety`), upheld by the caller.
     unsafe {
         if st.iter().any(|s| !s.none_active() || s.i >= n) {
@@ -345,8 +349,8 @@ pub(crate) unsafe fn skip_inactive<S: Simd>(st: &mut [State<'_, S>; GROUP], rec:
 /// entries each; degree indices stay below the padded length of the coefficients.
 #[inline(always)]
 unsafe fn group_states<'r, S: Simd, const W: usize>(
-    rec: &Rec<'r>,
-    lanes: &Lanes,
+    rec: &Rec<'r, S::E>,
+    lanes: &Lanes<S::E>,
     s0: usize,
     nb: usize,
     n: usize,
@@ -383,8 +387,8 @@ unsafe fn group_states<'r, S: Simd, const W: usize>(
 /// entries each; degree indices stay below the padded length of the coefficients.
 #[inline(always)]
 pub(crate) unsafe fn prefix_states<'m, 'r, S: Simd, const W: usize>(
-    rec: &Rec<'r>,
-    lanes: &Lanes,
+    rec: &Rec<'r, S::E>,
+    lanes: &Lanes<S::E>,
     v0: usize,
     n: usize,
     mem: &'m mut [MaybeUninit<State<'r, S>>],

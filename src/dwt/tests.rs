@@ -2,7 +2,7 @@
 //! and the one-beta column against the reference evaluation of `wigner`.
 
 use super::fixtures::{cluster_setup, cluster_setup_at, grid_lanes, test_skip_bits, ClusterInputs};
-use super::{forward, forward_raw, inverse, inverse_raw, Lanes, Prefetch, Rec};
+use super::{forward, forward_raw, inverse, inverse_raw, DwtElem, Lanes, Prefetch, Rec};
 use crate::simd::Isa;
 use crate::wigner::column::column;
 use crate::wigner::starts::{big, start_norm, BaseStart, BetaTables, SKIP_BITS_RANGE};
@@ -11,16 +11,16 @@ use crate::wigner::{RecCoeffs, RecTables};
 /// [`inverse`] with its input rows filled on demand from `fin`: rows start as NaN, so
 /// a read before the fill shows in `y`. Checks the fill contract (top down, each row
 /// once, down to a contiguous end at `n`) and returns the lowest row filled.
-fn inverse_from(
+pub(super) fn inverse_from<E: DwtElem>(
     isa: Isa,
     pw: usize,
-    rec: &Rec,
-    lanes: &Lanes,
-    fin: &[f64],
-    y: &mut [f64],
+    rec: &Rec<E>,
+    lanes: &Lanes<E>,
+    fin: &[E],
+    y: &mut [E],
 ) -> usize {
     let n = rec.len();
-    let mut buf = vec![f64::NAN; n * pw];
+    let mut buf = vec![E::from_f64(f64::NAN); n * pw];
     let mut have = n;
     inverse(
         isa,
@@ -28,7 +28,7 @@ fn inverse_from(
         rec,
         lanes,
         &mut buf,
-        &mut |b: &mut [f64], from: usize, to: usize| {
+        &mut |b: &mut [E], from: usize, to: usize| {
             assert!(
                 from < to && to == have,
                 "fill {from}..{to} with rows {have}.. filled"
@@ -59,7 +59,7 @@ unsafe fn inverse_rows_at(
     unsafe { inverse_raw(isa, pw, rec, lanes, &mut buf, &mut |_, _, _| {}, out) }
 }
 
-fn pseudo(n: usize, seed: u64) -> Vec<f64> {
+pub(super) fn pseudo(n: usize, seed: u64) -> Vec<f64> {
     let mut s = seed;
     (0..n)
         .map(|_| {
@@ -647,17 +647,29 @@ fn forward_parity_kernel_sums_each_degree_over_its_parity() {
 
 /// The batched inverse against single calls, bit for bit, for `counts` transforms: every
 /// output row (both store modes).
-fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
+pub(super) fn batch_case<E: DwtElem>(
+    isa: Isa,
+    pw: usize,
+    rec: &Rec<E>,
+    lanes: &mut Lanes<E>,
+    seed: u64,
+) {
     use super::{inverse_batch_raw, inverse_tile_len};
     use super::{BatchRows, Prefetch};
-    let (n, nbs, w) = (rec.len(), lanes.tau.len(), isa.lanes());
+    let (n, nbs, w) = (rec.len(), lanes.tau.len(), isa.lanes_of::<E>());
+    let nan = E::from_f64(f64::NAN);
     for count in [1usize, 2, 3] {
         for stream in [false, true] {
             lanes.stream = stream;
-            let fins: Vec<Vec<f64>> = (0..count)
-                .map(|t| pseudo(n * pw, seed + t as u64))
+            let fins: Vec<Vec<E>> = (0..count)
+                .map(|t| {
+                    pseudo(n * pw, seed + t as u64)
+                        .into_iter()
+                        .map(E::from_f64)
+                        .collect()
+                })
                 .collect();
-            let mut want = vec![f64::NAN; count * nbs * pw];
+            let mut want = vec![nan; count * nbs * pw];
             for (t, f) in fins.iter().enumerate() {
                 inverse_from(
                     isa,
@@ -668,11 +680,11 @@ fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
                     &mut want[t * nbs * pw..][..nbs * pw],
                 );
             }
-            let mut buf = vec![f64::NAN; count * n * pw];
-            let mut y = vec![f64::NAN; count * nbs * pw];
-            let mut tile = vec![f64::NAN; inverse_tile_len(n, w)];
+            let mut buf = vec![nan; count * n * pw];
+            let mut y = vec![nan; count * nbs * pw];
+            let mut tile = vec![nan; inverse_tile_len(n, w)];
             let mut hints = vec![Prefetch::none(); count];
-            let mut fill = |t: usize, rows: &mut [f64], from: usize, to: usize| {
+            let mut fill = |t: usize, rows: &mut [E], from: usize, to: usize| {
                 rows[from * pw..to * pw].copy_from_slice(&fins[t][from * pw..to * pw]);
             };
             let fin = BatchRows {
@@ -699,9 +711,10 @@ fn batch_case(isa: Isa, pw: usize, rec: &Rec, lanes: &mut Lanes, seed: u64) {
             };
             for (i, (u, v)) in y.iter().zip(&want).enumerate() {
                 assert_eq!(
-                    u.to_bits(),
-                    v.to_bits(),
-                    "{isa:?} P={pw} inverse x{count} at {i}"
+                    u.to_f64().to_bits(),
+                    v.to_f64().to_bits(),
+                    "{} {isa:?} P={pw} inverse x{count} at {i}",
+                    E::NAME
                 );
             }
         }

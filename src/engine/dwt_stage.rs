@@ -433,7 +433,10 @@ impl DwtStage {
             };
             let lo = cl.m.max(s.first);
             let len = self.l.saturating_sub(lo);
-            pf.push(coef.wrapping_add(block + lo - s.first).cast(), 2 * len);
+            pf.push(
+                coef.wrapping_add(block + lo - s.first).cast::<f64>(),
+                2 * len,
+            );
         }
     }
 

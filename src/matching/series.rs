@@ -263,7 +263,7 @@ impl SeriesTables {
     }
 
     #[inline(always)]
-    fn row_terms_in<S: Simd>(
+    fn row_terms_in<S: Simd<E = f64>>(
         &self,
         lanes: &Lanes,
         coeffs: &[Complex64],
@@ -422,7 +422,7 @@ impl Lanes {
 /// # Safety
 /// The CPU supports the instruction set of `S`.
 #[inline(always)]
-unsafe fn group_terms<S: Simd>(
+unsafe fn group_terms<S: Simd<E = f64>>(
     lanes: &Lanes,
     table: &ClusterTable,
     group: &Group,
@@ -502,7 +502,7 @@ unsafe fn group_terms<S: Simd>(
 /// The CPU supports the instruction set of `S`; `packed` holds `J n` coefficients and
 /// `scratch` `3 n w` doubles (`n` from the scratch length).
 #[inline(always)]
-unsafe fn member_sums<S: Simd, const J: usize>(
+unsafe fn member_sums<S: Simd<E = f64>, const J: usize>(
     packed: &[Complex64],
     scratch: &[f64],
 ) -> [[(S::V, S::V); 3]; 4] {

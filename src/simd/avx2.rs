@@ -8,7 +8,9 @@ use std::arch::x86_64::*;
 pub(crate) struct Avx2;
 
 impl Simd for Avx2 {
+    type E = f64;
     type V = __m256d;
+    const REGS: usize = 16;
     #[inline(always)]
     unsafe fn splat(x: f64) -> __m256d {
         // SAFETY: the caller guarantees AVX2 and FMA (the contract of `Simd`).

@@ -8,7 +8,11 @@ use std::arch::x86_64::*;
 pub(crate) struct Avx512;
 
 impl Simd for Avx512 {
+    type E = f64;
     type V = __m512d;
+    const GROUP_8: usize = 2;
+    const GROUP_16: usize = 1;
+    const REGS: usize = 32;
     #[inline(always)]
     unsafe fn splat(x: f64) -> __m512d {
         // SAFETY: the caller guarantees AVX-512F (the contract of `Simd`).

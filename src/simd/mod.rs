@@ -8,12 +8,18 @@
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx2;
 #[cfg(target_arch = "x86_64")]
+pub(crate) mod avx2_f32;
+#[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx512_f32;
 #[cfg(feature = "internals")]
 pub(crate) mod peak;
 pub(crate) mod scalar;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
+
+use crate::real::Elem;
 
 /// The environment variable that overrides [`Isa::detect`] (see [`Isa::selected`]).
 pub const ISA_VARIABLE: &str = "SO3FFT_ISA";
@@ -115,29 +121,42 @@ impl Isa {
 
     /// Number of doubles per vector.
     pub fn lanes(self) -> usize {
-        match self {
-            Isa::Avx512 => 8,
-            Isa::Avx2 => 4,
-            Isa::Scalar => 1,
-        }
+        self.lanes_of::<f64>()
+    }
+
+    /// Lanes of the kernels' widest vectors of `E` (lane arrays are padded to a multiple
+    /// of it).
+    pub(crate) fn lanes_of<E: Elem>(self) -> usize {
+        let bytes = match self {
+            Isa::Avx512 => 64,
+            Isa::Avx2 => 32,
+            Isa::Scalar => return 1,
+        };
+        bytes / E::BYTES
     }
 }
 
-/// Vector operations used by the kernels, one implementation per instruction set.
+/// Vector operations used by the kernels, one implementation per instruction set and
+/// element type.
 ///
 /// # Safety
 /// Every method is unsafe: the caller guarantees that the CPU supports the instruction set
 /// of the implementation ([`Isa::is_supported`]) and that every pointer argument is valid
-/// for `W` doubles (two for [`Simd::splat2`]), `W` the vector width.
+/// for `W` elements (two for [`Simd::splat2`], `G` for [`Simd::splat_group`]), `W` the
+/// vector width.
 pub(crate) trait Simd: Copy {
+    /// The element type.
+    type E: Elem;
     /// The vector type.
     type V: Copy;
+    /// Vector registers of the instruction set (the kernels' shapes depend on it).
+    const REGS: usize;
     /// `x` in every lane.
-    unsafe fn splat(x: f64) -> Self::V;
-    /// `W` doubles from `p` (no alignment needed).
-    unsafe fn load(p: *const f64) -> Self::V;
-    /// `v` to the `W` doubles at `p` (no alignment needed).
-    unsafe fn store(p: *mut f64, v: Self::V);
+    unsafe fn splat(x: Self::E) -> Self::V;
+    /// `W` elements from `p` (no alignment needed).
+    unsafe fn load(p: *const Self::E) -> Self::V;
+    /// `v` to the `W` elements at `p` (no alignment needed).
+    unsafe fn store(p: *mut Self::E, v: Self::V);
     /// `a + b`
     unsafe fn add(a: Self::V, b: Self::V) -> Self::V;
     /// `a * b`
@@ -157,34 +176,83 @@ pub(crate) trait Simd: Copy {
     /// Transpose the `W x W` block `v` (vector `j`, lane `w`) in registers: afterwards
     /// vector `w` holds lane `w` of every former vector.
     unsafe fn transpose(v: &mut [Self::V]);
+    /// Betas per group in the forward kernel's grouped mode for rows of 8 values
+    /// ([`Simd::splat_group`]; 1: no grouping).
+    const GROUP_8: usize = 1;
+    /// As [`Simd::GROUP_8`], for rows of 16 values.
+    const GROUP_16: usize = 1;
     /// `[p[0], p[1]]` repeated in every pair of lanes (`W >= 2` only).
-    unsafe fn splat2(p: *const f64) -> Self::V;
+    unsafe fn splat2(p: *const Self::E) -> Self::V;
     /// The even lanes of `a` and `b` interleaved, `[a0, b0, a2, b2, ...]` (`W >= 2` only).
     unsafe fn unpack_even(a: Self::V, b: Self::V) -> Self::V;
     /// The odd lanes of `a` and `b` interleaved, `[a1, b1, a3, b3, ...]` (`W >= 2` only).
     unsafe fn unpack_odd(a: Self::V, b: Self::V) -> Self::V;
+    /// The `G` values `p[0..G]` repeated over the lanes, `G = group_of::<Self>(P)`: the
+    /// d values of a group of betas, lane `k` holding beta `k % G`'s.
+    #[inline(always)]
+    unsafe fn splat_group<const P: usize>(p: *const Self::E) -> Self::V {
+        // SAFETY: the trait's contract (groups of 2 unless overridden).
+        unsafe { Self::splat2(p) }
+    }
+    /// The rows of `P` values of the `G` betas of a group (`x + b * stride`, `b < G`) in
+    /// two vectors: lane `k` of either holds a value of beta `k % G`'s row, and the two
+    /// products with [`Simd::splat_group`], summed over groups, give the column sums
+    /// through [`Simd::fold_group`].
+    #[inline(always)]
+    unsafe fn group_rows<const P: usize>(x: *const Self::E, stride: usize) -> [Self::V; 2] {
+        // SAFETY: the trait's contract; the caller guarantees both rows valid for `W`
+        // values (groups of 2 unless overridden: `P = W`).
+        unsafe {
+            let (a, b) = (Self::load(x), Self::load(x.add(stride)));
+            [Self::unpack_even(a, b), Self::unpack_odd(a, b)]
+        }
+    }
+    /// The `P` column sums (in the first `P` lanes, in order) from the sums of the
+    /// products with the two vectors of [`Simd::group_rows`].
+    #[inline(always)]
+    unsafe fn fold_group<const P: usize>(a: Self::V, b: Self::V) -> Self::V {
+        // SAFETY: the trait's contract (groups of 2 unless overridden).
+        unsafe { Self::add(Self::unpack_even(a, b), Self::unpack_odd(a, b)) }
+    }
+    /// The first `k` lanes of `v` to `p` (valid for `k` values).
+    #[inline(always)]
+    unsafe fn store_first(p: *mut Self::E, v: Self::V, k: usize) {
+        // SAFETY: the trait's contract; `p` valid for `k <= W` values.
+        unsafe {
+            let mut t = [Self::E::ZERO; MAX_LANES];
+            Self::store(t.as_mut_ptr(), v);
+            std::ptr::copy_nonoverlapping(t.as_ptr(), p, k);
+        }
+    }
     /// Store `v` at `p` without reading the cache line first (a non-temporal store) where
     /// `p` is aligned to the vector size, else an ordinary store. Callers end a run of these
     /// with [`sfence`].
     #[inline(always)]
-    unsafe fn stream(p: *mut f64, v: Self::V) {
+    unsafe fn stream(p: *mut Self::E, v: Self::V) {
         // SAFETY: the trait's contract.
         unsafe { Self::store(p, v) }
     }
-    /// Store the `W x W` block `v` (vector `j`, lane `w`) transposed: lane `w` of every
-    /// vector goes to the row `dst + w * stride`, vector `j` to its entry `j` (with
-    /// [`Simd::stream`] if `stream`, else ordinary stores).
+    /// Store the `k x W` block `v` (vector `j`, lane `w`; `k = v.len() <= W`) transposed:
+    /// lane `w` of every vector goes to the row `dst + w * stride`, vector `j` to its entry
+    /// `j` (full rows with [`Simd::stream`] if `stream`, else ordinary stores).
     #[inline(always)]
-    unsafe fn store_transposed(v: &[Self::V], dst: *mut f64, stride: usize, stream: bool) {
+    unsafe fn store_transposed<const W: usize>(
+        v: &[Self::V],
+        dst: *mut Self::E,
+        stride: usize,
+        stream: bool,
+    ) {
         // SAFETY: the instruction set by the trait's contract; the caller guarantees the
-        // `W` rows `dst + w * stride` (`W` doubles each) valid for writes.
+        // `W` rows `dst + w * stride` (`k` elements each) valid for writes.
         unsafe {
-            let mut t = [Self::zero(); 8];
-            let w = v.len();
-            t[..w].copy_from_slice(v);
-            Self::transpose(&mut t[..w]);
-            for (r, x) in t[..w].iter().enumerate() {
-                if stream {
+            let mut t = [Self::zero(); MAX_LANES];
+            let k = v.len();
+            t[..k].copy_from_slice(v);
+            Self::transpose(&mut t[..W]);
+            for (r, x) in t[..W].iter().enumerate() {
+                if k < W {
+                    Self::store_first(dst.add(r * stride), *x, k);
+                } else if stream {
                     Self::stream(dst.add(r * stride), *x);
                 } else {
                     Self::store(dst.add(r * stride), *x);
@@ -202,7 +270,19 @@ pub(crate) trait Simd: Copy {
     #[inline(always)]
     unsafe fn zero() -> Self::V {
         // SAFETY: the trait's contract.
-        unsafe { Self::splat(0.0) }
+        unsafe { Self::splat(Self::E::ZERO) }
+    }
+}
+
+/// The most lanes of any vector type (16 floats with AVX-512).
+pub(crate) const MAX_LANES: usize = 16;
+
+/// Betas per group of `S`'s grouped forward mode for rows of `p` values (1: none).
+pub(crate) const fn group_of<S: Simd>(p: usize) -> usize {
+    if p == 8 {
+        S::GROUP_8
+    } else {
+        S::GROUP_16
     }
 }
 

@@ -44,7 +44,7 @@ pub fn fma_peak(isa: Isa) -> f64 {
 /// The CPU supports `S`'s instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn chains<S: crate::simd::Simd, const C: usize>(iters: usize) -> f64 {
+unsafe fn chains<S: crate::simd::Simd<E = f64>, const C: usize>(iters: usize) -> f64 {
     // SAFETY: the caller guarantees the instruction set; `t` holds the 8 doubles a vector
     // stores at most.
     unsafe {

@@ -107,7 +107,7 @@ pub(crate) fn half_angles(beta: f64) -> (Dd, Dd) {
 /// # Safety
 /// The CPU supports the instruction set of `S`.
 #[inline(always)]
-pub(crate) unsafe fn columns<S: Simd, const K: usize>(
+pub(crate) unsafe fn columns<S: Simd<E = f64>, const K: usize>(
     isa: Isa,
     points: &Points,
     (m, mp, norm): (usize, usize, Ext),
