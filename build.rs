@@ -18,8 +18,11 @@ const CAPI_ROOT: &str = "src/capi/mod.rs";
 const SONAME: &str = "libso3fft.so.0";
 
 fn main() {
-    // fftw-sys's "system" feature links fftw3 only; the planner thread-safety hook lives in
-    // fftw3_threads.
+    // fftw-sys's "system" feature links fftw3 and fftw3f only; the planner thread-safety
+    // hooks (fftw_make_planner_thread_safe, fftwf_make_planner_thread_safe), which the
+    // library calls for both precisions when it is loaded, live in the threads libraries.
+    // Single precision first: a static link needs each threads library before its FFTW.
+    println!("cargo:rustc-link-lib=fftw3f_threads");
     println!("cargo:rustc-link-lib=fftw3_threads");
     println!("cargo:rerun-if-changed=build.rs");
 

@@ -7,7 +7,7 @@ use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A floating-point type the library computes in: `f64` or `f32`. Sealed: the kernels,
 /// the FFT stage and the recurrence's scaled form are written for these two only.
-pub trait Real: private::Elem {}
+pub trait Real: private::Elem + crate::fft::FftwApi {}
 
 impl Real for f64 {}
 impl Real for f32 {}

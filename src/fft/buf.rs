@@ -1,13 +1,24 @@
 //! Page-aligned buffers, the chunk buffer of a plan, and row copies.
 
 use crate::error::{Error, Result};
-use num_complex::Complex64;
+use crate::real::Elem;
+use num_complex::{Complex, Complex64};
 
-/// A page-aligned complex buffer, zero-filled. Large buffers are mapped directly and
-/// asked to use transparent huge pages: the chunk buffer is read and written with large
-/// strides, and 4 KiB pages would make nearly every access a TLB miss.
+/// Element types an [`AlignedBuf`] may be viewed as: the library's reals and complex values
+/// of them, plain data for which every bit pattern is a value and all-zero bytes are zero
+/// (the buffer is zero-filled).
+pub(crate) trait Plain: Copy + 'static {}
+
+impl<T: Elem> Plain for T {}
+impl<T: Elem> Plain for Complex<T> {}
+
+/// A page-aligned buffer, zero-filled, sized in bytes and viewed as any [`Plain`] element
+/// type (`f64`, `f32`, `Complex64`, `Complex32`); the names without a type (`new`,
+/// `as_mut_ptr`, `len`, `slice_mut`) count `Complex64` values. Large buffers are mapped
+/// directly and asked to use transparent huge pages: the chunk buffer is read and written
+/// with large strides, and 4 KiB pages would make nearly every access a TLB miss.
 pub(crate) struct AlignedBuf {
-    ptr: *mut Complex64,
+    ptr: *mut u8,
     bytes: usize,
 }
 
@@ -19,16 +30,26 @@ unsafe impl Send for AlignedBuf {}
 unsafe impl Sync for AlignedBuf {}
 
 impl AlignedBuf {
-    /// Allocate `len` complex values, zero-filled and touched (so page faults happen here).
-    /// From 2 MiB on the mapping starts on a 2 MiB boundary and is a whole number of 2 MiB
-    /// pages, so that transparent huge pages can back all of it (an unaligned mapping of a
-    /// little over 2 MiB holds no huge page at all).
+    /// Allocate `len` complex values (`Complex64`), zero-filled and touched.
     pub fn new(len: usize) -> Result<AlignedBuf> {
+        Self::of::<Complex64>(len)
+    }
+
+    /// Allocate `len` values of `U`, zero-filled and touched.
+    pub fn of<U: Plain>(len: usize) -> Result<AlignedBuf> {
+        let bytes = len
+            .checked_mul(size_of::<U>())
+            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?;
+        Self::with_bytes(bytes)
+    }
+
+    /// Allocate at least `want` bytes (4096 or more), zero-filled and touched (so page
+    /// faults happen here). From 2 MiB on the mapping starts on a 2 MiB boundary and is a
+    /// whole number of 2 MiB pages, so that transparent huge pages can back all of it (an
+    /// unaligned mapping of a little over 2 MiB holds no huge page at all).
+    pub fn with_bytes(want: usize) -> Result<AlignedBuf> {
         const HUGE: usize = 1 << 21;
-        let want = len
-            .checked_mul(16)
-            .ok_or(Error::OutOfMemory { bytes: usize::MAX })?
-            .max(4096);
+        let want = want.max(4096);
         let huge = want >= HUGE;
         let bytes = if huge {
             want.checked_next_multiple_of(HUGE)
@@ -86,27 +107,50 @@ impl AlignedBuf {
             std::ptr::write_bytes(ptr.cast::<u8>(), 0, bytes);
         }
         Ok(AlignedBuf {
-            ptr: ptr.cast::<Complex64>(),
+            ptr: ptr.cast::<u8>(),
             bytes,
         })
     }
 
-    /// Start of the buffer (valid for the `len` values asked for, while `self` lives).
+    /// Size in bytes (at least the size asked for).
+    pub fn bytes(&self) -> usize {
+        self.bytes
+    }
+
+    /// Start of the buffer as `U` values (page-aligned; valid for [`AlignedBuf::len_of`]
+    /// of them while `self` lives).
+    pub fn ptr<U: Plain>(&self) -> *mut U {
+        self.ptr.cast::<U>()
+    }
+
+    /// Number of `U` values the buffer holds (at least the number asked for).
+    pub fn len_of<U: Plain>(&self) -> usize {
+        self.bytes / size_of::<U>()
+    }
+
+    /// The first `len` values of `U` (`len <= self.len_of::<U>()`).
+    pub fn view_mut<U: Plain>(&mut self, len: usize) -> &mut [U] {
+        assert!(len <= self.len_of::<U>());
+        // SAFETY: `len` values from `ptr` lie in the mapping this value owns, page-aligned
+        // (aligned for `U`) and initialised (zero-filled at creation; every bit pattern is
+        // a `U`, `Plain`); `&mut self` makes the borrow exclusive.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr::<U>(), len) }
+    }
+
+    /// Start of the buffer as `Complex64` values (valid for the `len` values asked for,
+    /// while `self` lives).
     pub fn as_mut_ptr(&self) -> *mut Complex64 {
-        self.ptr
+        self.ptr::<Complex64>()
     }
 
-    /// Number of complex values the buffer holds (at least the `len` asked for).
+    /// Number of `Complex64` values the buffer holds (at least the `len` asked for).
     pub fn len(&self) -> usize {
-        self.bytes / 16
+        self.len_of::<Complex64>()
     }
 
-    /// The first `len` values (`len <= self.len()`).
+    /// The first `len` `Complex64` values (`len <= self.len()`).
     pub fn slice_mut(&mut self, len: usize) -> &mut [Complex64] {
-        assert!(len <= self.len());
-        // SAFETY: `len` values from `ptr` lie in the mapping this value owns, initialised
-        // (zero-filled at creation); `&mut self` makes the borrow exclusive.
-        unsafe { std::slice::from_raw_parts_mut(self.ptr, len) }
+        self.view_mut::<Complex64>(len)
     }
 }
 
@@ -120,35 +164,39 @@ impl Drop for AlignedBuf {
     }
 }
 
-/// Copy `rows` rows of `len` doubles from rows `ss` doubles apart at `src` to rows `ds`
-/// apart at `dst`; with `stream`, by non-temporal stores where `dst` and its rows are
-/// 16-byte aligned (for memory the transform does not read again: ordinary stores would
-/// first read every line).
+/// Copy `rows` rows of `len` values from rows `ss` values apart at `src` to rows `ds`
+/// apart at `dst`; with `stream`, by non-temporal stores where `dst` is 16-byte aligned and
+/// its rows and their stride whole 16-byte units (for memory the transform does not read
+/// again: ordinary stores would first read every line).
 ///
 /// # Safety
 /// `src` is valid for reads and `dst` for writes of those extents (`rows` rows of `len`
-/// doubles at the given strides), and the two do not overlap.
-pub(crate) unsafe fn copy_rows(
-    src: *const f64,
+/// values at the given strides), and the two do not overlap.
+pub(crate) unsafe fn copy_rows<U: Plain>(
+    src: *const U,
     ss: usize,
-    dst: *mut f64,
+    dst: *mut U,
     ds: usize,
     rows: usize,
     len: usize,
     stream: bool,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if stream && (dst as usize).is_multiple_of(16) && ds.is_multiple_of(2) && len.is_multiple_of(2)
+    if stream
+        && (dst as usize).is_multiple_of(16)
+        && (ds * size_of::<U>()).is_multiple_of(16)
+        && (len * size_of::<U>()).is_multiple_of(16)
     {
         use std::arch::x86_64::{_mm_loadu_pd, _mm_sfence, _mm_stream_pd};
+        let row_bytes = len * size_of::<U>();
         for r in 0..rows {
             // SAFETY: row `r` of both extents is in bounds (this function's contract); each
-            // store writes 2 doubles at an even offset of a 16-byte aligned row (checked
-            // above), and SSE2 is part of x86_64.
+            // store writes 16 bytes at a multiple of 16 bytes into a 16-byte aligned row
+            // (checked above), moving the bits unchanged; SSE2 is part of x86_64.
             unsafe {
-                let (s, d) = (src.add(r * ss), dst.add(r * ds));
-                for i in (0..len).step_by(2) {
-                    _mm_stream_pd(d.add(i), _mm_loadu_pd(s.add(i)));
+                let (s, d) = (src.add(r * ss).cast::<u8>(), dst.add(r * ds).cast::<u8>());
+                for i in (0..row_bytes).step_by(16) {
+                    _mm_stream_pd(d.add(i).cast::<f64>(), _mm_loadu_pd(s.add(i).cast::<f64>()));
                 }
             }
         }
@@ -178,10 +226,20 @@ impl ChunkBuffer {
         ChunkBuffer(std::sync::Mutex::new(made))
     }
 
-    /// Runs `f` with a buffer of at least `len` complex values (see [`ChunkBuffer`]).
+    /// Runs `f` with a buffer of at least `len` complex values (`Complex64`, see
+    /// [`ChunkBuffer`]).
     pub(crate) fn with<R>(
         &self,
         len: usize,
+        f: impl FnOnce(&AlignedBuf) -> Result<R>,
+    ) -> Result<R> {
+        self.with_bytes(16 * len, f)
+    }
+
+    /// Runs `f` with a buffer of at least `bytes` bytes (see [`ChunkBuffer`]).
+    pub(crate) fn with_bytes<R>(
+        &self,
+        bytes: usize,
         f: impl FnOnce(&AlignedBuf) -> Result<R>,
     ) -> Result<R> {
         use crate::system::{check_headroom, mem_available};
@@ -190,9 +248,8 @@ impl ChunkBuffer {
             Ok(g) => g,
             Err(TryLockError::Poisoned(e)) => e.into_inner(),
             Err(TryLockError::WouldBlock) => {
-                let bytes = 16 * len;
                 if mem_available().is_none_or(|a| a / 2 >= bytes) && check_headroom(bytes).is_ok() {
-                    return f(&AlignedBuf::new(len)?);
+                    return f(&AlignedBuf::with_bytes(bytes)?);
                 }
                 if rayon::current_thread_index().is_some() {
                     return Err(Error::OutOfMemory { bytes });
@@ -200,11 +257,11 @@ impl ChunkBuffer {
                 self.0.lock().unwrap_or_else(|e| e.into_inner())
             }
         };
-        if guard.as_ref().is_none_or(|b| b.len() < len) {
+        if guard.as_ref().is_none_or(|b| b.bytes() < bytes) {
             // The old buffer goes before the new one is mapped.
             *guard = None;
-            check_headroom(16 * len)?;
-            *guard = Some(AlignedBuf::new(len)?);
+            check_headroom(bytes)?;
+            *guard = Some(AlignedBuf::with_bytes(bytes)?);
         }
         f(guard.as_ref().expect("just made"))
     }
@@ -212,8 +269,37 @@ impl ChunkBuffer {
 
 #[cfg(test)]
 mod tests {
-    use super::{AlignedBuf, ChunkBuffer};
-    use num_complex::Complex64;
+    use super::{copy_rows, AlignedBuf, ChunkBuffer};
+    use num_complex::{Complex32, Complex64};
+
+    /// Rows copied in either precision, streamed (rows of whole 16-byte units into an
+    /// aligned destination) or not (odd row lengths, or not asked), land where they should
+    /// and nowhere else.
+    #[test]
+    fn copy_rows_of_both_precisions() {
+        fn check<U: super::Plain + PartialEq + std::fmt::Debug>(value: impl Fn(usize) -> U) {
+            for (len, stream) in [(8, true), (8, false), (3, true), (5, false)] {
+                let (rows, ss, ds) = (4, len + 2, len + 4);
+                let src: Vec<U> = (0..rows * ss).map(&value).collect();
+                let mut dst = AlignedBuf::of::<U>(rows * ds).unwrap();
+                let zero = dst.view_mut::<U>(1)[0];
+                // SAFETY: `rows` rows of `len` values at strides `ss` and `ds` lie inside
+                // `src` and `dst`, which do not overlap.
+                unsafe { copy_rows(src.as_ptr(), ss, dst.ptr::<U>(), ds, rows, len, stream) };
+                let d = dst.view_mut::<U>(rows * ds);
+                for r in 0..rows {
+                    for i in 0..ds {
+                        let want = if i < len { src[r * ss + i] } else { zero };
+                        assert_eq!(d[r * ds + i], want, "len {len} stream {stream} ({r}, {i})");
+                    }
+                }
+            }
+        }
+        check(|i| Complex32::new(i as f32, -(i as f32)));
+        check(|i| Complex64::new(i as f64, 0.5));
+        check(|i| i as f32 + 1.0);
+        check(|i| i as f64 + 1.0);
+    }
 
     /// A chunk buffer is made on first use and kept, grown when more is asked, and an
     /// execution that finds it taken (here the same thread, one call inside another) gets

@@ -1,24 +1,33 @@
 //! The FFTW stage: 2-D DFTs of beta slices over (alpha, gamma).
 //!
+//! Both precisions go through FFTW: `f64` through libfftw3 (`fftw_*`), `f32` through
+//! libfftw3f (`fftwf_*`), reached by code generic over the element type through
+//! [`FftwApi`] (`T::plan_many_dft`, `T::execute_dft`, ...; plans are [`RawPlan<T>`]).
+//!
 //! FFTW's planner is not thread-safe, and the host program may use FFTW too: every planner
-//! call (plan creation and destruction) holds the global planner lock, and
-//! `fftw_make_planner_thread_safe()` is called once so planning from the host's own threads
-//! is serialised with ours. Executing a plan on new arrays is thread-safe, so slices are
-//! transformed in parallel on the plan's rayon pool.
+//! call (plan creation and destruction) of either library holds the global planner lock,
+//! and `fftw_make_planner_thread_safe()` and `fftwf_make_planner_thread_safe()` are called
+//! once so planning from the host's own threads is serialised with ours. Executing a plan on
+//! new arrays is thread-safe, so slices are transformed in parallel on the plan's rayon pool.
 //!
 //! FFTW's process-wide thread setting: every plan is single-threaded (it runs inside the
 //! library's workers); a host that has set FFTW's thread count for new plans above 1
 //! keeps its setting, which is set to 1 only for the duration of each of the library's
 //! planner calls, under the planner lock.
 //!
+//! - `api`: the FFTW functions of each precision ([`FftwApi`]);
 //! - `planner`: the planner lock, owned FFTW plans;
 //! - `buf`: page-aligned buffers and row copies;
-//! - `wisdom`: FFTW's wisdom, exported and imported.
+//! - `wisdom`: FFTW's wisdom, exported and imported (one store per precision).
 
+mod api;
 mod buf;
 mod planner;
+#[cfg(test)]
+pub(crate) mod tests;
 pub mod wisdom;
 
+pub(crate) use api::FftwApi;
 pub(crate) use buf::{copy_rows, AlignedBuf, ChunkBuffer};
 pub(crate) use planner::{plan_guarded, planning_bytes, RawPlan};
 
