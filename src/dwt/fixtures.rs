@@ -2,8 +2,8 @@
 //! measuring tools in `benches/` (feature `internals`).
 
 use super::lanes::{Lanes, Prefetch, Rec};
+use crate::numeric::Elem;
 use crate::numeric::{frexp, ldexp};
-use crate::real::Elem;
 use crate::wigner::starts::{big, start_norm, BaseStart, BetaTables, DEFAULT_SKIP_BITS};
 use crate::wigner::{RecCoeffs, RecTables};
 

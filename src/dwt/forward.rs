@@ -3,7 +3,7 @@
 
 use super::lanes::{Lanes, Rec};
 use super::state::{prefix_states, State};
-use crate::real::Elem;
+use crate::numeric::Elem;
 use crate::simd::{group_of, Simd};
 use crate::wigner::REC_PAD;
 use std::mem::MaybeUninit;

@@ -1,7 +1,7 @@
 //! The kernels' inputs besides the data: recurrence coefficients ([`Rec`]), per-lane
 //! inputs and the data layout ([`Lanes`]), prefetch hints ([`Prefetch`]).
 
-use crate::real::Elem;
+use crate::numeric::Elem;
 use crate::wigner::{RecCoeffs, REC_PAD};
 
 /// Recurrence coefficients of one cluster, index `i = l - l0`, for the scaled values

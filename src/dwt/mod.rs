@@ -33,7 +33,7 @@ mod tests;
 #[cfg(test)]
 mod tests_f32;
 
-use crate::real::Elem;
+use crate::numeric::Elem;
 use crate::simd::Isa;
 
 pub(crate) use batch::{inverse_tile_len, BatchFill, BatchRows};

@@ -2,7 +2,7 @@
 //! in `l`, shared by the kernels.
 
 use super::lanes::{Lanes, Rec};
-use crate::real::Elem;
+use crate::numeric::Elem;
 use crate::simd::Simd;
 use std::mem::MaybeUninit;
 

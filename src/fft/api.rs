@@ -8,7 +8,7 @@
 //! thread setting) only under the planner lock (`planner::planner_lock`), new-array executes
 //! from any thread.
 
-use crate::real::Elem;
+use crate::numeric::Elem;
 use fftw_sys as fftw;
 use num_complex::Complex;
 use std::ffi::{c_char, c_int, c_uint, CStr};

@@ -1,7 +1,7 @@
 //! Page-aligned buffers, the chunk buffer of a plan, and row copies.
 
 use crate::error::{Error, Result};
-use crate::real::Elem;
+use crate::numeric::Elem;
 use num_complex::{Complex, Complex64};
 
 /// Element types an [`AlignedBuf`] may be viewed as: the library's reals and complex values

@@ -19,7 +19,7 @@ pub(crate) mod scalar;
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests;
 
-use crate::real::Elem;
+use crate::numeric::Elem;
 
 /// The environment variable that overrides [`Isa::detect`] (see [`Isa::selected`]).
 pub const ISA_VARIABLE: &str = "SO3FFT_ISA";

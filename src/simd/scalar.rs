@@ -1,7 +1,7 @@
 //! [`Simd`] in portable scalar code: one element per "vector", no fused multiply-add.
 
 use super::Simd;
-use crate::real::Elem;
+use crate::numeric::Elem;
 use std::marker::PhantomData;
 
 /// Portable scalar implementation for elements `E` (also the reference the SIMD paths are

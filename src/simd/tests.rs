@@ -6,7 +6,7 @@ use super::avx2_f32::Avx2F32;
 use super::avx512::Avx512;
 use super::avx512_f32::Avx512F32;
 use super::{group_of, Isa, Simd, MAX_LANES};
-use crate::real::Elem;
+use crate::numeric::Elem;
 
 /// `splat2`, `unpack_even` and `unpack_odd` against their definitions, lane by lane.
 fn pair_ops<S: Simd, const W: usize>() {
