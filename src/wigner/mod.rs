@@ -11,6 +11,8 @@
 
 pub(crate) mod column;
 pub(crate) mod derivatives;
+#[cfg(test)]
+mod f32_accuracy;
 pub(crate) mod recurrence;
 pub(crate) mod starts;
 
