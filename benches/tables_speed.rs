@@ -5,12 +5,17 @@
 //! Run: `cargo bench --features internals --bench tables_speed`
 
 use so3fft::internals::{start_norms, BetaTables, Ext, RecCoeffs, RecTables};
-use so3fft::{weights, Isa};
+use so3fft::{weights, Isa, Real};
 
 fn main() {
     table_build_speed();
     coeffs_speed();
-    starts_speed();
+    for isa in [Isa::Avx512, Isa::Avx2, Isa::Scalar] {
+        if isa.is_supported() {
+            starts_speed::<f64>(isa);
+            starts_speed::<f32>(isa);
+        }
+    }
 }
 
 /// Time of the plan's tables at large bandwidths.
@@ -57,14 +62,15 @@ fn coeffs_speed() {
 }
 
 /// Time of the starting values of every cluster at B = 256, two halves of 51 points
-/// per cluster and chunk, five chunks (what a plan with the default workspace does).
-fn starts_speed() {
+/// per cluster and chunk, five chunks (what a plan with the default workspace does), in
+/// element type `T` with the instruction set `isa`.
+fn starts_speed<T: Real>(isa: Isa) {
     let b = 256;
     let bt = BetaTables::grid(b);
     let norm = Ext { mant: 0.5, exp: 0 };
     let h = 51;
-    let (mut p, mut sc) = (vec![0.0; h], vec![0.0; h]);
-    let (isa, mut best) = (Isa::detect(), f64::MAX);
+    let (mut p, mut sc) = (vec![T::default(); h], vec![T::default(); h]);
+    let mut best = f64::MAX;
     for _ in 0..5 {
         let t = std::time::Instant::now();
         for lo in (0..b).step_by(h) {
@@ -81,7 +87,8 @@ fn starts_speed() {
         std::hint::black_box(&p);
     }
     println!(
-        "starts for all clusters and chunks of B = {b}: {:.2} ms",
+        "starts for all clusters and chunks of B = {b} ({}, {isa:?}): {:.2} ms",
+        std::any::type_name::<T>(),
         best * 1e3
     );
 }

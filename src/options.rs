@@ -5,9 +5,10 @@
 
 use crate::error::{Error, Result};
 use crate::fft::Rigor;
+use crate::real::Elem;
 use crate::simd::Isa;
 use crate::system::mem_available;
-use crate::wigner::{DEFAULT_SKIP_BITS, SKIP_BITS_RANGE};
+use crate::wigner::{skip_bits_range, DEFAULT_SKIP_BITS};
 
 /// Which transforms a plan can run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -173,16 +174,24 @@ impl Options {
         self
     }
 
-    /// The skip threshold's exponent and whether degrees below it are skipped: the default
-    /// 64; `Some(0)`, no skipping (the starting values still need a threshold: the widest);
-    /// an error outside 0 and 24..=560.
+    /// The skip threshold's exponent and whether degrees below it are skipped, for f64
+    /// plans: [`Options::skip_for`] of `f64`.
     pub(crate) fn skip(&self) -> Result<(u32, bool)> {
+        self.skip_for::<f64>()
+    }
+
+    /// The skip threshold's exponent and whether degrees below it are skipped, for plans
+    /// computing in `E`: the default 64; `Some(0)`, no skipping (the starting values still
+    /// need a threshold: the widest); an error outside 0 and `skip_bits_range::<E>()`
+    /// (24..=560 for f64, 24..=100 for f32).
+    pub(crate) fn skip_for<E: Elem>(&self) -> Result<(u32, bool)> {
+        let range = skip_bits_range::<E>();
         match self.skip_bits {
             None => Ok((DEFAULT_SKIP_BITS, true)),
-            Some(0) => Ok((*SKIP_BITS_RANGE.end(), false)),
-            Some(b) if SKIP_BITS_RANGE.contains(&b) => Ok((b, true)),
+            Some(0) => Ok((*range.end(), false)),
+            Some(b) if range.contains(&b) => Ok((b, true)),
             Some(b) => Err(Error::InvalidArgument(format!(
-                "skip_bits {b} outside {SKIP_BITS_RANGE:?}"
+                "skip_bits {b} outside {range:?}"
             ))),
         }
     }
@@ -216,5 +225,28 @@ impl Options {
             Some(avail) => d.min(avail / 2),
             None => d,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Options;
+
+    /// The accepted skip exponents per element type: f64 up to 560, f32 up to 100 (the
+    /// scaled starting values stay normal); `Some(0)` takes the widest threshold.
+    #[test]
+    fn skip_bits_per_element() {
+        let with = |b| Options::default().with_skip_bits(b);
+        assert_eq!(with(None).skip().unwrap(), (64, true));
+        assert_eq!(with(None).skip_for::<f32>().unwrap(), (64, true));
+        assert_eq!(with(Some(0)).skip().unwrap(), (560, false));
+        assert_eq!(with(Some(0)).skip_for::<f32>().unwrap(), (100, false));
+        assert_eq!(with(Some(560)).skip().unwrap(), (560, true));
+        assert_eq!(with(Some(100)).skip_for::<f32>().unwrap(), (100, true));
+        assert_eq!(with(Some(24)).skip_for::<f32>().unwrap(), (24, true));
+        assert!(with(Some(101)).skip_for::<f32>().is_err());
+        assert!(with(Some(561)).skip().is_err());
+        assert!(with(Some(23)).skip().is_err());
+        assert!(with(Some(23)).skip_for::<f32>().is_err());
     }
 }

@@ -11,6 +11,8 @@
 
 pub(crate) mod column;
 pub(crate) mod derivatives;
+#[cfg(test)]
+mod f32_accuracy;
 pub(crate) mod recurrence;
 pub(crate) mod starts;
 
@@ -20,7 +22,7 @@ use column::column;
 pub use derivatives::wigner_d_derivatives;
 pub(crate) use recurrence::{RecCoeffs, RecTables, REC_PAD};
 pub(crate) use starts::{
-    big, start_norm, start_norms, BetaTables, DEFAULT_SKIP_BITS, SKIP_BITS_RANGE,
+    big, skip_bits_range, start_norm, start_norms, BetaTables, DEFAULT_SKIP_BITS,
 };
 
 /// `d^l_{m,mp}(beta)` (standard, not normalised) for `l = max(|m|,|mp|) ..= lmax`.

@@ -2,6 +2,7 @@
 //! nearest to its exact value.
 
 use crate::numeric::Dd;
+use crate::real::Elem;
 
 /// Tables from which the recurrence coefficients of any base pair follow by a few
 /// double-double multiplications per degree (no square root per cluster), so that every
@@ -278,25 +279,26 @@ impl RecTables {
 pub(crate) const REC_PAD: usize = 8;
 
 /// Recurrence coefficients of one cluster (see [`RecTables::coeffs`]), index `i = l - l0`,
-/// for `len()` degrees; each array holds [`REC_PAD`] zeros after them.
+/// for `len()` degrees; each array holds [`REC_PAD`] zeros after them. In element type `E`:
+/// [`RecTables::coeffs`] fills the f64 form, [`RecCoeffs::narrow_from`] the f32 one.
 #[derive(Default)]
-pub struct RecCoeffs {
+pub struct RecCoeffs<E: Elem = f64> {
     /// `A'_i`
-    pub a: Vec<f64>,
+    pub a: Vec<E>,
     /// `-A'_i`
-    pub neg_a: Vec<f64>,
+    pub neg_a: Vec<E>,
     /// `A'_i + C'_i`
-    pub a_plus_c: Vec<f64>,
+    pub a_plus_c: Vec<E>,
     /// `C'_i - A'_i`
-    pub c_minus_a: Vec<f64>,
+    pub c_minus_a: Vec<E>,
     /// The scale `S_i` of the values (see [`RecTables::coeffs`]).
-    pub s: Vec<f64>,
+    pub s: Vec<E>,
     n: usize,
 }
 
-impl RecCoeffs {
+impl<E: Elem> RecCoeffs<E> {
     /// Arrays for `n` degrees.
-    pub fn new(n: usize) -> RecCoeffs {
+    pub fn new(n: usize) -> RecCoeffs<E> {
         let mut r = RecCoeffs::default();
         r.resize(n);
         r
@@ -316,16 +318,41 @@ impl RecCoeffs {
             &mut self.c_minus_a,
             &mut self.s,
         ] {
-            v.resize(n + REC_PAD, 0.0);
-            v[n..].fill(0.0);
+            v.resize(n + REC_PAD, E::ZERO);
+            v[n..].fill(E::ZERO);
         }
         self.n = n;
     }
 }
 
+impl RecCoeffs<f32> {
+    /// `src` with every entry (the padding's zeros included) rounded to the nearest `f32`,
+    /// in this value's arrays (no allocation once they are long enough): the coefficients
+    /// of the f32 kernels, `O(n)` per cluster. The coefficients are far from the f32 range's
+    /// ends (`|A'|`, `|C'|` below a few times the degree, `S_i` near 1), so all stay finite
+    /// and normal or zero.
+    #[allow(
+        dead_code,
+        reason = "used by the f32 DWT set-up (stage 2 of the f32 tier)"
+    )]
+    pub fn narrow_from(&mut self, src: &RecCoeffs<f64>) {
+        for (dst, src) in [
+            (&mut self.a, &src.a),
+            (&mut self.neg_a, &src.neg_a),
+            (&mut self.a_plus_c, &src.a_plus_c),
+            (&mut self.c_minus_a, &src.c_minus_a),
+            (&mut self.s, &src.s),
+        ] {
+            dst.clear();
+            dst.extend(src.iter().map(|&x| x as f32));
+        }
+        self.n = src.n;
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{RecCoeffs, RecTables};
+    use super::{RecCoeffs, RecTables, REC_PAD};
     use crate::numeric::exact::is_rounded_sqrt;
 
     /// The first coefficients of each base pair (where the scale is 1) against their
@@ -373,6 +400,46 @@ mod tests {
             checked.iter().all(|&c| c >= 20),
             "too few exact checks: {checked:?}"
         );
+    }
+
+    /// `narrow_from` rounds every entry, padding included, to the nearest f32, keeps the
+    /// length, and reuses its arrays when shrinking.
+    #[test]
+    fn narrowing_rounds_each_entry() {
+        let rt = RecTables::new(200);
+        let mut r32 = RecCoeffs::<f32>::new(3);
+        for (m, mp, n) in [(0, 0, 200), (7, 3, 150), (120, 120, 80), (199, 0, 1)] {
+            let mut r = RecCoeffs::new(n);
+            rt.coeffs(m, mp, &mut r);
+            let ptr = r32.a.as_ptr();
+            let grows = r32.a.capacity() < n + REC_PAD;
+            r32.narrow_from(&r);
+            assert!(grows || r32.a.as_ptr() == ptr, "reallocated");
+            assert_eq!(r32.len(), n);
+            for (wide, narrow) in [
+                (&r.a, &r32.a),
+                (&r.neg_a, &r32.neg_a),
+                (&r.a_plus_c, &r32.a_plus_c),
+                (&r.c_minus_a, &r32.c_minus_a),
+                (&r.s, &r32.s),
+            ] {
+                assert_eq!(narrow.len(), n + REC_PAD);
+                for (i, (&x, &y)) in wide.iter().zip(narrow).enumerate() {
+                    // Nearest: no f32 lies strictly closer to x than y.
+                    let err = (y as f64 - x).abs();
+                    let (up, down) = (
+                        f32::from_bits(y.to_bits() + 1),
+                        f32::from_bits(y.to_bits() - 1),
+                    );
+                    assert!(y.is_finite() && (i < n || y == 0.0), "m={m} mp={mp} i={i}");
+                    if y != 0.0 {
+                        assert!(err <= (up as f64 - x).abs() && err <= (down as f64 - x).abs());
+                    } else {
+                        assert_eq!(x, 0.0);
+                    }
+                }
+            }
+        }
     }
 
     /// The scaled coefficients undo their scales: `A'_i S_{i+1} / S_i = A_i` and

@@ -7,41 +7,72 @@
 //! `scale_index < 0` is below the skip threshold `2^-bits` and contributes nothing; the
 //! kernels rescale it by `2^-SCALE_STEP` whenever it grows past `big(bits)` until it reaches
 //! `scale_index = 0`, after which the recurrence continues in plain doubles.
+//!
+//! The form exists per element type `E` (`crate::real::Elem`): `SCALE_STEP` is
+//! `E::SCALE_STEP` (600 for f64, 96 for f32) and `bits` at most `E::MAX_SKIP_BITS`, so that
+//! every scaled value stays a normal number of `E`. The f32 form is computed in f64 and
+//! rounded once, the scale index being a small integer.
 
 use crate::numeric::{frexp, ldexp, sin_cos_dd, Dd, Ext, ExtDd, PI_DD};
+use crate::real::Elem;
 use crate::simd::Isa;
-/// Exponent step of one rescaling.
-pub(crate) const SCALE_STEP: i64 = 600;
-/// Default skip threshold: lanes whose true value is below `2^-DEFAULT_SKIP_BITS` are
-/// treated as zero (see `Options::skip_bits`).
-pub(crate) const DEFAULT_SKIP_BITS: u32 = 64;
-/// Accepted range of skip thresholds (`2^-bits`): the scaled values stay normal doubles.
-pub(crate) const SKIP_BITS_RANGE: std::ops::RangeInclusive<u32> = 24..=560;
+use std::any::TypeId;
+use std::ops::RangeInclusive;
 
-/// Rescale threshold of the scaled values for skip threshold `2^-bits`: `2^(SCALE_STEP - bits)`.
-pub(crate) fn big(bits: u32) -> f64 {
-    ldexp(1.0, SCALE_STEP - bits as i64)
+/// Exponent step of one rescaling of the f64 form (`Elem::SCALE_STEP` of `f64`).
+pub(crate) const SCALE_STEP: i64 = <f64 as Elem>::SCALE_STEP;
+/// Default skip threshold: lanes whose true value is below `2^-DEFAULT_SKIP_BITS` are
+/// treated as zero (see `Options::skip_bits`). Valid for both element types.
+pub(crate) const DEFAULT_SKIP_BITS: u32 = 64;
+/// Accepted range of skip thresholds (`2^-bits`) of the f64 form: [`skip_bits_range`].
+pub(crate) const SKIP_BITS_RANGE: RangeInclusive<u32> = skip_bits_range::<f64>();
+
+/// Accepted range of skip thresholds (`2^-bits`) for element type `E`: the scaled values
+/// `[2^(-bits-1), 2^(E::SCALE_STEP - bits))` stay normal numbers of `E`.
+pub(crate) const fn skip_bits_range<E: Elem>() -> RangeInclusive<u32> {
+    24..=E::MAX_SKIP_BITS
 }
-/// Rescaling factor `2^-SCALE_STEP`.
+
+/// Rescale threshold of the scaled values for skip threshold `2^-bits`:
+/// `2^(E::SCALE_STEP - bits)`.
+pub(crate) fn big<E: Elem>(bits: u32) -> E {
+    E::from_f64(ldexp(1.0, E::SCALE_STEP - bits as i64))
+}
+
+/// Rescaling factor `2^-E::SCALE_STEP` (a normal number of `E`).
+pub(crate) fn tiny<E: Elem>() -> E {
+    E::from_f64(ldexp(1.0, -E::SCALE_STEP))
+}
+
+/// Rescaling factor `2^-SCALE_STEP` of the f64 form ([`tiny`] of `f64`).
 pub(crate) const TINY: f64 = f64::from_bits(((1023 - SCALE_STEP) as u64) << 52);
 
-/// `value` in the kernels' scaled form `(start, scale_index)` for skip threshold
-/// `2^-bits`: true value `= start * 2^(SCALE_STEP * scale_index)`, `scale_index = 0` if the
-/// value is at least `2^-bits`, else `start` in `[2^(-bits-1), big(bits))`.
+/// `value` in the kernels' scaled form `(start, scale_index)` of element type `E` for skip
+/// threshold `2^-bits` (`bits` in [`skip_bits_range`] of `E`): true value
+/// `= start * 2^(E::SCALE_STEP * scale_index)`, `scale_index = 0` if the value is at least
+/// `2^-bits`, else `start` in `[2^(-bits-1), big(bits)]`. Computed in f64 and rounded
+/// once to `E` (for `f32`, a normal number: the rounding is that of the value itself; it
+/// may round up to `big(bits)`, which the kernels rescale at the next step).
 #[inline]
-pub(crate) fn to_scaled(value: Ext, bits: u32) -> (f64, f64) {
+pub(crate) fn to_scaled<E: Elem>(value: Ext, bits: u32) -> (E, E) {
+    debug_assert!(bits <= E::MAX_SKIP_BITS, "skip bits {bits} for {}", E::NAME);
+    let step = E::SCALE_STEP;
     let active_bits = bits as i64;
     if value.mant == 0.0 {
-        return (0.0, 0.0);
+        return (E::ZERO, E::ZERO);
     }
     let e = value.exp; // |value| in [2^(e-1), 2^e)
     if e > -active_bits {
-        return (ldexp(value.mant, e), 0.0);
+        return (E::from_f64(ldexp(value.mant, e)), E::ZERO);
     }
-    let j = (-active_bits - e + SCALE_STEP) / SCALE_STEP; // ceil((-T - e)/S) for -T-e >= 0, >= 1
-    (ldexp(value.mant, e + SCALE_STEP * j), -(j as f64))
+    let j = (-active_bits - e + step) / step; // ceil((-T - e)/S) for -T-e >= 0, >= 1
+    (
+        E::from_f64(ldexp(value.mant, e + step * j)),
+        E::from_f64(-(j as f64)),
+    )
 }
 
+/// `sqrt((2m+1)/2 * binom(2m, m-m'))` for every `0 <= m' <= m < b`, index `m(m+1)/2 + m'`,
 /// each the nearest double (times a power of two): the binomials are built in
 /// double-double arithmetic, whose rounding errors over the `m` steps stay far below one
 /// double ulp.
@@ -216,10 +247,11 @@ impl BetaTables {
         self.tau_hi[k] < self.tau_lo[k]
     }
 
-    /// Scaled starting value `weight * dt^m_{m,m'}` at point `k` (see [`to_scaled`]). (A
-    /// per-lane weight scales every degree of the recurrence alike.)
+    /// Scaled starting value `weight * dt^m_{m,m'}` at point `k` in the form of element
+    /// type `E` (see [`to_scaled`]). (A per-lane weight scales every degree of the
+    /// recurrence alike.)
     #[inline]
-    pub fn start(&self, k: usize, base: &BaseStart, weight: f64) -> (f64, f64) {
+    pub fn start<E: Elem>(&self, k: usize, base: &BaseStart, weight: f64) -> (E, E) {
         let (a, b) = (base.m + base.mp, base.m - base.mp);
         let [c1m, c1e, c2m, c2e] = self.cos_powers.rows(a, k);
         let [s1m, s1e, s2m, s2e] = self.sin_powers.rows(b, k);
@@ -233,12 +265,14 @@ impl BetaTables {
     }
 
     /// [`BetaTables::start`] (weight 1, base pair `(m, mp)` with `norm`, skip threshold
-    /// `2^-bits`) for the consecutive points `k0 .. k0 + values.len()`, into `values` and
-    /// `scale_indices`: with AVX-512 eight points at a time (`getexp`, `getmant` and
-    /// `scalef` do the exponent arithmetic exactly), with AVX2 four at a time (the same on
-    /// the bits of the doubles), else one at a time. All give the same bits.
+    /// `2^-bits`, `bits` at most `E::MAX_SKIP_BITS`) for the consecutive points
+    /// `k0 .. k0 + values.len()`, into `values` and `scale_indices`: with AVX-512 eight
+    /// points at a time (`getexp`, `getmant` and `scalef` do the exponent arithmetic
+    /// exactly), with AVX2 four at a time (the same on the bits of the doubles), else one at
+    /// a time. The vector paths compute in f64 lanes and round to `E` once, as the scalar
+    /// one does. All give the same bits.
     #[allow(clippy::too_many_arguments)]
-    pub fn starts(
+    pub fn starts<E: Elem>(
         &self,
         isa: Isa,
         k0: usize,
@@ -246,12 +280,13 @@ impl BetaTables {
         mp: usize,
         norm: Ext,
         bits: u32,
-        values: &mut [f64],
-        scale_indices: &mut [f64],
+        values: &mut [E],
+        scale_indices: &mut [E],
     ) {
         let base = &BaseStart::new(m, mp, norm, bits);
         let len = values.len();
         assert!(scale_indices.len() == len && k0 + len <= self.tau_lo.len());
+        assert!(bits <= E::MAX_SKIP_BITS, "skip bits {bits} for {}", E::NAME);
         #[cfg(target_arch = "x86_64")]
         if isa == Isa::Avx512 && isa.is_supported() {
             let rows = [
@@ -284,11 +319,17 @@ impl BetaTables {
     }
 }
 
+/// Whether `E` is `T` (a constant after monomorphisation).
+fn is<E: 'static, T: 'static>() -> bool {
+    TypeId::of::<E>() == TypeId::of::<T>()
+}
+
 /// Eight starting values at a time, with the arithmetic of [`BetaTables::start`] and
-/// [`to_scaled`]: the product of the five mantissas is split by `getexp`/`getmant`
-/// into `frexp` form, and the scaled value is built by `scalef` (an exact power-of-two
-/// scaling) with the scale index `j = floor((S - bits - e) / S)` where the value is below
-/// `2^-bits`. `rows` holds the rows of the cosine and of the sine powers
+/// [`to_scaled`] (with `E`'s step `S`): the product of the five mantissas is split by
+/// `getexp`/`getmant` into `frexp` form, and the scaled value is built by `scalef` (an
+/// exact power-of-two scaling) with the scale index `j = floor((S - bits - e) / S)` where
+/// the value is below `2^-bits`; for `f32` both are then rounded by `cvtpd2ps`, as `as
+/// f32` rounds. `rows` holds the rows of the cosine and of the sine powers
 /// ([`PowTable::rows`]).
 ///
 /// # Safety
@@ -296,20 +337,24 @@ impl BetaTables {
 /// `values.len()` entries.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn starts_avx512(
+unsafe fn starts_avx512<E: Elem>(
     rows: [[&[f64]; 4]; 2],
     base: &BaseStart,
-    values: &mut [f64],
-    scale_indices: &mut [f64],
+    values: &mut [E],
+    scale_indices: &mut [E],
 ) {
     use std::arch::x86_64::*;
+    // `E` is one of the two (`Elem` is sealed): the stores below depend on it.
+    let wide = is::<E, f64>();
+    assert!(wide || is::<E, f32>());
     let [c, s] = rows;
     let len = values.len();
     let nm = _mm512_set1_pd(base.norm.mant);
     let ne = _mm512_set1_pd(base.norm.exp as f64);
     let neg_t = _mm512_set1_pd(-(base.skip_bits as f64));
-    let step = _mm512_set1_pd(SCALE_STEP as f64);
-    let inv_step = _mm512_set1_pd(1.0 / SCALE_STEP as f64);
+    let floor_offset = _mm512_set1_pd(E::SCALE_STEP as f64 + 0.5 - base.skip_bits as f64);
+    let step = _mm512_set1_pd(E::SCALE_STEP as f64);
+    let inv_step = _mm512_set1_pd(1.0 / E::SCALE_STEP as f64);
     let zero = _mm512_setzero_pd();
     let one = _mm512_set1_pd(1.0);
     let negative = (base.m - base.mp) % 2 == 1;
@@ -343,15 +388,29 @@ unsafe fn starts_avx512(
         let e = _mm512_add_pd(_mm512_add_pd(exps, big_e), one);
         // Below the threshold (e <= -bits): j = floor((S - bits - e) / S) >= 1, else 0.
         let low = _mm512_cmp_pd_mask::<_CMP_LE_OQ>(e, neg_t);
-        let q = _mm512_mul_pd(_mm512_add_pd(_mm512_sub_pd(neg_t, e), step), inv_step);
+        // (x + S + 1/2) / S for x = -bits - e: its floor is j whatever the rounding of
+        // 1/S (see `starts_avx2`).
+        let q = _mm512_mul_pd(_mm512_sub_pd(floor_offset, e), inv_step);
         let j = _mm512_maskz_roundscale_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(low, q);
         let pv = _mm512_scalef_pd(fm, _mm512_fmadd_pd(j, step, e));
         let pv = _mm512_maskz_mul_pd(nonzero, pv, sign);
         let scv = _mm512_maskz_sub_pd(nonzero, zero, j);
-        // SAFETY: as the loads: the masked lanes lie inside `values` and `scale_indices`.
+        // SAFETY: as the loads: the masked lanes lie inside `values` and `scale_indices`,
+        // whose element type is f64 if `wide`, else f32 (asserted above).
         unsafe {
-            _mm512_mask_storeu_pd(values.as_mut_ptr().add(i), mask, pv);
-            _mm512_mask_storeu_pd(scale_indices.as_mut_ptr().add(i), mask, scv);
+            let (pv_out, scv_out) = (
+                values.as_mut_ptr().add(i),
+                scale_indices.as_mut_ptr().add(i),
+            );
+            if wide {
+                _mm512_mask_storeu_pd(pv_out.cast::<f64>(), mask, pv);
+                _mm512_mask_storeu_pd(scv_out.cast::<f64>(), mask, scv);
+            } else {
+                // Eight floats in the low half; the mask's bits select among them.
+                let narrow = |v| _mm512_castps256_ps512(_mm512_cvtpd_ps(v));
+                _mm512_mask_storeu_ps(pv_out.cast::<f32>(), mask as __mmask16, narrow(pv));
+                _mm512_mask_storeu_ps(scv_out.cast::<f32>(), mask as __mmask16, narrow(scv));
+            }
         }
         i += 8;
     }
@@ -359,7 +418,8 @@ unsafe fn starts_avx512(
 
 /// Four starting values at a time, for CPUs without AVX-512: the arithmetic of
 /// [`starts_avx512`], with `frexp` and the power-of-two scaling done on the bits of the
-/// doubles (AVX2 has no `getexp`, `getmant` or `scalef`). Returns false, with `values` and
+/// doubles (AVX2 has no `getexp`, `getmant` or `scalef`), and for `f32` the rounding by
+/// `cvtpd2ps`. Returns false, with `values` and
 /// `scale_indices` unspecified, if some value lies outside the range where this arithmetic
 /// is that of the scalar code (valid norms and tables never give one); the caller then
 /// uses the scalar code.
@@ -369,14 +429,17 @@ unsafe fn starts_avx512(
 /// least `values.len()` entries.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn starts_avx2(
+unsafe fn starts_avx2<E: Elem>(
     rows: [[&[f64]; 4]; 2],
     base: &BaseStart,
-    values: &mut [f64],
-    scale_indices: &mut [f64],
+    values: &mut [E],
+    scale_indices: &mut [E],
 ) -> bool {
     use std::arch::x86_64::*;
-    // Why the bits are those of `start` and `to_scaled` (S = SCALE_STEP, T = bits):
+    // `E` is one of the two (`Elem` is sealed): the stores below depend on it.
+    let wide = is::<E, f64>();
+    assert!(wide || is::<E, f32>());
+    // Why the bits are those of `start` and `to_scaled` (S = E::SCALE_STEP, T = bits):
     // - Exponents: all sums are integers below 2^53 in magnitude, so exact in doubles (the
     //   table exponents are at most 1075 times the highest power, the norm's is checked).
     // - frexp: where the product `mant` of the mantissas is a normal double (checked; five
@@ -386,11 +449,13 @@ unsafe fn starts_avx2(
     //   multiplication by the double of bits `(k + 1023) << 52`, built here the same way
     //   (a normal double: 23 <= k + 1023 <= 2023). Below the threshold (e <= -T), with
     //   x = -T - e >= 0: j = floor(x / S) + 1 and k = S - T - (x mod S), in [1 - T, S - T],
-    //   within [-559, 576] for T in SKIP_BITS_RANGE. Elsewhere j = 0 and k = e > -T >= -560,
-    //   and e <= 1000 as a valid starting value is at most sqrt((2m + 1) / 2). |k| <= 1000
-    //   is checked all the same (any norm, any T).
-    // - Floor: 1/S rounds up, so (x + S) * (1/S) rounds to at least j when S divides x + S
-    //   and stays below j + 1 otherwise (x far below 2^40), as the integer division does.
+    //   within [-559, 576] for T in `skip_bits_range::<E>()` (either element). Elsewhere
+    //   j = 0 and k = e > -T >= -560, and e <= 1000 as a valid starting value is at most
+    //   sqrt((2m + 1) / 2). |k| <= 1000 is checked all the same (any norm, any T).
+    // - f32: the f64 results rounded by `cvtpd2ps` (to nearest, as `as f32`).
+    // - Floor: (x + S + 1/2) / S (x + S + 1/2 exact) lies at least 1/(2S) above j and
+    //   below j + 1, far beyond the relative rounding errors of 1/S and of the product
+    //   (x far below 2^40), so its floor is j, as the integer division gives.
     if base.norm.exp.unsigned_abs() >= 1 << 40 {
         return false;
     }
@@ -399,8 +464,9 @@ unsafe fn starts_avx2(
     let nm = _mm256_set1_pd(base.norm.mant);
     let ne = _mm256_set1_pd(base.norm.exp as f64);
     let neg_t = _mm256_set1_pd(-(base.skip_bits as f64));
-    let step = _mm256_set1_pd(SCALE_STEP as f64);
-    let inv_step = _mm256_set1_pd(1.0 / SCALE_STEP as f64);
+    let floor_offset = _mm256_set1_pd(E::SCALE_STEP as f64 + 0.5 - base.skip_bits as f64);
+    let step = _mm256_set1_pd(E::SCALE_STEP as f64);
+    let inv_step = _mm256_set1_pd(1.0 / E::SCALE_STEP as f64);
     let max_k = _mm256_set1_pd(1000.0);
     let zero = _mm256_setzero_pd();
     let neg_zero = _mm256_set1_pd(-0.0);
@@ -439,7 +505,7 @@ unsafe fn starts_avx2(
         let e = _mm256_add_pd(exps, _mm256_sub_pd(biased, two52_1022));
         // Below the threshold (e <= -bits): j = floor((S - bits - e) / S) >= 1, else 0.
         let low = _mm256_cmp_pd::<_CMP_LE_OQ>(e, neg_t);
-        let q = _mm256_mul_pd(_mm256_add_pd(_mm256_sub_pd(neg_t, e), step), inv_step);
+        let q = _mm256_mul_pd(_mm256_sub_pd(floor_offset, e), inv_step);
         let j = _mm256_and_pd(
             low,
             _mm256_round_pd::<{ _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC }>(q),
@@ -479,10 +545,20 @@ unsafe fn starts_avx2(
             ld(s[3]),
         ]);
         outside = _mm256_or_pd(outside, out);
-        // SAFETY: as the loads: lanes `i .. i + 4` lie inside `values` and `scale_indices`.
+        // SAFETY: as the loads: lanes `i .. i + 4` lie inside `values` and `scale_indices`,
+        // whose element type is f64 if `wide`, else f32 (asserted above).
         unsafe {
-            _mm256_storeu_pd(values.as_mut_ptr().add(i), pv);
-            _mm256_storeu_pd(scale_indices.as_mut_ptr().add(i), scv);
+            let (pv_out, scv_out) = (
+                values.as_mut_ptr().add(i),
+                scale_indices.as_mut_ptr().add(i),
+            );
+            if wide {
+                _mm256_storeu_pd(pv_out.cast::<f64>(), pv);
+                _mm256_storeu_pd(scv_out.cast::<f64>(), scv);
+            } else {
+                _mm_storeu_ps(pv_out.cast::<f32>(), _mm256_cvtpd_ps(pv));
+                _mm_storeu_ps(scv_out.cast::<f32>(), _mm256_cvtpd_ps(scv));
+            }
         }
         i += 4;
     }
@@ -507,10 +583,23 @@ unsafe fn starts_avx2(
             ld(s[3]),
         ]);
         outside = _mm256_or_pd(outside, out);
-        // SAFETY: as the loads: the masked lanes lie inside `values` and `scale_indices`.
+        // SAFETY: as the loads: the masked lanes lie inside `values` and `scale_indices`,
+        // whose element type is f64 if `wide`, else f32 (asserted above).
         unsafe {
-            _mm256_maskstore_pd(values.as_mut_ptr().add(i), mask, pv);
-            _mm256_maskstore_pd(scale_indices.as_mut_ptr().add(i), mask, scv);
+            let (pv_out, scv_out) = (
+                values.as_mut_ptr().add(i),
+                scale_indices.as_mut_ptr().add(i),
+            );
+            if wide {
+                _mm256_maskstore_pd(pv_out.cast::<f64>(), mask, pv);
+                _mm256_maskstore_pd(scv_out.cast::<f64>(), mask, scv);
+            } else {
+                // The same lanes as 32-bit elements.
+                let mask =
+                    _mm_cmpgt_epi32(_mm_set1_epi32((len - i) as i32), _mm_setr_epi32(0, 1, 2, 3));
+                _mm_maskstore_ps(pv_out.cast::<f32>(), mask, _mm256_cvtpd_ps(pv));
+                _mm_maskstore_ps(scv_out.cast::<f32>(), mask, _mm256_cvtpd_ps(scv));
+            }
         }
     }
     _mm256_movemask_pd(outside) == 0
@@ -519,11 +608,12 @@ unsafe fn starts_avx2(
 #[cfg(test)]
 mod tests {
     use super::{
-        big, start_norm, start_norms, to_scaled, BaseStart, BetaTables, DEFAULT_SKIP_BITS,
-        SCALE_STEP,
+        big, skip_bits_range, start_norm, start_norms, tiny, to_scaled, BaseStart, BetaTables,
+        DEFAULT_SKIP_BITS, SCALE_STEP, SKIP_BITS_RANGE, TINY,
     };
     use crate::numeric::exact::is_rounded_sqrt;
     use crate::numeric::{frexp, ldexp, sin_cos_dd, Dd, Ext, PI_DD};
+    use crate::real::Elem;
     use crate::simd::Isa;
 
     /// Power tables at `beta = pi/2`, where `cos(beta/2) = sin(beta/2) = sqrt(2)/2`: even
@@ -571,25 +661,105 @@ mod tests {
         }
     }
 
+    /// The f64 constants are those of the generic form; the f32 ones are the powers of two.
+    #[test]
+    fn scale_constants() {
+        assert_eq!(tiny::<f64>(), TINY);
+        assert_eq!(SCALE_STEP, 600);
+        assert_eq!(skip_bits_range::<f64>(), SKIP_BITS_RANGE);
+        assert_eq!(skip_bits_range::<f32>(), 24..=100);
+        assert_eq!(tiny::<f32>(), 2f32.powi(-96));
+        for bits in [24u32, 64, 100] {
+            assert_eq!(big::<f32>(bits), 2f32.powi(96 - bits as i32));
+            assert_eq!(big::<f64>(bits), 2f64.powi(600 - bits as i32));
+        }
+    }
+
+    /// `(start, index)` against the extended value `x`: `start * 2^(S index)` is `x` rounded
+    /// to `E` (compared in extended form, exactly), `index = 0` exactly when
+    /// `|x| >= 2^-bits`, and a scaled-down `start` lies in `[2^(-bits-1), big(bits)]`.
+    fn check_scaled<E: Elem>((p, sc): (E, E), x: Ext, bits: u32) {
+        let (p, sc) = (p.to_f64(), sc.to_f64());
+        let what = format!("{} x={x:?} bits={bits}: ({p:e}, {sc})", E::NAME);
+        assert!(sc <= 0.0 && sc == sc.trunc(), "{what}");
+        if x.mant == 0.0 {
+            assert_eq!((p.to_bits(), sc.to_bits()), (0, 0), "{what}");
+            return;
+        }
+        assert_eq!(sc == 0.0, x.exp > -(bits as i64), "{what}");
+        if sc < 0.0 {
+            let (lo, hi) = (ldexp(1.0, -(bits as i64) - 1), big::<E>(bits).to_f64());
+            assert!(p.abs() >= lo && p.abs() <= hi, "{what}");
+        }
+        // The mantissa rounded to `E` (scale-free: `p` is a normal number of `E`).
+        let (wm, we) = frexp(E::from_f64(x.mant).to_f64());
+        let (pm, pe) = frexp(p);
+        assert_eq!(
+            (pm, pe + E::SCALE_STEP * sc as i64),
+            (wm, we + x.exp),
+            "{what}"
+        );
+    }
+
     #[test]
     fn scaled_form_is_consistent() {
-        for &e in &[0i64, -100, -299, -300, -301, -899, -900, -901, -5000] {
-            let x = Ext { mant: 0.75, exp: e };
-            let bits = DEFAULT_SKIP_BITS;
-            let (p, sc) = to_scaled(x, bits);
-            assert!(sc <= 0.0);
-            if sc < 0.0 {
-                assert!(p.abs() < big(bits) && p.abs() >= ldexp(1.0, -(bits as i64) - 1));
+        // A mantissa that rounds up to 1 in f32, one that rounds down, and 0.75 (exact).
+        let mants = [0.75, 1.0 - 1e-9, 0.6 + 1e-12, -0.6 - 1e-12];
+        for &e in &[
+            0i64, -23, -24, -25, -63, -64, -65, -99, -100, -101, -120, -196, -197, -299, -300,
+            -301, -899, -900, -901, -5000,
+        ] {
+            for mant in mants {
+                let x = Ext { mant, exp: e };
+                for bits in [24, DEFAULT_SKIP_BITS, 100] {
+                    check_scaled::<f32>(to_scaled(x, bits), x, bits);
+                    check_scaled::<f64>(to_scaled(x, bits), x, bits);
+                }
+                for bits in [300, 560] {
+                    check_scaled::<f64>(to_scaled(x, bits), x, bits);
+                }
             }
-            // reconstruct in extended form
-            let (pm, pe) = frexp(p);
-            assert_eq!(pm, 0.75);
-            assert_eq!(pe + SCALE_STEP * (sc as i64), e);
+        }
+        let zero = Ext { mant: 0.0, exp: 0 };
+        check_scaled::<f32>(to_scaled(zero, 64), zero, 64);
+        check_scaled::<f64>(to_scaled(zero, 64), zero, 64);
+    }
+
+    /// The f32 starting values are the f64 ones rounded, in the f32 scaled form: at every
+    /// grid point of a few clusters, skip thresholds across the f32 range.
+    #[test]
+    fn f32_starts_round_the_f64_ones() {
+        let b = 300;
+        let bt = BetaTables::grid(b);
+        let norms = start_norms(b);
+        for &(m, mp) in &[
+            (0usize, 0usize),
+            (1, 0),
+            (17, 3),
+            (150, 150),
+            (299, 0),
+            (299, 140),
+        ] {
+            let norm = norms[m * (m + 1) / 2 + mp];
+            for bits in [24u32, 64, 100] {
+                let base = BaseStart::new(m, mp, norm, bits);
+                for k in 0..2 * b {
+                    // The value in extended form, from the f64 scaled form (exact).
+                    let (p, sc) = bt.start::<f64>(k, &base, 1.0);
+                    let (pm, pe) = frexp(p);
+                    let x = Ext {
+                        mant: pm,
+                        exp: pe + SCALE_STEP * sc as i64,
+                    };
+                    check_scaled::<f32>(bt.start::<f32>(k, &base, 1.0), x, bits);
+                }
+            }
         }
     }
 
     /// `starts` of every instruction set this CPU supports against `start`, bit for bit,
-    /// for the points `k0 .. k0 + len`.
+    /// for the points `k0 .. k0 + len`, in both element types (`bits` within each one's
+    /// range).
     #[allow(clippy::too_many_arguments)]
     fn check_starts(
         bt: &BetaTables,
@@ -600,27 +770,48 @@ mod tests {
         norm: Ext,
         bits: u32,
     ) {
+        check_starts_of::<f64>(bt, k0, len, m, mp, norm, bits);
+        if bits <= f32::MAX_SKIP_BITS {
+            check_starts_of::<f32>(bt, k0, len, m, mp, norm, bits);
+        }
+    }
+
+    /// [`check_starts`] in element type `E`.
+    #[allow(clippy::too_many_arguments)]
+    fn check_starts_of<E: Elem>(
+        bt: &BetaTables,
+        k0: usize,
+        len: usize,
+        m: usize,
+        mp: usize,
+        norm: Ext,
+        bits: u32,
+    ) {
+        // Bits through f64 (exact for both types: keeps the sign of zero).
+        let bits_of = |x: E| x.to_f64().to_bits();
         let base = BaseStart::new(m, mp, norm, bits);
         let want: Vec<(u64, u64)> = (k0..k0 + len)
             .map(|k| {
-                let (p, sc) = bt.start(k, &base, 1.0);
-                (p.to_bits(), sc.to_bits())
+                let (p, sc) = bt.start::<E>(k, &base, 1.0);
+                (bits_of(p), bits_of(sc))
             })
             .collect();
         for isa in [Isa::Avx512, Isa::Avx2, Isa::Scalar] {
             if !isa.is_supported() {
                 continue;
             }
-            let (mut p, mut sc) = (vec![f64::NAN; len], vec![f64::NAN; len]);
+            let nan = E::from_f64(f64::NAN);
+            let (mut p, mut sc) = (vec![nan; len], vec![nan; len]);
             bt.starts(isa, k0, m, mp, norm, bits, &mut p, &mut sc);
             for i in 0..len {
                 assert_eq!(
-                    (p[i].to_bits(), sc[i].to_bits()),
+                    (bits_of(p[i]), bits_of(sc[i])),
                     want[i],
-                    "{isa:?} m={m} mp={mp} norm={norm:?} bits={bits} k={} ({:e} {})",
+                    "{} {isa:?} m={m} mp={mp} norm={norm:?} bits={bits} k={} ({:e} {})",
+                    E::NAME,
                     k0 + i,
-                    p[i],
-                    sc[i]
+                    p[i].to_f64(),
+                    sc[i].to_f64()
                 );
             }
         }
@@ -644,7 +835,7 @@ mod tests {
                 (b / 2, b / 2 - 1),
             ] {
                 let norm = norms[m * (m + 1) / 2 + mp];
-                for bits in [24u32, 300, 560] {
+                for bits in [24u32, 64, 100, 300, 560] {
                     let n = 2 * b;
                     let mut ranges = vec![(0usize, n), (3, b - 1), (b, b)];
                     // Every length up to 9 (not multiples of 4 or 8), ending at the last point.
@@ -659,6 +850,7 @@ mod tests {
             for exp in [1000i64, 1001, 1010, 1100, -600, -5000] {
                 let norm = Ext { mant: 0.75, exp };
                 check_starts(&bt, 0, 2 * b, 0, 0, norm, 64);
+                check_starts(&bt, 1, 2 * b - 1, 1, 0, norm, 100);
                 check_starts(&bt, 1, 2 * b - 1, 1, 0, norm, 560);
             }
         }
@@ -685,7 +877,7 @@ mod tests {
             (40, 39),
         ] {
             let norm = norms[m * (m + 1) / 2 + mp];
-            for bits in [24u32, 300, 560] {
+            for bits in [24u32, 100, 560] {
                 for k0 in 0..pts.len() {
                     for len in 1..=pts.len() - k0 {
                         check_starts(&bt, k0, len, m, mp, norm, bits);
