@@ -7,8 +7,8 @@
 //! is measured with the same vectors; the skip threshold follows `SO3FFT_SKIP_BITS` if set).
 
 use so3fft::internals::{
-    aligned, cluster_pairs, cluster_setup, fma_peak, forward, grid_lanes, inverse, ClusterInputs,
-    Rec,
+    aligned, cluster_pairs, cluster_setup, fma_peak, forward, forward_parity, grid_lanes, inverse,
+    inverse_parity, parity_partial_len, ClusterInputs, Rec,
 };
 use so3fft::Isa;
 
@@ -19,7 +19,66 @@ fn main() {
         fma_peak(isa)
     );
     kernel_gflops(isa);
+    parity_times(isa);
     all_clusters_gflops(isa);
+}
+
+/// The S^2 parity kernels (`m' = 0`, the B northern rings) in f64 and f32, best of 7
+/// batches of 20 calls, measured in alternation.
+fn parity_times(isa: Isa) {
+    for &(b, m) in &[(256usize, 40usize), (512, 100), (1024, 300)] {
+        let n = b - m;
+        let mut ci = cluster_setup(b, m, 0, 2 * b);
+        for v in [&mut ci.tau, &mut ci.p, &mut ci.sc] {
+            v.truncate(b);
+        }
+        let ci32 = ci.to_f32();
+        let rec = Rec::new(&ci.coeffs, n);
+        let mut lanes = grid_lanes(&ci.tau, &ci.p, &ci.sc, b);
+        let rec32 = ci32.rec(n);
+        let mut lanes32 = ci32.lanes(b);
+        (lanes.interleaved, lanes.stream) = (false, false);
+        (lanes32.interleaved, lanes32.stream) = (false, false);
+        let (w, w32) = (isa.lanes(), 2 * isa.lanes());
+        for c in [2usize, 4] {
+            let (fin, fin32) = (vec![0.5; n * c], vec![0.5f32; n * c]);
+            let (x, x32) = (vec![0.5; 2 * c * b], vec![0.5f32; 2 * c * b]);
+            let (mut y, mut y32) = (vec![0.0; 2 * c * b], vec![0.0f32; 2 * c * b]);
+            let mut part = vec![0.0; parity_partial_len(n, c, w)];
+            let mut ft = vec![0.0; (n * c).next_multiple_of(w)];
+            let mut part32 = vec![0.0f32; parity_partial_len(n, c, w32)];
+            let mut ft32 = vec![0.0f32; (n * c).next_multiple_of(w32)];
+            let mut best = [f64::INFINITY; 4];
+            for _ in 0..7 {
+                let mut time = |k: usize, f: &mut dyn FnMut()| {
+                    let t = std::time::Instant::now();
+                    for _ in 0..20 {
+                        f();
+                    }
+                    best[k] = best[k].min(t.elapsed().as_secs_f64() / 20.0);
+                };
+                time(0, &mut || {
+                    inverse_parity(isa, c, &rec, &lanes, &fin, &mut y)
+                });
+                time(1, &mut || {
+                    inverse_parity(isa, c, &rec32, &lanes32, &fin32, &mut y32)
+                });
+                time(2, &mut || {
+                    forward_parity(isa, c, &rec, &lanes, &x, (&mut part, &mut ft))
+                });
+                time(3, &mut || {
+                    forward_parity(isa, c, &rec32, &lanes32, &x32, (&mut part32, &mut ft32))
+                });
+            }
+            println!(
+                "parity B={b} m={m} C={c}: inverse {:.1} us, f32/f64 {:.2}; forward {:.1} us, f32/f64 {:.2}",
+                best[0] * 1e6,
+                best[1] / best[0],
+                best[2] * 1e6,
+                best[3] / best[2]
+            );
+        }
+    }
 }
 
 /// The instruction set `--isa NAME` names (default: the best this CPU has).

@@ -5,7 +5,7 @@ pub use crate::dwt::fixtures::{
     aligned, cluster_setup, grid_lanes, ClusterInputs, ClusterTables, FloatInputs,
 };
 pub use crate::dwt::lanes::Rec;
-pub use crate::dwt::{forward, inverse};
+pub use crate::dwt::{forward, forward_parity, inverse, inverse_parity, parity_partial_len};
 pub use crate::numeric::Ext;
 pub use crate::simd::peak::fma_peak;
 pub use crate::symmetry::cluster_pairs;

@@ -59,7 +59,7 @@ pub use grid::MAX_BANDWIDTH;
 pub use grid::{
     alpha, beta, coef_index, gamma, num_coeffs, num_samples, sample_index, try_coef_index, weights,
 };
-pub use num_complex::Complex64;
+pub use num_complex::{Complex, Complex32, Complex64};
 pub use options::{Betas, Direction, FftThreading, Options};
 pub use partial::PartialPlan;
 pub use plan::Plan;

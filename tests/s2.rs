@@ -197,8 +197,8 @@ fn sampled_harmonics_are_orthonormal() {
 
 #[test]
 fn bad_arguments_are_errors() {
-    assert!(S2Plan::new(0, &Options::default()).is_err());
-    assert!(S2Plan::new(1 << 20, &Options::default()).is_err());
+    assert!(S2Plan::<f64>::new(0, &Options::default()).is_err());
+    assert!(S2Plan::<f64>::new(1 << 20, &Options::default()).is_err());
     let p = plan(4, 1);
     let mut c = vec![Complex64::default(); 16];
     assert!(p.forward(&[Complex64::default(); 63], &mut c).is_err());
@@ -353,7 +353,7 @@ fn degree_and_order_limits_equal_zeroed_full_transforms() {
         );
     }
     let bad = |d, o| {
-        S2Plan::with_limits(
+        S2Plan::<f64>::with_limits(
             8,
             S2Limits {
                 degree_limit: d,

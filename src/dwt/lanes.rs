@@ -20,9 +20,9 @@ pub struct Rec<'a, E = f64> {
     n: usize,
 }
 
-impl<'a> Rec<'a> {
+impl<'a, E: Elem> Rec<'a, E> {
     /// The first `n` degrees of `r`.
-    pub fn new(r: &'a RecCoeffs, n: usize) -> Rec<'a> {
+    pub fn new(r: &'a RecCoeffs<E>, n: usize) -> Rec<'a, E> {
         assert!(n <= r.len());
         let end = n + REC_PAD;
         Rec {

@@ -28,7 +28,7 @@ fn plans_of_a_thread_count_share_the_process_pool() {
         .engine()
         .workers()
         .same_as(&WorkerPool::process(3).unwrap()));
-    let s2 = crate::s2::S2Plan::new(
+    let s2 = crate::s2::S2Plan::<f64>::new(
         8,
         &crate::options::Options {
             threads: 2,

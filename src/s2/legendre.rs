@@ -12,19 +12,19 @@
 
 use crate::dwt::{self, Lanes, Prefetch, Rec};
 use crate::numeric::Ext;
+use crate::real::Real;
 use crate::simd::Isa;
 use crate::wigner::{big, start_norm, BetaTables, RecCoeffs, RecTables, DEFAULT_SKIP_BITS};
-use num_complex::Complex64;
+use num_complex::Complex;
 use std::sync::Mutex;
 
 /// Most columns of the kernels: `E` and `O`, real and imaginary parts, of two groups.
 const P: usize = 8;
 
 /// Where an order's ring spectra are: `F_m(theta_k)` at `base + k * row + column(m)`.
-#[derive(Clone, Copy)]
-pub(super) struct Spectra {
+pub(super) struct Spectra<T> {
     /// The first ring's spectrum.
-    pub base: *mut Complex64,
+    pub base: *mut Complex<T>,
     /// Values from one ring to the next.
     pub row: usize,
     /// Real rings: only orders `m >= 0` are stored (`row = B + 1`), `F_{-m} = conj(F_m)`.
@@ -33,13 +33,20 @@ pub(super) struct Spectra {
 
 // SAFETY: an address only; the tasks of one execution access disjoint columns through it
 // (one order each), see the SAFETY comments at the dereferences.
-unsafe impl Send for Spectra {}
+unsafe impl<T> Send for Spectra<T> {}
 // SAFETY: as for Send.
-unsafe impl Sync for Spectra {}
+unsafe impl<T> Sync for Spectra<T> {}
 
-impl Spectra {
+impl<T> Clone for Spectra<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Spectra<T> {}
+
+impl<T> Spectra<T> {
     /// Pointer to `F_m` of ring `k` (`m` taken modulo the ring length for complex rings).
-    fn at(&self, k: usize, m: isize) -> *mut Complex64 {
+    fn at(&self, k: usize, m: isize) -> *mut Complex<T> {
         let col = if self.real {
             m as usize
         } else {
@@ -50,25 +57,31 @@ impl Spectra {
 }
 
 /// Where an order's coefficients are: `fhat(l, m)` at `base + start(m) + (l - |m|)`.
-#[derive(Clone, Copy)]
-pub(super) struct CoeffRows {
-    pub base: *mut Complex64,
+pub(super) struct CoeffRows<T> {
+    pub base: *mut Complex<T>,
     /// Start of each order's block, indexed by `m + B - 1`.
     pub starts: *const usize,
     pub b: usize,
 }
 
 // SAFETY: as for `Spectra`: each task reads or writes its own orders' blocks.
-unsafe impl Send for CoeffRows {}
+unsafe impl<T> Send for CoeffRows<T> {}
 // SAFETY: as for Send.
-unsafe impl Sync for CoeffRows {}
+unsafe impl<T> Sync for CoeffRows<T> {}
 
-impl CoeffRows {
+impl<T> Clone for CoeffRows<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for CoeffRows<T> {}
+
+impl<T> CoeffRows<T> {
     /// Pointer to `fhat(|m|, m)`, the start of order `m`'s block.
     ///
     /// # Safety
     /// `|m| < b` and `starts` holds `2b - 1` entries.
-    unsafe fn block(&self, m: isize) -> *mut Complex64 {
+    unsafe fn block(&self, m: isize) -> *mut Complex<T> {
         // SAFETY: index `m + b - 1` is in `0..2b-1` (caller's contract).
         let start = unsafe { *self.starts.add((m + self.b as isize - 1) as usize) };
         self.base.wrapping_add(start)
@@ -77,17 +90,23 @@ impl CoeffRows {
 
 /// Four kernel columns (`E` and `O`, real and imaginary parts) of one order's spectra, and
 /// where that order's coefficients go (or come from).
-#[derive(Clone, Copy)]
-pub(super) struct Group {
-    pub spectra: Spectra,
-    pub coef: CoeffRows,
+pub(super) struct Group<T> {
+    pub spectra: Spectra<T>,
+    pub coef: CoeffRows<T>,
     /// The order, `m` or `-m`.
     pub order: isize,
     /// Forward of a real function: also write `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
     pub partner: bool,
 }
 
-impl Group {
+impl<T> Clone for Group<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Group<T> {}
+
+impl<T> Group<T> {
     /// `(-1)^m` for a negative order (`dt^l_{-m,0} = (-1)^m dt^l_{m,0}`), else 1.
     fn sign(&self, m: usize) -> f64 {
         if self.order < 0 && m % 2 == 1 {
@@ -98,42 +117,92 @@ impl Group {
     }
 }
 
-/// Per-worker scratch.
-pub(super) struct Scratch {
-    rec: RecCoeffs,
-    tau: Vec<f64>,
-    start: Vec<f64>,
-    scale: Vec<f64>,
+/// A worker's kernel buffers in the kernels' element type `K`.
+struct KernelBufs<K> {
+    tau: Vec<K>,
+    start: Vec<K>,
+    scale: Vec<K>,
     /// Kernel columns of the rings (forward input, inverse output).
-    rows: Vec<f64>,
+    rows: Vec<K>,
     /// Forward: the kernel's sums (degree-major); inverse: its input.
-    sums: Vec<f64>,
+    sums: Vec<K>,
     /// The forward kernel's partial sums (lanes = rings).
-    part: Vec<f64>,
+    part: Vec<K>,
 }
 
-impl Scratch {
-    fn new(b: usize, lanes: usize, width: usize) -> Scratch {
-        Scratch {
-            rec: RecCoeffs::new(b),
-            tau: vec![0.0; lanes],
-            start: vec![0.0; lanes],
-            scale: vec![0.0; lanes],
-            rows: vec![0.0; lanes * P],
-            sums: vec![0.0; (b + width) * P],
-            part: vec![0.0; dwt::parity_partial_len(b, 4, width)],
+impl<K: Real> KernelBufs<K> {
+    fn new(b: usize, lanes: usize, width: usize) -> KernelBufs<K> {
+        let z = K::ZERO;
+        KernelBufs {
+            tau: vec![z; lanes],
+            start: vec![z; lanes],
+            scale: vec![z; lanes],
+            rows: vec![z; lanes * P],
+            sums: vec![z; (b + width) * P],
+            part: vec![z; dwt::parity_partial_len(b, 4, width)],
         }
     }
 }
 
-/// Tables and scratch of the Legendre stage for one bandwidth.
-pub(super) struct LegendreStage {
+/// Per-worker scratch: the coefficients of an order (double, and rounded to floats for
+/// float kernels) and the buffers of double and float kernels (made on first use).
+pub(super) struct Scratch {
+    rec: RecCoeffs,
+    rec32: RecCoeffs<f32>,
+    wide: Option<KernelBufs<f64>>,
+    narrow: Option<KernelBufs<f32>>,
+}
+
+impl Scratch {
+    fn new(b: usize) -> Scratch {
+        Scratch {
+            rec: RecCoeffs::new(b),
+            rec32: RecCoeffs::new(0),
+            wide: None,
+            narrow: None,
+        }
+    }
+}
+
+/// The kernels' element type for an order: doubles, or floats (see
+/// [`crate::wigner::single_precision_orders`]).
+trait KernelElem: Real {
+    /// This type's buffers in `sc` (made on first use), the order's coefficients in this
+    /// type and their scales `S_i` in doubles.
+    fn bufs(sc: &mut Scratch, dims: (usize, usize, usize)) -> KernelInputs<'_, Self>;
+}
+
+/// What [`KernelElem::bufs`] gives.
+type KernelInputs<'a, K> = (&'a mut KernelBufs<K>, &'a RecCoeffs<K>, &'a [f64]);
+
+impl KernelElem for f64 {
+    fn bufs(sc: &mut Scratch, (b, lanes, w): (usize, usize, usize)) -> KernelInputs<'_, f64> {
+        let bufs = sc.wide.get_or_insert_with(|| KernelBufs::new(b, lanes, w));
+        (bufs, &sc.rec, &sc.rec.s)
+    }
+}
+
+impl KernelElem for f32 {
+    fn bufs(sc: &mut Scratch, (b, lanes, w): (usize, usize, usize)) -> KernelInputs<'_, f32> {
+        sc.rec32.narrow_from(&sc.rec);
+        let bufs = sc
+            .narrow
+            .get_or_insert_with(|| KernelBufs::new(b, lanes, w));
+        (bufs, &sc.rec32, &sc.rec.s)
+    }
+}
+
+/// Tables and scratch of the Legendre stage for one bandwidth, samples and coefficients in
+/// `T`.
+pub(super) struct LegendreStage<T> {
     b: usize,
     /// Degrees computed: `l < lend` (`lend <= b`; the others are zero).
     lend: usize,
     isa: Isa,
-    /// Lanes: the `B` northern rings, padded to the vector width.
+    /// Lanes: the `B` northern rings, padded to the vector width of either element type.
     lanes: usize,
+    /// Orders `m >= narrow_from` run float kernels (`T = f32`); the others double ones.
+    narrow_from: usize,
     recurrence: RecTables,
     beta_tables: BetaTables,
     /// Norms of the starting values `dt^m_{m,0}`, per order.
@@ -141,35 +210,46 @@ pub(super) struct LegendreStage {
     /// Quadrature weights of the northern rings (the southern ones are the same).
     weights: Vec<f64>,
     scratch: Vec<Mutex<Scratch>>,
+    element: std::marker::PhantomData<T>,
 }
 
-impl LegendreStage {
+impl<T: Real> LegendreStage<T> {
     /// The stage for bandwidth `b` with `workers` scratches.
-    pub(super) fn new(b: usize, lend: usize, isa: Isa, workers: usize) -> LegendreStage {
+    pub(super) fn new(b: usize, lend: usize, isa: Isa, workers: usize) -> LegendreStage<T> {
         assert!(0 < lend && lend <= b);
-        let lanes = b.next_multiple_of(isa.lanes());
+        let lanes = b.next_multiple_of(isa.lanes_of::<f32>());
+        let narrow_from = if T::BYTES == 4 {
+            crate::wigner::single_precision_orders(b)
+        } else {
+            usize::MAX
+        };
         LegendreStage {
             b,
             lend,
             isa,
             lanes,
+            narrow_from,
             recurrence: RecTables::new(b),
             beta_tables: BetaTables::grid(b),
             norms: (0..b).map(|m| start_norm(m, 0)).collect(),
             weights: crate::grid::weights(b)[..b].to_vec(),
-            scratch: (0..workers)
-                .map(|_| Mutex::new(Scratch::new(b, lanes, isa.lanes())))
-                .collect(),
+            scratch: (0..workers).map(|_| Mutex::new(Scratch::new(b))).collect(),
+            element: std::marker::PhantomData,
         }
     }
 
     /// Bytes of the tables and scratch (approximately).
     pub(super) fn bytes(b: usize, workers: usize) -> usize {
-        let lanes = b + 8;
-        32 * (b + 1) * (b + 2)
-            + 64 * 2 * b * (66 + b / 32)
-            + 16 * b
-            + workers * 8 * (9 * lanes + 16 * b + 4 * (b + 2) * 8)
+        let lanes = b + 16;
+        let kernel = |size: usize| size * (9 * lanes + 16 * b + 4 * (b + 2) * 16);
+        let per_worker = 8 * 5 * b
+            + kernel(8)
+            + if T::BYTES == 4 {
+                kernel(4) + 4 * 5 * b
+            } else {
+                0
+            };
+        32 * (b + 1) * (b + 2) + 64 * 2 * b * (66 + b / 32) + 16 * b + workers * per_worker
     }
 
     /// Runs `f` with a free scratch (the worker's own, else another, else a new one).
@@ -183,39 +263,45 @@ impl LegendreStage {
                 Err(std::sync::TryLockError::WouldBlock) => {}
             }
         }
-        f(&mut Scratch::new(self.b, self.lanes, self.isa.lanes()))
+        f(&mut Scratch::new(self.b))
     }
 
-    /// Recurrence coefficients and lane inputs of order `m`; the number of degrees.
-    fn setup(&self, sc: &mut Scratch, m: usize) -> usize {
+    /// The recurrence coefficients of order `m` into `sc`; the number of degrees.
+    fn coeffs(&self, sc: &mut Scratch, m: usize) -> usize {
         let n = self.lend - m;
         sc.rec.resize(n);
         self.recurrence.coeffs(m, 0, &mut sc.rec);
+        n
+    }
+
+    /// The lane inputs of order `m` in `bufs`.
+    fn lane_inputs<K: Real>(&self, bufs: &mut KernelBufs<K>, m: usize) {
         let b = self.b;
-        self.beta_tables.starts(
+        self.beta_tables.starts::<K>(
             self.isa,
             0,
             m,
             0,
             self.norms[m],
             DEFAULT_SKIP_BITS,
-            &mut sc.start[..b],
-            &mut sc.scale[..b],
+            &mut bufs.start[..b],
+            &mut bufs.scale[..b],
         );
-        sc.tau[..b].copy_from_slice(&self.beta_tables.tau_lo[..b]);
-        for v in [&mut sc.tau, &mut sc.start, &mut sc.scale] {
-            v[b..].fill(0.0);
+        for (t, &x) in bufs.tau[..b].iter_mut().zip(&self.beta_tables.tau_lo[..b]) {
+            *t = K::from_f64(x);
         }
-        n
+        for v in [&mut bufs.tau, &mut bufs.start, &mut bufs.scale] {
+            v[b..].fill(K::ZERO);
+        }
     }
 
-    fn lanes<'a>(&self, sc: &'a Scratch) -> Lanes<'a> {
+    fn lanes<'a, K: Real>(&self, bufs: &'a KernelBufs<K>) -> Lanes<'a, K> {
         Lanes {
-            tau: &sc.tau,
-            p: &sc.start,
-            sc: &sc.scale,
+            tau: &bufs.tau,
+            p: &bufs.start,
+            sc: &bufs.scale,
             upper_from: self.lanes,
-            big: big(DEFAULT_SKIP_BITS),
+            big: big::<K>(DEFAULT_SKIP_BITS),
             skip: true,
             interleaved: false,
             prefetch: Prefetch::none(),
@@ -225,6 +311,11 @@ impl LegendreStage {
         }
     }
 
+    /// Whether order `m` runs float kernels.
+    fn narrow(&self, m: usize) -> bool {
+        m >= self.narrow_from
+    }
+
     /// Forward (analysis) of order `m >= 0` for up to two column groups (see [`Group`]):
     /// `fhat(l, g.order) = factor sign(g) sum_k w_k dt^l_{m,0}(theta_k) F_{g.order}(theta_k)`,
     /// `sign = (-1)^m` for a negative order.
@@ -232,39 +323,63 @@ impl LegendreStage {
     /// # Safety
     /// Each group's spectra hold the `2B` rings, its coefficients the whole array; no other
     /// task touches the groups' orders meanwhile.
-    pub(super) unsafe fn analyse(&self, m: usize, groups: &[Group], factor: f64) {
+    pub(super) unsafe fn analyse(&self, m: usize, groups: &[Group<T>], factor: f64) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            if self.narrow(m) {
+                self.analyse_in::<f32>(m, groups, factor)
+            } else {
+                self.analyse_in::<f64>(m, groups, factor)
+            }
+        }
+    }
+
+    /// [`LegendreStage::analyse`] with kernels in `K`.
+    ///
+    /// # Safety
+    /// As for [`LegendreStage::analyse`].
+    unsafe fn analyse_in<K: KernelElem>(&self, m: usize, groups: &[Group<T>], factor: f64) {
         assert!(!groups.is_empty() && groups.len() <= 2);
         let b = self.b;
+        let w = self.isa.lanes_of::<K>();
         self.with_scratch(|sc| {
-            let n = self.setup(sc, m);
+            let n = self.coeffs(sc, m);
+            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w));
+            self.lane_inputs(bufs, m);
             // Kernel input: the even combinations of each group's spectra (re, im), then the
             // odd ones, weighted, one column of `nb` rings each.
             let c = 2 * groups.len();
             let nb = self.lanes;
-            let mut x = std::mem::take(&mut sc.rows);
+            let mut x = std::mem::take(&mut bufs.rows);
             // The padding lanes are 0; the others are written below.
             for column in x[..2 * c * nb].chunks_exact_mut(nb) {
-                column[b..].fill(0.0);
+                column[b..].fill(K::ZERO);
             }
+            let wide = |z: Complex<T>| Complex::new(z.re.to_f64(), z.im.to_f64());
             for (q, g) in groups.iter().enumerate() {
                 for k in 0..b {
-                    let w = self.weights[k];
+                    let wk = self.weights[k];
                     let mirror = 2 * b - 1 - k;
                     // SAFETY: rings k and mirror < 2B hold the group's order; read only.
-                    let (u, v) =
-                        unsafe { (*g.spectra.at(k, g.order), *g.spectra.at(mirror, g.order)) };
-                    let (e, o) = ((u + v) * w, (u - v) * w);
-                    x[(2 * q) * nb + k] = e.re;
-                    x[(2 * q + 1) * nb + k] = e.im;
-                    x[(c + 2 * q) * nb + k] = o.re;
-                    x[(c + 2 * q + 1) * nb + k] = o.im;
+                    let (u, v) = unsafe {
+                        (
+                            wide(*g.spectra.at(k, g.order)),
+                            wide(*g.spectra.at(mirror, g.order)),
+                        )
+                    };
+                    let (e, o) = ((u + v) * wk, (u - v) * wk);
+                    x[(2 * q) * nb + k] = K::from_f64(e.re);
+                    x[(2 * q + 1) * nb + k] = K::from_f64(e.im);
+                    x[(c + 2 * q) * nb + k] = K::from_f64(o.re);
+                    x[(c + 2 * q + 1) * nb + k] = K::from_f64(o.im);
                 }
             }
-            let rec = Rec::new(&sc.rec, n);
-            let mut sums = std::mem::take(&mut sc.sums);
-            let mut part = std::mem::take(&mut sc.part);
-            let lanes = self.lanes(sc);
+            let rec = Rec::new(rc, n);
+            let mut sums = std::mem::take(&mut bufs.sums);
+            let mut part = std::mem::take(&mut bufs.part);
+            let lanes = self.lanes(bufs);
             dwt::forward_parity(self.isa, c, &rec, &lanes, &x, (&mut part, &mut sums));
+            let zero = Complex::new(T::ZERO, T::ZERO);
             for (q, g) in groups.iter().enumerate() {
                 let f = g.sign(m) * factor;
                 // SAFETY: |order| < b; the block has b - m >= n entries, this task's alone
@@ -273,31 +388,35 @@ impl LegendreStage {
                 for i in n..b - m {
                     // SAFETY: entry i < b - m of the blocks: degrees beyond the limit are 0.
                     unsafe {
-                        *own.add(i) = Complex64::default();
+                        *own.add(i) = zero;
                         if g.partner && m > 0 {
-                            *partner.add(i) = Complex64::default();
+                            *partner.add(i) = zero;
                         }
                     }
                 }
                 for i in 0..n {
                     let z = &sums[i * c + 2 * q..][..2];
-                    let v = Complex64::new(z[0], z[1]) * (sc.rec.s[i] * f);
+                    let sf = s[i] * f;
+                    let v = Complex::new(
+                        T::from_f64(z[0].to_f64() * sf),
+                        T::from_f64(z[1].to_f64() * sf),
+                    );
                     // SAFETY: entry i < n of the blocks (above).
                     unsafe {
                         *own.add(i) = v;
                         if g.partner && m > 0 {
                             *partner.add(i) = if m.is_multiple_of(2) {
-                                v.conj()
+                                Complex::new(v.re, -v.im)
                             } else {
-                                -v.conj()
+                                Complex::new(-v.re, v.im)
                             };
                         }
                     }
                 }
             }
-            sc.sums = sums;
-            sc.part = part;
-            sc.rows = x;
+            bufs.sums = sums;
+            bufs.part = part;
+            bufs.rows = x;
         });
     }
 
@@ -306,7 +425,7 @@ impl LegendreStage {
     ///
     /// # Safety
     /// As for [`LegendreStage::analyse`].
-    pub(super) unsafe fn zero_order(&self, m: usize, groups: &[Group], coeffs: bool) {
+    pub(super) unsafe fn zero_order(&self, m: usize, groups: &[Group<T>], coeffs: bool) {
         let b = self.b;
         for g in groups {
             if coeffs {
@@ -321,7 +440,7 @@ impl LegendreStage {
             } else {
                 for k in 0..2 * b {
                     // SAFETY: ring k's value of the order, this task's column.
-                    unsafe { *g.spectra.at(k, g.order) = Complex64::default() };
+                    unsafe { *g.spectra.at(k, g.order) = Complex::new(T::ZERO, T::ZERO) };
                 }
             }
         }
@@ -338,48 +457,74 @@ impl LegendreStage {
     ///
     /// # Safety
     /// As for [`LegendreStage::analyse`], with the roles of the arrays exchanged.
-    pub(super) unsafe fn synthesise(&self, m: usize, groups: &[Group], factor: f64) {
+    pub(super) unsafe fn synthesise(&self, m: usize, groups: &[Group<T>], factor: f64) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            if self.narrow(m) {
+                self.synthesise_in::<f32>(m, groups, factor)
+            } else {
+                self.synthesise_in::<f64>(m, groups, factor)
+            }
+        }
+    }
+
+    /// [`LegendreStage::synthesise`] with kernels in `K`.
+    ///
+    /// # Safety
+    /// As for [`LegendreStage::synthesise`].
+    unsafe fn synthesise_in<K: KernelElem>(&self, m: usize, groups: &[Group<T>], factor: f64) {
         assert!(!groups.is_empty() && groups.len() <= 2);
         let b = self.b;
+        let w = self.isa.lanes_of::<K>();
         self.with_scratch(|sc| {
-            let n = self.setup(sc, m);
+            let n = self.coeffs(sc, m);
+            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w));
+            self.lane_inputs(bufs, m);
             // Kernel input: per degree, the scaled coefficients of each group (re, im).
             let c = 2 * groups.len();
-            let mut fin = std::mem::take(&mut sc.sums);
+            let mut fin = std::mem::take(&mut bufs.sums);
             for (q, g) in groups.iter().enumerate() {
                 // SAFETY: |order| < b; the block has at least n entries, only read here.
                 let block = unsafe { g.coef.block(g.order) }.cast_const();
                 let f = g.sign(m) * factor;
-                for (i, &s) in sc.rec.s[..n].iter().enumerate() {
+                for (i, &si) in s[..n].iter().enumerate() {
                     // SAFETY: entry i < n of the block (above).
-                    let v = unsafe { *block.add(i) } * (s * f);
-                    fin[i * c + 2 * q] = v.re;
-                    fin[i * c + 2 * q + 1] = v.im;
+                    let v = unsafe { *block.add(i) };
+                    let sf = si * f;
+                    fin[i * c + 2 * q] = K::from_f64(v.re.to_f64() * sf);
+                    fin[i * c + 2 * q + 1] = K::from_f64(v.im.to_f64() * sf);
                 }
             }
-            let rec = Rec::new(&sc.rec, n);
-            let mut rows = std::mem::take(&mut sc.rows);
-            let lanes = self.lanes(sc);
+            let rec = Rec::new(rc, n);
+            let mut rows = std::mem::take(&mut bufs.rows);
+            let lanes = self.lanes(bufs);
             dwt::inverse_parity(self.isa, c, &rec, &lanes, &fin[..n * c], &mut rows);
             // Columns of the output: even sums, then odd sums, `nb` lanes each.
             let nb = self.lanes;
             let column =
                 |par: usize, q: usize, part: usize| &rows[(par * c + 2 * q + part) * nb..][..b];
+            let narrow = |x: f64| T::from_f64(x);
             for (q, g) in groups.iter().enumerate() {
                 let (er, ei) = (column(0, q, 0), column(0, q, 1));
                 let (or, oi) = (column(1, q, 0), column(1, q, 1));
                 for k in 0..b {
-                    let (e, o) = (Complex64::new(er[k], ei[k]), Complex64::new(or[k], oi[k]));
+                    let (e, o) = (
+                        Complex::new(er[k].to_f64(), ei[k].to_f64()),
+                        Complex::new(or[k].to_f64(), oi[k].to_f64()),
+                    );
                     let mirror = 2 * b - 1 - k;
+                    let (north, south) = (e + o, e - o);
                     // SAFETY: rings k and mirror, the group's order's column: this task's.
                     unsafe {
-                        *g.spectra.at(k, g.order) = e + o;
-                        *g.spectra.at(mirror, g.order) = e - o;
+                        *g.spectra.at(k, g.order) =
+                            Complex::new(narrow(north.re), narrow(north.im));
+                        *g.spectra.at(mirror, g.order) =
+                            Complex::new(narrow(south.re), narrow(south.im));
                     }
                 }
             }
-            sc.sums = fin;
-            sc.rows = rows;
+            bufs.sums = fin;
+            bufs.rows = rows;
         });
     }
 }

@@ -6,12 +6,13 @@ use super::rings::RingFft;
 use crate::error::{check_length, Error, Result};
 use crate::fft::AlignedBuf;
 use crate::options::Options;
+use crate::real::Real;
 use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::transform::StageTimes;
 use crate::transform::{Scratch, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
-use num_complex::Complex64;
+use num_complex::{Complex, Complex64};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::Mutex;
@@ -41,12 +42,12 @@ pub struct S2Limits {
 /// - inverse (synthesis): `f(theta_j, phi_k) = sum_{l<B} sum_{|m|<=l} fhat(l, m) Y_l^m`.
 ///
 /// Execution takes `&self`; one plan may run on different arrays from several threads.
-pub struct S2Plan {
+pub struct S2Plan<T: Real = f64> {
     b: usize,
     threads: usize,
     workers: WorkerPool,
-    rings: RingFft,
-    legendre: LegendreStage,
+    rings: RingFft<T>,
+    legendre: LegendreStage<T>,
     /// Start of each order's coefficient block, indexed by `m + B - 1`.
     starts: Vec<usize>,
     /// Orders `|m| <= order_limit` are computed.
@@ -58,16 +59,16 @@ pub struct S2Plan {
     spare: Mutex<Option<AlignedBuf>>,
 }
 
-impl S2Plan {
+impl<T: Real> S2Plan<T> {
     /// A plan for bandwidth `bandwidth` (`1 ..= S2_MAX_BANDWIDTH`), all degrees and
     /// orders. It reads the options' `threads`, `rigor` and `isa`.
-    pub fn new(bandwidth: usize, options: &Options) -> Result<S2Plan> {
-        S2Plan::new_on(bandwidth, S2Limits::default(), options, None)
+    pub fn new(bandwidth: usize, options: &Options) -> Result<S2Plan<T>> {
+        Self::new_on(bandwidth, S2Limits::default(), options, None)
     }
 
     /// [`S2Plan::new`] computing only the degrees and orders of `limits`.
-    pub fn with_limits(bandwidth: usize, limits: S2Limits, options: &Options) -> Result<S2Plan> {
-        S2Plan::new_on(bandwidth, limits, options, None)
+    pub fn with_limits(bandwidth: usize, limits: S2Limits, options: &Options) -> Result<S2Plan<T>> {
+        Self::new_on(bandwidth, limits, options, None)
     }
 
     /// [`S2Plan::with_limits`] on the workers of `shared` if given (with the plan's thread
@@ -77,7 +78,7 @@ impl S2Plan {
         limits: S2Limits,
         options: &Options,
         shared: Option<&WorkerPool>,
-    ) -> Result<S2Plan> {
+    ) -> Result<S2Plan<T>> {
         let b = bandwidth;
         if b == 0 || b > S2_MAX_BANDWIDTH {
             return Err(Error::InvalidBandwidth {
@@ -88,13 +89,13 @@ impl S2Plan {
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
         let n = 2 * b;
-        let bytes = S2Plan::memory_needed(b, threads);
+        let bytes = Self::memory_needed(b, threads);
         check_headroom(
             bytes
                 .saturating_add(threads * WORKER_STACK_BYTES)
                 .saturating_add(crate::fft::planning_bytes(16 * n)),
         )?;
-        let scratch = AlignedBuf::new(scratch_len(b))?;
+        let scratch = AlignedBuf::of::<Complex<T>>(scratch_len(b))?;
         let rings = RingFft::new(n, options.rigor)?;
         let lend = limits.degree_limit.unwrap_or(b);
         if lend == 0 || lend > b {
@@ -124,7 +125,7 @@ impl S2Plan {
     /// Calls on two fields at once (`*_many` with `howmany > 1`, `*_pair`) add a second
     /// ring scratch of the same size, made on their first use and kept with the plan.
     pub fn memory_needed(b: usize, threads: usize) -> usize {
-        16 * scratch_len(b) + LegendreStage::bytes(b, threads) + 8 * 2 * b
+        2 * T::BYTES * scratch_len(b) + LegendreStage::<T>::bytes(b, threads) + 8 * 2 * b
     }
 
     /// The plan's worker threads (for tests).
@@ -183,7 +184,7 @@ impl S2Plan {
     ) -> Result<R> {
         let len = scratch_len(self.b);
         if let Some(s) = scratch {
-            let a = s.holding(16 * len)?;
+            let a = s.holding(2 * T::BYTES * len)?;
             if !two {
                 return f(a, None);
             }
@@ -197,7 +198,7 @@ impl S2Plan {
         let a = match own {
             Some(buf) => buf,
             None => {
-                tmp = AlignedBuf::new(len)?;
+                tmp = AlignedBuf::of::<Complex<T>>(len)?;
                 &tmp
             }
         };
@@ -209,19 +210,19 @@ impl S2Plan {
         let bbuf = match second.as_mut() {
             Some(g) => {
                 if g.is_none() {
-                    **g = Some(AlignedBuf::new(len)?);
+                    **g = Some(AlignedBuf::of::<Complex<T>>(len)?);
                 }
                 g.as_ref().expect("just made")
             }
             None => {
-                tmp2 = AlignedBuf::new(len)?;
+                tmp2 = AlignedBuf::of::<Complex<T>>(len)?;
                 &tmp2
             }
         };
         f(a, Some(bbuf))
     }
 
-    fn coeff_rows(&self, base: *mut Complex64) -> CoeffRows {
+    fn coeff_rows(&self, base: *mut Complex<T>) -> CoeffRows<T> {
         CoeffRows {
             base,
             starts: self.starts.as_ptr(),
@@ -232,7 +233,12 @@ impl S2Plan {
     /// Ring DFTs of all rings in parallel: complex in place at `data` (`analysis`: sign
     /// -1), each task copying its rings in from or out to another array (`copy`) while
     /// they are in its cache.
-    fn rings_complex(&self, data: *mut Complex64, analysis: bool, copy: RingCopy) -> Result<()> {
+    fn rings_complex(
+        &self,
+        data: *mut Complex<T>,
+        analysis: bool,
+        copy: RingCopy<T>,
+    ) -> Result<()> {
         let (n, per) = (self.rings.len(), self.rings.per_call());
         let base = SendPtr(data);
         (0..n / per).into_par_iter().try_for_each(|c| {
@@ -256,7 +262,7 @@ impl S2Plan {
     ///
     /// # Safety
     /// As for `LegendreStage::analyse`.
-    unsafe fn analyse(&self, m: usize, groups: &[Group], factor: f64) {
+    unsafe fn analyse(&self, m: usize, groups: &[Group<T>], factor: f64) {
         // SAFETY: the caller's contract is the stage's.
         unsafe {
             if m <= self.order_limit && self.legendre.computes(m) {
@@ -271,7 +277,7 @@ impl S2Plan {
     ///
     /// # Safety
     /// As for `LegendreStage::synthesise`.
-    unsafe fn synthesise(&self, m: usize, groups: &[Group], factor: f64) {
+    unsafe fn synthesise(&self, m: usize, groups: &[Group<T>], factor: f64) {
         // SAFETY: the caller's contract is the stage's.
         unsafe {
             if m <= self.order_limit && self.legendre.computes(m) {
@@ -283,7 +289,7 @@ impl S2Plan {
     }
 
     /// The column groups of order `m` of a complex field: `m` and, for `m > 0`, `-m`.
-    fn complex_groups(m: usize, spectra: Spectra, coef: CoeffRows) -> ([Group; 2], usize) {
+    fn complex_groups(m: usize, spectra: Spectra<T>, coef: CoeffRows<T>) -> ([Group<T>; 2], usize) {
         let g = |order: isize| Group {
             spectra,
             coef,
@@ -295,7 +301,7 @@ impl S2Plan {
 
     /// Forward transform of complex samples (`(2B)^2`, ring-major) into `B^2` coefficients;
     /// the time of each stage (`fft`: the ring DFTs, `dwt`: the Legendre stage).
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.forward_in((samples, coeffs, 1), None)
     }
 
@@ -303,8 +309,8 @@ impl S2Plan {
     /// samples, `howmany B^2` coefficients).
     pub fn forward_many(
         &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
         howmany: usize,
     ) -> Result<StageTimes> {
         self.forward_in((samples, coeffs, howmany), None)
@@ -313,7 +319,7 @@ impl S2Plan {
     /// [`S2Plan::forward_many`] in the caller's `scratch` if given.
     fn forward_in(
         &self,
-        (samples, coeffs, howmany): (&[Complex64], &mut [Complex64], usize),
+        (samples, coeffs, howmany): (&[Complex<T>], &mut [Complex<T>], usize),
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
@@ -324,7 +330,7 @@ impl S2Plan {
         self.with_scratch((false, scratch), |buf, _| {
             for (field, out) in samples.chunks_exact(n * n).zip(coeffs.chunks_exact_mut(nc)) {
                 let spectra = Spectra {
-                    base: buf.as_mut_ptr(),
+                    base: buf.ptr::<Complex<T>>(),
                     row: n,
                     real: false,
                 };
@@ -332,7 +338,7 @@ impl S2Plan {
                 self.workers.pool().install(|| {
                     let t0 = Instant::now();
                     let src = SendConstPtr(field.as_ptr());
-                    self.rings_complex(buf.as_mut_ptr(), true, RingCopy::From(src))?;
+                    self.rings_complex(buf.ptr::<Complex<T>>(), true, RingCopy::From(src))?;
                     let t1 = Instant::now();
                     (0..b).into_par_iter().for_each(|m| {
                         let (groups, count) = Self::complex_groups(m, spectra, coef);
@@ -353,15 +359,15 @@ impl S2Plan {
 
     /// Inverse transform of `B^2` coefficients into complex samples; the time of each
     /// stage.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes> {
         self.inverse_in((coeffs, samples, 1), None)
     }
 
     /// [`S2Plan::inverse`] of `howmany` fields stored one after another.
     pub fn inverse_many(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
         howmany: usize,
     ) -> Result<StageTimes> {
         self.inverse_in((coeffs, samples, howmany), None)
@@ -370,7 +376,7 @@ impl S2Plan {
     /// [`S2Plan::inverse_many`] in the caller's `scratch` if given.
     fn inverse_in(
         &self,
-        (coeffs, samples, howmany): (&[Complex64], &mut [Complex64], usize),
+        (coeffs, samples, howmany): (&[Complex<T>], &mut [Complex<T>], usize),
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
@@ -381,11 +387,14 @@ impl S2Plan {
         self.with_scratch((false, scratch), |buf, _| {
             for (field, out) in coeffs.chunks_exact(nc).zip(samples.chunks_exact_mut(n * n)) {
                 // Straight into the output where FFTW may run on it, else through the scratch.
-                let direct = RingFft::aligned(out.as_ptr().cast());
+                let direct = RingFft::<T>::aligned(out.as_ptr().cast::<T>());
                 let (data, copy) = if direct {
                     (out.as_mut_ptr(), RingCopy::None)
                 } else {
-                    (buf.as_mut_ptr(), RingCopy::To(SendPtr(out.as_mut_ptr())))
+                    (
+                        buf.ptr::<Complex<T>>(),
+                        RingCopy::To(SendPtr(out.as_mut_ptr())),
+                    )
                 };
                 let spectra = Spectra {
                     base: data,
@@ -406,7 +415,7 @@ impl S2Plan {
                     // The frequency B is never used.
                     for k in 0..n {
                         // SAFETY: column B of ring k, inside the n*n values at `data`.
-                        unsafe { *data.get().add(k * n + b) = Complex64::default() };
+                        unsafe { *data.get().add(k * n + b) = Complex::new(T::ZERO, T::ZERO) };
                     }
                     self.rings_complex(data.get(), false, copy)?;
                     times.dwt += (t1 - t0).as_secs_f64();
@@ -422,7 +431,7 @@ impl S2Plan {
 
     /// Forward transform of real samples: all `B^2` coefficients, with
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))`.
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.forward_real_in((samples, coeffs, 1), None)
     }
 
@@ -430,8 +439,8 @@ impl S2Plan {
     /// share each kernel call (the recurrence is run once for both).
     pub fn forward_real_many(
         &self,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
         howmany: usize,
     ) -> Result<StageTimes> {
         self.forward_real_in((samples, coeffs, howmany), None)
@@ -440,7 +449,7 @@ impl S2Plan {
     /// [`S2Plan::forward_real_many`] in the caller's `scratch` if given (one field).
     fn forward_real_in(
         &self,
-        (samples, coeffs, howmany): (&[f64], &mut [Complex64], usize),
+        (samples, coeffs, howmany): (&[T], &mut [Complex<T>], usize),
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
@@ -468,8 +477,8 @@ impl S2Plan {
     /// kernel calls (as [`S2Plan::forward_real_many`]).
     pub fn forward_real_pair(
         &self,
-        samples: [&[f64]; 2],
-        coeffs: [&mut [Complex64]; 2],
+        samples: [&[T]; 2],
+        coeffs: [&mut [Complex<T>]; 2],
     ) -> Result<StageTimes> {
         for (s, c) in samples.iter().zip(&coeffs) {
             self.check(s.len(), c.len(), 1)?;
@@ -488,8 +497,8 @@ impl S2Plan {
     fn real_analysis(
         &self,
         bufs: [Option<&AlignedBuf>; 2],
-        fields: &[&[f64]],
-        outs: &mut [&mut [Complex64]],
+        fields: &[&[T]],
+        outs: &mut [&mut [Complex<T>]],
     ) -> Result<StageTimes> {
         let factor = (2.0 * PI).sqrt() / (2 * self.b) as f64;
         let t0 = Instant::now();
@@ -513,7 +522,7 @@ impl S2Plan {
     ///
     /// # Safety
     /// As for `LegendreStage::analyse` / `synthesise`, for each field.
-    unsafe fn real_orders(&self, groups: [Option<Group>; 2], factor: f64, analyse: bool) {
+    unsafe fn real_orders(&self, groups: [Option<Group<T>>; 2], factor: f64, analyse: bool) {
         let used = groups.iter().flatten().count();
         let first = groups[0].expect("at least one field");
         let groups = groups.map(|g| g.unwrap_or(first));
@@ -540,18 +549,18 @@ impl S2Plan {
     fn real_rings_forward(
         &self,
         buf: &AlignedBuf,
-        field: &[f64],
-        out: &mut [Complex64],
-    ) -> Result<Group> {
+        field: &[T],
+        out: &mut [Complex<T>],
+    ) -> Result<Group<T>> {
         let n = 2 * self.b;
         let per = self.rings.per_call();
         let half = self.b + 1;
         // Real rings in the first n*n/2 values of the scratch (unless FFTW may read the
         // field itself), their spectra after them.
         let direct = RingFft::aligned(field.as_ptr());
-        let reals = SendPtr(buf.as_mut_ptr().cast::<f64>());
+        let reals = SendPtr(buf.ptr::<T>());
         let src = SendConstPtr(field.as_ptr());
-        let spec = SendPtr(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        let spec = SendPtr(buf.ptr::<Complex<T>>().wrapping_add(n * n / 2));
         self.workers.pool().install(|| {
             (0..n / per).into_par_iter().try_for_each(|c| {
                 let at = c * per * n;
@@ -589,7 +598,7 @@ impl S2Plan {
     /// Inverse transform into real samples: reads the orders `m >= 0` and takes
     /// `fhat(l, -m) = (-1)^m conj(fhat(l, m))` (imaginary parts of `fhat(l, 0)` are
     /// ignored).
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+    pub fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes> {
         self.inverse_real_in((coeffs, samples, 1), None)
     }
 
@@ -597,8 +606,8 @@ impl S2Plan {
     /// per kernel call.
     pub fn inverse_real_many(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
         howmany: usize,
     ) -> Result<StageTimes> {
         self.inverse_real_in((coeffs, samples, howmany), None)
@@ -607,7 +616,7 @@ impl S2Plan {
     /// [`S2Plan::inverse_real_many`] in the caller's `scratch` if given (one field).
     fn inverse_real_in(
         &self,
-        (coeffs, samples, howmany): (&[Complex64], &mut [f64], usize),
+        (coeffs, samples, howmany): (&[Complex<T>], &mut [T], usize),
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.check(samples.len(), coeffs.len(), howmany)?;
@@ -635,8 +644,8 @@ impl S2Plan {
     /// calls (as [`S2Plan::inverse_real_many`]).
     pub fn inverse_real_pair(
         &self,
-        coeffs: [&[Complex64]; 2],
-        samples: [&mut [f64]; 2],
+        coeffs: [&[Complex<T>]; 2],
+        samples: [&mut [T]; 2],
     ) -> Result<StageTimes> {
         for (c, s) in coeffs.iter().zip(&samples) {
             self.check(s.len(), c.len(), 1)?;
@@ -655,8 +664,8 @@ impl S2Plan {
     fn real_synthesis(
         &self,
         bufs: [Option<&AlignedBuf>; 2],
-        fields: &[&[Complex64]],
-        outs: &mut [&mut [f64]],
+        fields: &[&[Complex<T>]],
+        outs: &mut [&mut [T]],
     ) -> Result<StageTimes> {
         let t0 = Instant::now();
         let (b, n) = (self.b, 2 * self.b);
@@ -667,7 +676,7 @@ impl S2Plan {
             let buf = bufs[i].expect("a second scratch for two fields");
             groups[i] = Some(Group {
                 spectra: Spectra {
-                    base: buf.as_mut_ptr().wrapping_add(n * n / 2),
+                    base: buf.ptr::<Complex<T>>().wrapping_add(n * n / 2),
                     row: half,
                     real: true,
                 },
@@ -692,16 +701,16 @@ impl S2Plan {
     }
 
     /// The `c2r` of one field's spectra in `buf` into `out`.
-    fn real_rings_inverse(&self, buf: &AlignedBuf, out: &mut [f64]) -> Result<()> {
+    fn real_rings_inverse(&self, buf: &AlignedBuf, out: &mut [T]) -> Result<()> {
         let (b, n) = (self.b, 2 * self.b);
         let per = self.rings.per_call();
         let half = b + 1;
-        let reals = SendPtr(buf.as_mut_ptr().cast::<f64>());
-        let spec = SendPtr(buf.as_mut_ptr().wrapping_add(n * n / 2));
+        let reals = SendPtr(buf.ptr::<T>());
+        let spec = SendPtr(buf.ptr::<Complex<T>>().wrapping_add(n * n / 2));
         self.workers.pool().install(|| {
             for k in 0..n {
                 // SAFETY: column B of spectrum row k, inside the scratch.
-                unsafe { *spec.get().add(k * half + b) = Complex64::default() };
+                unsafe { *spec.get().add(k * half + b) = Complex::new(T::ZERO, T::ZERO) };
             }
             let direct = RingFft::aligned(out.as_ptr());
             let dst = SendPtr(out.as_mut_ptr());
@@ -729,14 +738,20 @@ impl S2Plan {
 }
 
 /// Copies made by the ring DFT tasks around their DFTs (see `S2Plan::rings_complex`).
-#[derive(Clone, Copy)]
-enum RingCopy {
+enum RingCopy<T> {
     None,
     /// Copy the rings in from this array first.
-    From(SendConstPtr<Complex64>),
+    From(SendConstPtr<Complex<T>>),
     /// Copy the transformed rings out to this array.
-    To(SendPtr<Complex64>),
+    To(SendPtr<Complex<T>>),
 }
+
+impl<T: Copy> Clone for RingCopy<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T: Copy> Copy for RingCopy<T> {}
 
 /// The scratch behind `m` if no other execution holds it.
 fn try_take(
@@ -756,7 +771,7 @@ fn scratch_len(b: usize) -> usize {
     n * n + n
 }
 
-impl Transform for S2Plan {
+impl Transform for S2Plan<f64> {
     fn num_samples(&self) -> usize {
         S2Plan::num_samples(self)
     }

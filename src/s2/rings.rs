@@ -3,42 +3,42 @@
 
 use crate::error::{Error, Result};
 use crate::fft::{plan_guarded, RawPlan, Rigor};
-use fftw_sys as fftw;
-use num_complex::Complex64;
+use crate::real::Real;
+use num_complex::Complex;
 use std::ffi::c_int;
 
 /// Ring DFTs of one bandwidth: complex (in place, rows of `2B` values) in both directions,
 /// real `r2c` (rows of `2B` reals into rows of `B + 1` values) and `c2r`, each planned for
 /// [`RingFft::per_call`] consecutive rings.
-pub(super) struct RingFft {
+pub(super) struct RingFft<T: Real = f64> {
     n: usize,
     per_call: usize,
     /// Sign -1: `F_m = sum_k f_k e^{-i m phi_k}`.
-    analysis: RawPlan,
+    analysis: RawPlan<T>,
     /// Sign +1.
-    synthesis: RawPlan,
-    r2c: RawPlan,
-    c2r: RawPlan,
+    synthesis: RawPlan<T>,
+    r2c: RawPlan<T>,
+    c2r: RawPlan<T>,
 }
 
-impl RingFft {
+impl<T: Real> RingFft<T> {
     /// The DFTs of `n = 2B` points, planned with `rigor` on scratch memory.
-    pub(super) fn new(n: usize, rigor: Rigor) -> Result<RingFft> {
+    pub(super) fn new(n: usize, rigor: Rigor) -> Result<RingFft<T>> {
         // Rings per call: the largest power of two up to 16 that divides the ring count.
         let per_call = 1usize << n.trailing_zeros().min(4);
         let flags = rigor.flags();
         let len = per_call * n;
-        let scratch = crate::fft::AlignedBuf::new(len)?;
-        let real_in = crate::fft::AlignedBuf::new(len)?;
+        let scratch = crate::fft::AlignedBuf::of::<Complex<T>>(len)?;
+        let real_in = crate::fft::AlignedBuf::of::<Complex<T>>(len)?;
         let dims = [n as c_int];
         let (howmany, dist, half) = (per_call as c_int, n as c_int, (n / 2 + 1) as c_int);
-        let data = scratch.as_mut_ptr();
+        let data = scratch.ptr::<Complex<T>>();
         let complex = |sign: i32| {
             plan_guarded(len, || {
                 // SAFETY: under the planner lock (plan_guarded); `per_call` rows of `n` values
                 // in `scratch` (which outlives the call); FFTW keeps no pointer to `dims`.
                 unsafe {
-                    fftw::fftw_plan_many_dft(
+                    T::plan_many_dft(
                         1,
                         dims.as_ptr(),
                         howmany,
@@ -56,12 +56,12 @@ impl RingFft {
                 }
             })
         };
-        let reals = real_in.as_mut_ptr().cast::<f64>();
+        let reals = real_in.ptr::<T>();
         let r2c = plan_guarded(len, || {
             // SAFETY: as above: `per_call` rows of `n` reals in `real_in` into rows of
             // `n/2 + 1` values in `scratch` (both hold `per_call * n` complex values).
             unsafe {
-                fftw::fftw_plan_many_dft_r2c(
+                T::plan_many_dft_r2c(
                     1,
                     dims.as_ptr(),
                     howmany,
@@ -73,14 +73,14 @@ impl RingFft {
                     std::ptr::null(),
                     1,
                     half,
-                    flags | fftw::FFTW_PRESERVE_INPUT,
+                    flags | fftw_sys::FFTW_PRESERVE_INPUT,
                 )
             }
         })?;
         let c2r = plan_guarded(len, || {
             // SAFETY: as for `r2c`, in the other direction.
             unsafe {
-                fftw::fftw_plan_many_dft_c2r(
+                T::plan_many_dft_c2r(
                     1,
                     dims.as_ptr(),
                     howmany,
@@ -112,13 +112,13 @@ impl RingFft {
     }
 
     /// Whether FFTW's plans may run on data at `p` (aligned as the planned arrays: 16 bytes).
-    pub(super) fn aligned(p: *const f64) -> bool {
+    pub(super) fn aligned(p: *const T) -> bool {
         // SAFETY: fftw_alignment_of only inspects the address.
-        unsafe { fftw::fftw_alignment_of(p.cast_mut()) == 0 }
+        unsafe { T::alignment_of(p.cast_mut()) == 0 }
     }
 
     /// An error unless `p` is aligned as FFTW's plans were made for (see [`RingFft::aligned`]).
-    fn check_alignment(p: *const f64) -> Result<()> {
+    fn check_alignment(p: *const T) -> Result<()> {
         if !Self::aligned(p) {
             return Err(Error::Fftw("ring data not aligned for FFTW".into()));
         }
@@ -130,7 +130,7 @@ impl RingFft {
     ///
     /// # Safety
     /// `rows` is valid for reads and writes of `per_call * 2B` values, used by no one else.
-    pub(super) unsafe fn complex(&self, rows: *mut Complex64, analysis: bool) -> Result<()> {
+    pub(super) unsafe fn complex(&self, rows: *mut Complex<T>, analysis: bool) -> Result<()> {
         Self::check_alignment(rows.cast())?;
         let plan = if analysis {
             &self.analysis
@@ -139,7 +139,7 @@ impl RingFft {
         };
         // SAFETY: the plan's extent and layout (caller's contract); new-array execute is
         // thread-safe.
-        unsafe { fftw::fftw_execute_dft(plan.0, rows, rows) };
+        unsafe { T::execute_dft(plan.0, rows, rows) };
         Ok(())
     }
 
@@ -149,11 +149,11 @@ impl RingFft {
     /// # Safety
     /// `input` is valid for reading `per_call * 2B` reals, `out` for writing
     /// `per_call * (B + 1)` values, not overlapping, `out` used by no one else.
-    pub(super) unsafe fn r2c(&self, input: *const f64, out: *mut Complex64) -> Result<()> {
+    pub(super) unsafe fn r2c(&self, input: *const T, out: *mut Complex<T>) -> Result<()> {
         Self::check_alignment(input)?;
         Self::check_alignment(out.cast())?;
         // SAFETY: as above; FFTW_PRESERVE_INPUT: `input` is only read.
-        unsafe { fftw::fftw_execute_dft_r2c(self.r2c.0, input.cast_mut(), out) };
+        unsafe { T::execute_dft_r2c(self.r2c.0, input.cast_mut(), out) };
         Ok(())
     }
 
@@ -162,11 +162,11 @@ impl RingFft {
     /// # Safety
     /// `input` is valid for reads and writes of `per_call * (B + 1)` values, `out` for
     /// writing `per_call * 2B` reals, not overlapping, neither used by anyone else.
-    pub(super) unsafe fn c2r(&self, input: *mut Complex64, out: *mut f64) -> Result<()> {
+    pub(super) unsafe fn c2r(&self, input: *mut Complex<T>, out: *mut T) -> Result<()> {
         Self::check_alignment(input.cast())?;
         Self::check_alignment(out)?;
         // SAFETY: as above.
-        unsafe { fftw::fftw_execute_dft_c2r(self.c2r.0, input, out) };
+        unsafe { T::execute_dft_c2r(self.c2r.0, input, out) };
         Ok(())
     }
 

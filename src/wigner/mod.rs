@@ -89,3 +89,12 @@ pub fn dt_on_grid(b: usize, m: isize, mp: isize) -> Vec<f64> {
     }
     out
 }
+
+/// The lowest order from which the `m' = 0` recurrences (the S^2 Legendre stage) run in
+/// single precision at bandwidth `b`; lower orders run in doubles. The single-precision
+/// recurrence loses accuracy near the poles, where the low orders have their weight: at
+/// `m < 16` its error reaches 1e-5 to 4e-4 from B = 256 on, at `m >= 16` it stays near
+/// `B x 1e-8` (measured in `notes/reference/f32_recurrence/rust-twin.md`).
+pub(crate) fn single_precision_orders(b: usize) -> usize {
+    16.min(b)
+}

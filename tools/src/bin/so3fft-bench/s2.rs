@@ -5,7 +5,7 @@
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
 use so3fft::s2::{s2_coef_index, S2Plan};
-use so3fft::Complex64;
+use so3fft::{Complex, Complex64};
 use std::time::Instant;
 
 /// Flops of one Legendre stage (either direction): per order `m` and degree `l >= m`, the
@@ -46,15 +46,81 @@ fn timed<T>(runs: usize, mut f: impl FnMut() -> so3fft::Result<T>) -> so3fft::Re
     Ok(median(&t))
 }
 
-/// Runs the S^2 measurement for every bandwidth and thread count of `opts`.
+/// One precision's medians at one bandwidth and thread count, in seconds: real synthesis,
+/// analysis, the same per field of a pair, complex synthesis and analysis; and the real and
+/// complex round-trip errors.
+struct Row {
+    times: [f64; 6],
+    err_real: f64,
+    err_cx: f64,
+    threads: usize,
+}
+
+/// `v` in `T`.
+fn narrow<T: so3fft::Real>(v: &[Complex64]) -> Vec<Complex<T>> {
+    v.iter()
+        .map(|z| Complex::new(T::from_f64(z.re), T::from_f64(z.im)))
+        .collect()
+}
+
+/// `v` in doubles.
+fn widen<T: so3fft::Real>(v: &[Complex<T>]) -> Vec<Complex64> {
+    v.iter()
+        .map(|z| Complex64::new(z.re.to_f64(), z.im.to_f64()))
+        .collect()
+}
+
+/// The measurements of an S^2 plan in `T` (see [`Row`]).
+fn measure<T: so3fft::Real>(b: usize, threads: usize, opts: &Options) -> so3fft::Result<Row> {
+    let plan = S2Plan::<T>::new(
+        b,
+        &so3fft::Options::default()
+            .with_threads(threads)
+            .with_rigor(opts.rigor),
+    )?;
+    let runs = opts.runs.unwrap_or(if b >= 1024 { 3 } else { 7 });
+    let (ns, nc) = (plan.num_samples(), plan.num_coeffs());
+    let zero = Complex::new(T::ZERO, T::ZERO);
+    let real_coefs = hermitian(b, 7);
+    let coefs = random_coeffs(nc, 11);
+    let (real_in, coefs_in) = (narrow::<T>(&real_coefs), narrow::<T>(&coefs));
+    let mut real = vec![T::ZERO; ns];
+    let mut samples = vec![zero; ns];
+    let mut back = vec![zero; nc];
+    let re_syn = timed(runs, || plan.inverse_real(&real_in, &mut real))?;
+    let re_ana = timed(runs, || plan.forward_real(&real, &mut back))?;
+    let err_real = rel_l2(&widen(&back), &widen(&real_in));
+    let pair_coefs = narrow::<T>(&[real_coefs.clone(), hermitian(b, 8)].concat());
+    let mut pair_real = vec![T::ZERO; 2 * ns];
+    let mut pair_back = vec![zero; 2 * nc];
+    let re_syn2 = timed(runs, || {
+        plan.inverse_real_many(&pair_coefs, &mut pair_real, 2)
+    })? / 2.0;
+    let re_ana2 = timed(runs, || {
+        plan.forward_real_many(&pair_real, &mut pair_back, 2)
+    })? / 2.0;
+    let cx_syn = timed(runs, || plan.inverse(&coefs_in, &mut samples))?;
+    let cx_ana = timed(runs, || plan.forward(&samples, &mut back))?;
+    let err_cx = rel_l2(&widen(&back), &widen(&coefs_in));
+    Ok(Row {
+        times: [re_syn, re_ana, re_syn2, re_ana2, cx_syn, cx_ana],
+        err_real,
+        err_cx,
+        threads: plan.threads(),
+    })
+}
+
+/// Runs the S^2 measurement for every bandwidth and thread count of `opts`, in double and
+/// in single precision (measured one after the other), with the time ratios.
 pub fn run(opts: &Options) -> so3fft::Result<()> {
     let peak1 = crate::peak::measure(1).one_core;
     println!("S^2 transforms: medians of the runs in ms; GFLOP/s of the Legendre sums");
     println!("FMA peak of one core: {peak1:.1} GFLOP/s");
     println!(
-        "{:>5} {:>3} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6} {:>10} {:>10}",
+        "{:>5} {:>3} {:>4} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6} {:>10} {:>10}",
         "B",
         "thr",
+        "prec",
         "re syn",
         "re ana",
         "re syn/2",
@@ -66,49 +132,39 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
         "err real",
         "err cx"
     );
-    println!("(re .../2: two real fields per call, time per field)");
+    println!("(re .../2: two real fields per call, time per field; f32/f64: time ratios)");
     for &b in &opts.bandwidths {
         for &threads in &opts.threads {
-            let plan = S2Plan::new(
-                b,
-                &so3fft::Options::default()
-                    .with_threads(threads)
-                    .with_rigor(opts.rigor),
-            )?;
-            let runs = opts.runs.unwrap_or(if b >= 1024 { 3 } else { 7 });
-            let (ns, nc) = (plan.num_samples(), plan.num_coeffs());
-            let real_coefs = hermitian(b, 7);
-            let coefs = random_coeffs(nc, 11);
-            let mut real = vec![0.0; ns];
-            let mut samples = vec![Complex64::default(); ns];
-            let mut back = vec![Complex64::default(); nc];
-            let re_syn = timed(runs, || plan.inverse_real(&real_coefs, &mut real))?;
-            let re_ana = timed(runs, || plan.forward_real(&real, &mut back))?;
-            let err_real = rel_l2(&back, &real_coefs);
-            let pair_coefs = [real_coefs.clone(), hermitian(b, 8)].concat();
-            let mut pair_real = vec![0.0; 2 * ns];
-            let mut pair_back = vec![Complex64::default(); 2 * nc];
-            let re_syn2 = timed(runs, || {
-                plan.inverse_real_many(&pair_coefs, &mut pair_real, 2)
-            })? / 2.0;
-            let re_ana2 = timed(runs, || {
-                plan.forward_real_many(&pair_real, &mut pair_back, 2)
-            })? / 2.0;
-            let cx_syn = timed(runs, || plan.inverse(&coefs, &mut samples))?;
-            let cx_ana = timed(runs, || plan.forward(&samples, &mut back))?;
-            let err_cx = rel_l2(&back, &coefs);
-            let gflops = legendre_flops(b) / cx_ana.min(cx_syn) / 1e9;
-            let cores = plan.threads().min(2) as f64;
+            let rows = [
+                ("f64", measure::<f64>(b, threads, opts)?),
+                ("f32", measure::<f32>(b, threads, opts)?),
+            ];
+            for (name, r) in &rows {
+                let [re_syn, re_ana, re_syn2, re_ana2, cx_syn, cx_ana] = r.times;
+                let gflops = legendre_flops(b) / cx_ana.min(cx_syn) / 1e9;
+                let cores = r.threads.min(2) as f64;
+                println!(
+                    "{b:>5} {:>3} {name:>4} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {gflops:>8.1} {:>5.0}% {:>10.2e} {:>10.2e}",
+                    r.threads,
+                    re_syn * 1e3,
+                    re_ana * 1e3,
+                    re_syn2 * 1e3,
+                    re_ana2 * 1e3,
+                    cx_syn * 1e3,
+                    cx_ana * 1e3,
+                    100.0 * gflops / (peak1 * cores),
+                    r.err_real,
+                    r.err_cx,
+                );
+            }
+            let ratio: Vec<String> = (0..6)
+                .map(|k| format!("{:>9.2}", rows[1].1.times[k] / rows[0].1.times[k]))
+                .collect();
             println!(
-                "{b:>5} {:>3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {:>9.3} {gflops:>8.1} {:>5.0}% {err_real:>10.2e} {err_cx:>10.2e}",
-                plan.threads(),
-                re_syn * 1e3,
-                re_ana * 1e3,
-                re_syn2 * 1e3,
-                re_ana2 * 1e3,
-                cx_syn * 1e3,
-                cx_ana * 1e3,
-                100.0 * gflops / (peak1 * cores),
+                "{b:>5} {:>3} {:>4} {}",
+                rows[0].1.threads,
+                "f32/",
+                ratio.join(" ")
             );
         }
     }
