@@ -29,6 +29,8 @@ pub(super) struct Spectra<T> {
     pub row: usize,
     /// Real rings: only orders `m >= 0` are stored (`row = B + 1`), `F_{-m} = conj(F_m)`.
     pub real: bool,
+    /// A block's copy (see [`Spectra::gather`]): the first order and the block's width.
+    pub block: Option<(usize, usize)>,
 }
 
 // SAFETY: an address only; the tasks of one execution access disjoint columns through it
@@ -47,12 +49,75 @@ impl<T> Copy for Spectra<T> {}
 impl<T> Spectra<T> {
     /// Pointer to `F_m` of ring `k` (`m` taken modulo the ring length for complex rings).
     fn at(&self, k: usize, m: isize) -> *mut Complex<T> {
-        let col = if self.real {
-            m as usize
-        } else {
-            m.rem_euclid(self.row as isize) as usize
+        let col = match self.block {
+            // Orders first.. in the first `width` columns, their negatives in the next,
+            // reversed (as they lie in a ring).
+            Some((first, width)) if m < 0 => 2 * width - 1 - (m.unsigned_abs() - first),
+            Some((first, _)) => m as usize - first,
+            None if self.real => m as usize,
+            None => m.rem_euclid(self.row as isize) as usize,
         };
         self.base.wrapping_add(k * self.row + col)
+    }
+}
+
+impl<T: Copy> Spectra<T> {
+    /// The view of a block's copy in `buf` (`rings * 2 width` values) of orders
+    /// `first ..` (see [`Spectra::gather`]).
+    pub(super) fn block_view(
+        &self,
+        (first, width): (usize, usize),
+        buf: *mut Complex<T>,
+    ) -> Spectra<T> {
+        Spectra {
+            base: buf,
+            row: 2 * width,
+            real: self.real,
+            block: Some((first, width)),
+        }
+    }
+
+    /// Copies orders `first .. first + len` (and, for complex rings, their negatives) of
+    /// each of the `rings` between these spectra and the block view `block`: into the block
+    /// with `gather`, else back. Each ring's orders are read as a few cache lines instead of
+    /// one line per ring and order.
+    ///
+    /// # Safety
+    /// Both hold the `rings` rings of those orders (`block` from [`Spectra::block_view`]
+    /// with `len <= width`); no other task touches them meanwhile.
+    pub(super) unsafe fn copy_block(
+        &self,
+        block: &Spectra<T>,
+        rings: usize,
+        len: usize,
+        gather: bool,
+    ) {
+        let Some((first, _)) = block.block else {
+            unreachable!("not a block view")
+        };
+        // Orders -(first + len - 1) ..= -lo, without -0: ascending columns in both.
+        let lo = first.max(1);
+        let top = -((first + len - 1) as isize);
+        // SAFETY: orders first..first+len are contiguous in a ring (below the ring length),
+        // so are their negatives (wrapped to the ring's end; reversed in the block view);
+        // the caller's contract covers the rest.
+        unsafe {
+            for k in 0..rings {
+                let (pos, neg) = (
+                    (self.at(k, first as isize), block.at(k, first as isize)),
+                    (self.at(k, top), block.at(k, top)),
+                );
+                let ((s1, d1), (s2, d2)) = if gather {
+                    (pos, neg)
+                } else {
+                    ((pos.1, pos.0), (neg.1, neg.0))
+                };
+                std::ptr::copy_nonoverlapping(s1, d1, len);
+                if !self.real && lo < first + len {
+                    std::ptr::copy_nonoverlapping(s2, d2, first + len - lo);
+                }
+            }
+        }
     }
 }
 

@@ -57,7 +57,13 @@ pub struct S2Plan<T: Real = f64> {
     /// A second ring scratch for the real transforms of two fields at once (made on first
     /// use).
     spare: Mutex<Option<AlignedBuf>>,
+    /// Per-worker copies of a block of orders' columns (see [`S2Plan::run_orders`]).
+    blocks: Vec<Mutex<Vec<Complex<T>>>>,
 }
+
+/// Orders per task of the Legendre stage: each ring's values of a block are read as whole
+/// cache lines.
+const ORDER_BLOCK: usize = 8;
 
 impl<T: Real> S2Plan<T> {
     /// A plan for bandwidth `bandwidth` (`1 ..= S2_MAX_BANDWIDTH`), all degrees and
@@ -118,6 +124,7 @@ impl<T: Real> S2Plan<T> {
             order_limit: limits.order_limit.unwrap_or(b),
             scratch: Mutex::new(Some(scratch)),
             spare: Mutex::new(None),
+            blocks: (0..threads).map(|_| Mutex::new(Vec::new())).collect(),
         })
     }
 
@@ -325,7 +332,7 @@ impl<T: Real> S2Plan<T> {
         self.check(samples.len(), coeffs.len(), howmany)?;
         let start = Instant::now();
         let mut times = StageTimes::default();
-        let (b, n, nc) = (self.b, 2 * self.b, self.num_coeffs());
+        let (n, nc) = (2 * self.b, self.num_coeffs());
         let factor = (2.0 * PI).sqrt() / n as f64;
         self.with_scratch((false, scratch), |buf, _| {
             for (field, out) in samples.chunks_exact(n * n).zip(coeffs.chunks_exact_mut(nc)) {
@@ -333,6 +340,7 @@ impl<T: Real> S2Plan<T> {
                     base: buf.ptr::<Complex<T>>(),
                     row: n,
                     real: false,
+                    block: None,
                 };
                 let coef = self.coeff_rows(out.as_mut_ptr());
                 self.workers.pool().install(|| {
@@ -340,12 +348,11 @@ impl<T: Real> S2Plan<T> {
                     let src = SendConstPtr(field.as_ptr());
                     self.rings_complex(buf.ptr::<Complex<T>>(), true, RingCopy::From(src))?;
                     let t1 = Instant::now();
-                    (0..b).into_par_iter().for_each(|m| {
-                        let (groups, count) = Self::complex_groups(m, spectra, coef);
-                        // SAFETY: each task handles orders +-m only; the spectra and the
-                        // coefficient array are whole (lengths checked).
-                        unsafe { self.analyse(m, &groups[..count], factor) }
-                    });
+                    // SAFETY: each task handles its orders +-m only; the spectra and the
+                    // coefficient array are whole (lengths checked).
+                    unsafe {
+                        self.run_orders((true, factor), &|m| Self::complex_groups(m, spectra, coef))
+                    };
                     times.fft += (t1 - t0).as_secs_f64();
                     times.dwt += t1.elapsed().as_secs_f64();
                     Ok::<(), Error>(())
@@ -400,17 +407,19 @@ impl<T: Real> S2Plan<T> {
                     base: data,
                     row: n,
                     real: false,
+                    block: None,
                 };
                 let data = SendPtr(data);
                 let coef = self.coeff_rows(field.as_ptr().cast_mut());
                 self.workers.pool().install(|| {
                     let t0 = Instant::now();
-                    (0..b).into_par_iter().for_each(|m| {
-                        let (groups, count) = Self::complex_groups(m, spectra, coef);
-                        // SAFETY: each task writes the columns of orders +-m only and reads
-                        // their coefficient blocks (never written).
-                        unsafe { self.synthesise(m, &groups[..count], factor) }
-                    });
+                    // SAFETY: each task writes the columns of its orders +-m only and reads
+                    // their coefficient blocks (never written).
+                    unsafe {
+                        self.run_orders((false, factor), &|m| {
+                            Self::complex_groups(m, spectra, coef)
+                        })
+                    };
                     let t1 = Instant::now();
                     // The frequency B is never used.
                     for k in 0..n {
@@ -527,21 +536,95 @@ impl<T: Real> S2Plan<T> {
         let first = groups[0].expect("at least one field");
         let groups = groups.map(|g| g.unwrap_or(first));
         self.workers.pool().install(|| {
-            (0..self.b).into_par_iter().for_each(|m| {
+            let of = |m: usize| {
                 let g = groups.map(|src| Group {
                     order: m as isize,
                     ..src
                 });
-                // SAFETY: each task handles order m of each field only (caller's contract).
+                (g, used)
+            };
+            // SAFETY: each task handles its orders of each field only (caller's contract).
+            unsafe { self.run_orders((analyse, factor), &of) }
+        });
+    }
+
+    /// The Legendre analysis (`analyse`) or synthesis of every order, the groups of order
+    /// `m` given by `groups_of(m)` (those of all orders on the same spectra), in tasks of
+    /// [`ORDER_BLOCK`] orders: each task copies its orders' columns of every ring into a
+    /// block of its own before the analysis, or from it after the synthesis, so that the
+    /// rings' values are read and written as whole cache lines.
+    ///
+    /// # Safety
+    /// As for `LegendreStage::analyse` / `synthesise`, for every order's groups.
+    unsafe fn run_orders(
+        &self,
+        (analyse, factor): (bool, f64),
+        groups_of: &(dyn Fn(usize) -> ([Group<T>; 2], usize) + Sync),
+    ) {
+        let (b, rings) = (self.b, 2 * self.b);
+        let width = ORDER_BLOCK;
+        (0..b.div_ceil(width)).into_par_iter().for_each(|blk| {
+            let (first, len) = (blk * width, width.min(b - blk * width));
+            // The distinct spectra of the groups (one per field).
+            let (g0, count) = groups_of(first);
+            let mut fields: Vec<Spectra<T>> = Vec::with_capacity(2);
+            for g in &g0[..count] {
+                if !fields.iter().any(|f| f.base == g.spectra.base) {
+                    fields.push(g.spectra);
+                }
+            }
+            let each = rings * 2 * width;
+            self.with_block(fields.len() * each, |buf| {
+                let views: Vec<Spectra<T>> = fields
+                    .iter()
+                    .enumerate()
+                    .map(|(i, f)| f.block_view((first, width), buf[i * each..].as_mut_ptr()))
+                    .collect();
+                // SAFETY: the block's orders of each field: this task's (caller's contract);
+                // each view covers `each` values of `buf`.
                 unsafe {
                     if analyse {
-                        self.analyse(m, &g[..used], factor)
-                    } else {
-                        self.synthesise(m, &g[..used], factor)
+                        for (f, v) in fields.iter().zip(&views) {
+                            f.copy_block(v, rings, len, true);
+                        }
+                    }
+                    for m in first..first + len {
+                        let (mut g, count) = groups_of(m);
+                        for gi in g[..count].iter_mut() {
+                            let i = fields.iter().position(|f| f.base == gi.spectra.base);
+                            gi.spectra = views[i.expect("a field of the block")];
+                        }
+                        if analyse {
+                            self.analyse(m, &g[..count], factor)
+                        } else {
+                            self.synthesise(m, &g[..count], factor)
+                        }
+                    }
+                    if !analyse {
+                        for (f, v) in fields.iter().zip(&views) {
+                            f.copy_block(v, rings, len, false);
+                        }
                     }
                 }
-            })
+            });
         });
+    }
+
+    /// Runs `f` with a worker's block buffer of at least `len` values (another's if its
+    /// own is in use, else a new one).
+    fn with_block(&self, len: usize, f: impl FnOnce(&mut [Complex<T>])) {
+        let zero = Complex::new(T::ZERO, T::ZERO);
+        let n = self.blocks.len();
+        let me = rayon::current_thread_index().unwrap_or(0);
+        for i in 0..n {
+            if let Ok(mut g) = self.blocks[(me + i) % n].try_lock() {
+                if g.len() < len {
+                    g.resize(len, zero);
+                }
+                return f(&mut g[..len]);
+            }
+        }
+        f(&mut vec![zero; len])
     }
 
     /// The `r2c` of one real field's rings (copied into `buf` first); the field's column
@@ -588,6 +671,7 @@ impl<T: Real> S2Plan<T> {
                 base: spec.get(),
                 row: half,
                 real: true,
+                block: None,
             },
             coef: self.coeff_rows(out.as_mut_ptr()),
             order: 0,
@@ -679,6 +763,7 @@ impl<T: Real> S2Plan<T> {
                     base: buf.ptr::<Complex<T>>().wrapping_add(n * n / 2),
                     row: half,
                     real: true,
+                    block: None,
                 },
                 coef: self.coeff_rows(field.as_ptr().cast_mut()),
                 order: 0,
