@@ -10,21 +10,14 @@ use so3fft::s2::{s2_coef_index, S2Limits, S2Plan};
 use so3fft::Options;
 use std::f64::consts::PI;
 
-/// Samples (`j k re im`) and coefficients (`index l m re im`) of a reference file.
+/// Samples and coefficients of a reference file, each coefficient's `(l, m)` checked
+/// against its index.
 fn samples_and_coefs(name: &str, b: usize) -> (Vec<Complex64>, Vec<Complex64>) {
-    let r = common::read_s2_reference(name);
-    let n = 2 * b;
-    let mut samples = vec![Complex64::default(); n * n];
-    for row in &r["samples"] {
-        samples[row[0] as usize * n + row[1] as usize] = Complex64::new(row[2], row[3]);
-    }
-    let mut coefs = vec![Complex64::default(); b * b];
-    for row in &r["coefs"] {
+    for row in &common::read_s2_reference(name)["coefs"] {
         let (l, m) = (row[1] as usize, row[2] as isize);
         assert_eq!(s2_coef_index(b, l, m), row[0] as usize);
-        coefs[row[0] as usize] = Complex64::new(row[3], row[4]);
     }
-    (samples, coefs)
+    common::s2_samples_and_coefs(name, b)
 }
 
 fn max_abs(v: &[Complex64]) -> f64 {

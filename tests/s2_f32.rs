@@ -44,32 +44,17 @@ fn hermitian(mut c: Vec<Complex64>, b: usize) -> Vec<Complex64> {
     c
 }
 
-/// Samples (`j k re im`) and coefficients (`index l m re im`) of a reference file.
-fn reference(name: &str, b: usize) -> (Vec<Complex64>, Vec<Complex64>) {
-    let r = common::read_s2_reference(name);
-    let n = 2 * b;
-    let mut samples = vec![Complex64::default(); n * n];
-    for row in &r["samples"] {
-        samples[row[0] as usize * n + row[1] as usize] = Complex64::new(row[2], row[3]);
-    }
-    let mut coefs = vec![Complex64::default(); b * b];
-    for row in &r["coefs"] {
-        coefs[row[0] as usize] = Complex64::new(row[3], row[4]);
-    }
-    (samples, coefs)
-}
-
 /// The reference transforms (mpmath) at B = 8, to single-precision accuracy.
 #[test]
 fn float_transforms_match_reference() {
     let b = 8;
     let p = plan32(b, None);
-    let (samples, want) = reference("fst_B8_complex.txt", b);
+    let (samples, want) = common::s2_samples_and_coefs("fst_B8_complex.txt", b);
     let mut got = vec![Complex32::default(); b * b];
     p.forward(&narrow(&samples), &mut got).unwrap();
     let err = relative_l2(&widen(&got), &want);
     assert!(err < 1e-6, "forward against the reference: {err:e}");
-    let (want, coefs) = reference("inv_B8_complex.txt", b);
+    let (want, coefs) = common::s2_samples_and_coefs("inv_B8_complex.txt", b);
     let mut back = vec![Complex32::default(); 4 * b * b];
     p.inverse(&narrow(&coefs), &mut back).unwrap();
     let err = relative_l2(&widen(&back), &want);

@@ -576,3 +576,20 @@ pub fn rnd(state: &mut u64) -> f64 {
         .wrapping_add(1442695040888963407);
     (*state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
 }
+
+/// Samples (`j k re im`) and coefficients (`index l m re im`) of an S^2 reference file at
+/// bandwidth `b`, the samples ring-major (`2B x 2B`), the coefficients in `seanindex`
+/// order (the index each row names, checked against `l` and `m` by the callers).
+pub fn s2_samples_and_coefs(name: &str, b: usize) -> (Vec<Complex64>, Vec<Complex64>) {
+    let r = read_s2_reference(name);
+    let n = 2 * b;
+    let mut samples = vec![Complex64::default(); n * n];
+    for row in &r["samples"] {
+        samples[row[0] as usize * n + row[1] as usize] = Complex64::new(row[2], row[3]);
+    }
+    let mut coefs = vec![Complex64::default(); b * b];
+    for row in &r["coefs"] {
+        coefs[row[0] as usize] = Complex64::new(row[3], row[4]);
+    }
+    (samples, coefs)
+}
