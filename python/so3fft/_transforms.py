@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Optional, Tuple
+from typing import Optional, Protocol, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -11,7 +11,31 @@ from . import _so3fft
 from ._arrays import apart, as_input, bandwidth_arg, check_output, threads_arg
 
 
-class Plan:
+class _HasBandwidth(Protocol):
+    """An extension plan: it knows its bandwidth."""
+
+    @property
+    def bandwidth(self) -> int: ...
+
+
+class _Bandwidth:
+    """What every plan answers: its bandwidth and whether its samples are real."""
+
+    _plan: _HasBandwidth
+    _real: bool
+
+    @property
+    def B(self) -> int:
+        """The bandwidth."""
+        return self._plan.bandwidth
+
+    @property
+    def real(self) -> bool:
+        """Whether the samples are real."""
+        return self._real
+
+
+class Plan(_Bandwidth):
     """Forward and inverse FFT on SO(3) at bandwidth ``B`` (SOFT 2.0's conventions).
 
     Samples are a ``(2B, 2B, 2B)`` array indexed ``[k, j, i]``: the function at
@@ -58,23 +82,13 @@ class Plan:
         self, B: int, *, real: bool = False, threads: int = 0, rigor: str = "estimate"
     ) -> None:
         B = bandwidth_arg(B)
-        self._plan = _so3fft.Plan(B, bool(real), threads_arg(threads), rigor)
+        self._plan: _so3fft.Plan = _so3fft.Plan(B, bool(real), threads_arg(threads), rigor)
         self._real = bool(real)
         n = 2 * B
         self._sample_shape = (n, n, n)
         self._sample_shapes = ((n, n, n), (n * n * n,))
         self._sample_dtype = np.float64 if self._real else np.complex128
         self._num_coeffs = self._plan.num_coeffs
-
-    @property
-    def B(self) -> int:
-        """The bandwidth."""
-        return self._plan.bandwidth
-
-    @property
-    def real(self) -> bool:
-        """Whether the samples are real."""
-        return self._real
 
     @property
     def sample_shape(self) -> Tuple[int, ...]:
@@ -146,7 +160,7 @@ class Plan:
         return out
 
 
-class S2Plan:
+class S2Plan(_Bandwidth):
     """Spherical-harmonic transforms on the sphere at bandwidth ``B`` (SOFT 2.0's grid and
     coefficient order), of one field or many.
 
@@ -180,19 +194,9 @@ class S2Plan:
         self, B: int, *, real: bool = False, threads: int = 0, rigor: str = "estimate"
     ) -> None:
         B = bandwidth_arg(B)
-        self._plan = _so3fft.S2Plan(B, threads_arg(threads), rigor)
+        self._plan: _so3fft.S2Plan = _so3fft.S2Plan(B, threads_arg(threads), rigor)
         self._real = bool(real)
         self._sample_dtype = np.float64 if self._real else np.complex128
-
-    @property
-    def B(self) -> int:
-        """The bandwidth."""
-        return self._plan.bandwidth
-
-    @property
-    def real(self) -> bool:
-        """Whether the samples are real."""
-        return self._real
 
     @property
     def sample_shape(self) -> Tuple[int, ...]:

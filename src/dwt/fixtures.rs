@@ -3,8 +3,8 @@
 
 use super::lanes::{Lanes, Prefetch, Rec};
 use crate::numeric::Elem;
-use crate::numeric::{frexp, ldexp};
-use crate::wigner::starts::{big, start_norm, BaseStart, BetaTables, DEFAULT_SKIP_BITS};
+use crate::numeric::{frexp, Ext};
+use crate::wigner::starts::{big, start_norm, to_scaled, BaseStart, BetaTables, DEFAULT_SKIP_BITS};
 use crate::wigner::{RecCoeffs, RecTables};
 
 /// Skip threshold of the kernel tests and benchmarks: `SO3FFT_SKIP_BITS` or the default.
@@ -115,7 +115,7 @@ pub fn grid_lanes<'a>(tau: &'a [f64], p: &'a [f64], sc: &'a [f64], upper_from: u
 
 /// A cluster's kernel inputs in floats (see [`ClusterInputs::to_f32`]).
 pub struct FloatInputs {
-    coeffs: [Vec<f32>; 4],
+    coeffs: RecCoeffs<f32>,
     /// Recurrence argument of each beta.
     pub tau: Vec<f32>,
     /// Scaled starting value of each beta, in the float scaled form.
@@ -126,30 +126,27 @@ pub struct FloatInputs {
 
 impl ClusterInputs {
     /// The inputs rounded to floats: the coefficients and arguments to nearest, each start
-    /// moved from the double scaled form (step `f64::SCALE_STEP`) to the float one.
+    /// moved from the double scaled form to the float one.
     pub fn to_f32(&self) -> FloatInputs {
-        let r = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
-        let c = &self.coeffs;
-        let bits = test_skip_bits() as i64;
-        let (mut p, mut sc) = (vec![0.0f32; self.p.len()], vec![0.0f32; self.p.len()]);
-        for (s, (&v, &k)) in self.p.iter().zip(&self.sc).enumerate() {
-            if v == 0.0 {
-                continue;
-            }
-            // The true value is v 2^(step k), |.| in [2^(e-1), 2^e).
-            let (mant, e0) = frexp(v);
-            let e = e0 + f64::SCALE_STEP * k as i64;
-            let step = f32::SCALE_STEP;
-            let j = if e > -bits {
-                0
-            } else {
-                (-bits - e + step) / step
-            };
-            (p[s], sc[s]) = (ldexp(mant, e + step * j) as f32, -(j as f32));
-        }
+        let mut coeffs = RecCoeffs::new(0);
+        coeffs.narrow_from(&self.coeffs);
+        let (p, sc) = self
+            .p
+            .iter()
+            .zip(&self.sc)
+            .map(|(&v, &k)| {
+                // The true value is v 2^(step k).
+                let (mant, e) = frexp(v);
+                let value = Ext {
+                    mant,
+                    exp: e + f64::SCALE_STEP * k as i64,
+                };
+                to_scaled::<f32>(value, test_skip_bits())
+            })
+            .unzip();
         FloatInputs {
-            coeffs: [r(&c.a), r(&c.neg_a), r(&c.a_plus_c), r(&c.c_minus_a)],
-            tau: r(&self.tau),
+            coeffs,
+            tau: self.tau.iter().map(|&x| x as f32).collect(),
             p,
             sc,
         }
@@ -159,8 +156,7 @@ impl ClusterInputs {
 impl FloatInputs {
     /// The coefficients of the first `n` degrees.
     pub fn rec(&self, n: usize) -> Rec<'_, f32> {
-        let c = &self.coeffs;
-        Rec::from_slices([&c[0], &c[1], &c[2], &c[3]], n)
+        Rec::new(&self.coeffs, n)
     }
 
     /// Kernel lanes as [`grid_lanes`] gives them.
@@ -171,7 +167,7 @@ impl FloatInputs {
             p: &self.p,
             sc: &self.sc,
             upper_from,
-            big: ldexp(1.0, f32::SCALE_STEP - test_skip_bits() as i64) as f32,
+            big: big::<f32>(test_skip_bits()),
             skip: l.skip,
             interleaved: l.interleaved,
             prefetch: l.prefetch,

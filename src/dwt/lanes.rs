@@ -33,21 +33,6 @@ impl<'a, E: Elem> Rec<'a, E> {
             n,
         }
     }
-}
-
-impl<'a, E: Elem> Rec<'a, E> {
-    /// The first `n` degrees of the four coefficient arrays `[a, neg_a, a_plus_c,
-    /// c_minus_a]` (each padded by [`REC_PAD`] entries).
-    pub fn from_slices(c: [&'a [E]; 4], n: usize) -> Rec<'a, E> {
-        let end = n + REC_PAD;
-        Rec {
-            a: &c[0][..end],
-            neg_a: &c[1][..end],
-            a_plus_c: &c[2][..end],
-            c_minus_a: &c[3][..end],
-            n,
-        }
-    }
 
     /// Number of degrees.
     pub(crate) fn len(&self) -> usize {

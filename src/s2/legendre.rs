@@ -15,7 +15,8 @@ use crate::numeric::Ext;
 use crate::real::Real;
 use crate::simd::Isa;
 use crate::wigner::{big, start_norm, BetaTables, RecCoeffs, RecTables, DEFAULT_SKIP_BITS};
-use num_complex::Complex;
+use crate::workers::lock_free;
+use num_complex::{Complex, Complex64};
 use std::sync::Mutex;
 
 /// Most columns of the kernels: `E` and `O`, real and imaginary parts, of two groups.
@@ -29,7 +30,7 @@ pub(super) struct Spectra<T> {
     pub row: usize,
     /// Real rings: only orders `m >= 0` are stored (`row = B + 1`), `F_{-m} = conj(F_m)`.
     pub real: bool,
-    /// A block's copy (see [`Spectra::gather`]): the first order and the block's width.
+    /// A block's copy (see [`Spectra::copy_block`]): the first order and the block's width.
     pub block: Option<(usize, usize)>,
 }
 
@@ -63,7 +64,7 @@ impl<T> Spectra<T> {
 
 impl<T: Copy> Spectra<T> {
     /// The view of a block's copy in `buf` (`rings * 2 width` values) of orders
-    /// `first ..` (see [`Spectra::gather`]).
+    /// `first ..` (see [`Spectra::copy_block`]).
     pub(super) fn block_view(
         &self,
         (first, width): (usize, usize),
@@ -119,6 +120,16 @@ impl<T: Copy> Spectra<T> {
             }
         }
     }
+}
+
+/// `z` in doubles (exact).
+fn widen<T: Real>(z: Complex<T>) -> Complex64 {
+    Complex64::new(z.re.to_f64(), z.im.to_f64())
+}
+
+/// `z` rounded to `T`.
+fn narrow<T: Real>(z: Complex64) -> Complex<T> {
+    Complex::new(T::from_f64(z.re), T::from_f64(z.im))
 }
 
 /// Where an order's coefficients are: `fhat(l, m)` at `base + start(m) + (l - |m|)`.
@@ -196,10 +207,16 @@ struct KernelBufs<K> {
 }
 
 impl<K: Real> KernelBufs<K> {
-    fn new(b: usize, lanes: usize, width: usize) -> KernelBufs<K> {
+    /// Buffers for `lanes` lanes, vectors of `width`, the recurrence arguments `tau` of the
+    /// `B` northern rings (the same for every order) set once; padding lanes stay 0.
+    fn new(b: usize, lanes: usize, width: usize, tau: &[f64]) -> KernelBufs<K> {
         let z = K::ZERO;
+        let mut t = vec![z; lanes];
+        for (t, &x) in t.iter_mut().zip(&tau[..b]) {
+            *t = K::from_f64(x);
+        }
         KernelBufs {
-            tau: vec![z; lanes],
+            tau: t,
             start: vec![z; lanes],
             scale: vec![z; lanes],
             rows: vec![z; lanes * P],
@@ -234,25 +251,30 @@ impl Scratch {
 trait KernelElem: Real {
     /// This type's buffers in `sc` (made on first use), the order's coefficients in this
     /// type and their scales `S_i` in doubles.
-    fn bufs(sc: &mut Scratch, dims: (usize, usize, usize)) -> KernelInputs<'_, Self>;
+    fn bufs<'a>(sc: &'a mut Scratch, dims: BufDims<'_>) -> KernelInputs<'a, Self>;
 }
 
 /// What [`KernelElem::bufs`] gives.
 type KernelInputs<'a, K> = (&'a mut KernelBufs<K>, &'a RecCoeffs<K>, &'a [f64]);
 
+/// The sizes of new [`KernelBufs`] (`b`, lanes, vector width) and the rings' `tau`.
+type BufDims<'t> = (usize, usize, usize, &'t [f64]);
+
 impl KernelElem for f64 {
-    fn bufs(sc: &mut Scratch, (b, lanes, w): (usize, usize, usize)) -> KernelInputs<'_, f64> {
-        let bufs = sc.wide.get_or_insert_with(|| KernelBufs::new(b, lanes, w));
+    fn bufs<'a>(sc: &'a mut Scratch, (b, lanes, w, tau): BufDims<'_>) -> KernelInputs<'a, f64> {
+        let bufs = sc
+            .wide
+            .get_or_insert_with(|| KernelBufs::new(b, lanes, w, tau));
         (bufs, &sc.rec, &sc.rec.s)
     }
 }
 
 impl KernelElem for f32 {
-    fn bufs(sc: &mut Scratch, (b, lanes, w): (usize, usize, usize)) -> KernelInputs<'_, f32> {
+    fn bufs<'a>(sc: &'a mut Scratch, (b, lanes, w, tau): BufDims<'_>) -> KernelInputs<'a, f32> {
         sc.rec32.narrow_from(&sc.rec);
         let bufs = sc
             .narrow
-            .get_or_insert_with(|| KernelBufs::new(b, lanes, w));
+            .get_or_insert_with(|| KernelBufs::new(b, lanes, w, tau));
         (bufs, &sc.rec32, &sc.rec.s)
     }
 }
@@ -264,7 +286,8 @@ pub(super) struct LegendreStage<T> {
     /// Degrees computed: `l < lend` (`lend <= b`; the others are zero).
     lend: usize,
     isa: Isa,
-    /// Lanes: the `B` northern rings, padded to the vector width of either element type.
+    /// Lanes: the `B` northern rings, padded to the vector width of `T` (a multiple of
+    /// the double width too).
     lanes: usize,
     /// Orders `m >= narrow_from` run float kernels (`T = f32`); the others double ones.
     narrow_from: usize,
@@ -282,7 +305,7 @@ impl<T: Real> LegendreStage<T> {
     /// The stage for bandwidth `b` with `workers` scratches.
     pub(super) fn new(b: usize, lend: usize, isa: Isa, workers: usize) -> LegendreStage<T> {
         assert!(0 < lend && lend <= b);
-        let lanes = b.next_multiple_of(isa.lanes_of::<f32>());
+        let lanes = b.next_multiple_of(isa.lanes_of::<T>());
         let narrow_from = if T::BYTES == 4 {
             crate::wigner::single_precision_orders(b)
         } else {
@@ -319,16 +342,10 @@ impl<T: Real> LegendreStage<T> {
 
     /// Runs `f` with a free scratch (the worker's own, else another, else a new one).
     fn with_scratch<R>(&self, f: impl FnOnce(&mut Scratch) -> R) -> R {
-        let n = self.scratch.len();
-        let me = rayon::current_thread_index().unwrap_or(0);
-        for i in 0..n {
-            match self.scratch[(me + i) % n].try_lock() {
-                Ok(mut g) => return f(&mut g),
-                Err(std::sync::TryLockError::Poisoned(e)) => return f(&mut e.into_inner()),
-                Err(std::sync::TryLockError::WouldBlock) => {}
-            }
+        match lock_free(&self.scratch) {
+            Some(mut g) => f(&mut g),
+            None => f(&mut Scratch::new(self.b)),
         }
-        f(&mut Scratch::new(self.b))
     }
 
     /// The recurrence coefficients of order `m` into `sc`; the number of degrees.
@@ -339,7 +356,7 @@ impl<T: Real> LegendreStage<T> {
         n
     }
 
-    /// The lane inputs of order `m` in `bufs`.
+    /// The starting values of order `m` in `bufs` (the padding lanes stay 0).
     fn lane_inputs<K: Real>(&self, bufs: &mut KernelBufs<K>, m: usize) {
         let b = self.b;
         self.beta_tables.starts::<K>(
@@ -352,12 +369,6 @@ impl<T: Real> LegendreStage<T> {
             &mut bufs.start[..b],
             &mut bufs.scale[..b],
         );
-        for (t, &x) in bufs.tau[..b].iter_mut().zip(&self.beta_tables.tau_lo[..b]) {
-            *t = K::from_f64(x);
-        }
-        for v in [&mut bufs.tau, &mut bufs.start, &mut bufs.scale] {
-            v[b..].fill(K::ZERO);
-        }
     }
 
     fn lanes<'a, K: Real>(&self, bufs: &'a KernelBufs<K>) -> Lanes<'a, K> {
@@ -409,7 +420,7 @@ impl<T: Real> LegendreStage<T> {
         let w = self.isa.lanes_of::<K>();
         self.with_scratch(|sc| {
             let n = self.coeffs(sc, m);
-            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w));
+            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w, &self.beta_tables.tau_lo));
             self.lane_inputs(bufs, m);
             // Kernel input: the even combinations of each group's spectra (re, im), then the
             // odd ones, weighted, one column of `nb` rings each.
@@ -420,7 +431,6 @@ impl<T: Real> LegendreStage<T> {
             for column in x[..2 * c * nb].chunks_exact_mut(nb) {
                 column[b..].fill(K::ZERO);
             }
-            let wide = |z: Complex<T>| Complex::new(z.re.to_f64(), z.im.to_f64());
             for (q, g) in groups.iter().enumerate() {
                 for k in 0..b {
                     let wk = self.weights[k];
@@ -428,8 +438,8 @@ impl<T: Real> LegendreStage<T> {
                     // SAFETY: rings k and mirror < 2B hold the group's order; read only.
                     let (u, v) = unsafe {
                         (
-                            wide(*g.spectra.at(k, g.order)),
-                            wide(*g.spectra.at(mirror, g.order)),
+                            widen(*g.spectra.at(k, g.order)),
+                            widen(*g.spectra.at(mirror, g.order)),
                         )
                     };
                     let (e, o) = ((u + v) * wk, (u - v) * wk);
@@ -461,11 +471,7 @@ impl<T: Real> LegendreStage<T> {
                 }
                 for i in 0..n {
                     let z = &sums[i * c + 2 * q..][..2];
-                    let sf = s[i] * f;
-                    let v = Complex::new(
-                        T::from_f64(z[0].to_f64() * sf),
-                        T::from_f64(z[1].to_f64() * sf),
-                    );
+                    let v = narrow(Complex64::new(z[0].to_f64(), z[1].to_f64()) * (s[i] * f));
                     // SAFETY: entry i < n of the blocks (above).
                     unsafe {
                         *own.add(i) = v;
@@ -543,7 +549,7 @@ impl<T: Real> LegendreStage<T> {
         let w = self.isa.lanes_of::<K>();
         self.with_scratch(|sc| {
             let n = self.coeffs(sc, m);
-            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w));
+            let (bufs, rc, s) = K::bufs(sc, (b, self.lanes, w, &self.beta_tables.tau_lo));
             self.lane_inputs(bufs, m);
             // Kernel input: per degree, the scaled coefficients of each group (re, im).
             let c = 2 * groups.len();
@@ -554,10 +560,9 @@ impl<T: Real> LegendreStage<T> {
                 let f = g.sign(m) * factor;
                 for (i, &si) in s[..n].iter().enumerate() {
                     // SAFETY: entry i < n of the block (above).
-                    let v = unsafe { *block.add(i) };
-                    let sf = si * f;
-                    fin[i * c + 2 * q] = K::from_f64(v.re.to_f64() * sf);
-                    fin[i * c + 2 * q + 1] = K::from_f64(v.im.to_f64() * sf);
+                    let v = widen(unsafe { *block.add(i) }) * (si * f);
+                    fin[i * c + 2 * q] = K::from_f64(v.re);
+                    fin[i * c + 2 * q + 1] = K::from_f64(v.im);
                 }
             }
             let rec = Rec::new(rc, n);
@@ -568,7 +573,6 @@ impl<T: Real> LegendreStage<T> {
             let nb = self.lanes;
             let column =
                 |par: usize, q: usize, part: usize| &rows[(par * c + 2 * q + part) * nb..][..b];
-            let narrow = |x: f64| T::from_f64(x);
             for (q, g) in groups.iter().enumerate() {
                 let (er, ei) = (column(0, q, 0), column(0, q, 1));
                 let (or, oi) = (column(1, q, 0), column(1, q, 1));
@@ -578,13 +582,10 @@ impl<T: Real> LegendreStage<T> {
                         Complex::new(or[k].to_f64(), oi[k].to_f64()),
                     );
                     let mirror = 2 * b - 1 - k;
-                    let (north, south) = (e + o, e - o);
                     // SAFETY: rings k and mirror, the group's order's column: this task's.
                     unsafe {
-                        *g.spectra.at(k, g.order) =
-                            Complex::new(narrow(north.re), narrow(north.im));
-                        *g.spectra.at(mirror, g.order) =
-                            Complex::new(narrow(south.re), narrow(south.im));
+                        *g.spectra.at(k, g.order) = narrow(e + o);
+                        *g.spectra.at(mirror, g.order) = narrow(e - o);
                     }
                 }
             }

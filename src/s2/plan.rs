@@ -11,7 +11,7 @@ use crate::simd::Isa;
 use crate::system::check_headroom;
 use crate::transform::StageTimes;
 use crate::transform::{Scratch, Transform};
-use crate::workers::{SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
+use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool, WORKER_STACK_BYTES};
 use num_complex::{Complex, Complex64};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -128,11 +128,14 @@ impl<T: Real> S2Plan<T> {
         })
     }
 
-    /// Bytes a plan of bandwidth `b` on `threads` threads holds (ring scratch, tables).
+    /// Bytes a plan of bandwidth `b` on `threads` threads holds (ring scratch, tables,
+    /// the Legendre stage's buffers).
     /// Calls on two fields at once (`*_many` with `howmany > 1`, `*_pair`) add a second
     /// ring scratch of the same size, made on their first use and kept with the plan.
     pub fn memory_needed(b: usize, threads: usize) -> usize {
-        2 * T::BYTES * scratch_len(b) + LegendreStage::<T>::bytes(b, threads) + 8 * 2 * b
+        // The block buffers: two fields' columns of a block of orders per worker.
+        let blocks = threads * 2 * (2 * b) * (2 * ORDER_BLOCK) * 2 * T::BYTES;
+        2 * T::BYTES * scratch_len(b) + LegendreStage::<T>::bytes(b, threads) + 8 * 2 * b + blocks
     }
 
     /// The plan's worker threads (for tests).
@@ -614,17 +617,15 @@ impl<T: Real> S2Plan<T> {
     /// own is in use, else a new one).
     fn with_block(&self, len: usize, f: impl FnOnce(&mut [Complex<T>])) {
         let zero = Complex::new(T::ZERO, T::ZERO);
-        let n = self.blocks.len();
-        let me = rayon::current_thread_index().unwrap_or(0);
-        for i in 0..n {
-            if let Ok(mut g) = self.blocks[(me + i) % n].try_lock() {
+        match lock_free(&self.blocks) {
+            Some(mut g) => {
                 if g.len() < len {
                     g.resize(len, zero);
                 }
-                return f(&mut g[..len]);
+                f(&mut g[..len])
             }
+            None => f(&mut vec![zero; len]),
         }
-        f(&mut vec![zero; len])
     }
 
     /// The `r2c` of one real field's rings (copied into `buf` first); the field's column

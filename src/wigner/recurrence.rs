@@ -331,10 +331,6 @@ impl RecCoeffs<f32> {
     /// of the f32 kernels, `O(n)` per cluster. The coefficients are far from the f32 range's
     /// ends (`|A'|`, `|C'|` below a few times the degree, `S_i` near 1), so all stay finite
     /// and normal or zero.
-    #[allow(
-        dead_code,
-        reason = "used by the f32 DWT set-up (stage 2 of the f32 tier)"
-    )]
     pub fn narrow_from(&mut self, src: &RecCoeffs<f64>) {
         for (dst, src) in [
             (&mut self.a, &src.a),
