@@ -3,7 +3,8 @@
 
 use crate::error::{Error, Result};
 use crate::fft::AlignedBuf;
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 
 /// Wall time of each stage of one execution, in seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -46,7 +47,7 @@ impl Scratch {
     }
 
     /// A scratch for the calls of `plan`.
-    pub fn for_plan(plan: &(impl Transform + ?Sized)) -> Result<Scratch> {
+    pub fn for_plan<T: Real>(plan: &(impl Transform<T> + ?Sized)) -> Result<Scratch> {
         Scratch::new(plan.scratch_bytes())
     }
 
@@ -86,8 +87,9 @@ impl Scratch {
 /// Both give the same results, bit for bit.
 ///
 /// Lengths: [`Transform::num_samples`] samples (complex, or real for the real forms) and
-/// [`Transform::num_coeffs`] coefficients, else [`Error::LengthMismatch`].
-pub trait Transform {
+/// [`Transform::num_coeffs`] coefficients, else [`Error::LengthMismatch`]. `T` is the
+/// precision the plan computes in (`f64`, or `f32` for the single-precision plans).
+pub trait Transform<T: Real = f64> {
     /// Samples of one transform.
     fn num_samples(&self) -> usize;
 
@@ -98,46 +100,46 @@ pub trait Transform {
     fn scratch_bytes(&self) -> usize;
 
     /// Forward transform: samples to coefficients.
-    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes>;
+    fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes>;
 
     /// Inverse transform: coefficients to samples.
-    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes>;
+    fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes>;
 
     /// Forward transform of real samples (a plan made with [`Options::real`](crate::Options::real)).
-    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes>;
+    fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes>;
 
     /// Inverse transform to real samples (a plan made with [`Options::real`](crate::Options::real)).
-    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes>;
+    fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes>;
 
     /// [`Transform::forward`] in the caller's scratch.
     fn forward_with_scratch(
         &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes>;
 
     /// [`Transform::inverse`] in the caller's scratch.
     fn inverse_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes>;
 
     /// [`Transform::forward_real`] in the caller's scratch.
     fn forward_real_with_scratch(
         &self,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes>;
 
     /// [`Transform::inverse_real`] in the caller's scratch.
     fn inverse_real_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
         scratch: &mut Scratch,
     ) -> Result<StageTimes>;
 }

@@ -195,7 +195,9 @@ fn collective_errors() {
     for bits in [5u32, 1000] {
         let bad = opts(false).with_skip_bits(Some(bits));
         let refused = |r: so3fft::Result<()>| matches!(r, Err(so3fft::Error::InvalidArgument(m)) if m.contains("skip_bits"));
-        assert!(refused(PartialPlan::new(&Shape::new(6), &bad).map(|_| ())));
+        assert!(refused(
+            PartialPlan::<f64>::new(&Shape::new(6), &bad).map(|_| ())
+        ));
         let group = ThreadExchange::group(2);
         std::thread::scope(|scope| {
             for comm in &group {

@@ -11,24 +11,24 @@ fn opts() -> Options {
 
 #[test]
 fn invalid_bandwidth() {
-    match Plan::new(0, &opts()) {
+    match Plan::<f64>::new(0, &opts()) {
         Err(Error::InvalidBandwidth { bandwidth, max }) => {
             assert_eq!(bandwidth, 0);
             assert_eq!(max, MAX_BANDWIDTH);
         }
-        Err(e) => panic!("Plan::new(0): expected InvalidBandwidth, got {e:?}"),
-        Ok(_) => panic!("Plan::new(0) succeeded"),
+        Err(e) => panic!("Plan::<f64>::new(0): expected InvalidBandwidth, got {e:?}"),
+        Ok(_) => panic!("Plan::<f64>::new(0) succeeded"),
     }
-    match Plan::new(MAX_BANDWIDTH + 1, &opts()) {
+    match Plan::<f64>::new(MAX_BANDWIDTH + 1, &opts()) {
         Err(Error::InvalidBandwidth { bandwidth, max }) => {
             assert_eq!(bandwidth, MAX_BANDWIDTH + 1);
             assert_eq!(max, MAX_BANDWIDTH);
         }
-        Err(e) => panic!("Plan::new(MAX+1): expected InvalidBandwidth, got {e:?}"),
-        Ok(_) => panic!("Plan::new(MAX_BANDWIDTH+1) succeeded"),
+        Err(e) => panic!("Plan::<f64>::new(MAX+1): expected InvalidBandwidth, got {e:?}"),
+        Ok(_) => panic!("Plan::<f64>::new(MAX_BANDWIDTH+1) succeeded"),
     }
     // the error must be displayable
-    let e = Plan::new(0, &opts()).err().unwrap();
+    let e = Plan::<f64>::new(0, &opts()).err().unwrap();
     assert!(!format!("{e}").is_empty());
     let _: &dyn std::error::Error = &e;
 }
@@ -36,7 +36,7 @@ fn invalid_bandwidth() {
 #[test]
 fn length_mismatch_leaves_output_untouched() {
     let b = 4;
-    let p = Plan::new(b, &opts()).unwrap();
+    let p = Plan::<f64>::new(b, &opts()).unwrap();
     let (ns, nc) = (n_samples(b), n_coeffs(b));
     let sentinel = Complex64::new(12345.0, -678.0);
     let good_s = vec![Complex64::new(0.5, 0.25); ns];
@@ -118,7 +118,7 @@ fn wrong_direction() {
     let b = 4;
     let (ns, nc) = (n_samples(b), n_coeffs(b));
     let sentinel = Complex64::new(-3.0, 7.0);
-    let pi = Plan::new(b, &opts().with_direction(Direction::Inverse)).unwrap();
+    let pi = Plan::<f64>::new(b, &opts().with_direction(Direction::Inverse)).unwrap();
     let s = vec![Complex64::new(1.0, 0.0); ns];
     let mut c = vec![sentinel; nc];
     let r = pi.forward(&s, &mut c);
@@ -132,7 +132,7 @@ fn wrong_direction() {
     pi.inverse(&c, &mut vec![Complex64::new(0.0, 0.0); ns])
         .unwrap();
 
-    let pf = Plan::new(b, &opts().with_direction(Direction::Forward)).unwrap();
+    let pf = Plan::<f64>::new(b, &opts().with_direction(Direction::Forward)).unwrap();
     let c = vec![Complex64::new(1.0, 0.0); nc];
     let mut s = vec![sentinel; ns];
     let r = pf.inverse(&c, &mut s);
@@ -187,7 +187,7 @@ fn try_coef_index_errors() {
 /// default beta-chunk workspace are plenty.
 const CHILD_AS_LIMIT_KIB: u64 = 8 * 1024 * 1024; // 8 GiB
 
-/// Plan::new(MAX_BANDWIDTH) must either succeed or return OutOfMemory, without panicking or
+/// Plan::<f64>::new(MAX_BANDWIDTH) must either succeed or return OutOfMemory, without panicking or
 /// aborting. It runs in a child process (this test binary, running the ignored test below) under
 /// `ulimit -v` so that a plan which over-allocates gets a failed allocation instead of eating the
 /// machine's memory. An over-allocating library that uses infallible allocation aborts the child;
@@ -221,7 +221,7 @@ fn max_bandwidth_plan_does_not_panic() {
         .join("\n");
     assert!(
         out.status.success() && stdout.contains("CHILD-RESULT:"),
-        "Plan::new(MAX_BANDWIDTH = {}) under a {} GiB address-space limit did not return Ok/OutOfMemory cleanly \
+        "Plan::<f64>::new(MAX_BANDWIDTH = {}) under a {} GiB address-space limit did not return Ok/OutOfMemory cleanly \
          (exit status {:?}; a signal means abort/kill, e.g. an infallible allocation failed).\nchild stdout:\n{stdout}\nchild stderr (tail):\n{tail}",
         MAX_BANDWIDTH,
         CHILD_AS_LIMIT_KIB / (1024 * 1024),
@@ -238,24 +238,26 @@ fn child_max_bandwidth_plan() {
     }
     let t0 = std::time::Instant::now();
     let r = std::panic::catch_unwind(|| {
-        Plan::new(MAX_BANDWIDTH, &Options::default())
+        Plan::<f64>::new(MAX_BANDWIDTH, &Options::default())
             .map(|p| (p.bandwidth(), p.num_samples(), p.num_coeffs()))
     });
     match r {
-        Err(_) => panic!("Plan::new(MAX_BANDWIDTH) panicked"),
+        Err(_) => panic!("Plan::<f64>::new(MAX_BANDWIDTH) panicked"),
         Ok(Ok((bw, ns, nc))) => {
             assert_eq!(bw, MAX_BANDWIDTH);
             assert_eq!(ns, n_samples(MAX_BANDWIDTH));
             assert_eq!(nc, n_coeffs(MAX_BANDWIDTH));
             println!(
-                "CHILD-RESULT: Plan::new(MAX_BANDWIDTH={MAX_BANDWIDTH}) succeeded in {:.2}s",
+                "CHILD-RESULT: Plan::<f64>::new(MAX_BANDWIDTH={MAX_BANDWIDTH}) succeeded in {:.2}s",
                 t0.elapsed().as_secs_f64()
             );
         }
         Ok(Err(Error::OutOfMemory { bytes })) => {
-            println!("CHILD-RESULT: Plan::new(MAX_BANDWIDTH) -> OutOfMemory {{ bytes: {bytes} }}")
+            println!(
+                "CHILD-RESULT: Plan::<f64>::new(MAX_BANDWIDTH) -> OutOfMemory {{ bytes: {bytes} }}"
+            )
         }
-        Ok(Err(e)) => panic!("Plan::new(MAX_BANDWIDTH) returned unexpected error {e:?}"),
+        Ok(Err(e)) => panic!("Plan::<f64>::new(MAX_BANDWIDTH) returned unexpected error {e:?}"),
     }
 }
 
@@ -263,7 +265,7 @@ fn child_max_bandwidth_plan() {
 #[test]
 fn tiny_workspace_cap() {
     let b = 16;
-    match Plan::new(b, &Options::default().with_max_workspace_bytes(Some(4096))) {
+    match Plan::<f64>::new(b, &Options::default().with_max_workspace_bytes(Some(4096))) {
         Ok(p) => {
             let mut rng = Rng::new(5);
             let c = rng.complex_vec(n_coeffs(b));
@@ -372,7 +374,7 @@ fn sample_index_and_grid_helpers() {
 #[test]
 fn invalid_skip_bits() {
     for bits in [1u32, 23, 561, 10_000] {
-        let r = Plan::new(4, &Options::default().with_skip_bits(Some(bits)));
+        let r = Plan::<f64>::new(4, &Options::default().with_skip_bits(Some(bits)));
         assert!(
             matches!(r, Err(Error::InvalidArgument(_))),
             "skip_bits {bits}"
@@ -387,8 +389,8 @@ fn invalid_skip_bits() {
 fn default_plan_memory_within_five_percent_at_512() {
     let b = 512;
     let options = Options::default().with_direction(Direction::Forward);
-    let estimate = Plan::memory_needed(b, &options).unwrap();
-    match Plan::new(b, &options) {
+    let estimate = Plan::<f64>::memory_needed(b, &options).unwrap();
+    match Plan::<f64>::new(b, &options) {
         Ok(plan) => {
             let arrays = (plan.num_samples() + plan.num_coeffs()) * 16;
             let ratio = plan.memory_bytes() as f64 / arrays as f64;
@@ -431,8 +433,8 @@ fn memory_estimate_matches_plans() {
                     .with_real(real)
                     .with_threads(2)
                     .with_max_workspace_bytes(cap);
-                let estimate = Plan::memory_needed(b, &options).unwrap();
-                let plan = Plan::new(b, &options).unwrap();
+                let estimate = Plan::<f64>::memory_needed(b, &options).unwrap();
+                let plan = Plan::<f64>::new(b, &options).unwrap();
                 assert_eq!(
                     estimate,
                     plan.memory_bytes(),
@@ -469,8 +471,8 @@ fn memory_estimate_matches_plans() {
         }
     }
     assert!(matches!(
-        Plan::memory_needed(0, &Options::default()),
+        Plan::<f64>::memory_needed(0, &Options::default()),
         Err(Error::InvalidBandwidth { .. })
     ));
-    assert!(Plan::memory_needed(8, &Options::default().with_skip_bits(Some(7))).is_err());
+    assert!(Plan::<f64>::memory_needed(8, &Options::default().with_skip_bits(Some(7))).is_err());
 }

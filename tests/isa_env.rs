@@ -33,7 +33,7 @@ fn isa_variable_selects_the_kernels() {
         };
         if !isa.is_supported() {
             // A set this CPU lacks: planning refuses, naming the variable.
-            let err = Plan::new(b, &Options::default()).err().unwrap();
+            let err = Plan::<f64>::new(b, &Options::default()).err().unwrap();
             assert!(matches!(&err, Error::InvalidArgument(m) if m.contains(ISA_VARIABLE)));
             continue;
         }
@@ -56,7 +56,7 @@ fn isa_variable_selects_the_kernels() {
     // Not an instruction set: an error, not a guess.
     std::env::set_var(ISA_VARIABLE, "sse9");
     assert!(matches!(Isa::selected(), Err(Error::InvalidArgument(_))));
-    let err = Plan::new(b, &Options::default()).err().unwrap();
+    let err = Plan::<f64>::new(b, &Options::default()).err().unwrap();
     assert!(matches!(&err, Error::InvalidArgument(m) if m.contains("sse9")));
     // Empty: as if unset.
     std::env::set_var(ISA_VARIABLE, "");

@@ -518,7 +518,9 @@ fn invalid_shapes_and_calls_are_rejected() {
         (Shape::new(8).with_grid(7, 16, 16), "B_grid >= L"),
     ];
     for (s, what) in bad {
-        let err = PartialPlan::new(&s, &opts()).err().expect("rejected");
+        let err = PartialPlan::<f64>::new(&s, &opts())
+            .err()
+            .expect("rejected");
         assert!(
             err.to_string().contains(what),
             "{s:?}: '{err}' lacks '{what}'"
@@ -528,7 +530,7 @@ fn invalid_shapes_and_calls_are_rejected() {
     // Undersampled beta grid: fine for the inverse.
     let s = Shape::new(8).with_grid(4, 16, 16);
     let o = opts().with_direction(Direction::Inverse);
-    assert!(PartialPlan::new(&s, &o).is_ok());
+    assert!(PartialPlan::<f64>::new(&s, &o).is_ok());
     let s = Shape::new(6).with_orders(2, 2);
     for (betas, what) in [
         (Betas::Indices(vec![12]), "outside the grid"),
@@ -538,16 +540,16 @@ fn invalid_shapes_and_calls_are_rejected() {
         (Betas::Indices(vec![]), "no betas"),
     ] {
         let o = opts().with_betas(betas);
-        let err = PartialPlan::new(&s, &o).err().expect("rejected");
+        let err = PartialPlan::<f64>::new(&s, &o).err().expect("rejected");
         assert!(err.to_string().contains(what), "'{err}' lacks '{what}'");
     }
     let o = opts()
         .with_betas(Betas::Indices(vec![1]))
         .with_direction(Direction::Forward);
-    assert!(PartialPlan::new(&s, &o).is_err());
+    assert!(PartialPlan::<f64>::new(&s, &o).is_err());
     for bits in [1, 23, 561] {
         let o = opts().with_skip_bits(Some(bits));
-        assert!(PartialPlan::new(&s, &o).is_err());
+        assert!(PartialPlan::<f64>::new(&s, &o).is_err());
     }
     let pp = PartialPlan::new(&s, &opts()).unwrap();
     let c = zeros(pp.num_coeffs());
@@ -649,7 +651,7 @@ fn chained_inverse_against_direct_summation() {
 fn default_workspace_holds_all_pairs_of_a_small_shape() {
     let b = 2048;
     let s = Shape::new(b).with_orders(8, 8).with_grid(b, 17, 17);
-    let pp = PartialPlan::new(&s, &opts()).unwrap();
+    let pp = PartialPlan::<f64>::new(&s, &opts()).unwrap();
     // Two lane rows per beta pair, each with at least the 17 x 17 in-band order pairs.
     let all_rows = b * 2 * 17 * 17 * 16;
     let scratch = pp.scratch_bytes();

@@ -52,7 +52,7 @@ pub extern "C" fn so3fft_plan_memory(B: c_int, flags: c_uint, nthreads: c_int) -
             max_workspace_bytes: planner_workspace_cap(),
             ..Options::default()
         };
-        Ok(Plan::memory_needed(b, &options)? as isize)
+        Ok(Plan::<f64>::memory_needed(b, &options)? as isize)
     })
 }
 

@@ -195,7 +195,7 @@ impl RankView {
     fn widths(&self) -> Vec<usize> {
         self.segments
             .iter()
-            .map(|s| padded_row(s.1 - s.0))
+            .map(|s| padded_row::<f64>(s.1 - s.0))
             .collect()
     }
 }

@@ -190,7 +190,8 @@ impl<E> Lanes<'_, E> {
         // Lower rows `u ps` (`u < upper_from`), upper rows `gap + u ps`.
         let uf = self.upper_from;
         assert!(gap == 0 || (ps >= p && (gap == p || uf >= nb || gap >= uf * ps)));
-        assert!(gap != p || ps >= 2 * p);
+        // A gap of one row with pairs closer than two rows leaves room for one pair only.
+        assert!(gap != p || ps >= 2 * p || nb <= 2);
     }
 
     /// Offset (in values) of the first row of the vector of lanes starting at `s0`, rows of

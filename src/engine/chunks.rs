@@ -18,27 +18,28 @@ use crate::system::check_headroom;
 use crate::transform::Scratch;
 use crate::transform::StageTimes;
 use crate::workers::{lock_free, SendConstPtr, SendPtr, WorkerPool};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 use std::f64::consts::PI;
 use std::sync::Mutex;
 
-/// A plan of the engine.
-pub(crate) struct Engine {
+/// A plan of the engine, computing in `T`.
+pub(crate) struct Engine<T: Real = f64> {
     pub(crate) layout: CoefLayout,
     pub(crate) pairs: LanePairs,
     /// Every member of each cluster (complex transforms, distributed plans). Its clusters
     /// are never changed after `new`: `slots` is made from them.
-    pub(crate) dwt: DwtStage,
-    pub(crate) fft: FftStage,
+    pub(crate) dwt: DwtStage<T>,
+    pub(crate) fft: FftStage<T>,
     /// The slots of a lane row, flat (for the scatters and gathers, complex and real).
     pub(crate) slots: SlotTable,
     /// The real transforms' members (`M' >= 0`, see `DwtStage::new`) with their slots, for
     /// plans made with `Options::real`.
-    pub(super) half: Option<(DwtStage, SlotTable)>,
+    pub(super) half: Option<(DwtStage<T>, SlotTable)>,
     /// What the complex and the real inverse zero in a worker's buffer before each slice.
     pub(super) clears: [Clear; 2],
     /// Forward: `w_{B_grid}(j) 2 pi / (n_alpha n_gamma)` per lane pair (grid betas).
-    pub(crate) pair_weight: Vec<f64>,
+    pub(crate) pair_weight: Vec<T>,
     /// Per-worker FFT buffers (made on first use).
     pub(super) work: Vec<Mutex<Work>>,
     /// The chunk buffer (taken by one execution at a time).
@@ -49,38 +50,38 @@ pub(crate) struct Engine {
 
 /// The clusters and slots a transform runs on (see [`Engine::members`]).
 #[derive(Clone, Copy)]
-pub(crate) struct Members<'a> {
-    pub(crate) dwt: &'a DwtStage,
+pub(crate) struct Members<'a, T: Real = f64> {
+    pub(crate) dwt: &'a DwtStage<T>,
     pub(crate) slots: &'a SlotTable,
 }
 
 /// A chunk and its buffer (lane row `r < hp` at `buf + r row_len`, the upper half
 /// `ch.upper_gap` further).
 #[derive(Clone, Copy)]
-pub(super) struct PlacedLanes {
+pub(super) struct PlacedLanes<T> {
     pub(super) ch: ChunkLanes,
-    pub(super) buf: SendPtr<f64>,
+    pub(super) buf: SendPtr<T>,
 }
 
 /// The samples of one execution (all arrays of a batch) and how they are stored. A
 /// forward only reads them.
 #[derive(Clone, Copy)]
-pub(crate) enum Data {
-    Complex(SendPtr<Complex64>),
-    Real(SendPtr<f64>),
+pub(crate) enum Data<T = f64> {
+    Complex(SendPtr<Complex<T>>),
+    Real(SendPtr<T>),
     /// Reals in the real parts of complex values: the inverse sets the imaginary parts to
     /// 0, the forward does not read them.
-    RealParts(SendPtr<Complex64>),
+    RealParts(SendPtr<Complex<T>>),
 }
 
-impl Data {
+impl<T: Copy> Data<T> {
     /// Whether the samples are a real signal.
     pub(crate) fn is_real(self) -> bool {
         !matches!(self, Data::Complex(_))
     }
 
     /// The samples `values` values further on (in the samples' own type).
-    pub(super) fn offset(self, values: usize) -> Data {
+    pub(super) fn offset(self, values: usize) -> Data<T> {
         match self {
             Data::Complex(p) => Data::Complex(SendPtr(p.get().wrapping_add(values))),
             Data::Real(p) => Data::Real(SendPtr(p.get().wrapping_add(values))),
@@ -91,25 +92,25 @@ impl Data {
     /// Bytes of one value.
     pub(super) fn value_bytes(self) -> usize {
         match self {
-            Data::Real(_) => 8,
-            _ => 16,
+            Data::Real(_) => size_of::<T>(),
+            _ => 2 * size_of::<T>(),
         }
     }
 }
 
-impl Engine {
+impl<T: Real> Engine<T> {
     pub(crate) fn new(
         shape: &Shape,
         pairs: LanePairs,
         (isa, skip, threads): (Isa, (u32, bool), usize),
         options: &Options,
         shared: Option<&WorkerPool>,
-    ) -> Result<Engine> {
+    ) -> Result<Engine<T>> {
         let layout = CoefLayout::new(shape);
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
-        let w = isa.lanes();
+        let w = isa.lanes_of::<T>();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
-        let footprint = Footprint::new(shape, &pairs, (isa, threads), options);
+        let footprint = Footprint::new::<T>(shape, &pairs, (isa, threads), options);
         check_headroom(
             footprint
                 .rest
@@ -135,7 +136,10 @@ impl Engine {
         let pair_weight = if options.betas == Betas::All {
             let wts = crate::grid::weights(shape.grid_bandwidth);
             let f = 2.0 * PI / (na * ng) as f64;
-            wts[..pairs.pairs].iter().map(|x| x * f).collect()
+            wts[..pairs.pairs]
+                .iter()
+                .map(|x| T::from_f64(x * f))
+                .collect()
         } else {
             Vec::new()
         };
@@ -171,28 +175,28 @@ impl Engine {
     }
 
     /// Lane pairs the workspace cap holds for one transform (at least one).
-    pub(super) fn most_pairs(&self, m: Members) -> usize {
+    pub(super) fn most_pairs(&self, m: Members<T>) -> usize {
         self.footprint.most_pairs(m.dwt.row_stride)
     }
 
     /// Lane pairs per chunk (see [`Footprint::chunk_pairs`]).
-    pub(super) fn chunk_pairs(&self, m: Members) -> usize {
+    pub(super) fn chunk_pairs(&self, m: Members<T>) -> usize {
         self.footprint.chunk_pairs(m.dwt.row_stride)
     }
 
     /// Transforms of a batch run together (sharing each cluster's recurrence coefficients,
     /// starting values and d values, see `dwt/batch.rs`): as many as the workspace cap holds
     /// at the chunk size (at least one).
-    pub(super) fn group_size(&self, m: Members) -> usize {
+    pub(super) fn group_size(&self, m: Members<T>) -> usize {
         let hp = self.chunk_pairs(m).next_multiple_of(self.lanes_w());
-        (self.footprint.budget / (hp * m.dwt.row_stride * 2 * 8).max(1)).max(1)
+        (self.footprint.budget / (hp * m.dwt.row_stride * 2 * T::BYTES).max(1)).max(1)
     }
 
     /// Runs `run(first, sub_batch)` on the groups of `batch` (see [`Engine::group_size`]),
     /// summing the stage times.
     pub(super) fn by_groups(
         &self,
-        (batch, m): (Batch, Members),
+        (batch, m): (Batch, Members<T>),
         mut run: impl FnMut(usize, Batch) -> Result<StageTimes>,
     ) -> Result<StageTimes> {
         let g = self.group_size(m);
@@ -210,9 +214,9 @@ impl Engine {
     pub(crate) fn inverse(
         &self,
         batch: Batch,
-        coef: SendConstPtr<Complex64>,
-        out: Data,
-        (scratch, watch): (Option<&Scratch>, Option<SliceWatch>),
+        coef: SendConstPtr<Complex<T>>,
+        out: Data<T>,
+        (scratch, watch): (Option<&Scratch>, Option<SliceWatch<T>>),
     ) -> Result<StageTimes> {
         let m = self.members(out.is_real());
         self.by_groups((batch, m), |t0, b| {
@@ -227,8 +231,8 @@ impl Engine {
     pub(crate) fn forward(
         &self,
         batch: Batch,
-        inp: Data,
-        coef: SendPtr<Complex64>,
+        inp: Data<T>,
+        coef: SendPtr<Complex<T>>,
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         let m = self.members(inp.is_real());
@@ -239,18 +243,17 @@ impl Engine {
         })
     }
 
-    /// Runs `f` with a chunk buffer of at least `len` doubles: the caller's `scratch` if
+    /// Runs `f` with a chunk buffer of at least `len` values: the caller's `scratch` if
     /// given (checked to hold them), else the plan's (see [`ChunkBuffer`]).
     pub(super) fn with_buf<R>(
         &self,
         (len, scratch): (usize, Option<&Scratch>),
-        f: impl FnOnce(*mut f64) -> Result<R>,
+        f: impl FnOnce(*mut T) -> Result<R>,
     ) -> Result<R> {
+        let bytes = len.saturating_mul(T::BYTES);
         match scratch {
-            Some(s) => f(s.holding(8 * len)?.as_mut_ptr().cast::<f64>()),
-            None => self
-                .buf
-                .with(len.div_ceil(2), |b| f(b.as_mut_ptr().cast::<f64>())),
+            Some(s) => f(s.holding(bytes)?.ptr::<T>()),
+            None => self.buf.with_bytes(bytes, |b| f(b.ptr::<T>())),
         }
     }
 
@@ -258,8 +261,7 @@ impl Engine {
     /// FFT buffers), so that executing allocates nothing large and a plan that cannot have
     /// them is refused when it is made.
     pub(crate) fn reserve(&self) -> Result<()> {
-        self.buf
-            .with(self.scratch_bytes().div_ceil(16), |_| Ok(()))?;
+        self.buf.with_bytes(self.scratch_bytes(), |_| Ok(()))?;
         let real = self.half.is_some();
         for w in &self.work {
             let mut w = w.lock().unwrap_or_else(|e| e.into_inner());
@@ -288,7 +290,7 @@ impl Engine {
 
     /// The clusters and slots of the complex transforms (every member), or of the real
     /// ones (`real`: the members `M' >= 0` where the plan has them).
-    pub(crate) fn members(&self, real: bool) -> Members<'_> {
+    pub(crate) fn members(&self, real: bool) -> Members<'_, T> {
         match (&self.half, real) {
             (Some((dwt, slots)), true) => Members { dwt, slots },
             _ => Members {
@@ -307,7 +309,10 @@ impl Engine {
     }
 
     /// The chunks of `h` lane pairs (the last one shorter).
-    pub(super) fn chunks(&self, (h, m): (usize, Members)) -> impl Iterator<Item = ChunkLanes> + '_ {
+    pub(super) fn chunks(
+        &self,
+        (h, m): (usize, Members<T>),
+    ) -> impl Iterator<Item = ChunkLanes> + '_ {
         let row_len = m.dwt.row_stride;
         let w = self.lanes_w();
         (0..self.pairs.pairs).step_by(h).map(move |j0| {
@@ -338,7 +343,7 @@ impl Engine {
     pub(crate) fn chained_chunks(&self, real: bool) -> usize {
         // Only the output's alignment matters (a page boundary here); nothing is accessed.
         let at = std::ptr::null_mut::<u8>().wrapping_add(4096);
-        let out = if real {
+        let out: Data<T> = if real {
             Data::Real(SendPtr(at.cast()))
         } else {
             Data::Complex(SendPtr(at.cast()))

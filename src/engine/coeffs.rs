@@ -3,9 +3,13 @@
 //! contiguous run of degrees per order pair. These copies move one pair's run between the
 //! two, with the pair's sign for even and odd degree offsets applied on the way.
 //!
-//! Each complex value moves as one 16-byte vector (SSE2, part of x86-64).
+//! Coefficients and kernel rows may differ in precision (an f32 plan runs some clusters'
+//! kernels in f64); the factors are applied in f64 and each value rounded once. A complex
+//! double moves as one 16-byte vector (SSE2, part of x86-64).
 
-use num_complex::Complex64;
+use crate::numeric::Elem;
+use crate::Real;
+use num_complex::{Complex, Complex64};
 
 /// The factor of degree offset `i < n` (`n = scales.len()`): `signs[i % 2] * scales[i]`,
 /// the order pair's sign for even and odd offsets times the kernels' value scale (see
@@ -21,7 +25,34 @@ pub(crate) struct DegreeFactors<'a> {
 ///
 /// # Safety
 /// `src` valid for `n` reads, `dst` for writes at `i * p` and `i * p + 1`, `i < n`.
-pub(crate) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
+pub(crate) unsafe fn gather<T: Real, K: Elem>(
+    dst: *mut K,
+    src: *const Complex<T>,
+    p: usize,
+    f: DegreeFactors,
+) {
+    if T::BYTES == 8 && K::BYTES == 8 {
+        // SAFETY: both types are f64 (the only 8-byte `Real` and `Elem`); the caller's
+        // contract.
+        unsafe { gather_f64(dst.cast::<f64>(), src.cast::<Complex64>(), p, f) };
+        return;
+    }
+    for (i, &si) in f.scales.iter().enumerate() {
+        let g = f.signs[i & 1] * si;
+        // SAFETY: the caller's contract.
+        unsafe {
+            let z = *src.add(i);
+            *dst.add(i * p) = K::from_f64(z.re.to_f64() * g);
+            *dst.add(i * p + 1) = K::from_f64(z.im.to_f64() * g);
+        }
+    }
+}
+
+/// [`gather`] in f64.
+///
+/// # Safety
+/// As for [`gather`].
+unsafe fn gather_f64(dst: *mut f64, src: *const Complex64, p: usize, f: DegreeFactors) {
     let (sg, s) = (f.signs, f.scales);
     // SAFETY: the caller's contract (see `# Safety`): reads of `src` below `n`, writes at
     // `i * p` and `i * p + 1` of `dst` for `i < n`.
@@ -55,7 +86,55 @@ pub(crate) unsafe fn gather(dst: *mut f64, src: *const Complex64, p: usize, f: D
 /// # Safety
 /// `dst` valid for `n` reads and writes (and `d2` for `n` writes), `src` for reads at
 /// `i * p` and `i * p + 1`, `i < n`; no overlap.
-pub(crate) unsafe fn scatter(
+pub(crate) unsafe fn scatter<T: Real, K: Elem>(
+    dst: *mut Complex<T>,
+    src: *const K,
+    p: usize,
+    f: DegreeFactors,
+    add: bool,
+    partner: Option<(*mut Complex<T>, f64)>,
+) {
+    if T::BYTES == 8 && K::BYTES == 8 {
+        let partner = partner.map(|(d2, ps)| (d2.cast::<Complex64>(), ps));
+        // SAFETY: both types are f64 (the only 8-byte `Real` and `Elem`); the caller's
+        // contract.
+        unsafe {
+            scatter_f64(
+                dst.cast::<Complex64>(),
+                src.cast::<f64>(),
+                p,
+                f,
+                add,
+                partner,
+            )
+        };
+        return;
+    }
+    let narrow = |z: Complex64| Complex::new(T::from_f64(z.re), T::from_f64(z.im));
+    for (i, &si) in f.scales.iter().enumerate() {
+        let g = f.signs[i & 1] * si;
+        // SAFETY: the caller's contract.
+        unsafe {
+            let mut z =
+                Complex64::new((*src.add(i * p)).to_f64(), (*src.add(i * p + 1)).to_f64()) * g;
+            if add {
+                let d = *dst.add(i);
+                z += Complex64::new(d.re.to_f64(), d.im.to_f64());
+            }
+            let v = narrow(z);
+            *dst.add(i) = v;
+            if let Some((d2, ps)) = partner {
+                *d2.add(i) = narrow(Complex64::new(v.re.to_f64(), v.im.to_f64()).conj() * ps);
+            }
+        }
+    }
+}
+
+/// [`scatter`] in f64.
+///
+/// # Safety
+/// As for [`scatter`].
+unsafe fn scatter_f64(
     dst: *mut Complex64,
     src: *const f64,
     p: usize,

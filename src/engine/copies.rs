@@ -4,9 +4,22 @@
 use super::chunks::{Engine, Members};
 use super::dwt_stage::ChunkLanes;
 use super::slots::{LaneRows, SlotTable};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 
-impl Engine {
+/// `z w`
+#[inline(always)]
+fn times<T: Real>(z: Complex<T>, w: T) -> Complex<T> {
+    Complex::new(z.re * w, z.im * w)
+}
+
+/// `conj(z)`
+#[inline(always)]
+fn conj<T: Real>(z: Complex<T>) -> Complex<T> {
+    Complex::new(z.re, -z.im)
+}
+
+impl<T: Real> Engine<T> {
     /// The FFT stage's tasks of a chunk: `(transform, pair in chunk, upper, slice)` for
     /// every slice the chunk's pairs write.
     pub(super) fn slice_tasks(
@@ -54,10 +67,10 @@ impl Engine {
     /// own row for a direct member, the mirror row for a reversed one, and the other way).
     #[inline(always)]
     pub(super) fn for_each_pair_slot(
-        m: Members,
-        parts: &[LaneRows],
+        m: Members<T>,
+        parts: &[LaneRows<T>],
         real: bool,
-        mut f: impl FnMut(*mut f64, *mut f64, u32),
+        mut f: impl FnMut(*mut T, *mut T, u32),
     ) {
         for rows in parts {
             let table = if real {
@@ -85,9 +98,9 @@ impl Engine {
     /// As for [`Engine::scatter`].
     pub(crate) unsafe fn scatter_pair(
         &self,
-        m: Members,
-        (w0, w1): (&mut [Complex64], &mut [Complex64]),
-        parts: &[LaneRows],
+        m: Members<T>,
+        (w0, w1): (&mut [Complex<T>], &mut [Complex<T>]),
+        parts: &[LaneRows<T>],
     ) {
         self.clear_inverse_buffer(w0);
         self.clear_inverse_buffer(w1);
@@ -95,8 +108,8 @@ impl Engine {
             // SAFETY: the slot's two doubles in both lane rows of the part (the table holds
             // the offsets of `dwt.clusters`' slots).
             unsafe {
-                w0[work as usize] = Complex64::new(*lo, *lo.add(1));
-                w1[work as usize] = Complex64::new(*hi, *hi.add(1));
+                w0[work as usize] = Complex::new(*lo, *lo.add(1));
+                w1[work as usize] = Complex::new(*hi, *hi.add(1));
             }
         });
     }
@@ -108,9 +121,9 @@ impl Engine {
     /// As for [`Engine::scatter`].
     pub(crate) unsafe fn scatter_real_pair(
         &self,
-        m: Members,
-        (w0, w1): (&mut [Complex64], &mut [Complex64]),
-        parts: &[LaneRows],
+        m: Members<T>,
+        (w0, w1): (&mut [Complex<T>], &mut [Complex<T>]),
+        parts: &[LaneRows<T>],
     ) {
         self.clears[1].apply(w0);
         self.clears[1].apply(w1);
@@ -118,8 +131,8 @@ impl Engine {
             if idx & SlotTable::CONJ == 0 {
                 // SAFETY: as in `scatter_pair`.
                 unsafe {
-                    w0[idx as usize] = Complex64::new(*lo, -*lo.add(1));
-                    w1[idx as usize] = Complex64::new(*hi, -*hi.add(1));
+                    w0[idx as usize] = Complex::new(*lo, -*lo.add(1));
+                    w1[idx as usize] = Complex::new(*hi, -*hi.add(1));
                 }
             }
         });
@@ -133,13 +146,16 @@ impl Engine {
     /// As for [`Engine::gather`]; both lane rows of every part are the caller's.
     pub(crate) unsafe fn gather_pair(
         &self,
-        m: Members,
-        (w0, w1): (&[Complex64], &[Complex64]),
-        parts: &[LaneRows],
-        weight: f64,
+        m: Members<T>,
+        (w0, w1): (&[Complex<T>], &[Complex<T>]),
+        parts: &[LaneRows<T>],
+        weight: T,
     ) {
         Self::for_each_pair_slot(m, parts, false, |lo, hi, work| {
-            let (v0, v1) = (w0[work as usize] * weight, w1[work as usize] * weight);
+            let (v0, v1) = (
+                times(w0[work as usize], weight),
+                times(w1[work as usize], weight),
+            );
             // SAFETY: the slot's two doubles in both lane rows (the table holds the offsets
             // of `dwt.clusters`' slots), the caller's.
             unsafe { (*lo, *lo.add(1), *hi, *hi.add(1)) = (v0.re, v0.im, v1.re, v1.im) };
@@ -153,19 +169,19 @@ impl Engine {
     /// As for [`Engine::gather_pair`].
     pub(crate) unsafe fn gather_real_pair(
         &self,
-        m: Members,
-        (w0, w1): (&[Complex64], &[Complex64]),
-        parts: &[LaneRows],
-        weight: f64,
+        m: Members<T>,
+        (w0, w1): (&[Complex<T>], &[Complex<T>]),
+        parts: &[LaneRows<T>],
+        weight: T,
     ) {
         Self::for_each_pair_slot(m, parts, true, |lo, hi, idx| {
-            let value = |w: &[Complex64]| {
+            let value = |w: &[Complex<T>]| {
                 let v = if idx & SlotTable::CONJ != 0 {
                     w[(idx & !SlotTable::CONJ) as usize]
                 } else {
-                    w[idx as usize].conj()
+                    conj(w[idx as usize])
                 };
-                v * weight
+                times(v, weight)
             };
             let (v0, v1) = (value(w0), value(w1));
             // SAFETY: as in `gather_pair`.
@@ -176,11 +192,11 @@ impl Engine {
     /// The lane rows of a slice (its own, and its mirror's, where its reversed members
     /// are) in the chunk buffer at `buf`, transform offset `at`.
     pub(crate) fn lane_rows(
-        m: Members,
-        (buf, at): (*mut f64, usize),
+        m: Members<T>,
+        (buf, at): (*mut T, usize),
         ch: ChunkLanes,
         (jj, upper): (usize, bool),
-    ) -> LaneRows {
+    ) -> LaneRows<T> {
         let lower = buf.wrapping_add(at + jj * m.dwt.row_stride);
         let mirror = lower.wrapping_add(ch.upper_gap);
         let (own, mirror) = if upper {
@@ -197,7 +213,7 @@ impl Engine {
 
     /// Zeroes what the complex inverse's work buffer `w` holds from the previous slice
     /// where this slice places no value (see [`Clear`](super::slots::Clear)).
-    pub(super) fn clear_inverse_buffer(&self, w: &mut [Complex64]) {
+    pub(super) fn clear_inverse_buffer(&self, w: &mut [Complex<T>]) {
         self.clears[0].apply(w);
     }
 
@@ -206,14 +222,14 @@ impl Engine {
     ///
     /// # Safety
     /// Each part's lane rows hold its clusters' slots, written by the DWT stage.
-    pub(crate) unsafe fn scatter(&self, m: Members, w: &mut [Complex64], rows: &[LaneRows]) {
+    pub(crate) unsafe fn scatter(&self, m: Members<T>, w: &mut [Complex<T>], rows: &[LaneRows<T>]) {
         self.clear_inverse_buffer(w);
         for part in rows {
             for &(at, work) in m.slots.of(part.clusters) {
                 let x = part.at(at);
                 // SAFETY: the slot's two doubles are inside the part's lane row (the table
                 // holds the offsets of `dwt.clusters`' slots).
-                w[work as usize] = unsafe { Complex64::new(*x, *x.add(1)) };
+                w[work as usize] = unsafe { Complex::new(*x, *x.add(1)) };
             }
         }
     }
@@ -222,7 +238,12 @@ impl Engine {
     ///
     /// # Safety
     /// As for [`Engine::scatter`].
-    pub(crate) unsafe fn scatter_real(&self, m: Members, w: &mut [Complex64], rows: &[LaneRows]) {
+    pub(crate) unsafe fn scatter_real(
+        &self,
+        m: Members<T>,
+        w: &mut [Complex<T>],
+        rows: &[LaneRows<T>],
+    ) {
         self.clears[1].apply(w);
         for part in rows {
             for &(at, idx) in m.slots.real_of(part.clusters) {
@@ -231,7 +252,7 @@ impl Engine {
                 }
                 let x = part.at(at);
                 // SAFETY: as in `scatter`.
-                w[idx as usize] = unsafe { Complex64::new(*x, -*x.add(1)) };
+                w[idx as usize] = unsafe { Complex::new(*x, -*x.add(1)) };
             }
         }
     }
@@ -243,14 +264,14 @@ impl Engine {
     /// As for [`Engine::scatter`], for writes; no other task writes these slots.
     pub(crate) unsafe fn gather(
         &self,
-        m: Members,
-        w: &[Complex64],
-        rows: &[LaneRows],
-        weight: f64,
+        m: Members<T>,
+        w: &[Complex<T>],
+        rows: &[LaneRows<T>],
+        weight: T,
     ) {
         for part in rows {
             for &(at, work) in m.slots.of(part.clusters) {
-                let v = w[work as usize] * weight;
+                let v = times(w[work as usize], weight);
                 let x = part.at(at);
                 // SAFETY: as in `scatter`; these slots are this task's (caller's contract).
                 unsafe {
@@ -268,18 +289,21 @@ impl Engine {
     /// As for [`Engine::gather`].
     pub(crate) unsafe fn gather_real(
         &self,
-        m: Members,
-        w: &[Complex64],
-        rows: &[LaneRows],
-        weight: f64,
+        m: Members<T>,
+        w: &[Complex<T>],
+        rows: &[LaneRows<T>],
+        weight: T,
     ) {
         for part in rows {
             for &(at, idx) in m.slots.real_of(part.clusters) {
-                let v = if idx & SlotTable::CONJ != 0 {
-                    w[(idx & !SlotTable::CONJ) as usize]
-                } else {
-                    w[idx as usize].conj()
-                } * weight;
+                let v = times(
+                    if idx & SlotTable::CONJ != 0 {
+                        w[(idx & !SlotTable::CONJ) as usize]
+                    } else {
+                        conj(w[idx as usize])
+                    },
+                    weight,
+                );
                 let x = part.at(at);
                 // SAFETY: as in `gather`.
                 unsafe {
@@ -295,7 +319,7 @@ impl Engine {
     ///
     /// # Safety
     /// The chunk's `2 hp` lane rows at `rows` are the caller's.
-    pub(crate) unsafe fn zero_padding(m: Members, rows: *mut f64, ch: ChunkLanes) {
+    pub(crate) unsafe fn zero_padding(m: Members<T>, rows: *mut T, ch: ChunkLanes) {
         let rt = m.dwt.row_stride;
         for half in [0, ch.upper_gap] {
             // SAFETY: lane rows `h..hp` of the half, inside the chunk's rows.

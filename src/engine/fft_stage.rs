@@ -14,9 +14,12 @@
 //! and (`FFTW_UNALIGNED`) for the others; plans inside the page-aligned work buffers once.
 
 use crate::error::Result;
-use crate::fft::{copy_rows, plan_guarded, AlignedBuf, RawPlan, Rigor, SIGN_MINUS, SIGN_PLUS};
+use crate::fft::{
+    copy_rows, plan_guarded, AlignedBuf, Plain, RawPlan, Rigor, SIGN_MINUS, SIGN_PLUS,
+};
+use crate::Real;
 use fftw_sys as fftw;
-use num_complex::Complex64;
+use num_complex::Complex;
 use std::ffi::c_int;
 
 /// Complex values of padding after each row of a work buffer.
@@ -25,12 +28,12 @@ pub(crate) const ROW_PAD: usize = 4;
 /// One output slice of an inverse, handed to a [`SliceWatch`] right after it is
 /// computed (while in the cache): the real slice as written, or a complex slice in a work
 /// buffer or the output, `row` values per row and rows `stride` values apart.
-pub(crate) enum SliceRef<'a> {
+pub(crate) enum SliceRef<'a, T = f64> {
     /// The `n_alpha n_gamma` reals of the slice.
-    Real(&'a [f64]),
+    Real(&'a [T]),
     /// The `n_alpha` rows of the slice.
     Complex {
-        values: &'a [Complex64],
+        values: &'a [Complex<T>],
         row: usize,
         stride: usize,
     },
@@ -39,10 +42,10 @@ pub(crate) enum SliceRef<'a> {
 /// What an inverse calls with the slice index and the values of each output slice, once
 /// per slice, from whichever worker computed it (for scans fused into the transform, such
 /// as a grid's argmax).
-pub(crate) type SliceWatch<'a> = &'a (dyn Fn(usize, SliceRef) + Sync);
+pub(crate) type SliceWatch<'a, T = f64> = &'a (dyn Fn(usize, SliceRef<T>) + Sync);
 
 /// A [`SliceWatch`] bound to one slice, for the FFT stage.
-pub(crate) type Seen<'a> = Option<&'a dyn Fn(SliceRef)>;
+pub(crate) type Seen<'a, T> = Option<&'a dyn Fn(SliceRef<T>)>;
 
 /// A batch of 1-D DFTs: `howmany` transforms of `n` points, `stride` apart within one,
 /// `dist` from one to the next, on the input and the output side.
@@ -68,12 +71,12 @@ enum Kind {
 /// # Safety
 /// `inp` and `out` cover the batch's extent (complex values, or reals on the real side of
 /// `R2c` / `C2r`).
-unsafe fn plan_batch(
+unsafe fn plan_batch<T: Real>(
     b: DftBatch,
     kind: Kind,
-    (inp, out): (*mut Complex64, *mut Complex64),
+    (inp, out): (*mut Complex<T>, *mut Complex<T>),
     flags: u32,
-) -> Result<RawPlan> {
+) -> Result<RawPlan<T>> {
     let dims = [b.n as c_int];
     let (h, s, id, od) = (
         b.howmany as c_int,
@@ -86,7 +89,7 @@ unsafe fn plan_batch(
         // (caller's contract); FFTW keeps no pointer to `dims`.
         unsafe {
             match kind {
-                Kind::Complex(sign) => fftw::fftw_plan_many_dft(
+                Kind::Complex(sign) => T::plan_many_dft(
                     1,
                     dims.as_ptr(),
                     h,
@@ -101,11 +104,11 @@ unsafe fn plan_batch(
                     sign,
                     flags,
                 ),
-                Kind::R2c => fftw::fftw_plan_many_dft_r2c(
+                Kind::R2c => T::plan_many_dft_r2c(
                     1,
                     dims.as_ptr(),
                     h,
-                    inp.cast::<f64>(),
+                    inp.cast::<T>(),
                     std::ptr::null(),
                     1,
                     id,
@@ -115,7 +118,7 @@ unsafe fn plan_batch(
                     od,
                     flags | fftw::FFTW_PRESERVE_INPUT,
                 ),
-                Kind::C2r => fftw::fftw_plan_many_dft_c2r(
+                Kind::C2r => T::plan_many_dft_c2r(
                     1,
                     dims.as_ptr(),
                     h,
@@ -123,7 +126,7 @@ unsafe fn plan_batch(
                     std::ptr::null(),
                     1,
                     id,
-                    out.cast::<f64>(),
+                    out.cast::<T>(),
                     std::ptr::null(),
                     1,
                     od,
@@ -135,20 +138,20 @@ unsafe fn plan_batch(
 }
 
 /// A plan touching a caller's array: aligned and unaligned variants.
-struct TwoWay {
-    aligned: RawPlan,
-    unaligned: RawPlan,
+struct TwoWay<T: Real> {
+    aligned: RawPlan<T>,
+    unaligned: RawPlan<T>,
 }
 
-impl TwoWay {
+impl<T: Real> TwoWay<T> {
     /// # Safety
     /// As for [`plan_batch`].
     unsafe fn new(
         b: DftBatch,
         kind: Kind,
-        arrays: (*mut Complex64, *mut Complex64),
+        arrays: (*mut Complex<T>, *mut Complex<T>),
         rigor: Rigor,
-    ) -> Result<TwoWay> {
+    ) -> Result<TwoWay<T>> {
         // SAFETY: the caller's contract.
         unsafe {
             Ok(TwoWay {
@@ -159,11 +162,11 @@ impl TwoWay {
     }
 
     /// The variant for these arrays.
-    fn pick(&self, a: *const Complex64, b: *const Complex64) -> fftw::fftw_plan {
+    fn pick(&self, a: *const Complex<T>, b: *const Complex<T>) -> *mut T::PlanS {
         // SAFETY: fftw_alignment_of only inspects the addresses.
         let ok = unsafe {
-            fftw::fftw_alignment_of(a.cast::<f64>().cast_mut()) == 0
-                && fftw::fftw_alignment_of(b.cast::<f64>().cast_mut()) == 0
+            T::alignment_of(a.cast::<T>().cast_mut()) == 0
+                && T::alignment_of(b.cast::<T>().cast_mut()) == 0
         };
         if ok {
             self.aligned.0
@@ -174,22 +177,22 @@ impl TwoWay {
 }
 
 /// The work buffers of a slice and its mirror.
-pub(crate) type BufPair<'a> = (&'a mut [Complex64], &'a mut [Complex64]);
+pub(crate) type BufPair<'a, T> = (&'a mut [Complex<T>], &'a mut [Complex<T>]);
 
 /// `len` values of two buffers, made on first use.
-fn buf_pair<'a>(
+fn buf_pair<'a, T: Real>(
     (a, b): (&'a mut Option<AlignedBuf>, &'a mut Option<AlignedBuf>),
     len: usize,
-) -> Result<BufPair<'a>> {
-    for x in [&mut *a, &mut *b] {
-        if x.is_none() {
-            *x = Some(AlignedBuf::new(len)?);
-        }
+) -> Result<BufPair<'a, T>> {
+    Ok((view(a, len)?, view(b, len)?))
+}
+
+/// `len` values of `U` of a buffer, made on first use.
+fn view<U: Plain>(buf: &mut Option<AlignedBuf>, len: usize) -> Result<&mut [U]> {
+    if buf.is_none() {
+        *buf = Some(AlignedBuf::of::<U>(len)?);
     }
-    Ok((
-        a.as_mut().expect("just made").slice_mut(len),
-        b.as_mut().expect("just made").slice_mut(len),
-    ))
+    Ok(buf.as_mut().expect("just made").view_mut::<U>(len))
 }
 
 /// A worker's buffers, each made on first use (a plan makes them, `Engine::reserve`):
@@ -208,8 +211,8 @@ pub(crate) struct Work {
     pub dirty: bool,
 }
 
-/// The slice DFTs of one shape.
-pub(crate) struct FftStage {
+/// The slice DFTs of one shape, in `T`.
+pub(crate) struct FftStage<T: Real = f64> {
     na: usize,
     ng: usize,
     n: usize,
@@ -217,42 +220,47 @@ pub(crate) struct FftStage {
     rs: usize,
     hs: usize,
     /// Columns `0..=N` and `-N..-1` over alpha, in place: sign -1 (inverse), +1 (forward).
-    inv_cols: [Option<RawPlan>; 2],
-    fwd_cols: [Option<RawPlan>; 2],
-    inv_rows: InverseRows,
+    inv_cols: [Option<RawPlan<T>>; 2],
+    fwd_cols: [Option<RawPlan<T>>; 2],
+    inv_rows: InverseRows<T>,
     /// The forward's rows in place in the work buffer, after a copy of the caller's slice
     /// there (a sequential read the prefetchers follow).
-    fwd_rows_in_place: RawPlan,
-    real: Option<RealFfts>,
+    fwd_rows_in_place: RawPlan<T>,
+    real: Option<RealFfts<T>>,
 }
 
 /// The inverse's rows over gamma.
-enum InverseRows {
+enum InverseRows<T: Real> {
     /// In place in the work buffer, then streamed to the caller's slice: where most
     /// columns are in the band (`2N + 1 >= n_gamma / 2`), so the rows are transformed
     /// whole anyway and FFTW's own stores into the caller's slice would first read each of
     /// its lines from memory.
-    InPlace(RawPlan),
+    InPlace(RawPlan<T>),
     /// Straight into the caller's slice (the columns outside the band stay zero in the
     /// work buffer).
-    IntoSlice(TwoWay),
+    IntoSlice(TwoWay<T>),
 }
 
-struct RealFfts {
-    r2c: TwoWay,
-    c2r: TwoWay,
+struct RealFfts<T: Real> {
+    r2c: TwoWay<T>,
+    c2r: TwoWay<T>,
     /// Columns `0..=N` of the half spectrum, sign -1 (forward) and +1 (inverse).
-    cols_minus: RawPlan,
-    cols_plus: RawPlan,
+    cols_minus: RawPlan<T>,
+    cols_plus: RawPlan<T>,
 }
 
-impl FftStage {
+impl<T: Real> FftStage<T> {
     /// Plans for slices of `na x ng` values with orders `|M'| <= n`.
-    pub fn new((na, ng): (usize, usize), n: usize, real: bool, rigor: Rigor) -> Result<FftStage> {
+    pub fn new(
+        (na, ng): (usize, usize),
+        n: usize,
+        real: bool,
+        rigor: Rigor,
+    ) -> Result<FftStage<T>> {
         let (rs, hs) = (ng + ROW_PAD, ng / 2 + 1 + ROW_PAD);
-        let a = AlignedBuf::new(na * rs)?;
-        let b = AlignedBuf::new(na * rs)?;
-        let (pa, pb) = (a.as_mut_ptr(), b.as_mut_ptr());
+        let a = AlignedBuf::of::<Complex<T>>(na * rs)?;
+        let b = AlignedBuf::of::<Complex<T>>(na * rs)?;
+        let (pa, pb) = (a.ptr::<Complex<T>>(), b.ptr::<Complex<T>>());
         let flags = rigor.flags();
         let cols = |howmany: usize, stride: usize| DftBatch {
             n: na,
@@ -273,7 +281,7 @@ impl FftStage {
         // (`c + howmany <= ng`, or `<= hs` of the half spectrum) of `na` values, or the
         // `na` rows.
         let col_plan =
-            |howmany: usize, at: usize, stride: usize, sign: i32| -> Result<Option<RawPlan>> {
+            |howmany: usize, at: usize, stride: usize, sign: i32| -> Result<Option<RawPlan<T>>> {
                 if howmany == 0 {
                     return Ok(None);
                 }
@@ -343,55 +351,43 @@ impl FftStage {
     }
 
     /// The inverse's work buffer, zero where no value is ever placed.
-    pub fn inv_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
+    pub fn inv_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex<T>]> {
         self.inv_pair(work).map(|(a, _)| a)
     }
 
     /// Two inverse work buffers (a slice and its mirror), zero where no value is ever
     /// placed (cleared whole after a forward used them).
-    pub fn inv_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+    pub fn inv_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a, T>> {
         let clear = std::mem::take(&mut work.dirty);
         let (a, b) = buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)?;
         if clear {
-            a.fill(Complex64::new(0.0, 0.0));
-            b.fill(Complex64::new(0.0, 0.0));
+            a.fill(Complex::new(T::ZERO, T::ZERO));
+            b.fill(Complex::new(T::ZERO, T::ZERO));
         }
         Ok((a, b))
     }
 
     /// Two forward work buffers (a slice and its mirror): the inverse's, marked as written.
-    pub fn fwd_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+    pub fn fwd_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a, T>> {
         work.dirty = true;
         buf_pair((&mut work.inv, &mut work.inv2), self.na * self.rs)
     }
 
     /// Two half buffers (the real transforms of a slice and its mirror).
-    pub fn half_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a>> {
+    pub fn half_pair<'a>(&self, work: &'a mut Work) -> Result<BufPair<'a, T>> {
         buf_pair((&mut work.half, &mut work.half2), self.na * self.hs)
     }
 
     /// Two half buffers and the reals of a slice (the real forward of real parts).
-    pub fn half_pair_reals<'a>(&self, work: &'a mut Work) -> Result<(BufPair<'a>, &'a mut [f64])> {
-        let len = self.slice_len().div_ceil(2);
-        if work.reals.is_none() {
-            work.reals = Some(AlignedBuf::new(len)?);
-        }
-        let reals = work.reals.as_mut().expect("just made").slice_mut(len);
-        // SAFETY: `len` complex values of a buffer of that many, as doubles (twice as
-        // many, at least `na ng`), borrowed as long as the complex slice.
-        let reals =
-            unsafe { std::slice::from_raw_parts_mut(reals.as_mut_ptr().cast::<f64>(), 2 * len) };
+    pub fn half_pair_reals<'a>(&self, work: &'a mut Work) -> Result<(BufPair<'a, T>, &'a mut [T])> {
+        let reals = view::<T>(&mut work.reals, self.slice_len())?;
         let pair = buf_pair((&mut work.half, &mut work.half2), self.na * self.hs)?;
         Ok((pair, reals))
     }
 
     /// The real transforms' half-spectrum buffer.
-    pub fn half_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex64]> {
-        let len = self.na * self.hs;
-        if work.half.is_none() {
-            work.half = Some(AlignedBuf::new(len)?);
-        }
-        Ok(work.half.as_mut().expect("just made").slice_mut(len))
+    pub fn half_buf<'a>(&self, work: &'a mut Work) -> Result<&'a mut [Complex<T>]> {
+        view::<Complex<T>>(&mut work.half, self.na * self.hs)
     }
 
     /// Inverse of a slice: `w` (the inverse's work buffer) holds the values at
@@ -401,20 +397,20 @@ impl FftStage {
     /// # Safety
     /// `w` is [`FftStage::inv_buf`]'s; `out` is valid for writes of `na ng` values, nobody
     /// else's meanwhile.
-    pub unsafe fn inverse(&self, w: &mut [Complex64], out: *mut Complex64, seen: Seen) {
+    pub unsafe fn inverse(&self, w: &mut [Complex<T>], out: *mut Complex<T>, seen: Seen<T>) {
         let w = w.as_mut_ptr();
         for (plan, at) in self.inv_cols.iter().zip([0, self.ng - self.n]) {
             if let Some(p) = plan {
                 // SAFETY: the plan was made at this offset of a page-aligned buffer of
                 // the same size (same alignment); the work buffer is this worker's.
-                unsafe { fftw::fftw_execute_dft(p.0, w.add(at), w.add(at)) };
+                unsafe { T::execute_dft(p.0, w.add(at), w.add(at)) };
             }
         }
         match &self.inv_rows {
             // SAFETY: as for the columns; then `out` holds the slice's `na` rows of `ng`
             // values (caller's contract), apart from the work buffer.
             InverseRows::InPlace(p) => unsafe {
-                fftw::fftw_execute_dft(p.0, w, w);
+                T::execute_dft(p.0, w, w);
                 if let Some(seen) = seen {
                     let len = (self.na - 1) * self.rs + self.ng;
                     seen(SliceRef::Complex {
@@ -424,9 +420,9 @@ impl FftStage {
                     });
                 }
                 copy_rows(
-                    w.cast::<f64>(),
+                    w.cast::<T>(),
                     2 * self.rs,
-                    out.cast::<f64>(),
+                    out.cast::<T>(),
                     2 * self.ng,
                     self.na,
                     2 * self.ng,
@@ -436,7 +432,7 @@ impl FftStage {
             // SAFETY: `out` holds the slice (caller's contract); the variant matches the
             // arrays' alignment; the input rows are only read (out of place).
             InverseRows::IntoSlice(two) => unsafe {
-                fftw::fftw_execute_dft(two.pick(w, out), w, out);
+                T::execute_dft(two.pick(w, out), w, out);
                 if let Some(seen) = seen {
                     seen(SliceRef::Complex {
                         values: std::slice::from_raw_parts(out, self.na * self.ng),
@@ -463,27 +459,27 @@ impl FftStage {
     ///
     /// # Safety
     /// `inp` is valid for reads of `na ng` values; `w` is one of [`FftStage::fwd_pair`]'s buffers.
-    pub unsafe fn forward(&self, w: &mut [Complex64], inp: *const Complex64) {
+    pub unsafe fn forward(&self, w: &mut [Complex<T>], inp: *const Complex<T>) {
         let w = w.as_mut_ptr();
         // SAFETY: `inp` holds the slice's `na` rows of `ng` values and is only read; the
         // work buffer (`na` rows of `rs`) is this worker's; the plan was made in place on a
         // same-size page-aligned buffer.
         unsafe {
             copy_rows(
-                inp.cast::<f64>(),
+                inp.cast::<T>(),
                 2 * self.ng,
-                w.cast::<f64>(),
+                w.cast::<T>(),
                 2 * self.rs,
                 self.na,
                 2 * self.ng,
                 false,
             );
-            fftw::fftw_execute_dft(self.fwd_rows_in_place.0, w, w);
+            T::execute_dft(self.fwd_rows_in_place.0, w, w);
         }
         for (plan, at) in self.fwd_cols.iter().zip([0, self.ng - self.n]) {
             if let Some(p) = plan {
                 // SAFETY: as in `inverse`: same offset in a same-size page-aligned buffer.
-                unsafe { fftw::fftw_execute_dft(p.0, w.add(at), w.add(at)) };
+                unsafe { T::execute_dft(p.0, w.add(at), w.add(at)) };
             }
         }
     }
@@ -495,14 +491,14 @@ impl FftStage {
     /// # Safety
     /// `out` valid for writes of `na ng` doubles, nobody else's; the plan is real; `w` is
     /// [`FftStage::half_buf`]'s.
-    pub unsafe fn inverse_real(&self, w: &mut [Complex64], out: *mut f64, seen: Seen) {
+    pub unsafe fn inverse_real(&self, w: &mut [Complex<T>], out: *mut T, seen: Seen<T>) {
         let r = self.real.as_ref().expect("real plans");
         let w = w.as_mut_ptr();
         // SAFETY: plan made on a same-size page-aligned buffer; the buffer is this worker's.
-        unsafe { fftw::fftw_execute_dft(r.cols_plus.0, w, w) };
-        let o = out.cast::<Complex64>();
+        unsafe { T::execute_dft(r.cols_plus.0, w, w) };
+        let o = out.cast::<Complex<T>>();
         // SAFETY: `out` holds the slice's reals (caller's contract); variant by alignment.
-        unsafe { fftw::fftw_execute_dft_c2r(r.c2r.pick(w, o), w, out) };
+        unsafe { T::execute_dft_c2r(r.c2r.pick(w, o), w, out) };
         if let Some(seen) = seen {
             // SAFETY: the reals just written, this caller's alone.
             seen(SliceRef::Real(unsafe {
@@ -519,8 +515,13 @@ impl FftStage {
     /// # Safety
     /// As for [`FftStage::inverse_real`], with `out` valid for writes of `na ng` complex
     /// values.
-    pub unsafe fn inverse_real_parts(&self, w: &mut [Complex64], out: *mut Complex64, seen: Seen) {
-        let reals = out.cast::<f64>();
+    pub unsafe fn inverse_real_parts(
+        &self,
+        w: &mut [Complex<T>],
+        out: *mut Complex<T>,
+        seen: Seen<T>,
+    ) {
+        let reals = out.cast::<T>();
         // SAFETY: the first `na ng` doubles of the caller's slice (caller's contract).
         unsafe { self.inverse_real(w, reals, seen) };
         for i in (0..self.slice_len()).rev() {
@@ -528,7 +529,7 @@ impl FftStage {
             // before anything at or below `2 i` (written only for larger `i`) changes it.
             unsafe {
                 let x = *reals.add(i);
-                *reals.add(2 * i + 1) = 0.0;
+                *reals.add(2 * i + 1) = T::ZERO;
                 *reals.add(2 * i) = x;
             }
         }
@@ -542,8 +543,8 @@ impl FftStage {
     /// [`FftStage::half_buf`]'s; `reals` this caller's.
     pub unsafe fn forward_real_parts(
         &self,
-        (w, reals): (&mut [Complex64], &mut [f64]),
-        inp: *const Complex64,
+        (w, reals): (&mut [Complex<T>], &mut [T]),
+        inp: *const Complex<T>,
     ) {
         for (i, x) in reals[..self.slice_len()].iter_mut().enumerate() {
             // SAFETY: `i < na ng` (caller's contract).
@@ -559,14 +560,14 @@ impl FftStage {
     /// # Safety
     /// `inp` valid for reads of `na ng` doubles; the plan is real; `w` is
     /// [`FftStage::half_buf`]'s.
-    pub unsafe fn forward_real(&self, w: &mut [Complex64], inp: *const f64) {
+    pub unsafe fn forward_real(&self, w: &mut [Complex<T>], inp: *const T) {
         let r = self.real.as_ref().expect("real plans");
         let w = w.as_mut_ptr();
         let i = inp.cast_mut();
         // SAFETY: `inp` holds the slice and is only read (FFTW_PRESERVE_INPUT); variant
         // by alignment.
-        unsafe { fftw::fftw_execute_dft_r2c(r.r2c.pick(i.cast(), w), i, w) };
+        unsafe { T::execute_dft_r2c(r.r2c.pick(i.cast(), w), i, w) };
         // SAFETY: as in `inverse_real`.
-        unsafe { fftw::fftw_execute_dft(r.cols_minus.0, w, w) };
+        unsafe { T::execute_dft(r.cols_minus.0, w, w) };
     }
 }

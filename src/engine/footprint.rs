@@ -7,6 +7,7 @@ use crate::options::Options;
 use crate::shape::{CoefLayout, Shape};
 use crate::simd::Isa;
 use crate::workers::WORKER_STACK_BYTES;
+use crate::Real;
 
 /// What a plan of the engine holds, known before it is made.
 #[derive(Clone, Copy, Debug)]
@@ -19,40 +20,46 @@ pub(crate) struct Footprint {
     /// Lane pairs and lanes per vector.
     pub(super) pairs: usize,
     pub(super) lanes_w: usize,
+    /// Bytes of a value of the lane rows.
+    pub(super) value_bytes: usize,
     /// Lane-row strides of the complex transforms and (real plans) of the real ones.
     pub(super) strides: [Option<usize>; 2],
 }
 
 impl Footprint {
-    /// The footprint of the plan [`Engine::new`](super::Engine::new) makes of these arguments.
-    pub(crate) fn new(
+    /// The footprint of the plan [`Engine::new`](super::Engine::new) in `T` makes of these
+    /// arguments.
+    pub(crate) fn new<T: Real>(
         shape: &Shape,
         pairs: &LanePairs,
         (isa, threads): (Isa, usize),
         options: &Options,
     ) -> Footprint {
         let layout = CoefLayout::new(shape);
-        let w = isa.lanes();
+        let w = isa.lanes_of::<T>();
         let max_lanes = 2 * pairs.pairs.next_multiple_of(w);
         let tables = pairs.pairs * LanePairs::bytes_per_pair(shape.degree_limit);
-        let rest = DwtStage::bytes(shape.degree_limit, 0, threads, max_lanes)
-            .saturating_add(threads * (Self::work_bytes(shape, options) + WORKER_STACK_BYTES))
+        let rest = DwtStage::<T>::bytes(shape.degree_limit, 0, threads, max_lanes)
+            .saturating_add(threads * (Self::work_bytes::<T>(shape, options) + WORKER_STACK_BYTES))
             .saturating_add(tables);
         // The library's one rule (see `Options::default_workspace`).
-        let sample_bytes = if options.real { 8 } else { 16 };
-        let arrays = sample_bytes * shape.num_samples() + 16 * shape.num_coeffs();
+        let sample_bytes = if options.real { T::BYTES } else { 2 * T::BYTES };
+        let arrays = sample_bytes * shape.num_samples() + 2 * T::BYTES * shape.num_coeffs();
         let budget = options
             .max_workspace_bytes
             .unwrap_or_else(|| Options::default_workspace_here(arrays).saturating_sub(rest));
         let strides = [
-            Some(DwtStage::row_stride_of(&layout, false)),
-            options.real.then(|| DwtStage::row_stride_of(&layout, true)),
+            Some(DwtStage::<T>::row_stride_of(&layout, false)),
+            options
+                .real
+                .then(|| DwtStage::<T>::row_stride_of(&layout, true)),
         ];
         Footprint {
             rest,
             budget,
             pairs: pairs.pairs,
             lanes_w: w,
+            value_bytes: T::BYTES,
             strides,
         }
     }
@@ -60,18 +67,19 @@ impl Footprint {
     /// Bytes of one worker's FFT buffers (see [`Engine::reserve`](super::Engine::reserve)): two work buffers of
     /// a slice (the forward's and the inverse's), and on a real plan two half-spectrum
     /// buffers and the reals of a slice.
-    pub(super) fn work_bytes(shape: &Shape, options: &Options) -> usize {
+    pub(super) fn work_bytes<T: Real>(shape: &Shape, options: &Options) -> usize {
         let (na, ng) = (shape.n_alpha, shape.n_gamma);
-        let mut bytes = 2 * na * (ng + ROW_PAD) * 16;
+        let value = 2 * T::BYTES;
+        let mut bytes = 2 * na * (ng + ROW_PAD) * value;
         if options.real {
-            bytes += 2 * na * (ng / 2 + 1 + ROW_PAD) * 16 + na * ng * 8;
+            bytes += 2 * na * (ng / 2 + 1 + ROW_PAD) * value + na * ng * T::BYTES;
         }
         bytes
     }
 
-    /// Lane pairs whose rows, `row_stride` doubles apart, the workspace cap holds.
+    /// Lane pairs whose rows, `row_stride` values apart, the workspace cap holds.
     pub(super) fn room(&self, row_stride: usize) -> usize {
-        self.budget / (row_stride * 2 * 8).max(1)
+        self.budget / (row_stride * 2 * self.value_bytes).max(1)
     }
 
     /// [`Footprint::room`] for one transform: at least one pair, at most all.
@@ -103,7 +111,9 @@ impl Footprint {
         self.strides
             .iter()
             .flatten()
-            .map(|&rs| 8 * rs * 2 * self.chunk_pairs(rs).next_multiple_of(self.lanes_w))
+            .map(|&rs| {
+                self.value_bytes * rs * 2 * self.chunk_pairs(rs).next_multiple_of(self.lanes_w)
+            })
             .max()
             .unwrap_or(0)
     }

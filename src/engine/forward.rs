@@ -9,11 +9,12 @@ use crate::error::Result;
 use crate::transform::Scratch;
 use crate::transform::StageTimes;
 use crate::workers::SendPtr;
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 use rayon::prelude::*;
 use std::time::Instant;
 
-impl Engine {
+impl<T: Real> Engine<T> {
     /// The slice DFTs of a forward from the slices `inp` (one or two, of one kind) into
     /// `work`'s two buffers for that kind, in order; returns the buffers (for a gather).
     ///
@@ -22,8 +23,8 @@ impl Engine {
     pub(super) unsafe fn slices_in<'a>(
         &self,
         work: &'a mut Work,
-        inp: &[Data],
-    ) -> Result<BufPair<'a>> {
+        inp: &[Data<T>],
+    ) -> Result<BufPair<'a, T>> {
         let ((w0, w1), mut reals) = match inp[0] {
             Data::Complex(_) => (self.fft.fwd_pair(work)?, None),
             Data::Real(_) => (self.fft.half_pair(work)?, None),
@@ -49,9 +50,9 @@ impl Engine {
     /// Forward of a group of transforms, chunk by chunk.
     pub(super) fn forward_group(
         &self,
-        (batch, m): (Batch, Members),
-        inp: Data,
-        coef: SendPtr<Complex64>,
+        (batch, m): (Batch, Members<T>),
+        inp: Data<T>,
+        coef: SendPtr<Complex<T>>,
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         let start = Instant::now();

@@ -10,19 +10,20 @@ use crate::error::Result;
 use crate::transform::Scratch;
 use crate::transform::StageTimes;
 use crate::workers::{SendConstPtr, SendPtr};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 use rayon::prelude::*;
 use std::time::Instant;
 
-impl Engine {
+impl<T: Real> Engine<T> {
     /// Inverse of a group of transforms: chunk by chunk, or all chunks in one pass of the
     /// DWT stage where [`Engine::inverse_chain`] places their buffers.
     pub(super) fn inverse_group(
         &self,
-        (batch, m): (Batch, Members),
-        coef: SendConstPtr<Complex64>,
-        out: Data,
-        (scratch, watch): (Option<&Scratch>, Option<SliceWatch>),
+        (batch, m): (Batch, Members<T>),
+        coef: SendConstPtr<Complex<T>>,
+        out: Data<T>,
+        (scratch, watch): (Option<&Scratch>, Option<SliceWatch<T>>),
     ) -> Result<StageTimes> {
         let start = Instant::now();
         let mut times = StageTimes::default();
@@ -32,7 +33,7 @@ impl Engine {
         self.with_buf((batch.count * per_t_max, scratch), |buf| {
             let own = SendPtr(buf);
             let chain = self.inverse_chain((batch.count, m), out, own);
-            let groups: Vec<Vec<PlacedLanes>> = match chain {
+            let groups: Vec<Vec<PlacedLanes<T>>> = match chain {
                 Some(chain) => vec![chain],
                 None => self
                     .chunks((self.chunk_pairs(m), m))
@@ -42,7 +43,7 @@ impl Engine {
             self.workers.pool().install(|| {
                 for group in groups {
                     // Chunks of padding pairs only (selections) write nothing.
-                    let group: Vec<PlacedLanes> = group
+                    let group: Vec<PlacedLanes<T>> = group
                         .into_iter()
                         .filter(|pl| (0..pl.ch.h).any(|jj| self.writes(pl.ch, jj)))
                         .collect();
@@ -50,7 +51,7 @@ impl Engine {
                         continue;
                     }
                     // Rows far larger than the caches go out with non-temporal stores.
-                    let stream = group.len() * batch.count * per_t_max * 8 > 8 << 20;
+                    let stream = group.len() * batch.count * per_t_max * T::BYTES > 8 << 20;
                     let t0 = Instant::now();
                     self.inverse_dwt((batch, m), coef, &group, (real, stream));
                     let t1 = Instant::now();
@@ -87,10 +88,10 @@ impl Engine {
     /// chunks, or rows that do not fit.
     pub(super) fn inverse_chain(
         &self,
-        (count, m): (usize, Members),
-        out: Data,
-        own: SendPtr<f64>,
-    ) -> Option<Vec<PlacedLanes>> {
+        (count, m): (usize, Members<T>),
+        out: Data<T>,
+        own: SendPtr<T>,
+    ) -> Option<Vec<PlacedLanes<T>>> {
         // The most pairs the plan's buffer holds, rounded down to the vector width.
         let w = self.lanes_w();
         let most = (self.chunk_pairs(m).next_multiple_of(w)).min(self.most_pairs(m));
@@ -111,7 +112,7 @@ impl Engine {
         }];
         for pair in chunks.windows(2) {
             let (host, ch) = (pair[0], pair[1]);
-            let half_bytes = 8 * ch.hp * rt;
+            let half_bytes = T::BYTES * ch.hp * rt;
             // The first slice of `host`'s consecutive lower (u = 0) or upper (u = 1)
             // points, aligned room for a half from there.
             let region = |u: usize| -> Option<*mut u8> {
@@ -136,8 +137,8 @@ impl Engine {
             if (upper as usize) < lower as usize + half_bytes {
                 return None;
             }
-            let gap = (upper as usize - lower as usize) / 8;
-            if gap * 8 != upper as usize - lower as usize {
+            let gap = (upper as usize - lower as usize) / T::BYTES;
+            if gap * T::BYTES != upper as usize - lower as usize {
                 return None;
             }
             chain.push(PlacedLanes {
@@ -145,7 +146,7 @@ impl Engine {
                     upper_gap: gap,
                     ..ch
                 },
-                buf: SendPtr(lower.cast::<f64>()),
+                buf: SendPtr(lower.cast::<T>()),
             });
         }
         Some(chain)
@@ -155,9 +156,9 @@ impl Engine {
     /// turn, its coefficients cached after the first).
     pub(super) fn inverse_dwt(
         &self,
-        (batch, m): (Batch, Members),
-        coef: SendConstPtr<Complex64>,
-        group: &[PlacedLanes],
+        (batch, m): (Batch, Members<T>),
+        coef: SendConstPtr<Complex<T>>,
+        group: &[PlacedLanes<T>],
         (real, stream): (bool, bool),
     ) {
         let clusters = &m.dwt.clusters;
@@ -229,9 +230,9 @@ impl Engine {
     /// slice shown to `watch` if given.
     pub(super) fn inverse_fft(
         &self,
-        (batch, m): (Batch, Members),
-        pl: PlacedLanes,
-        (out, watch): (Data, Option<SliceWatch>),
+        (batch, m): (Batch, Members<T>),
+        pl: PlacedLanes<T>,
+        (out, watch): (Data<T>, Option<SliceWatch<T>>),
     ) -> Result<()> {
         let (ch, buf) = (pl.ch, pl.buf);
         let per_t = m.dwt.row_stride * ch.lanes();
@@ -293,12 +294,12 @@ impl Engine {
     /// buffer of `out`'s kind (half buffer for the real kinds).
     pub(super) unsafe fn slice_out(
         &self,
-        w: &mut [Complex64],
-        out: Data,
-        (watch, s): (Option<SliceWatch>, usize),
+        w: &mut [Complex<T>],
+        out: Data<T>,
+        (watch, s): (Option<SliceWatch<T>>, usize),
     ) {
-        let bound = watch.map(|f| move |r: SliceRef| f(s, r));
-        let seen = bound.as_ref().map(|f| f as &dyn Fn(SliceRef));
+        let bound = watch.map(|f| move |r: SliceRef<T>| f(s, r));
+        let seen = bound.as_ref().map(|f| f as &dyn Fn(SliceRef<T>));
         // SAFETY: the caller's contract.
         unsafe {
             match out {

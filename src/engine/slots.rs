@@ -5,24 +5,25 @@
 use super::dwt_stage::DwtStage;
 use crate::error::{Error, Result};
 
-/// A slice's lane rows: its own and its mirror's, for the clusters `clusters.0 ..
-/// clusters.1`; cluster `c`'s slots start `offset(c)` doubles after the pointers (which may
-/// point before the rows when they hold only a later part of the clusters).
+/// A slice's lane rows (values of `T`): its own and its mirror's, for the clusters
+/// `clusters.0 .. clusters.1`; cluster `c`'s slots start `offset(c)` values after the
+/// pointers (which may point before the rows when they hold only a later part of the
+/// clusters).
 #[derive(Clone, Copy)]
-pub(crate) struct LaneRows {
-    pub(crate) own: *mut f64,
-    pub(crate) mirror: *mut f64,
+pub(crate) struct LaneRows<T = f64> {
+    pub(crate) own: *mut T,
+    pub(crate) mirror: *mut T,
     pub(crate) clusters: (usize, usize),
 }
 
-impl LaneRows {
+impl<T> LaneRows<T> {
     /// Rows that hold the clusters `clusters` only, the first of which at offset `first`
     /// of the full lane row: their slots at `own` and `mirror` onwards.
     pub(crate) fn part(
-        (own, mirror): (*mut f64, *mut f64),
+        (own, mirror): (*mut T, *mut T),
         clusters: (usize, usize),
         first: usize,
-    ) -> LaneRows {
+    ) -> LaneRows<T> {
         LaneRows {
             own: own.wrapping_sub(first),
             mirror: mirror.wrapping_sub(first),
@@ -32,7 +33,7 @@ impl LaneRows {
 
     /// Where a slot of a [`SlotTable`] entry is.
     #[inline(always)]
-    pub(crate) fn at(&self, at: u32) -> *mut f64 {
+    pub(crate) fn at(&self, at: u32) -> *mut T {
         let row = if at & SlotTable::MIRROR != 0 {
             self.mirror
         } else {
@@ -64,7 +65,10 @@ impl SlotTable {
 
     /// The table of `dwt`'s clusters; the real entries for a half buffer of `na` rows `hs`
     /// apart.
-    pub(crate) fn new(dwt: &DwtStage, (na, hs): (usize, usize)) -> Result<SlotTable> {
+    pub(crate) fn new<T: crate::Real>(
+        dwt: &DwtStage<T>,
+        (na, hs): (usize, usize),
+    ) -> Result<SlotTable> {
         let too_large =
             || Error::InvalidArgument("shape too large for the engine's slot table".into());
         let fits = |x: usize| u32::try_from(x).ok().filter(|a| a & (1 << 31) == 0);
@@ -169,8 +173,8 @@ impl Clear {
     }
 
     /// Zeroes them in `w`.
-    pub(crate) fn apply(&self, w: &mut [num_complex::Complex64]) {
-        let zero = num_complex::Complex64::default();
+    pub(crate) fn apply<T: Copy + Default>(&self, w: &mut [T]) {
+        let zero = T::default();
         match self {
             Clear::Holes(h) => h.iter().for_each(|&i| w[i] = zero),
             Clear::Columns { cols, rows, stride } => {

@@ -147,11 +147,6 @@ impl AlignedBuf {
     pub fn len(&self) -> usize {
         self.len_of::<Complex64>()
     }
-
-    /// The first `len` `Complex64` values (`len <= self.len()`).
-    pub fn slice_mut(&mut self, len: usize) -> &mut [Complex64] {
-        self.view_mut::<Complex64>(len)
-    }
 }
 
 impl Drop for AlignedBuf {
@@ -226,16 +221,6 @@ impl ChunkBuffer {
         ChunkBuffer(std::sync::Mutex::new(made))
     }
 
-    /// Runs `f` with a buffer of at least `len` complex values (`Complex64`, see
-    /// [`ChunkBuffer`]).
-    pub(crate) fn with<R>(
-        &self,
-        len: usize,
-        f: impl FnOnce(&AlignedBuf) -> Result<R>,
-    ) -> Result<R> {
-        self.with_bytes(16 * len, f)
-    }
-
     /// Runs `f` with a buffer of at least `bytes` bytes (see [`ChunkBuffer`]).
     pub(crate) fn with_bytes<R>(
         &self,
@@ -307,14 +292,16 @@ mod tests {
     #[test]
     fn chunk_buffer_is_kept_grown_and_never_shared() {
         let cb = ChunkBuffer::new(None);
-        let first = cb.with(100, |b| Ok((b.as_mut_ptr(), b.len()))).unwrap();
+        let first = cb
+            .with_bytes(16 * 100, |b| Ok((b.as_mut_ptr(), b.len())))
+            .unwrap();
         assert!(first.1 >= 100);
-        let again = cb.with(50, |b| Ok(b.as_mut_ptr())).unwrap();
+        let again = cb.with_bytes(16 * 50, |b| Ok(b.as_mut_ptr())).unwrap();
         assert_eq!(again, first.0, "kept");
-        let grown = cb.with(1 << 16, |b| Ok(b.len())).unwrap();
+        let grown = cb.with_bytes(16 << 16, |b| Ok(b.len())).unwrap();
         assert!(grown >= 1 << 16);
-        cb.with(10, |outer| {
-            let inner = cb.with(1000, |b| Ok((b.as_mut_ptr(), b.len())))?;
+        cb.with_bytes(16 * 10, |outer| {
+            let inner = cb.with_bytes(16 * 1000, |b| Ok((b.as_mut_ptr(), b.len())))?;
             assert_ne!(inner.0, outer.as_mut_ptr(), "a taken buffer is not shared");
             assert!(inner.1 >= 1000);
             Ok(())

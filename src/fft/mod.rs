@@ -28,7 +28,7 @@ pub(crate) mod tests;
 pub mod wisdom;
 
 pub(crate) use api::FftwApi;
-pub(crate) use buf::{copy_rows, AlignedBuf, ChunkBuffer};
+pub(crate) use buf::{copy_rows, AlignedBuf, ChunkBuffer, Plain};
 pub(crate) use planner::{plan_guarded, planning_bytes, RawPlan};
 
 use fftw_sys as fftw;

@@ -290,7 +290,7 @@ mod tests {
     fn wisdom_survives_a_round_trip_through_a_file() {
         // A measured plan leaves wisdom about its 12-point slice DFTs.
         let options = Options::default().with_rigor(Rigor::Measure);
-        PartialPlan::new(&Shape::new(6), &options).unwrap();
+        PartialPlan::<f64>::new(&Shape::new(6), &options).unwrap();
         let before = export_to_string().unwrap();
         assert!(before.starts_with("(fftw-3"), "{before}");
         let path = std::env::temp_dir().join(format!("so3fft-wisdom-{}", std::process::id()));

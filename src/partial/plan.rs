@@ -10,7 +10,8 @@ use crate::simd::Isa;
 use crate::system::{mem_available, mem_total};
 use crate::transform::{Scratch, StageTimes, Transform};
 use crate::workers::{SendConstPtr, SendPtr, WorkerPool};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 
 /// A transform on SO(3) that computes only what a [`Shape`] holds: band-limited,
 /// order-limited, oversampled or undersampled in alpha and gamma, restricted to some
@@ -19,14 +20,17 @@ use num_complex::Complex64;
 /// Every shape runs on one engine: the DWT kernels per cluster of order pairs over
 /// chunks of beta pairs, and pruned slice DFTs ([`Plan`](crate::Plan) is its full shape).
 /// Execution takes `&self`; one plan may run on different arrays from several threads.
-pub struct PartialPlan {
+///
+/// `T` is the precision of the arrays and of the computation: `f64`, or `f32` for about
+/// half the time and memory at a relative error near `1e-6` (see `docs/precision.md`).
+pub struct PartialPlan<T: Real = f64> {
     shape: Shape,
     direction: Direction,
     real: bool,
     threads: usize,
     n_slices: usize,
     isa: Isa,
-    engine: Box<Engine>,
+    engine: Box<Engine<T>>,
 }
 
 /// What [`PartialPlan::new`] checks and resolves before it builds anything.
@@ -38,10 +42,10 @@ struct Checked {
     pairs: LanePairs,
 }
 
-impl PartialPlan {
+impl<T: Real> PartialPlan<T> {
     /// A plan for `shape` with `options`.
-    pub fn new(shape: &Shape, options: &Options) -> Result<PartialPlan> {
-        PartialPlan::new_on(shape, options, None)
+    pub fn new(shape: &Shape, options: &Options) -> Result<PartialPlan<T>> {
+        Self::new_on(shape, options, None)
     }
 
     /// [`PartialPlan::new`] on the workers of `shared` if given (with the plan's thread
@@ -50,15 +54,16 @@ impl PartialPlan {
         shape: &Shape,
         options: &Options,
         shared: Option<&WorkerPool>,
-    ) -> Result<PartialPlan> {
-        let c = PartialPlan::validate(shape, options)?;
+    ) -> Result<PartialPlan<T>> {
+        let c = Self::validate(shape, options)?;
         let n_slices = c.pairs.n_slices;
         // Fail cleanly instead of meeting the OOM killer: the plan must fit in the available
         // memory, and plan plus the caller's arrays in the machine. Checked on the estimate
         // before the tables are built (they take minutes at the largest bandwidths), and on
         // the plan's own count before its large buffers are made.
-        let arrays = (n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(16);
-        let estimate = Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total();
+        let arrays =
+            (n_slices * shape.slice_len() + shape.num_coeffs()).saturating_mul(2 * T::BYTES);
+        let estimate = Footprint::new::<T>(shape, &c.pairs, (c.isa, c.threads), options).total();
         if !fits_in_memory(estimate, arrays) {
             return Err(Error::OutOfMemory { bytes: estimate });
         }
@@ -91,8 +96,8 @@ impl PartialPlan {
     /// workspace depends on the memory available at the time of the call (at most half of
     /// it is used), so a plan made later may differ if that has changed.
     pub fn memory_needed(shape: &Shape, options: &Options) -> Result<usize> {
-        let c = PartialPlan::validate(shape, options)?;
-        Ok(Footprint::new(shape, &c.pairs, (c.isa, c.threads), options).total())
+        let c = Self::validate(shape, options)?;
+        Ok(Footprint::new::<T>(shape, &c.pairs, (c.isa, c.threads), options).total())
     }
 
     /// The checks of [`PartialPlan::new`].
@@ -116,9 +121,9 @@ impl PartialPlan {
         }
         let threads = crate::workers::thread_count(options.threads)?;
         let isa = Isa::resolve(options.isa)?;
-        let skip = options.skip()?;
+        let skip = options.skip_for::<T>()?;
         options.check_workspace()?;
-        let pairs = LanePairs::new(shape, &options.betas, Some(isa.lanes()))?;
+        let pairs = LanePairs::new(shape, &options.betas, Some(isa.lanes_of::<T>()))?;
         Ok(Checked {
             direction,
             threads,
@@ -192,23 +197,23 @@ impl PartialPlan {
     }
 
     /// Forward: samples to coefficients; the time of each stage.
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.forward_in(one(samples.len(), coeffs.len()), samples, coeffs, None)
     }
 
     /// Inverse: coefficients to samples; the time of each stage.
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes> {
         self.inverse_in(one(coeffs.len(), samples.len()), coeffs, samples, None)
     }
 
     /// Forward of a real signal (`num_samples` doubles): every coefficient block written.
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.forward_real_in(one(samples.len(), coeffs.len()), samples, coeffs, None)
     }
 
     /// Inverse to a real signal: reads only the blocks `M' > 0`, or `M' = 0` and `M >= 0`,
     /// and takes the others as `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+    pub fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes> {
         self.inverse_real_in(one(coeffs.len(), samples.len()), coeffs, samples, None)
     }
 
@@ -222,9 +227,9 @@ impl PartialPlan {
     /// computed (a single transform; the slice index is the watch's first argument).
     pub(crate) fn inverse_watched(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
-        watch: SliceWatch,
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
+        watch: SliceWatch<T>,
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());
         self.check(false, false, b, coeffs.len(), samples.len())?;
@@ -235,9 +240,9 @@ impl PartialPlan {
     /// [`PartialPlan::inverse_real`] with a watch, as [`PartialPlan::inverse_watched`].
     pub(crate) fn inverse_real_watched(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
-        watch: SliceWatch,
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
+        watch: SliceWatch<T>,
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());
         self.check(false, true, b, coeffs.len(), samples.len())?;
@@ -250,8 +255,8 @@ impl PartialPlan {
     /// the C API with `SO3FFT_REAL` and the SOFT layer).
     pub(crate) fn inverse_real_to_complex(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());
         self.check(false, true, b, coeffs.len(), samples.len())?;
@@ -263,8 +268,8 @@ impl PartialPlan {
     /// read): the real path for callers whose real data sit in a complex array.
     pub(crate) fn forward_real_parts(
         &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         let b = one(samples.len(), coeffs.len());
         self.check(true, true, b, samples.len(), coeffs.len())?;
@@ -276,9 +281,9 @@ impl PartialPlan {
     fn run_inverse(
         &self,
         batch: Batch,
-        coeffs: &[Complex64],
-        out: Data,
-        extras: (Option<&Scratch>, Option<SliceWatch>),
+        coeffs: &[Complex<T>],
+        out: Data<T>,
+        extras: (Option<&Scratch>, Option<SliceWatch<T>>),
     ) -> Result<StageTimes> {
         self.engine
             .inverse(batch, SendConstPtr(coeffs.as_ptr()), out, extras)
@@ -288,8 +293,8 @@ impl PartialPlan {
     fn run_forward(
         &self,
         batch: Batch,
-        inp: Data,
-        coeffs: &mut [Complex64],
+        inp: Data<T>,
+        coeffs: &mut [Complex<T>],
         scratch: Option<&Scratch>,
     ) -> Result<StageTimes> {
         self.engine
@@ -300,8 +305,8 @@ impl PartialPlan {
     pub fn forward_many(
         &self,
         batch: Batch,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         self.forward_in(batch, samples, coeffs, None)
     }
@@ -310,8 +315,8 @@ impl PartialPlan {
     pub fn inverse_many(
         &self,
         batch: Batch,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         self.inverse_in(batch, coeffs, samples, None)
     }
@@ -320,8 +325,8 @@ impl PartialPlan {
     pub fn forward_real_many(
         &self,
         batch: Batch,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         self.forward_real_in(batch, samples, coeffs, None)
     }
@@ -330,8 +335,8 @@ impl PartialPlan {
     pub fn inverse_real_many(
         &self,
         batch: Batch,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
     ) -> Result<StageTimes> {
         self.inverse_real_in(batch, coeffs, samples, None)
     }
@@ -340,8 +345,8 @@ impl PartialPlan {
     fn forward_in(
         &self,
         batch: Batch,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(true, false, batch, samples.len(), coeffs.len())?;
@@ -354,8 +359,8 @@ impl PartialPlan {
     fn inverse_in(
         &self,
         batch: Batch,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(false, false, batch, coeffs.len(), samples.len())?;
@@ -368,8 +373,8 @@ impl PartialPlan {
     fn forward_real_in(
         &self,
         batch: Batch,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(true, true, batch, samples.len(), coeffs.len())?;
@@ -383,8 +388,8 @@ impl PartialPlan {
     fn inverse_real_in(
         &self,
         batch: Batch,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
         scratch: Option<&mut Scratch>,
     ) -> Result<StageTimes> {
         self.check(false, true, batch, coeffs.len(), samples.len())?;
@@ -468,39 +473,39 @@ fn one(inp: usize, out: usize) -> Batch {
     }
 }
 
-impl Transform for PartialPlan {
+impl<T: Real> Transform<T> for PartialPlan<T> {
     fn num_samples(&self) -> usize {
-        PartialPlan::num_samples(self)
+        PartialPlan::<T>::num_samples(self)
     }
 
     fn num_coeffs(&self) -> usize {
-        PartialPlan::num_coeffs(self)
+        PartialPlan::<T>::num_coeffs(self)
     }
 
     fn scratch_bytes(&self) -> usize {
-        PartialPlan::scratch_bytes(self)
+        PartialPlan::<T>::scratch_bytes(self)
     }
 
-    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        PartialPlan::forward(self, samples, coeffs)
+    fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
+        PartialPlan::<T>::forward(self, samples, coeffs)
     }
 
-    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
-        PartialPlan::inverse(self, coeffs, samples)
+    fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes> {
+        PartialPlan::<T>::inverse(self, coeffs, samples)
     }
 
-    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        PartialPlan::forward_real(self, samples, coeffs)
+    fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
+        PartialPlan::<T>::forward_real(self, samples, coeffs)
     }
 
-    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
-        PartialPlan::inverse_real(self, coeffs, samples)
+    fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes> {
+        PartialPlan::<T>::inverse_real(self, coeffs, samples)
     }
 
     fn forward_with_scratch(
         &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         let b = one(samples.len(), coeffs.len());
@@ -509,8 +514,8 @@ impl Transform for PartialPlan {
 
     fn inverse_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());
@@ -519,8 +524,8 @@ impl Transform for PartialPlan {
 
     fn forward_real_with_scratch(
         &self,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         let b = one(samples.len(), coeffs.len());
@@ -529,8 +534,8 @@ impl Transform for PartialPlan {
 
     fn inverse_real_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         let b = one(coeffs.len(), samples.len());

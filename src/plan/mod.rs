@@ -15,7 +15,8 @@ use crate::shape::Shape;
 use crate::simd::Isa;
 use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 
 /// A precomputed SO(3) FFT of one bandwidth: Wigner starting-value tables, cluster
 /// schedule, FFTW plans, worker pool and chunk buffer.
@@ -23,15 +24,19 @@ use num_complex::Complex64;
 /// Execution methods take `&self`; a plan may be executed from several threads at once
 /// on different arrays (a concurrent call that finds the chunk buffer busy allocates its
 /// own; the `*_with_scratch` calls of [`Transform`](crate::Transform) never do).
-pub struct Plan {
+///
+/// `T` is the precision of the arrays and of the computation: `f64`, or `f32`
+/// (`Plan::<f32>::new`) for about half the time and memory at a relative error near
+/// `1e-6` (see `docs/precision.md`).
+pub struct Plan<T: Real = f64> {
     /// The engine's full shape of `B`.
-    engine: PartialPlan,
+    engine: PartialPlan<T>,
 }
 
-impl Plan {
+impl<T: Real> Plan<T> {
     /// Make a plan for bandwidth `bandwidth` (1 ..= [`MAX_BANDWIDTH`]).
-    pub fn new(bandwidth: usize, options: &Options) -> Result<Plan> {
-        Plan::new_on(bandwidth, options, None)
+    pub fn new(bandwidth: usize, options: &Options) -> Result<Plan<T>> {
+        Self::new_on(bandwidth, options, None)
     }
 
     /// [`Plan::new`] on the workers of `shared` if given (with the plan's thread count).
@@ -39,10 +44,10 @@ impl Plan {
         bandwidth: usize,
         options: &Options,
         shared: Option<&WorkerPool>,
-    ) -> Result<Plan> {
-        let shape = Plan::shape(bandwidth)?;
+    ) -> Result<Plan<T>> {
+        let shape = Self::shape(bandwidth)?;
         Ok(Plan {
-            engine: PartialPlan::new_on(&shape, &Plan::engine_options(options), shared)?,
+            engine: PartialPlan::new_on(&shape, &Self::engine_options(options), shared)?,
         })
     }
 
@@ -71,8 +76,8 @@ impl Plan {
     /// default workspace depends on the memory available at the time of the call (at most
     /// half of it is used), so a plan made later may differ if that has changed.
     pub fn memory_needed(bandwidth: usize, options: &Options) -> Result<usize> {
-        let shape = Plan::shape(bandwidth)?;
-        PartialPlan::memory_needed(&shape, &Plan::engine_options(options))
+        let shape = Self::shape(bandwidth)?;
+        PartialPlan::<T>::memory_needed(&shape, &Self::engine_options(options))
     }
 
     /// Runs `f` on the plan's worker threads (rayon's parallel iterators inside it use
@@ -148,20 +153,20 @@ impl Plan {
     /// Forward transform: samples (`(2B)^3`, the sample layout of docs/conventions.md) to
     /// coefficients (`(4B^3-B)/3`); the time of each stage. As
     /// [`Transform::forward`](crate::Transform::forward).
-    pub fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.engine.forward(samples, coeffs)
     }
 
     /// Inverse transform: coefficients to samples; the time of each stage. As
     /// [`Transform::inverse`](crate::Transform::inverse).
-    pub fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes> {
         self.engine.inverse(coeffs, samples)
     }
 
     /// Forward transform of a real signal: `(2B)^3` real samples to all `(4B^3-B)/3`
     /// coefficients, which satisfy the real symmetry. About half the work of
     /// [`Plan::forward`]. Needs a plan made with [`Options::real`].
-    pub fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
+    pub fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
         self.engine.forward_real(samples, coeffs)
     }
 
@@ -169,7 +174,7 @@ impl Plan {
     /// `M' = 0` and `M >= 0`, and takes the others as
     /// `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`. Needs a plan made with
     /// [`Options::real`].
-    pub fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
+    pub fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes> {
         self.engine.inverse_real(coeffs, samples)
     }
 
@@ -179,8 +184,8 @@ impl Plan {
     /// [`Plan::forward`].
     pub fn forward_destroying_input(
         &self,
-        samples: &mut [Complex64],
-        coeffs: &mut [Complex64],
+        samples: &mut [Complex<T>],
+        coeffs: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         self.engine.forward(samples, coeffs)
     }
@@ -189,15 +194,15 @@ impl Plan {
     /// [`Plan::forward_destroying_input`].
     pub fn forward_real_destroying_input(
         &self,
-        samples: &mut [f64],
-        coeffs: &mut [Complex64],
+        samples: &mut [T],
+        coeffs: &mut [Complex<T>],
     ) -> Result<StageTimes> {
         self.engine.forward_real(samples, coeffs)
     }
 
     /// The engine's plan of the full shape, for the crate's calls beyond the public ones
     /// (watched inverses, real data in complex arrays).
-    pub(crate) fn engine(&self) -> &PartialPlan {
+    pub(crate) fn engine(&self) -> &PartialPlan<T> {
         &self.engine
     }
 }

@@ -77,7 +77,7 @@ fn plans_share_a_pool() {
         threads: 3,
         ..Default::default()
     };
-    assert!(super::Plan::new_on(6, &three, Some(&pool)).is_err());
+    assert!(super::Plan::<f64>::new_on(6, &three, Some(&pool)).is_err());
     let own = super::Plan::new(6, &options).unwrap();
     let coeffs: Vec<Complex64> = (0..own.num_coeffs())
         .map(|i| Complex64::new((i as f64 * 0.7).sin(), (i as f64 * 1.3).cos()))

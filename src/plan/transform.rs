@@ -3,15 +3,16 @@
 use super::Plan;
 use crate::error::Result;
 use crate::transform::{Scratch, StageTimes, Transform};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 
-impl Transform for Plan {
+impl<T: Real> Transform<T> for Plan<T> {
     fn num_samples(&self) -> usize {
-        Plan::num_samples(self)
+        Plan::<T>::num_samples(self)
     }
 
     fn num_coeffs(&self) -> usize {
-        Plan::num_coeffs(self)
+        Plan::<T>::num_coeffs(self)
     }
 
     /// The chunk buffer ([`Plan::workspace_bytes`]).
@@ -19,26 +20,26 @@ impl Transform for Plan {
         self.workspace_bytes()
     }
 
-    fn forward(&self, samples: &[Complex64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        Plan::forward(self, samples, coeffs)
+    fn forward(&self, samples: &[Complex<T>], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
+        Plan::<T>::forward(self, samples, coeffs)
     }
 
-    fn inverse(&self, coeffs: &[Complex64], samples: &mut [Complex64]) -> Result<StageTimes> {
-        Plan::inverse(self, coeffs, samples)
+    fn inverse(&self, coeffs: &[Complex<T>], samples: &mut [Complex<T>]) -> Result<StageTimes> {
+        Plan::<T>::inverse(self, coeffs, samples)
     }
 
-    fn forward_real(&self, samples: &[f64], coeffs: &mut [Complex64]) -> Result<StageTimes> {
-        Plan::forward_real(self, samples, coeffs)
+    fn forward_real(&self, samples: &[T], coeffs: &mut [Complex<T>]) -> Result<StageTimes> {
+        Plan::<T>::forward_real(self, samples, coeffs)
     }
 
-    fn inverse_real(&self, coeffs: &[Complex64], samples: &mut [f64]) -> Result<StageTimes> {
-        Plan::inverse_real(self, coeffs, samples)
+    fn inverse_real(&self, coeffs: &[Complex<T>], samples: &mut [T]) -> Result<StageTimes> {
+        Plan::<T>::inverse_real(self, coeffs, samples)
     }
 
     fn forward_with_scratch(
         &self,
-        samples: &[Complex64],
-        coeffs: &mut [Complex64],
+        samples: &[Complex<T>],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         self.engine().forward_with_scratch(samples, coeffs, scratch)
@@ -46,8 +47,8 @@ impl Transform for Plan {
 
     fn inverse_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [Complex64],
+        coeffs: &[Complex<T>],
+        samples: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         self.engine().inverse_with_scratch(coeffs, samples, scratch)
@@ -55,8 +56,8 @@ impl Transform for Plan {
 
     fn forward_real_with_scratch(
         &self,
-        samples: &[f64],
-        coeffs: &mut [Complex64],
+        samples: &[T],
+        coeffs: &mut [Complex<T>],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         self.engine()
@@ -65,8 +66,8 @@ impl Transform for Plan {
 
     fn inverse_real_with_scratch(
         &self,
-        coeffs: &[Complex64],
-        samples: &mut [f64],
+        coeffs: &[Complex<T>],
+        samples: &mut [T],
         scratch: &mut Scratch,
     ) -> Result<StageTimes> {
         self.engine()

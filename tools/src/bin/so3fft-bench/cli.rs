@@ -61,6 +61,10 @@ pub enum ToolCommand {
     /// the peak, round-trip errors; B up to 4096 allowed.
     #[command(long_flag = "s2")]
     S2,
+    /// The SO(3) transforms in single against double precision: complex and real, inverse
+    /// and forward, calls alternating run by run; medians, time ratios, round-trip errors and
+    /// plan memory; defaults --bandwidths 64,128,256 --threads 2.
+    Precision,
     /// Rotational matching: a rotated random function recovered; pipeline medians (complex,
     /// real), one refinement and ten peaks refined together, grid and refined angle errors;
     /// the pipeline against its floor (FFTW alone on the grid's slices + the DWT at its
@@ -178,6 +182,8 @@ pub enum Tool {
     Real,
     /// The S^2 (spherical-harmonic) transforms (`s2.rs`).
     S2,
+    /// SO(3) transforms in f32 against f64 (`precision.rs`).
+    Precision,
     /// Rotational matching (`matching.rs`).
     Match,
     /// Partial plans (`partial.rs`).
@@ -350,6 +356,7 @@ impl From<ToolCommand> for Tool {
             ToolCommand::Scaling => Tool::Scaling,
             ToolCommand::Real => Tool::Real,
             ToolCommand::S2 => Tool::S2,
+            ToolCommand::Precision => Tool::Precision,
             ToolCommand::Match => Tool::Match,
             ToolCommand::MpiModel => Tool::MpiModel,
             ToolCommand::Partial => Tool::Partial,
@@ -392,6 +399,7 @@ fn apply_tool_defaults(opts: &mut Options, bandwidths_given: bool, threads_given
         Tool::Scaling => (vec![64, 128, 256], vec![1, 2], Some(5)),
         Tool::Real => (vec![64, 128, 256], vec![1, 2], None),
         Tool::S2 => (vec![128, 256, 512, 1024], vec![1, 2], None),
+        Tool::Precision => (vec![64, 128, 256], vec![2], None),
         Tool::Match => (vec![16, 32, 64, 128], vec![2], None),
         Tool::Partial => (vec![256], vec![2], None),
         Tool::MpiModel => (vec![128], vec![1], None),

@@ -29,6 +29,7 @@ mod naive;
 mod partial;
 mod peak;
 mod plot;
+mod precision;
 mod regular;
 mod report;
 mod s2;
@@ -71,6 +72,7 @@ fn run_tool(opts: &Options) -> ExitCode {
         Tool::Scaling => report_failure("scaling", scaling::run(opts)),
         Tool::Real => report_failure("real", run_real(opts)),
         Tool::S2 => report_failure("s2", s2::run(opts)),
+        Tool::Precision => report_failure("precision", precision::run(opts)),
         Tool::Match => report_failure("match", matching::run(opts)),
         Tool::Partial => report_failure("partial", partial::run(opts)),
         Tool::MpiModel => report_failure("mpi-model", mpi_model::run(opts)),
