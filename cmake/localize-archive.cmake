@@ -1,5 +1,6 @@
-# Turns cargo's libso3fft.a into one relocatable object whose only global symbols are so3fft_*,
-# and the archives built on it (cmake -P; run by the so3fft_cargo target):
+# Turns cargo's libso3fft.a into one relocatable object whose only global symbols are so3fft_*
+# and so3fftf_* (the single-precision API), and the archives built on it (cmake -P; run by the
+# so3fft_cargo target):
 #
 #   cmake -DIN=<cargo's libso3fft.a> -DOBJECT=<so3fft.o> -DARCHIVE=<libso3fft.a>
 #         -DLINKER=ld -DOBJCOPY=objcopy -DAR=ar -P localize-archive.cmake
@@ -34,7 +35,7 @@ endfunction()
 
 set(_all "${OBJECT}.all.o")
 _run("${LINKER}" -r --whole-archive "${IN}" -o "${_all}")
-_run("${OBJCOPY}" --wildcard "--keep-global-symbol=so3fft_*"
+_run("${OBJCOPY}" --wildcard "--keep-global-symbol=so3fft_*" "--keep-global-symbol=so3fftf_*"
      --remove-section=.llvmbc --remove-section=.llvmcmd "${_all}" "${OBJECT}")
 file(REMOVE "${_all}" "${ARCHIVE}")
 _run("${AR}" rcs "${ARCHIVE}" "${OBJECT}")

@@ -13,8 +13,11 @@
  * Layouts are SOFT 2.0's: (2B)^3 samples f(alpha_j1, beta_k, gamma_j2) at k*(2B)^2 + j1*(2B) + j2;
  * (4B^3-B)/3 coefficients in so3CoefLoc order. Errors: NULL / negative SO3FFT_E* code plus a
  * thread-local error state. so3fft serialises its FFTW planner calls, calls
- * fftw_make_planner_thread_safe() once; a host's fftw_plan_with_nthreads() setting above 1
- * is set to 1 during so3fft's own planner calls and restored.
+ * fftw_make_planner_thread_safe() and fftwf_make_planner_thread_safe() once; a host's
+ * fftw_plan_with_nthreads() setting above 1 is set to 1 during so3fft's own planner calls and
+ * restored.
+ * Single precision (last section): so3fftf_* on float data (so3fftf_complex = float[2]); sizes,
+ * indices, planner settings and the error state are shared with the double API.
  * Full reference: docs/c-api.md (conventions: docs/conventions.md).
  */
 
@@ -112,6 +115,10 @@ typedef struct so3fft_plan_s so3fft_plan_s;
 // Opaque S^2 plan object (made by `so3fft_plan_s2`, released by `so3fft_destroy_s2_plan`).
 typedef struct so3fft_s2_plan_s so3fft_s2_plan_s;
 
+// Opaque single-precision S^2 plan object (made by `so3fftf_plan_s2`, released by
+// `so3fftf_destroy_s2_plan`).
+typedef struct so3fftf_s2_plan_s so3fftf_s2_plan_s;
+
 // A plan: a pointer to an opaque object (like `fftw_plan`).
 typedef struct so3fft_plan_s *so3fft_plan;
 
@@ -163,6 +170,12 @@ typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
 
 // A correlation plan: a pointer to an opaque object.
 typedef struct so3fft_correlation_s *so3fft_correlation;
+
+// A single-precision S^2 plan: a pointer to an opaque object.
+typedef struct so3fftf_s2_plan_s *so3fftf_s2_plan;
+
+// One single-precision complex number `{re, im}`, identical to `fftwf_complex` (`float[2]`).
+typedef float so3fftf_complex[2];
 
 #ifdef __cplusplus
 extern "C" {
@@ -473,6 +486,63 @@ const char *so3fft_last_error(void);
 
 // Static description of an error code.
 const char *so3fft_strerror(int code);
+
+// Single precision (`so3fftf_`, `float` data): as `so3fft_plan_s2`. The ring DFTs use
+// single-precision FFTW (libfftw3f); the lowest orders run in double. NULL on error.
+so3fftf_s2_plan so3fftf_plan_s2(int B, unsigned int flags, int nthreads);
+
+// As `so3fft_plan_s2_limited`, in single precision.
+so3fftf_s2_plan so3fftf_plan_s2_limited(int B, int L, int Mmax, unsigned int flags, int nthreads);
+
+// As `so3fft_destroy_s2_plan`; NULL is a no-op.
+void so3fftf_destroy_s2_plan(so3fftf_s2_plan p);
+
+// The bandwidth of a single-precision S^2 plan (`SO3FFT_ENULL` for NULL).
+int so3fftf_s2_get_bandwidth(so3fftf_s2_plan p);
+
+// As `so3fft_s2_execute_forward`: `(2B)^2` complex samples to `B^2` coefficients.
+int so3fftf_s2_execute_forward(so3fftf_s2_plan p, so3fftf_complex *samples, so3fftf_complex *coeffs);
+
+// As `so3fft_s2_execute_inverse`: `B^2` coefficients to `(2B)^2` complex samples.
+int so3fftf_s2_execute_inverse(so3fftf_s2_plan p, so3fftf_complex *coeffs, so3fftf_complex *samples);
+
+// As `so3fft_s2_execute_forward_real`: `(2B)^2` real samples to all `B^2` coefficients.
+int so3fftf_s2_execute_forward_real(so3fftf_s2_plan p, const float *samples, so3fftf_complex *coeffs);
+
+// As `so3fft_s2_execute_inverse_real`: coefficients (orders `m >= 0` read) to `(2B)^2`
+// real samples.
+int so3fftf_s2_execute_inverse_real(so3fftf_s2_plan p, so3fftf_complex *coeffs, float *samples);
+
+// As `so3fft_s2_execute_forward_many`: `howmany` fields stored one after another.
+int so3fftf_s2_execute_forward_many(so3fftf_s2_plan p, int howmany, so3fftf_complex *samples, so3fftf_complex *coeffs);
+
+// As `so3fft_s2_execute_inverse_many`.
+int so3fftf_s2_execute_inverse_many(so3fftf_s2_plan p, int howmany, so3fftf_complex *coeffs, so3fftf_complex *samples);
+
+// As `so3fft_s2_execute_forward_real_many` (two fields per kernel pass).
+int so3fftf_s2_execute_forward_real_many(so3fftf_s2_plan p, int howmany, const float *samples, so3fftf_complex *coeffs);
+
+// As `so3fft_s2_execute_inverse_real_many` (two fields per kernel pass).
+int so3fftf_s2_execute_inverse_real_many(so3fftf_s2_plan p, int howmany, so3fftf_complex *coeffs, float *samples);
+
+// Writes single-precision FFTW's wisdom (libfftw3f's store, separate from the double
+// one) to the file `filename`, as `so3fft_export_wisdom_to_filename`.
+int so3fftf_export_wisdom_to_filename(const char *filename);
+
+// Loads single-precision FFTW wisdom from the file `filename` (`SO3FFT_EINVAL` also for
+// double-precision wisdom).
+int so3fftf_import_wisdom_from_filename(const char *filename);
+
+// Single-precision FFTW's wisdom as a NUL-terminated string to be released with `free()`;
+// NULL on error.
+char *so3fftf_export_wisdom_to_string(void);
+
+// Loads single-precision FFTW wisdom from the NUL-terminated string `wisdom`.
+// `SO3FFT_OK` or an error code.
+int so3fftf_import_wisdom_from_string(const char *wisdom);
+
+// Forgets single-precision FFTW's wisdom (plans already made are not affected).
+void so3fftf_forget_wisdom(void);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -19,9 +19,10 @@
 //!   thread writes an input or accesses an output during the call;
 //! - the arrays given to a planner stay valid as long as `so3fft_execute` is used on the plan.
 //!
-//! The library checks what it can: NULL, alignment like `double`, overlap of input and
-//! output, and that an array's extent fits in the address space. The extent itself cannot
-//! be checked and rests on the caller, as with FFTW.
+//! The library checks what it can: NULL, alignment like the element type (`double`, or
+//! `float` for the single-precision `so3fftf_*` functions), overlap of input and output, and
+//! that an array's extent fits in the address space. The extent itself cannot be checked and
+//! rests on the caller, as with FFTW.
 
 // Names follow C conventions (so3fft_plan, B); the safety contract is stated once above
 // rather than in a "# Safety" section per function (those sections would fill the header).
@@ -49,6 +50,8 @@ mod matching;
 mod wisdom;
 // Version and errors.
 mod errors;
+// Single precision (so3fftf_*): last, so that its section follows the double API.
+mod single;
 
 use crate::ffi::last_error::LastErrorSink;
 use crate::ffi::{boundary, CallError, ErrorKind};

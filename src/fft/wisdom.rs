@@ -93,7 +93,7 @@ pub mod f32 {
 }
 
 /// All of `T`'s FFTW wisdom, in FFTW's text format.
-fn export_string<T: FftwApi>() -> Result<String> {
+pub(crate) fn export_string<T: FftwApi>() -> Result<String> {
     let _lock = planner_lock();
     check_headroom(wisdom_bytes(1 << 20))?;
     // SAFETY: under the planner lock; FFTW returns a NUL-terminated string from malloc, or
@@ -112,7 +112,7 @@ fn export_string<T: FftwApi>() -> Result<String> {
 }
 
 /// Loads `wisdom` into `T`'s FFTW.
-fn import_string<T: FftwApi>(wisdom: &str) -> Result<()> {
+pub(crate) fn import_string<T: FftwApi>(wisdom: &str) -> Result<()> {
     let text = CString::new(wisdom)
         .map_err(|_| Error::InvalidArgument("wisdom contains a NUL byte".into()))?;
     let _lock = planner_lock();
@@ -127,7 +127,7 @@ fn import_string<T: FftwApi>(wisdom: &str) -> Result<()> {
 }
 
 /// Writes `T`'s FFTW wisdom to the file `path`, through a temporary file and a rename.
-fn export_file<T: FftwApi>(path: &Path) -> Result<()> {
+pub(crate) fn export_file<T: FftwApi>(path: &Path) -> Result<()> {
     let text = export_string::<T>()?;
     let io = |e: std::io::Error| {
         Error::InvalidArgument(format!("cannot write wisdom to {}: {e}", path.display()))
@@ -142,7 +142,7 @@ fn export_file<T: FftwApi>(path: &Path) -> Result<()> {
 }
 
 /// Loads the wisdom in the file `path` into `T`'s FFTW.
-fn import_file<T: FftwApi>(path: &Path) -> Result<()> {
+pub(crate) fn import_file<T: FftwApi>(path: &Path) -> Result<()> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         Error::InvalidArgument(format!("cannot read wisdom from {}: {e}", path.display()))
     })?;
@@ -153,7 +153,7 @@ fn import_file<T: FftwApi>(path: &Path) -> Result<()> {
 }
 
 /// Forgets all of `T`'s FFTW wisdom.
-fn forget_all<T: FftwApi>() {
+pub(crate) fn forget_all<T: FftwApi>() {
     let _lock = planner_lock();
     // SAFETY: under the planner lock; takes no arguments.
     unsafe { T::forget_wisdom() };
