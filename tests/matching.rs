@@ -130,9 +130,9 @@ fn bad_arguments_are_errors() {
             .with_b_out(b_out)
             .with_deg_lim(deg_lim)
     };
-    assert!(Correlation::new(0, &opts(None, None)).is_err());
-    assert!(Correlation::new(8, &opts(Some(4), Some(4))).is_err());
-    assert!(Correlation::new(8, &opts(None, Some(8))).is_err());
+    assert!(Correlation::<f64>::new(0, &opts(None, None)).is_err());
+    assert!(Correlation::<f64>::new(8, &opts(Some(4), Some(4))).is_err());
+    assert!(Correlation::<f64>::new(8, &opts(None, Some(8))).is_err());
     let plan = Correlation::new(4, &opts(None, None)).unwrap();
     let s = vec![Complex64::default(); 64];
     let mut out = vec![Complex64::default(); plan.num_grid()];

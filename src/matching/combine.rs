@@ -4,7 +4,8 @@ use crate::error::{Error, Result};
 use crate::grid::{block_start, num_coeffs};
 use crate::s2::order_start;
 use crate::workers::SendPtr;
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::{Complex, Complex64};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -210,15 +211,18 @@ pub(super) enum Combine {
 /// the caller with [`check`]), or writes it (`mode`); with `half`, only the order pairs a
 /// real-signal inverse reads (`M' > 0`, or `M' = 0` and `M >= 0`; the others are left as
 /// they are). For each order pair the degrees are consecutive in all three arrays, so the
-/// inner loop runs over contiguous runs.
-pub(super) fn add_combined(
-    (sig, pat): (&[Complex64], &[Complex64]),
+/// inner loop runs over contiguous runs. In `f32` the products are formed in `f64` and each
+/// result rounded once.
+pub(super) fn add_combined<T: Real>(
+    (sig, pat): (&[Complex<T>], &[Complex<T>]),
     b_in: usize,
     (from, to): (usize, usize),
     b_out: usize,
-    (scale, out): (f64, &mut [Complex64]),
+    (scale, out): (f64, &mut [Complex<T>]),
     (half, mode): (bool, Combine),
 ) {
+    let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
+    let narrow = |z: Complex64| Complex::new(T::from_f64(z.re), T::from_f64(z.im));
     if from > to && mode == Combine::Add {
         return;
     }
@@ -250,23 +254,24 @@ pub(super) fn add_combined(
             };
             let base = block_start(b_out, m1, m2) - first;
             assert!(base + to < len);
-            let value = |l: usize| f_row[l - a1] * h_row[l - a2].conj() * (sign * norms[l]);
+            let value =
+                |l: usize| wide(f_row[l - a1]) * wide(h_row[l - a2]).conj() * (sign * norms[l]);
             // Entry `base + l`, `l <= to`, is inside `out` (asserted above) and in the block
             // of `(m1, m2)`, which is this row's alone: no other task touches it.
             let at = |l: usize| dst.get().wrapping_add(base + l);
             if mode == Combine::Assign {
                 for l in first..l0.min(to + 1) {
                     // SAFETY: `at` above.
-                    unsafe { *at(l) = Complex64::default() };
+                    unsafe { *at(l) = Complex::new(T::ZERO, T::ZERO) };
                 }
                 for l in l0..=to {
                     // SAFETY: `at` above.
-                    unsafe { *at(l) = value(l) };
+                    unsafe { *at(l) = narrow(value(l)) };
                 }
             } else {
                 for l in l0..=to {
                     // SAFETY: `at` above.
-                    unsafe { *at(l) += value(l) };
+                    unsafe { *at(l) = narrow(wide(*at(l)) + value(l)) };
                 }
             }
         }

@@ -14,7 +14,9 @@ use crate::s2::{S2Limits, S2Plan};
 use crate::shape::Shape;
 use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::{Complex, Complex64};
+use std::any::Any;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// What a [`Correlation`] computes, and the [`Options`] of its plans. Made with
@@ -78,37 +80,69 @@ impl CorrelationOptions {
     }
 }
 
-/// Coefficient arrays of one correlation (signal, pattern, SO(3)).
-struct Buffers {
-    sig: Vec<Complex64>,
-    pat: Vec<Complex64>,
+/// Coefficient arrays of one correlation (signal, pattern, SO(3)) in `C`.
+struct Buffers<C> {
+    sig: Vec<Complex<C>>,
+    pat: Vec<Complex<C>>,
     /// The combined coefficients in the layout of bandwidth `deg_lim + 1`: the inverse
     /// plan's input (all higher degrees are zero).
-    so3: Vec<Complex64>,
+    so3: Vec<Complex<C>>,
 }
+
+impl<C: Real> Buffers<C> {
+    /// Zeroed buffers for inputs of bandwidth `b_in` combined up to `deg_lim`.
+    fn new(b_in: usize, deg_lim: usize) -> Result<Buffers<C>> {
+        let vec = |n: usize| -> Result<Vec<Complex<C>>> {
+            let mut v = Vec::new();
+            v.try_reserve_exact(n).map_err(|_| Error::OutOfMemory {
+                bytes: 2 * C::BYTES * n,
+            })?;
+            v.resize(n, Complex::new(C::ZERO, C::ZERO));
+            Ok(v)
+        };
+        Ok(Buffers {
+            sig: vec(b_in * b_in)?,
+            pat: vec(b_in * b_in)?,
+            so3: vec(num_coeffs(deg_lim + 1))?,
+        })
+    }
+}
+
+/// The S^2 forward of one kind of samples into coefficients of `C`.
+type S2Forward<'a, X, C> = &'a (dyn Fn(&[X], &mut [Complex<C>]) -> Result<StageTimes> + Sync);
 
 /// The correlation `C(g) = int_{S^2} f(x) conj(h(g^-1 x)) dx` of a signal `f` and a pattern
 /// `h` of bandwidth `b_in` (samples on SOFT's S^2 grid), for every rotation `g` of the SO(3)
 /// grid of bandwidth `b_out`, stored like the SO(3) samples (beta slowest, gamma fastest;
 /// see `docs/conventions.md`). `C` is largest where the signal is the pattern rotated by
 /// `g = Rz(alpha) Ry(beta) Rz(gamma)`: `f(x) = h(g^-1 x)`.
-pub struct Correlation {
+///
+/// `T` is the precision of the samples, the grid and the transforms: `f64`, or `f32` for
+/// about half the time and memory. The SO(3) coefficients for refinement
+/// ([`Correlation::coefficients`]) are always computed in `f64` from the samples (exactly
+/// widened), so a refined rotation is the same in both precisions.
+pub struct Correlation<T: Real = f64> {
     b_in: usize,
     b_out: usize,
     deg_lim: usize,
     real: bool,
     normalized: bool,
-    s2: S2Plan,
+    s2: S2Plan<T>,
     /// The inverse onto the grid: degrees `l <= deg_lim` (bandwidth `deg_lim + 1`).
-    so3: PartialPlan,
-    buffers: Mutex<Option<Buffers>>,
+    so3: PartialPlan<T>,
+    buffers: Mutex<Option<Buffers<T>>>,
     /// Tables of [`So3Series`](super::So3Series) for refinement, built on first use.
     series: OnceLock<Arc<SeriesTables>>,
+    /// An `f64` S^2 plan for the coefficients of an `f32` correlation, made on first use.
+    s2_wide: OnceLock<S2Plan<f64>>,
+    /// The options the plans were made with (for `s2_wide`).
+    plans: Options,
+    workers: WorkerPool,
 }
 
-impl Correlation {
+impl<T: Real> Correlation<T> {
     /// A correlation plan for inputs of bandwidth `b_in`.
-    pub fn new(b_in: usize, options: &CorrelationOptions) -> Result<Correlation> {
+    pub fn new(b_in: usize, options: &CorrelationOptions) -> Result<Correlation<T>> {
         let b_out = options.b_out.unwrap_or(b_in);
         let deg_lim = options.deg_lim.unwrap_or(b_in.min(b_out).saturating_sub(1));
         if b_in == 0 || b_out == 0 || deg_lim >= b_in.min(b_out) {
@@ -124,11 +158,7 @@ impl Correlation {
         let workers = WorkerPool::process(threads)?;
         let s2 = S2Plan::new_on(
             b_in,
-            // Only the combined degrees are needed.
-            S2Limits {
-                degree_limit: Some(deg_lim + 1),
-                order_limit: None,
-            },
+            Self::s2_limits(deg_lim),
             &options.plans,
             Some(&workers),
         )?;
@@ -154,7 +184,35 @@ impl Correlation {
             so3,
             buffers: Mutex::new(None),
             series: OnceLock::new(),
+            s2_wide: OnceLock::new(),
+            plans: options.plans.clone(),
+            workers,
         })
+    }
+
+    /// The S^2 plans' limits: only the combined degrees are needed.
+    fn s2_limits(deg_lim: usize) -> S2Limits {
+        S2Limits {
+            degree_limit: Some(deg_lim + 1),
+            order_limit: None,
+        }
+    }
+
+    /// The plan's S^2 plan in `f64`: its own for `T = f64`, else one made on first use.
+    fn s2_f64(&self) -> Result<&S2Plan<f64>> {
+        if let Some(own) = (&self.s2 as &dyn Any).downcast_ref::<S2Plan<f64>>() {
+            return Ok(own);
+        }
+        if let Some(p) = self.s2_wide.get() {
+            return Ok(p);
+        }
+        let made = S2Plan::new_on(
+            self.b_in,
+            Self::s2_limits(self.deg_lim),
+            &self.plans,
+            Some(&self.workers),
+        )?;
+        Ok(self.s2_wide.get_or_init(|| made))
     }
 
     /// Input bandwidth.
@@ -174,27 +232,16 @@ impl Correlation {
 
     /// Runs `f` with the plan's coefficient buffers (new ones when they are in use), on
     /// the plans' worker threads.
-    fn with_buffers<R: Send>(&self, f: impl FnOnce(&mut Buffers) -> Result<R> + Send) -> Result<R> {
+    fn with_buffers<R: Send>(
+        &self,
+        f: impl FnOnce(&mut Buffers<T>) -> Result<R> + Send,
+    ) -> Result<R> {
         self.s2.install(|| self.with_buffers_here(f))
     }
 
     /// [`Correlation::with_buffers`] on the calling thread.
-    fn with_buffers_here<R>(&self, f: impl FnOnce(&mut Buffers) -> Result<R>) -> Result<R> {
-        let fresh = || -> Result<Buffers> {
-            let vec = |n: usize| -> Result<Vec<Complex64>> {
-                let mut v = Vec::new();
-                v.try_reserve_exact(n)
-                    .map_err(|_| Error::OutOfMemory { bytes: 16 * n })?;
-                v.resize(n, Complex64::default());
-                Ok(v)
-            };
-            let n = self.b_in * self.b_in;
-            Ok(Buffers {
-                sig: vec(n)?,
-                pat: vec(n)?,
-                so3: vec(num_coeffs(self.deg_lim + 1))?,
-            })
-        };
+    fn with_buffers_here<R>(&self, f: impl FnOnce(&mut Buffers<T>) -> Result<R>) -> Result<R> {
+        let fresh = || Buffers::new(self.b_in, self.deg_lim);
         match self.buffers.try_lock() {
             Ok(mut guard) => {
                 if guard.is_none() {
@@ -210,15 +257,11 @@ impl Correlation {
     /// writes them (`mode`) (with `forward` the S^2 transform of the samples); with
     /// `normalized`, from degree 1 on, and the weighted squared norms of degrees
     /// `1..=deg_lim` added to `norms`.
-    fn add_shell<T>(
+    fn add_shell<X, C: Real>(
         &self,
-        (signal, pattern, weight): (&[T], &[T], f64),
-        (forward, half, mode): (
-            &impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes>,
-            bool,
-            Combine,
-        ),
-        buf: &mut Buffers,
+        (signal, pattern, weight): (&[X], &[X], f64),
+        (forward, half, mode): (S2Forward<X, C>, bool, Combine),
+        buf: &mut Buffers<C>,
         norms: &mut [f64; 2],
     ) -> Result<()> {
         if !weight.is_finite() {
@@ -231,13 +274,14 @@ impl Correlation {
         let from = usize::from(self.normalized);
         if self.normalized {
             for (norm, c) in norms.iter_mut().zip([&buf.sig, &buf.pat]) {
-                let sq: f64 = c.iter().map(|z| z.norm_sqr()).sum::<f64>()
+                let norm_sqr = |z: &Complex<C>| z.re.to_f64().powi(2) + z.im.to_f64().powi(2);
+                let sq: f64 = c.iter().map(norm_sqr).sum::<f64>()
                     - (0..self.b_in)
                         .filter(|&l| l > self.deg_lim || l == 0)
                         .map(|l| {
                             let li = l as isize;
                             (-li..=li)
-                                .map(|m| c[crate::s2::s2_coef_index(self.b_in, l, m)].norm_sqr())
+                                .map(|m| norm_sqr(&c[crate::s2::s2_coef_index(self.b_in, l, m)]))
                                 .sum::<f64>()
                         })
                         .sum::<f64>();
@@ -261,11 +305,11 @@ impl Correlation {
 
     /// The SO(3) coefficients of the weighted sum over `shells` into `buf.so3` (normalised
     /// if the plan says so); with `half`, only those a real-signal inverse reads.
-    fn combine_shells<T>(
+    fn combine_shells<X, C: Real>(
         &self,
-        shells: &[(&[T], &[T], f64)],
-        (forward, half): (impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes>, bool),
-        buf: &mut Buffers,
+        shells: &[(&[X], &[X], f64)],
+        (forward, half): (S2Forward<X, C>, bool),
+        buf: &mut Buffers<C>,
     ) -> Result<()> {
         if shells.is_empty() {
             return Err(Error::InvalidArgument("no shells given".into()));
@@ -278,7 +322,7 @@ impl Correlation {
             } else {
                 Combine::Add
             };
-            self.add_shell(shell, (&forward, half, mode), buf, &mut norms)?;
+            self.add_shell(shell, (forward, half, mode), buf, &mut norms)?;
         }
         if self.normalized {
             let denominator = (norms[0] * norms[1]).sqrt();
@@ -287,36 +331,56 @@ impl Correlation {
             } else {
                 0.0
             };
-            buf.so3.iter_mut().for_each(|c| *c *= scale);
+            let scale = |x: C| C::from_f64(x.to_f64() * scale);
+            buf.so3
+                .iter_mut()
+                .for_each(|c| *c = Complex::new(scale(c.re), scale(c.im)));
         }
         Ok(())
     }
 
     /// The SO(3) coefficients of the correlation of complex samples (`(4 b_out^3 - b_out)/3`
-    /// values, for [`So3Series`](super::So3Series) and peak refinement).
+    /// values, for [`So3Series`](super::So3Series) and peak refinement), in `f64` whatever
+    /// `T` is.
     pub fn coefficients(
         &self,
-        signal: &[Complex64],
-        pattern: &[Complex64],
+        signal: &[Complex<T>],
+        pattern: &[Complex<T>],
         out: &mut [Complex64],
     ) -> Result<()> {
-        self.with_buffers(|buf| {
-            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
-            self.widen(&buf.so3, out)
-        })
+        let s2 = self.s2_f64()?;
+        let wide = |x: &[Complex<T>]| -> Vec<Complex64> {
+            x.iter()
+                .map(|z| Complex64::new(z.re.to_f64(), z.im.to_f64()))
+                .collect()
+        };
+        let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&wide(x), c);
+        self.coefficients_in((signal, pattern), &fwd, out)
     }
 
     /// [`Correlation::coefficients`] of real samples.
     pub fn coefficients_real(
         &self,
-        signal: &[f64],
-        pattern: &[f64],
+        signal: &[T],
+        pattern: &[T],
         out: &mut [Complex64],
     ) -> Result<()> {
-        self.with_buffers(|buf| {
-            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
+        let s2 = self.s2_f64()?;
+        let wide = |x: &[T]| -> Vec<f64> { x.iter().map(|v| v.to_f64()).collect() };
+        let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&wide(x), c);
+        self.coefficients_in((signal, pattern), &fwd, out)
+    }
+
+    /// The body of the `coefficients` functions, with the `f64` S^2 forward `fwd`.
+    fn coefficients_in<X: Sync>(
+        &self,
+        (signal, pattern): (&[X], &[X]),
+        fwd: S2Forward<X, f64>,
+        out: &mut [Complex64],
+    ) -> Result<()> {
+        self.s2.install(|| {
+            let mut buf = Buffers::<f64>::new(self.b_in, self.deg_lim)?;
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), &mut buf)?;
             self.widen(&buf.so3, out)
         })
     }
@@ -402,44 +466,41 @@ impl Correlation {
     /// For a plan made with `real`, use [`Correlation::correlate_real`].
     pub fn correlate(
         &self,
-        signal: &[Complex64],
-        pattern: &[Complex64],
-        out: &mut [Complex64],
+        signal: &[Complex<T>],
+        pattern: &[Complex<T>],
+        out: &mut [Complex<T>],
     ) -> Result<()> {
         self.correlate_shells(&[(signal, pattern, 1.0)], out)
     }
 
     /// The correlation of real samples into the real grid `out` (plan made with `real`).
-    pub fn correlate_real(&self, signal: &[f64], pattern: &[f64], out: &mut [f64]) -> Result<()> {
+    pub fn correlate_real(&self, signal: &[T], pattern: &[T], out: &mut [T]) -> Result<()> {
         self.correlate_shells_real(&[(signal, pattern, 1.0)], out)
     }
 
     /// The weighted sum `sum_s w_s C_s` of the correlations of several shells (pairs of
     /// signal and pattern samples, e.g. the radial shells of two volumes): one pair of S^2
     /// transforms per shell and one inverse SO(3) transform.
+    #[allow(clippy::type_complexity)]
     pub fn correlate_shells(
         &self,
-        shells: &[(&[Complex64], &[Complex64], f64)],
-        out: &mut [Complex64],
+        shells: &[(&[Complex<T>], &[Complex<T>], f64)],
+        out: &mut [Complex<T>],
     ) -> Result<()> {
         self.need(false)?;
         self.with_buffers(|buf| {
-            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-            self.combine_shells(shells, (fwd, false), buf)?;
+            let fwd = |x: &[Complex<T>], c: &mut [Complex<T>]| self.s2.forward(x, c);
+            self.combine_shells(shells, (&fwd, false), buf)?;
             self.so3.inverse(&buf.so3, out).map(|_| ())
         })
     }
 
     /// [`Correlation::correlate_shells`] of real samples.
-    pub fn correlate_shells_real(
-        &self,
-        shells: &[(&[f64], &[f64], f64)],
-        out: &mut [f64],
-    ) -> Result<()> {
+    pub fn correlate_shells_real(&self, shells: &[(&[T], &[T], f64)], out: &mut [T]) -> Result<()> {
         self.need(true)?;
         self.with_buffers(|buf| {
-            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-            self.combine_shells(shells, (fwd, true), buf)?;
+            let fwd = |x: &[T], c: &mut [Complex<T>]| self.s2.forward_real(x, c);
+            self.combine_shells(shells, (&fwd, true), buf)?;
             self.so3.inverse_real(&buf.so3, out).map(|_| ())
         })
     }
@@ -449,16 +510,16 @@ impl Correlation {
     /// grid instead of in a second pass over it.
     pub fn correlate_argmax(
         &self,
-        signal: &[Complex64],
-        pattern: &[Complex64],
-        out: &mut [Complex64],
+        signal: &[Complex<T>],
+        pattern: &[Complex<T>],
+        out: &mut [Complex<T>],
     ) -> Result<Peak> {
         self.need(false)?;
         self.with_buffers(|buf| {
-            let fwd = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
+            let fwd = |x: &[Complex<T>], c: &mut [Complex<T>]| self.s2.forward(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], (&fwd, false), buf)?;
             let seen = SliceArgmax::new(self.b_out);
-            let watch = |k: usize, s: SliceRef| seen.watch(k, s);
+            let watch = |k: usize, s: SliceRef<T>| seen.watch(k, s);
             self.so3.inverse_watched(&buf.so3, out, &watch)?;
             Ok(seen.peak())
         })
@@ -468,16 +529,16 @@ impl Correlation {
     /// ([`grid_argmax_real`](super::grid_argmax_real)), as [`Correlation::correlate_argmax`].
     pub fn correlate_real_argmax(
         &self,
-        signal: &[f64],
-        pattern: &[f64],
-        out: &mut [f64],
+        signal: &[T],
+        pattern: &[T],
+        out: &mut [T],
     ) -> Result<Peak> {
         self.need(true)?;
         self.with_buffers(|buf| {
-            let fwd = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, true), buf)?;
+            let fwd = |x: &[T], c: &mut [Complex<T>]| self.s2.forward_real(x, c);
+            self.combine_shells(&[(signal, pattern, 1.0)], (&fwd, true), buf)?;
             let seen = SliceArgmax::new(self.b_out);
-            let watch = |k: usize, s: SliceRef| seen.watch(k, s);
+            let watch = |k: usize, s: SliceRef<T>| seen.watch(k, s);
             self.so3.inverse_real_watched(&buf.so3, out, &watch)?;
             Ok(seen.peak())
         })
@@ -488,47 +549,42 @@ impl Correlation {
     /// once.
     pub fn correlate_many(
         &self,
-        signal: &[Complex64],
-        patterns: &[Complex64],
-        out: &mut [Complex64],
+        signal: &[Complex<T>],
+        patterns: &[Complex<T>],
+        out: &mut [Complex<T>],
     ) -> Result<()> {
         self.need(false)?;
-        let forward = |x: &[Complex64], c: &mut [Complex64]| self.s2.forward(x, c);
-        let inverse = |c: &[Complex64], g: &mut [Complex64]| self.so3.inverse(c, g);
+        let forward = |x: &[Complex<T>], c: &mut [Complex<T>]| self.s2.forward(x, c);
+        let inverse = |c: &[Complex<T>], g: &mut [Complex<T>]| self.so3.inverse(c, g);
         self.many((signal, patterns, out), (forward, false), inverse)
     }
 
     /// [`Correlation::correlate_many`] of real samples.
-    pub fn correlate_many_real(
-        &self,
-        signal: &[f64],
-        patterns: &[f64],
-        out: &mut [f64],
-    ) -> Result<()> {
+    pub fn correlate_many_real(&self, signal: &[T], patterns: &[T], out: &mut [T]) -> Result<()> {
         self.need(true)?;
-        let forward = |x: &[f64], c: &mut [Complex64]| self.s2.forward_real(x, c);
-        let inverse = |c: &[Complex64], g: &mut [f64]| self.so3.inverse_real(c, g);
+        let forward = |x: &[T], c: &mut [Complex<T>]| self.s2.forward_real(x, c);
+        let inverse = |c: &[Complex<T>], g: &mut [T]| self.so3.inverse_real(c, g);
         self.many((signal, patterns, out), (forward, true), inverse)
     }
 
     /// The body of the `correlate_many` functions, with the S^2 forward and SO(3) inverse
     /// of the plan's kind of samples.
-    fn many<T: Sync, G: Send>(
+    fn many<X: Sync, G: Send>(
         &self,
-        (signal, patterns, out): (&[T], &[T], &mut [G]),
+        (signal, patterns, out): (&[X], &[X], &mut [G]),
         (forward, half): (
-            impl Fn(&[T], &mut [Complex64]) -> Result<StageTimes> + Sync,
+            impl Fn(&[X], &mut [Complex<T>]) -> Result<StageTimes> + Sync,
             bool,
         ),
-        inverse: impl Fn(&[Complex64], &mut [G]) -> Result<StageTimes> + Sync,
+        inverse: impl Fn(&[Complex<T>], &mut [G]) -> Result<StageTimes> + Sync,
     ) -> Result<()> {
         let (ns, ng) = (4 * self.b_in * self.b_in, self.num_grid());
         check_many(patterns.len(), ns, out.len(), ng)?;
         self.with_buffers(|buf| {
-            let mut sig = vec![Complex64::default(); self.b_in * self.b_in];
+            let mut sig = vec![Complex::new(T::ZERO, T::ZERO); self.b_in * self.b_in];
             forward(signal, &mut sig)?;
             // The signal's transform is made once; the patterns' each time.
-            let known = |x: &[T], c: &mut [Complex64]| {
+            let known = |x: &[X], c: &mut [Complex<T>]| {
                 if std::ptr::eq(x, signal) {
                     c.copy_from_slice(&sig);
                     Ok(StageTimes::default())
@@ -537,7 +593,7 @@ impl Correlation {
                 }
             };
             for (pattern, grid) in patterns.chunks_exact(ns).zip(out.chunks_exact_mut(ng)) {
-                self.combine_shells(&[(signal, pattern, 1.0)], (known, half), buf)?;
+                self.combine_shells(&[(signal, pattern, 1.0)], (&known, half), buf)?;
                 inverse(&buf.so3, grid)?;
             }
             Ok(())

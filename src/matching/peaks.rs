@@ -2,7 +2,8 @@
 
 use super::rotation::quaternion_angle;
 use crate::grid::{alpha, beta, gamma};
-use num_complex::Complex64;
+use crate::Real;
+use num_complex::Complex;
 use rayon::prelude::*;
 
 /// A grid point of a correlation: its flat index, Euler angles (z-y-z) and value.
@@ -42,14 +43,29 @@ impl Peak {
 
 /// The largest `|C|^2` of the grid `values` (bandwidth `b`), scanned in flat order from 0
 /// and replaced only by a strictly larger value: ties go to the lowest index, an all-zero
-/// grid gives index 0 (SOFT's `softFFTWCor2` rule). NaN values are never taken.
-pub fn grid_argmax(b: usize, values: &[Complex64]) -> Peak {
-    argmax_by(b, values, |z| z.norm_sqr())
+/// grid gives index 0 (SOFT's `softFFTWCor2` rule). NaN values are never taken. The
+/// magnitudes are computed in `f64`, exactly for an `f32` grid.
+pub fn grid_argmax<T: Real>(b: usize, values: &[Complex<T>]) -> Peak {
+    argmax_by(b, values, norm_sqr)
 }
 
 /// [`grid_argmax`] of a real grid (`|C|^2 = C^2`).
-pub fn grid_argmax_real(b: usize, values: &[f64]) -> Peak {
-    argmax_by(b, values, |x| x * x)
+pub fn grid_argmax_real<T: Real>(b: usize, values: &[T]) -> Peak {
+    argmax_by(b, values, square)
+}
+
+/// `|z|^2` in `f64`.
+#[inline(always)]
+fn norm_sqr<T: Real>(z: Complex<T>) -> f64 {
+    let (re, im) = (z.re.to_f64(), z.im.to_f64());
+    re * re + im * im
+}
+
+/// `x^2` in `f64`.
+#[inline(always)]
+fn square<T: Real>(x: T) -> f64 {
+    let x = x.to_f64();
+    x * x
 }
 
 /// The first largest `f(v)` of `values` (strictly larger replaces; NaN is never taken),
@@ -138,14 +154,12 @@ impl SliceArgmax {
     }
 
     /// Scans beta slice `k` (`|C|^2`: `|z|^2` of complex values, `x^2` of real ones).
-    pub(crate) fn watch(&self, k: usize, slice: crate::engine::SliceRef) {
+    pub(crate) fn watch<T: Real>(&self, k: usize, slice: crate::engine::SliceRef<T>) {
         use crate::engine::SliceRef;
         let n = 2 * self.b;
         let base = k * n * n;
         let found = match slice {
-            SliceRef::Real(v) => {
-                first_largest_in(&v[..n * n], base, &|x: f64| x * x, (0.0, usize::MAX))
-            }
+            SliceRef::Real(v) => first_largest_in(&v[..n * n], base, &square, (0.0, usize::MAX)),
             SliceRef::Complex {
                 values,
                 row,
@@ -153,7 +167,7 @@ impl SliceArgmax {
             } => (0..row).fold((0.0, usize::MAX), |acc, r| {
                 // Rows in flat order, each with the largest value before it.
                 let cells = &values[r * stride..][..row];
-                first_largest_in(cells, base + r * row, &|z: Complex64| z.norm_sqr(), acc)
+                first_largest_in(cells, base + r * row, &norm_sqr, acc)
             }),
         };
         let mut best = self.best.lock().unwrap_or_else(|e| e.into_inner());
@@ -173,16 +187,16 @@ impl SliceArgmax {
 ///
 /// # Panics
 /// If `values` does not hold `(2b)^3` values or `min_angle` is negative or NaN.
-pub fn top_peaks(b: usize, values: &[Complex64], k: usize, min_angle: f64) -> Vec<Peak> {
-    select_peaks(b, values, |z| z.norm_sqr(), (k, min_angle))
+pub fn top_peaks<T: Real>(b: usize, values: &[Complex<T>], k: usize, min_angle: f64) -> Vec<Peak> {
+    select_peaks(b, values, norm_sqr, (k, min_angle))
 }
 
 /// [`top_peaks`] of a real grid (`C^2`).
 ///
 /// # Panics
 /// As [`top_peaks`].
-pub fn top_peaks_real(b: usize, values: &[f64], k: usize, min_angle: f64) -> Vec<Peak> {
-    select_peaks(b, values, |x| x * x, (k, min_angle))
+pub fn top_peaks_real<T: Real>(b: usize, values: &[T], k: usize, min_angle: f64) -> Vec<Peak> {
+    select_peaks(b, values, square, (k, min_angle))
 }
 
 fn select_peaks<T: Copy + Sync>(
@@ -310,6 +324,7 @@ fn local_maxima<T: Copy>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use num_complex::Complex64;
 
     /// The rule itself: a one-by-one scan taking only strictly larger values.
     fn plain(values: &[f64]) -> (usize, f64) {

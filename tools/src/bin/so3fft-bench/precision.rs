@@ -1,10 +1,13 @@
 //! `so3fft-bench precision`: the SO(3) transforms in single against double precision. Per
 //! bandwidth and thread count, both plans are made, then their calls alternate run by run
 //! (complex inverse and forward, real inverse and forward): medians, the f32/f64 time
-//! ratios, the round-trip errors of both, and the plans' memory.
+//! ratios, the round-trip errors of both, and the plans' memory; then rotational matching
+//! in both precisions (bandwidths up to 128).
 
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
+use so3fft::matching::{rotate_s2_coeffs, Correlation, CorrelationOptions, Peak, Rotation};
+use so3fft::s2::{s2_coef_index, S2Plan};
 use so3fft::{Complex, Complex64, Plan, Real};
 use std::time::Instant;
 
@@ -190,5 +193,154 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             }
         }
     }
+    run_matching(opts)
+}
+
+/// One precision's correlation plans (complex and real) and inputs at one bandwidth.
+struct Matching<T: Real> {
+    complex: Correlation<T>,
+    real: Correlation<T>,
+    sig: Vec<Complex<T>>,
+    pat: Vec<Complex<T>>,
+    rsig: Vec<T>,
+    rpat: Vec<T>,
+    grid: Vec<Complex<T>>,
+    rgrid: Vec<T>,
+    /// Seconds of each pipeline run: complex, real.
+    times: [Vec<f64>; 2],
+    peaks: [Option<Peak>; 2],
+}
+
+impl<T: Real> Matching<T> {
+    /// The plans for bandwidth `l`, the signal the pattern rotated by `truth`.
+    fn new(
+        l: usize,
+        options: &so3fft::Options,
+        (sig, pat): (&[Complex64], &[Complex64]),
+    ) -> so3fft::Result<Matching<T>> {
+        let plan = |real: bool| {
+            Correlation::<T>::new(
+                l,
+                &CorrelationOptions::default()
+                    .with_real(real)
+                    .with_plans(options.clone()),
+            )
+        };
+        let (complex, real) = (plan(false)?, plan(true)?);
+        let re = |v: &[Complex64]| v.iter().map(|z| T::from_f64(z.re)).collect::<Vec<T>>();
+        Ok(Matching {
+            grid: vec![Complex::new(T::ZERO, T::ZERO); complex.num_grid()],
+            rgrid: vec![T::ZERO; real.num_grid()],
+            sig: narrow(sig),
+            pat: narrow(pat),
+            rsig: re(sig),
+            rpat: re(pat),
+            complex,
+            real,
+            times: Default::default(),
+            peaks: [None, None],
+        })
+    }
+
+    /// One run of both pipelines (correlation and its argmax), timed.
+    fn run(&mut self) -> so3fft::Result<()> {
+        let t = Instant::now();
+        let p = self
+            .complex
+            .correlate_argmax(&self.sig, &self.pat, &mut self.grid)?;
+        self.times[0].push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        let q = self
+            .real
+            .correlate_real_argmax(&self.rsig, &self.rpat, &mut self.rgrid)?;
+        self.times[1].push(t.elapsed().as_secs_f64());
+        self.peaks = [Some(p), Some(q)];
+        Ok(())
+    }
+
+    /// The refined rotation from the complex pipeline's peak (coefficients in f64).
+    fn refined(&self) -> so3fft::Result<Rotation> {
+        let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(self.complex.b_out())];
+        self.complex
+            .coefficients(&self.sig, &self.pat, &mut coeffs)?;
+        let start = self.peaks[0].expect("run first").rotation();
+        Ok(self.complex.refine(&coeffs, &start)?.0)
+    }
+}
+
+/// Matching pipelines in f64 and f32 (a pattern rotated off the grid, complex and real
+/// inputs), alternating run by run: medians, ratios, the grid peaks and the refined
+/// rotations of both.
+pub fn run_matching(opts: &Options) -> so3fft::Result<()> {
+    println!();
+    println!("rotational matching in f64 and f32: pipeline medians in ms (two S^2 forwards,");
+    println!("combine, inverse, argmax), calls alternating; the refined angle from each peak");
+    println!(
+        "{:>5} {:>3} {:>4} {:>9} {:>9} {:>12} {:>12} {:>13}",
+        "L", "thr", "prec", "complex", "real", "peak cx", "peak re", "refined diff"
+    );
+    for &l in opts.bandwidths.iter().filter(|&&l| l <= 128) {
+        for &threads in &opts.threads {
+            let options = so3fft::Options::default()
+                .with_threads(threads)
+                .with_rigor(opts.rigor);
+            let truth = Rotation::new(2.1234567, 1.2345678, 0.3456789);
+            let s2 = S2Plan::<f64>::new(l, &options)?;
+            let hat = real_signal_s2(l, &random_coeffs(l * l, 3));
+            let (mut sig, mut pat) = (
+                vec![Complex64::default(); s2.num_samples()],
+                vec![Complex64::default(); s2.num_samples()],
+            );
+            s2.inverse(&rotate_s2_coeffs(l, &hat, &truth)?, &mut sig)?;
+            s2.inverse(&hat, &mut pat)?;
+            let mut wide = Matching::<f64>::new(l, &options, (&sig, &pat))?;
+            let mut narrow = Matching::<f32>::new(l, &options, (&sig, &pat))?;
+            wide.run()?;
+            narrow.run()?;
+            wide.times = Default::default();
+            narrow.times = Default::default();
+            for _ in 0..opts.runs.unwrap_or(9) {
+                wide.run()?;
+                narrow.run()?;
+            }
+            let diff = narrow.refined()?.angle_to(&wide.refined()?);
+            let med = |m: &[Vec<f64>; 2]| [median(&m[0]), median(&m[1])];
+            let (m64, m32) = (med(&wide.times), med(&narrow.times));
+            let index = |p: Option<Peak>| p.map_or(0, |p| p.index);
+            for (name, m, peaks) in [("f64", m64, wide.peaks), ("f32", m32, narrow.peaks)] {
+                println!(
+                    "{l:>5} {threads:>3} {name:>4} {:>9.3} {:>9.3} {:>12} {:>12} {:>13}",
+                    m[0] * 1e3,
+                    m[1] * 1e3,
+                    index(peaks[0]),
+                    index(peaks[1]),
+                    if name == "f32" {
+                        format!("{diff:.1e}")
+                    } else {
+                        String::new()
+                    },
+                );
+            }
+            println!(
+                "{l:>5} {threads:>3} {:>4} {:>9.2} {:>9.2}",
+                "f32/",
+                m32[0] / m64[0],
+                m32[1] / m64[1]
+            );
+        }
+    }
     Ok(())
+}
+
+/// S^2 coefficients of a real function (Hermitian in `m`) from any `c`.
+fn real_signal_s2(l: usize, c: &[Complex64]) -> Vec<Complex64> {
+    let mut c = c.to_vec();
+    for deg in 0..l {
+        c[s2_coef_index(l, deg, 0)].im = 0.0;
+        for m in 1..=deg as isize {
+            let v = c[s2_coef_index(l, deg, m)];
+            c[s2_coef_index(l, deg, -m)] = if m % 2 == 0 { v.conj() } else { -v.conj() };
+        }
+    }
+    c
 }
