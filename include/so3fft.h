@@ -115,6 +115,13 @@ typedef struct so3fft_plan_s so3fft_plan_s;
 // Opaque S^2 plan object (made by `so3fft_plan_s2`, released by `so3fft_destroy_s2_plan`).
 typedef struct so3fft_s2_plan_s so3fft_s2_plan_s;
 
+// Opaque single-precision partial plan object (made by `so3fftf_plan_partial`).
+typedef struct so3fftf_partial_s so3fftf_partial_s;
+
+// Opaque single-precision plan object (made by a `so3fftf_plan_*` planner, released by
+// `so3fftf_destroy_plan`).
+typedef struct so3fftf_plan_s so3fftf_plan_s;
+
 // Opaque single-precision S^2 plan object (made by `so3fftf_plan_s2`, released by
 // `so3fftf_destroy_s2_plan`).
 typedef struct so3fftf_s2_plan_s so3fftf_s2_plan_s;
@@ -171,11 +178,17 @@ typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
 // A correlation plan: a pointer to an opaque object.
 typedef struct so3fft_correlation_s *so3fft_correlation;
 
-// A single-precision S^2 plan: a pointer to an opaque object.
-typedef struct so3fftf_s2_plan_s *so3fftf_s2_plan;
+// A single-precision plan: a pointer to an opaque object (like `fftwf_plan`).
+typedef struct so3fftf_plan_s *so3fftf_plan;
 
 // One single-precision complex number `{re, im}`, identical to `fftwf_complex` (`float[2]`).
 typedef float so3fftf_complex[2];
+
+// A single-precision partial plan: a pointer to an opaque object.
+typedef struct so3fftf_partial_s *so3fftf_partial;
+
+// A single-precision S^2 plan: a pointer to an opaque object.
+typedef struct so3fftf_s2_plan_s *so3fftf_s2_plan;
 
 #ifdef __cplusplus
 extern "C" {
@@ -487,8 +500,90 @@ const char *so3fft_last_error(void);
 // Static description of an error code.
 const char *so3fft_strerror(int code);
 
-// Single precision (`so3fftf_`, `float` data): as `so3fft_plan_s2`. The ring DFTs use
-// single-precision FFTW (libfftw3f); the lowest orders run in double. NULL on error.
+// Single precision (`so3fftf_`, `float` data): as `so3fft_plan_forward`, samples `in`
+// ((2B)^3) to coefficients `out` ((4B^3-B)/3), both NULL for new-array execute only.
+// Planner settings (`so3fft_plan_with_nthreads` ...) are shared with double. NULL on error.
+so3fftf_plan so3fftf_plan_forward(int B, so3fftf_complex *in, so3fftf_complex *out, unsigned int flags);
+
+// As `so3fft_plan_inverse`, in single precision: coefficients `in` to samples `out`.
+so3fftf_plan so3fftf_plan_inverse(int B, so3fftf_complex *in, so3fftf_complex *out, unsigned int flags);
+
+// As `so3fft_plan_both`, in single precision (new-array execute only).
+so3fftf_plan so3fftf_plan_both(int B, unsigned int flags);
+
+// As `so3fft_plan_general`, in single precision.
+so3fftf_plan so3fftf_plan_general(int B, int direction, so3fftf_complex *in, so3fftf_complex *out, unsigned int flags, int nthreads);
+
+// Destroys a single-precision plan; NULL is a no-op.
+void so3fftf_destroy_plan(so3fftf_plan p);
+
+// As `so3fft_execute`: runs a plan on the arrays given at planning.
+int so3fftf_execute(so3fftf_plan p);
+
+// As `so3fft_execute_forward`: samples `in` to coefficients `out` (new-array execute).
+int so3fftf_execute_forward(so3fftf_plan p, so3fftf_complex *in, so3fftf_complex *out);
+
+// As `so3fft_execute_inverse`: coefficients `in` to samples `out` (new-array execute).
+int so3fftf_execute_inverse(so3fftf_plan p, so3fftf_complex *in, so3fftf_complex *out);
+
+// The bandwidth of a single-precision plan (`SO3FFT_ENULL` for NULL).
+int so3fftf_get_bandwidth(so3fftf_plan p);
+
+// The worker thread count of a single-precision plan (`SO3FFT_ENULL` for NULL).
+int so3fftf_get_nthreads(so3fftf_plan p);
+
+// Bytes of memory a single-precision plan holds (`SO3FFT_ENULL` for NULL).
+ptrdiff_t so3fftf_get_memory(so3fftf_plan p);
+
+// As `so3fft_plan_memory`, for a single-precision plan (its own figure).
+ptrdiff_t so3fftf_plan_memory(int B, unsigned int flags, int nthreads);
+
+// As `so3fft_get_fft_threading` (`SO3FFT_ENULL` for NULL).
+int so3fftf_get_fft_threading(so3fftf_plan p);
+
+// Writes the `2B` quadrature weights `w_B(k)` to `w` as floats (`so3fft_weights` rounded).
+int so3fftf_weights(int B, float *w);
+
+// As `so3fft_plan_partial`, in single precision (the shape and the options, with their
+// double beta values, are the same). NULL on error.
+so3fftf_partial so3fftf_plan_partial(const struct so3fft_shape *shape, const struct so3fft_partial_options *options, unsigned int flags);
+
+// Destroys a single-precision partial plan; NULL is a no-op.
+void so3fftf_destroy_partial(so3fftf_partial p);
+
+// Coefficients of one transform of the plan.
+ptrdiff_t so3fftf_partial_num_coeffs(so3fftf_partial p);
+
+// Samples of one transform of the plan (`n_alpha n_gamma` per beta evaluated).
+ptrdiff_t so3fftf_partial_num_samples(so3fftf_partial p);
+
+// As `so3fft_partial_forward_many`: `howmany` forwards, samples `idist` values apart to
+// coefficients `odist` apart.
+int so3fftf_partial_forward_many(so3fftf_partial p, int howmany, so3fftf_complex *samples, ptrdiff_t idist, so3fftf_complex *coeffs, ptrdiff_t odist);
+
+// As `so3fft_partial_inverse_many`.
+int so3fftf_partial_inverse_many(so3fftf_partial p, int howmany, so3fftf_complex *coeffs, ptrdiff_t idist, so3fftf_complex *samples, ptrdiff_t odist);
+
+// As `so3fft_partial_forward_real_many`, real samples as floats.
+int so3fftf_partial_forward_real_many(so3fftf_partial p, int howmany, const float *samples, ptrdiff_t idist, so3fftf_complex *coeffs, ptrdiff_t odist);
+
+// As `so3fft_partial_inverse_real_many`, real samples as floats.
+int so3fftf_partial_inverse_real_many(so3fftf_partial p, int howmany, so3fftf_complex *coeffs, ptrdiff_t idist, float *samples, ptrdiff_t odist);
+
+// One forward transform (`so3fftf_partial_forward_many` with `howmany = 1`).
+int so3fftf_partial_forward(so3fftf_partial p, so3fftf_complex *samples, so3fftf_complex *coeffs);
+
+// One inverse transform.
+int so3fftf_partial_inverse(so3fftf_partial p, so3fftf_complex *coeffs, so3fftf_complex *samples);
+
+// One forward transform of real samples.
+int so3fftf_partial_forward_real(so3fftf_partial p, const float *samples, so3fftf_complex *coeffs);
+
+// One inverse transform to real samples.
+int so3fftf_partial_inverse_real(so3fftf_partial p, so3fftf_complex *coeffs, float *samples);
+
+// As `so3fft_plan_s2`, in single precision. The ring DFTs use single-precision FFTW
+// (libfftw3f); the lowest orders run in double. NULL on error.
 so3fftf_s2_plan so3fftf_plan_s2(int B, unsigned int flags, int nthreads);
 
 // As `so3fft_plan_s2_limited`, in single precision.

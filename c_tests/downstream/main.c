@@ -1,5 +1,5 @@
-/* A minimal downstream program: inverse and forward transform of one coefficient, and an S^2
- * round trip in single precision (libfftw3f linked). It defines functions named like SOFT's
+/* A minimal downstream program: inverse and forward transform of one coefficient, and an SO(3)
+ * and an S^2 round trip in single precision (libfftw3f linked). It defines functions named like SOFT's
  * (transpose, csecond), as numerical codes often do: libso3fft must neither clash with them in
  * a static link nor replace them. */
 #include <math.h>
@@ -37,6 +37,29 @@ static double s2_float_round_trip(void) {
     return err;
 }
 
+/* Single precision: the SO(3) round trip of one coefficient; its error, or -1 on failure. */
+static double so3_float_round_trip(void) {
+    const int B = 6;
+    size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B), i;
+    so3fftf_complex *c = calloc(nc, sizeof *c), *s = calloc(ns, sizeof *s);
+    so3fftf_plan p = so3fftf_plan_both(B, SO3FFT_ESTIMATE);
+    ptrdiff_t k = so3fft_coef_index(B, 4, 2, -3);
+    double err = -1.0;
+    if (c && s && p && k >= 0) {
+        c[k][0] = 1.0f;
+        if (so3fftf_execute_inverse(p, c, s) == SO3FFT_OK &&
+            so3fftf_execute_forward(p, s, c) == SO3FFT_OK) {
+            for (err = 0.0, i = 0; i < nc; i++)
+                err = fmax(err, hypot(c[i][0] - (i == (size_t)k), c[i][1]));
+        }
+    }
+    if (err < 0.0) fprintf(stderr, "so3fft (single precision): %s\n", so3fft_last_error());
+    so3fftf_destroy_plan(p);
+    free(c);
+    free(s);
+    return err;
+}
+
 int main(void) {
     const int B = 8;
     size_t nc = so3fft_num_coeffs(B), ns = so3fft_num_samples(B), i;
@@ -44,7 +67,7 @@ int main(void) {
     so3fft_complex *samples = malloc(ns * sizeof *samples);
     so3fft_complex *back = malloc(nc * sizeof *back);
     so3fft_plan plan;
-    double err = 0.0, err_f;
+    double err = 0.0, err_f, err_so3f;
     ptrdiff_t k = so3fft_coef_index(B, 3, -1, 2);
 
     if (transpose(3) != 21 || csecond() != 42.0) {
@@ -75,5 +98,10 @@ int main(void) {
     free(back);
     err_f = s2_float_round_trip();
     printf("so3fft %s: S^2 single precision round trip error %.3g\n", so3fft_version(), err_f);
-    return err < 1e-12 && err_f >= 0.0 && err_f < 1e-5 ? EXIT_SUCCESS : EXIT_FAILURE;
+    err_so3f = so3_float_round_trip();
+    printf("so3fft %s: SO(3) single precision round trip error %.3g\n", so3fft_version(),
+           err_so3f);
+    return err < 1e-12 && err_f >= 0.0 && err_f < 1e-5 && err_so3f >= 0.0 && err_so3f < 1e-5
+               ? EXIT_SUCCESS
+               : EXIT_FAILURE;
 }

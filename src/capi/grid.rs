@@ -1,9 +1,12 @@
-//! Sizes, indices, sample angles and quadrature weights at a bandwidth.
+//! Sizes, indices, sample angles and quadrature weights at a bandwidth. All but the weights
+//! are the same for both precisions; the body of the weights is generic over the element
+//! type (`so3fftf_weights` in `single.rs`).
 
 use super::{guarded, guarded_code, SO3FFT_MAX_BANDWIDTH};
 use crate::ffi::checks::{self, Array};
 use crate::ffi::last_error;
 use crate::ffi::CallError;
+use crate::Real;
 use std::ffi::{c_double, c_int};
 
 /// Number of samples `(2B)^3` (0 for an invalid `B`).
@@ -91,19 +94,31 @@ pub extern "C" fn so3fft_gamma(B: c_int, j: c_int) -> c_double {
     angle(B, j, "gamma", crate::gamma)
 }
 
-/// Writes the `2B` quadrature weights `w_B(k)` to `w` (SOFT's `makeweights2`).
-#[no_mangle]
-pub unsafe extern "C" fn so3fft_weights(B: c_int, w: *mut c_double) -> c_int {
+/// The body of `so3fft_weights` for the element type `T`: the weights (computed in double)
+/// rounded to `T`.
+///
+/// # Safety
+/// `w` is NULL or has room for `2B` values of `T` (the API's contract).
+pub(super) unsafe fn weights<T: Real>(B: c_int, w: *mut T) -> c_int {
     guarded_code(|| {
         let b = checks::bandwidth(B)?;
         let values = crate::weights(b);
         Array::new(w.cast_const(), values.len(), "weights").check()?;
-        // SAFETY: `w` is non-NULL and aligned (checked) and has room for 2B doubles (the
-        // caller's contract); `values.len() == 2B`; a caller's array never overlaps the
-        // fresh vector.
-        unsafe { std::ptr::copy_nonoverlapping(values.as_ptr(), w, values.len()) };
+        for (i, &v) in values.iter().enumerate() {
+            // SAFETY: `w` is non-NULL and aligned (checked) and has room for 2B values (the
+            // caller's contract); `i < values.len() == 2B`. Written, never read, so the
+            // caller's array may be uninitialised.
+            unsafe { w.add(i).write(T::from_f64(v)) };
+        }
         Ok(())
     })
+}
+
+/// Writes the `2B` quadrature weights `w_B(k)` to `w` (SOFT's `makeweights2`).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_weights(B: c_int, w: *mut c_double) -> c_int {
+    // SAFETY: `w` is NULL or has room for 2B doubles (the caller's contract).
+    unsafe { weights(B, w) }
 }
 
 /// `SO3FFT_MAX_BANDWIDTH` of the library linked.

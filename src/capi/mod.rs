@@ -55,7 +55,7 @@ mod single;
 
 use crate::ffi::last_error::LastErrorSink;
 use crate::ffi::{boundary, CallError, ErrorKind};
-use crate::{Direction, Plan, Rigor, MAX_BANDWIDTH};
+use crate::{Direction, Plan, Real, Rigor, MAX_BANDWIDTH};
 use std::ffi::{c_double, c_int, c_uint};
 
 /// One complex number `{re, im}`, identical to `fftw_complex` (`double[2]`).
@@ -63,18 +63,49 @@ pub type so3fft_complex = [c_double; 2];
 
 /// Opaque plan object (made by a planner, released by `so3fft_destroy_plan`).
 pub struct so3fft_plan_s {
-    plan: Plan,
-    /// Input array given at planning (samples for a forward plan, coefficients for an
-    /// inverse plan), or NULL.
-    input: *mut so3fft_complex,
-    /// Output array given at planning, or NULL.
-    output: *mut so3fft_complex,
-    /// Made with `SO3FFT_REAL`: transforms take the real-signal path.
-    real: bool,
+    state: PlanState<f64>,
 }
 
 /// A plan: a pointer to an opaque object (like `fftw_plan`).
 pub type so3fft_plan = *mut so3fft_plan_s;
+
+/// What an SO(3) plan handle of the element type `T` holds: the plan and the arrays given
+/// at planning.
+struct PlanState<T: Real> {
+    plan: Plan<T>,
+    /// Input array given at planning (samples for a forward plan, coefficients for an
+    /// inverse plan), or NULL.
+    input: *mut [T; 2],
+    /// Output array given at planning, or NULL.
+    output: *mut [T; 2],
+    /// Made with `SO3FFT_REAL`: transforms take the real-signal path.
+    real: bool,
+}
+
+/// The opaque object behind the SO(3) plan handles of one precision (`so3fft_plan_s`,
+/// `so3fftf_plan_s`): it owns a [`PlanState`] of its element type. The bodies of the
+/// planners, executes and queries are generic over it.
+trait PlanHandle: Sized + 'static {
+    /// The element type of the plan (`f64` or `f32`).
+    type T: Real;
+    /// The prefix of the precision's C names (`so3fft` or `so3fftf`), for messages.
+    const PREFIX: &'static str;
+    /// The object owning `state`.
+    fn wrap(state: PlanState<Self::T>) -> Self;
+    /// The state it owns.
+    fn state(&self) -> &PlanState<Self::T>;
+}
+
+impl PlanHandle for so3fft_plan_s {
+    type T = f64;
+    const PREFIX: &'static str = "so3fft";
+    fn wrap(state: PlanState<f64>) -> Self {
+        so3fft_plan_s { state }
+    }
+    fn state(&self) -> &PlanState<f64> {
+        &self.state
+    }
+}
 
 // ---------------------------------------------------------------------------------------
 // Constants
@@ -204,13 +235,15 @@ fn threads_of(nthreads: c_int) -> Result<usize, CallError> {
     })
 }
 
-/// The plan behind a handle; an error for NULL.
+/// The plan state behind a handle; an error for NULL.
 ///
 /// # Safety
-/// `p` is NULL or a plan returned by a planner and not destroyed yet, not destroyed while
-/// the returned reference is used.
-unsafe fn plan_ref<'a>(p: so3fft_plan) -> Result<&'a so3fft_plan_s, CallError> {
+/// `p` is NULL or a plan returned by a planner of `H` and not destroyed yet, not destroyed
+/// while the returned reference is used.
+unsafe fn plan_ref<'a, H: PlanHandle>(p: *mut H) -> Result<&'a PlanState<H::T>, CallError> {
     // SAFETY: non-NULL handles are live plans (this function's contract); the plan is only
     // read through shared references, so concurrent calls on one plan do not alias mutably.
-    unsafe { p.as_ref() }.ok_or_else(|| CallError::new(ErrorKind::Null, "the plan is NULL"))
+    unsafe { p.as_ref() }
+        .map(H::state)
+        .ok_or_else(|| CallError::new(ErrorKind::Null, "the plan is NULL"))
 }

@@ -1,12 +1,17 @@
 //! Partial plans (guru interface): a shape, options, planner, execute, sizes and index.
+//!
+//! The shape, the options and their functions serve both precisions. The bodies of the
+//! planner, destroy, sizes and executes are generic over the plan's handle
+//! ([`PartialHandle`]), whose element type is the precision: the `so3fft_partial*` functions
+//! here and the `so3fftf_partial*` ones of `single.rs` are one-line wrappers over them.
 
 use super::{direction_of, guarded, guarded_code, guarded_count, rigor_of, threads_of};
 use super::{so3fft_complex, SO3FFT_DESTROY_INPUT, SO3FFT_REAL};
 use crate::ffi::checks::{input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
 use crate::options::{Betas, Direction, Options};
-use crate::Complex64;
 use crate::{Batch, PartialPlan, Shape};
+use crate::{Complex, Real};
 use std::ffi::{c_int, c_uint};
 
 /// What a partial plan computes: degrees `L0 <= l < L`, orders `|m| <= m_max`,
@@ -57,6 +62,27 @@ pub struct so3fft_partial_s {
 
 /// A partial plan: a pointer to an opaque object.
 pub type so3fft_partial = *mut so3fft_partial_s;
+
+/// The opaque object behind the partial plan handles of one precision (`so3fft_partial_s`,
+/// `so3fftf_partial_s`): it owns a `PartialPlan` of its element type.
+pub(super) trait PartialHandle: Sized + 'static {
+    /// The element type of the plan (`f64` or `f32`).
+    type T: Real;
+    /// The object owning `plan`.
+    fn wrap(plan: PartialPlan<Self::T>) -> Self;
+    /// The plan it owns.
+    fn plan(&self) -> &PartialPlan<Self::T>;
+}
+
+impl PartialHandle for so3fft_partial_s {
+    type T = f64;
+    fn wrap(plan: PartialPlan<f64>) -> Self {
+        so3fft_partial_s { plan }
+    }
+    fn plan(&self) -> &PartialPlan<f64> {
+        &self.plan
+    }
+}
 
 /// The shape of a C shape (values checked for sign; `Shape::validate` does the rest).
 fn shape_of(s: &so3fft_shape) -> Result<Shape, CallError> {
@@ -251,6 +277,43 @@ pub(super) unsafe fn options_of(
     Ok(opts)
 }
 
+/// The body of `so3fft_plan_partial` for the handle type `H`: a new plan, or NULL on error.
+///
+/// # Safety
+/// `shape` is NULL or points to a shape; `options` is NULL or points to options whose
+/// non-NULL beta array holds `nbetas` values (the API's contract).
+pub(super) unsafe fn plan_partial<H: PartialHandle>(
+    shape: *const so3fft_shape,
+    options: *const so3fft_partial_options,
+    flags: c_uint,
+) -> *mut H {
+    guarded(std::ptr::null_mut(), || {
+        // SAFETY: this function's contract.
+        let s = unsafe { checked_shape(shape) }?;
+        // SAFETY: this function's contract.
+        let o = unsafe { options_of(options, flags) }?;
+        let plan = PartialPlan::<H::T>::new(&s, &o)?;
+        Ok(Box::into_raw(Box::new(H::wrap(plan))))
+    })
+}
+
+/// The body of `so3fft_destroy_partial` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a plan made by [`plan_partial`] with the same `H`, not destroyed yet and
+/// used by no other thread.
+pub(super) unsafe fn destroy_partial<H: PartialHandle>(p: *mut H) {
+    guarded((), || {
+        if !p.is_null() {
+            // SAFETY: a non-NULL `p` came from Box::into_raw of a `Box<H>` in
+            // `plan_partial` and is destroyed once, while no other thread uses it (this
+            // function's contract).
+            drop(unsafe { Box::from_raw(p) });
+        }
+        Ok(())
+    })
+}
+
 /// Plans the transforms of `shape` with `options` (NULL: defaults); `flags` a planner
 /// rigour, `| SO3FFT_REAL` for the real-signal executes too. A beta selection makes an
 /// inverse-only plan. NULL on error.
@@ -260,52 +323,59 @@ pub unsafe extern "C" fn so3fft_plan_partial(
     options: *const so3fft_partial_options,
     flags: c_uint,
 ) -> so3fft_partial {
-    guarded(std::ptr::null_mut(), || {
-        // SAFETY: the API's contract.
-        let s = unsafe { checked_shape(shape) }?;
-        // SAFETY: the API's contract.
-        let o = unsafe { options_of(options, flags) }?;
-        let plan = PartialPlan::new(&s, &o)?;
-        Ok(Box::into_raw(Box::new(so3fft_partial_s { plan })))
-    })
+    // SAFETY: the API's contract.
+    unsafe { plan_partial(shape, options, flags) }
 }
 
 /// Destroys a partial plan; NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_destroy_partial(p: so3fft_partial) {
-    guarded((), || {
-        if !p.is_null() {
-            // SAFETY: a non-NULL `p` came from Box::into_raw in `so3fft_plan_partial` and
-            // is destroyed once, while no other thread uses it (the caller's contract).
-            drop(unsafe { Box::from_raw(p) });
-        }
-        Ok(())
-    })
+    // SAFETY: `p` is NULL or a live plan of this type, used by no other thread (the API's
+    // contract).
+    unsafe { destroy_partial(p) }
 }
 
 /// The plan behind a handle; an error for NULL.
 ///
 /// # Safety
 /// `p` is NULL or a live partial plan, not destroyed during the reference's use.
-unsafe fn partial_ref<'a>(p: so3fft_partial) -> Result<&'a PartialPlan, CallError> {
+unsafe fn partial_ref<'a, H: PartialHandle>(p: *mut H) -> Result<&'a PartialPlan<H::T>, CallError> {
     // SAFETY: non-NULL handles are live plans (this function's contract), only read.
     unsafe { p.as_ref() }
-        .map(|s| &s.plan)
+        .map(H::plan)
         .ok_or_else(|| CallError::new(ErrorKind::Null, "the partial plan is NULL"))
+}
+
+/// The body of `so3fft_partial_num_coeffs` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`.
+pub(super) unsafe fn partial_num_coeffs<H: PartialHandle>(p: *mut H) -> isize {
+    // SAFETY: this function's contract.
+    guarded_count(|| Ok(unsafe { partial_ref(p) }?.num_coeffs() as isize))
+}
+
+/// The body of `so3fft_partial_num_samples` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`.
+pub(super) unsafe fn partial_num_samples<H: PartialHandle>(p: *mut H) -> isize {
+    // SAFETY: this function's contract.
+    guarded_count(|| Ok(unsafe { partial_ref(p) }?.num_samples() as isize))
 }
 
 /// Coefficients of one transform of the plan.
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_partial_num_coeffs(p: so3fft_partial) -> isize {
     // SAFETY: the API's contract.
-    guarded_count(|| Ok(unsafe { partial_ref(p) }?.num_coeffs() as isize))
+    unsafe { partial_num_coeffs(p) }
 }
 
 /// Samples of one transform of the plan (`n_alpha n_gamma` per beta evaluated).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_partial_num_samples(p: so3fft_partial) -> isize {
     // SAFETY: the API's contract.
-    guarded_count(|| Ok(unsafe { partial_ref(p) }?.num_samples() as isize))
+    unsafe { partial_num_samples(p) }
 }
 
 /// The batch of a `_many` call: `howmany > 0`, distances `>= 0`.
@@ -340,16 +410,18 @@ enum Op {
     InverseReal,
 }
 
-/// Checks and runs one `_many` call.
+/// Checks and runs one `_many` call of the plan `p` (element type `H::T`); `inp` and `out`
+/// point to the first value (`T`, the real part of the first complex value).
 ///
 /// # Safety
-/// The API's contract: arrays hold the batch's extents.
-unsafe fn run_many(
-    p: so3fft_partial,
+/// The API's contract: `p` is NULL or a live plan of type `H`; non-NULL arrays hold the
+/// batch's extents.
+unsafe fn run_many<H: PartialHandle>(
+    p: *mut H,
     op: Op,
     (howmany, idist, odist): (c_int, isize, isize),
-    inp: *const u8,
-    out: *mut u8,
+    inp: *const H::T,
+    out: *mut H::T,
 ) -> Result<(), CallError> {
     // SAFETY: the API's contract.
     let plan = unsafe { partial_ref(p) }?;
@@ -359,42 +431,139 @@ unsafe fn run_many(
         Op::Forward | Op::ForwardReal => (extent(&b, b.in_dist, ns)?, extent(&b, b.out_dist, nc)?),
         _ => (extent(&b, b.in_dist, nc)?, extent(&b, b.out_dist, ns)?),
     };
-    let (iw, ow) = match op {
-        Op::ForwardReal => (8, 16),
-        Op::InverseReal => (16, 8),
-        _ => (16, 16),
-    };
     let (iname, oname) = match op {
         Op::Forward | Op::ForwardReal => ("samples", "coefficients"),
         _ => ("coefficients", "samples"),
     };
-    // Checked as bytes of f64 (alignment of double, extent in bytes / 8).
+    // The arrays are checked as values of T (its alignment): two per complex element.
+    let values = |len: usize, complex: bool| {
+        if !complex {
+            return Ok(len);
+        }
+        len.checked_mul(2)
+            .ok_or_else(|| CallError::invalid("batch extent overflows".to_string()))
+    };
+    let ivals = values(ilen, op != Op::ForwardReal)?;
+    let ovals = values(olen, op != Op::InverseReal)?;
     input_output(
-        &Array::new(inp.cast::<f64>(), ilen * iw / 8, iname),
-        &Array::new(out.cast_const().cast::<f64>(), olen * ow / 8, oname),
+        &Array::new(inp, ivals, iname),
+        &Array::new(out.cast_const(), ovals, oname),
     )?;
-    // SAFETY: non-NULL, aligned like double, disjoint, extents per the API's contract;
-    // Complex64 is #[repr(C)] {re, im}, the layout of so3fft_complex.
+    // SAFETY: non-NULL, aligned like T, disjoint, extents per the API's contract;
+    // Complex<T> is #[repr(C)] {re, im}, the layout of T[2].
     unsafe {
-        let cin = || std::slice::from_raw_parts(inp.cast::<Complex64>(), ilen);
-        let cout = || std::slice::from_raw_parts_mut(out.cast::<Complex64>(), olen);
+        let cin = || std::slice::from_raw_parts(inp.cast::<Complex<H::T>>(), ilen);
+        let cout = || std::slice::from_raw_parts_mut(out.cast::<Complex<H::T>>(), olen);
         match op {
             Op::Forward => plan.forward_many(b, cin(), cout()),
             Op::Inverse => plan.inverse_many(b, cin(), cout()),
-            Op::ForwardReal => plan.forward_real_many(
-                b,
-                std::slice::from_raw_parts(inp.cast::<f64>(), ilen),
-                cout(),
-            ),
-            Op::InverseReal => plan.inverse_real_many(
-                b,
-                cin(),
-                std::slice::from_raw_parts_mut(out.cast::<f64>(), olen),
-            ),
+            Op::ForwardReal => {
+                plan.forward_real_many(b, std::slice::from_raw_parts(inp, ilen), cout())
+            }
+            Op::InverseReal => {
+                plan.inverse_real_many(b, cin(), std::slice::from_raw_parts_mut(out, olen))
+            }
         }
     }
     .map(|_| ())
     .map_err(CallError::from)
+}
+
+/// The body of `so3fft_partial_forward_many` for the handle type `H`.
+///
+/// # Safety
+/// The API's contract: `p` is NULL or a live plan of type `H`; non-NULL arrays hold the
+/// batch's extents.
+pub(super) unsafe fn partial_forward_many<H: PartialHandle>(
+    p: *mut H,
+    howmany: c_int,
+    samples: *mut [H::T; 2],
+    idist: isize,
+    coeffs: *mut [H::T; 2],
+    odist: isize,
+) -> c_int {
+    // SAFETY: this function's contract.
+    guarded_code(|| unsafe {
+        run_many(
+            p,
+            Op::Forward,
+            (howmany, idist, odist),
+            samples.cast_const().cast(),
+            coeffs.cast(),
+        )
+    })
+}
+
+/// The body of `so3fft_partial_inverse_many` for the handle type `H`.
+///
+/// # Safety
+/// As [`partial_forward_many`].
+pub(super) unsafe fn partial_inverse_many<H: PartialHandle>(
+    p: *mut H,
+    howmany: c_int,
+    coeffs: *mut [H::T; 2],
+    idist: isize,
+    samples: *mut [H::T; 2],
+    odist: isize,
+) -> c_int {
+    // SAFETY: this function's contract.
+    guarded_code(|| unsafe {
+        run_many(
+            p,
+            Op::Inverse,
+            (howmany, idist, odist),
+            coeffs.cast_const().cast(),
+            samples.cast(),
+        )
+    })
+}
+
+/// The body of `so3fft_partial_forward_real_many` for the handle type `H`.
+///
+/// # Safety
+/// As [`partial_forward_many`].
+pub(super) unsafe fn partial_forward_real_many<H: PartialHandle>(
+    p: *mut H,
+    howmany: c_int,
+    samples: *const H::T,
+    idist: isize,
+    coeffs: *mut [H::T; 2],
+    odist: isize,
+) -> c_int {
+    // SAFETY: this function's contract.
+    guarded_code(|| unsafe {
+        run_many(
+            p,
+            Op::ForwardReal,
+            (howmany, idist, odist),
+            samples,
+            coeffs.cast(),
+        )
+    })
+}
+
+/// The body of `so3fft_partial_inverse_real_many` for the handle type `H`.
+///
+/// # Safety
+/// As [`partial_forward_many`].
+pub(super) unsafe fn partial_inverse_real_many<H: PartialHandle>(
+    p: *mut H,
+    howmany: c_int,
+    coeffs: *mut [H::T; 2],
+    idist: isize,
+    samples: *mut H::T,
+    odist: isize,
+) -> c_int {
+    // SAFETY: this function's contract.
+    guarded_code(|| unsafe {
+        run_many(
+            p,
+            Op::InverseReal,
+            (howmany, idist, odist),
+            coeffs.cast_const().cast(),
+            samples,
+        )
+    })
 }
 
 /// `howmany` forward transforms: samples `idist` values apart (only read) to coefficients
@@ -409,15 +578,7 @@ pub unsafe extern "C" fn so3fft_partial_forward_many(
     odist: isize,
 ) -> c_int {
     // SAFETY: the API's contract.
-    guarded_code(|| unsafe {
-        run_many(
-            p,
-            Op::Forward,
-            (howmany, idist, odist),
-            samples.cast(),
-            coeffs.cast(),
-        )
-    })
+    unsafe { partial_forward_many(p, howmany, samples, idist, coeffs, odist) }
 }
 
 /// `howmany` inverse transforms: coefficients `idist` apart to samples `odist` apart.
@@ -431,15 +592,7 @@ pub unsafe extern "C" fn so3fft_partial_inverse_many(
     odist: isize,
 ) -> c_int {
     // SAFETY: the API's contract.
-    guarded_code(|| unsafe {
-        run_many(
-            p,
-            Op::Inverse,
-            (howmany, idist, odist),
-            coeffs.cast(),
-            samples.cast(),
-        )
-    })
+    unsafe { partial_inverse_many(p, howmany, coeffs, idist, samples, odist) }
 }
 
 /// `howmany` forward transforms of real samples (doubles, `idist` apart); every
@@ -454,15 +607,7 @@ pub unsafe extern "C" fn so3fft_partial_forward_real_many(
     odist: isize,
 ) -> c_int {
     // SAFETY: the API's contract.
-    guarded_code(|| unsafe {
-        run_many(
-            p,
-            Op::ForwardReal,
-            (howmany, idist, odist),
-            samples.cast(),
-            coeffs.cast(),
-        )
-    })
+    unsafe { partial_forward_real_many(p, howmany, samples, idist, coeffs, odist) }
 }
 
 /// `howmany` inverse transforms to real samples; reads the blocks `mp > 0`, or `mp = 0`
@@ -477,15 +622,7 @@ pub unsafe extern "C" fn so3fft_partial_inverse_real_many(
     odist: isize,
 ) -> c_int {
     // SAFETY: the API's contract.
-    guarded_code(|| unsafe {
-        run_many(
-            p,
-            Op::InverseReal,
-            (howmany, idist, odist),
-            coeffs.cast(),
-            samples.cast(),
-        )
-    })
+    unsafe { partial_inverse_real_many(p, howmany, coeffs, idist, samples, odist) }
 }
 
 /// One forward transform (`so3fft_partial_forward_many` with `howmany = 1`).

@@ -1,9 +1,14 @@
 //! Planners, `so3fft_destroy_plan`, and the process-wide planner settings (thread count,
 //! workspace cap, FFT threading).
+//!
+//! The planner and destroy bodies are generic over the plan's handle ([`PlanHandle`]), whose
+//! element type is the precision: the `so3fft_*` functions here and the `so3fftf_*` ones of
+//! `single.rs` are one-line wrappers over them. The settings are the library's, shared by
+//! both precisions.
 
 use super::{
-    direction_of, guarded, guarded_code, rigor_of, so3fft_complex, so3fft_plan, so3fft_plan_s,
-    threads_of, SO3FFT_BOTH, SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS,
+    direction_of, guarded, guarded_code, rigor_of, so3fft_complex, so3fft_plan, threads_of,
+    PlanHandle, PlanState, SO3FFT_BOTH, SO3FFT_FFT_FFTW_THREADS, SO3FFT_FFT_SLICES_ACROSS_WORKERS,
     SO3FFT_FORWARD, SO3FFT_INVERSE, SO3FFT_OK, SO3FFT_REAL,
 };
 use crate::ffi::checks::{self, input_output, Array};
@@ -107,15 +112,22 @@ fn fft_threading_of(mode: c_int) -> Result<FftThreading, CallError> {
 // Planners
 // ---------------------------------------------------------------------------------------
 
-/// The shared body of the planners: checks the arguments and makes the plan object.
-fn make_plan(
+/// The thread count the planners other than `so3fft_plan_general` use
+/// (`so3fft_plan_with_nthreads`).
+pub(super) fn planner_threads() -> c_int {
+    PLANNER_THREADS.load(Ordering::Relaxed)
+}
+
+/// The shared body of the planners for the handle type `H`: checks the arguments and makes
+/// the plan object (NULL on error).
+pub(super) fn make_plan<H: PlanHandle>(
     b: c_int,
     direction: c_int,
-    input: *mut so3fft_complex,
-    output: *mut so3fft_complex,
+    input: *mut [H::T; 2],
+    output: *mut [H::T; 2],
     flags: c_uint,
     nthreads: c_int,
-) -> so3fft_plan {
+) -> *mut H {
     guarded(std::ptr::null_mut(), || {
         let b = checks::bandwidth(b)?;
         let direction = direction_of(direction)?;
@@ -155,13 +167,13 @@ fn make_plan(
             fft_threading: fft_threading_of(PLANNER_FFT_THREADING.load(Ordering::Relaxed))?,
             ..Options::default()
         };
-        let plan = Plan::new(b, &options)?;
-        Ok(Box::into_raw(Box::new(so3fft_plan_s {
+        let plan = Plan::<H::T>::new(b, &options)?;
+        Ok(Box::into_raw(Box::new(H::wrap(PlanState {
             plan,
             input,
             output,
             real,
-        })))
+        }))))
     })
 }
 
@@ -174,14 +186,7 @@ pub extern "C" fn so3fft_plan_forward(
     out: *mut so3fft_complex,
     flags: c_uint,
 ) -> so3fft_plan {
-    make_plan(
-        B,
-        SO3FFT_FORWARD,
-        r#in,
-        out,
-        flags,
-        PLANNER_THREADS.load(Ordering::Relaxed),
-    )
+    make_plan(B, SO3FFT_FORWARD, r#in, out, flags, planner_threads())
 }
 
 /// Plans the inverse transform, coefficients `in` to samples `out`. NULL on error.
@@ -192,14 +197,7 @@ pub extern "C" fn so3fft_plan_inverse(
     out: *mut so3fft_complex,
     flags: c_uint,
 ) -> so3fft_plan {
-    make_plan(
-        B,
-        SO3FFT_INVERSE,
-        r#in,
-        out,
-        flags,
-        PLANNER_THREADS.load(Ordering::Relaxed),
-    )
+    make_plan(B, SO3FFT_INVERSE, r#in, out, flags, planner_threads())
 }
 
 /// Plans both transforms, without arrays (new-array execute only). NULL on error.
@@ -211,7 +209,7 @@ pub extern "C" fn so3fft_plan_both(B: c_int, flags: c_uint) -> so3fft_plan {
         std::ptr::null_mut(),
         std::ptr::null_mut(),
         flags,
-        PLANNER_THREADS.load(Ordering::Relaxed),
+        planner_threads(),
     )
 }
 
@@ -229,16 +227,27 @@ pub extern "C" fn so3fft_plan_general(
     make_plan(B, direction, r#in, out, flags, nthreads)
 }
 
-/// Destroys a plan (after the worker threads it was the last to use have finished); NULL
-/// is a no-op.
-#[no_mangle]
-pub unsafe extern "C" fn so3fft_destroy_plan(p: so3fft_plan) {
+/// The body of `so3fft_destroy_plan` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a plan made by [`make_plan`] with the same `H`, not destroyed yet and
+/// used by no other thread.
+pub(super) unsafe fn destroy_plan<H: PlanHandle>(p: *mut H) {
     guarded((), || {
         if !p.is_null() {
-            // SAFETY: a non-NULL `p` came from Box::into_raw in a planner and is destroyed
-            // once, while no other thread uses it (the caller's contract).
+            // SAFETY: a non-NULL `p` came from Box::into_raw of a `Box<H>` in a planner and
+            // is destroyed once, while no other thread uses it (this function's contract).
             drop(unsafe { Box::from_raw(p) });
         }
         Ok(())
     })
+}
+
+/// Destroys a plan (after the worker threads it was the last to use have finished); NULL
+/// is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_destroy_plan(p: so3fft_plan) {
+    // SAFETY: `p` is NULL or a live plan of this type, used by no other thread (the API's
+    // contract).
+    unsafe { destroy_plan(p) }
 }
