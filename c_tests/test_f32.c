@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "test_util.h"
+#include "f32_twins.h"
 
 /* Tolerance of a single-precision result, relative L2 (docs/precision.md). */
 static const double TOL = 1e-5;
@@ -222,76 +223,10 @@ static void many(int b, int k) {
 
 /* A call's outcome: its return value (or whether a planner returned NULL), the error code and
  * a copy of the message. */
-struct outcome {
-    long ret;
-    int code;
-    char msg[512];
-};
-
-static struct outcome outcome_of(long ret) {
-    struct outcome o;
-    o.ret = ret;
-    o.code = so3fft_last_error_code();
-    strncpy(o.msg, so3fft_last_error(), sizeof o.msg - 1);
-    o.msg[sizeof o.msg - 1] = '\0';
-    return o;
-}
-
-/* Both calls failed with `code` (returned, where the function returns one, and in the error
- * state), with a message, the same message when `same_msg`. */
-static void same_failure(int line, int code, struct outcome f, struct outcome d, int same_msg) {
-    if (f.code != code || d.code != code || f.ret != d.ret || f.msg[0] == '\0' ||
-        (same_msg && strcmp(f.msg, d.msg) != 0)) {
-        fprintf(stderr,
-                "test_f32.c:%d: expected error %d from both; f32: %ld, %d \"%s\"; "
-                "f64: %ld, %d \"%s\"\n",
-                line, code, f.ret, f.code, f.msg, d.ret, d.code, d.msg);
-        g_failures++;
-    }
-}
-
-/* Compares an f32 call returning an error code with its f64 twin. */
-#define SAME_CODE(code, fcall, dcall)                                                       \
-    do {                                                                                    \
-        struct outcome f_ = outcome_of(fcall);                                              \
-        struct outcome d_ = outcome_of(dcall);                                              \
-        CHECK(f_.ret == (code));                                                            \
-        same_failure(__LINE__, (code), f_, d_, 1);                                          \
-    } while (0)
-
-/* The same where the messages may differ (they name an address or an alignment). */
-#define SAME_CODE_ONLY(code, fcall, dcall)                                                  \
-    do {                                                                                    \
-        struct outcome f_ = outcome_of(fcall);                                              \
-        struct outcome d_ = outcome_of(dcall);                                              \
-        CHECK(f_.ret == (code));                                                            \
-        same_failure(__LINE__, (code), f_, d_, 0);                                          \
-    } while (0)
-
-/* Compares an f32 planner with its f64 twin: both NULL, the same code and message. */
+/* Compares an f32 S^2 planner with its f64 twin: both NULL, the same code and message. */
 #define SAME_PLAN_FAILURE(code, fcall, dcall)                                               \
-    do {                                                                                    \
-        so3fftf_s2_plan fp_ = (fcall);                                                      \
-        struct outcome f_ = outcome_of(fp_ != NULL);                                        \
-        so3fft_s2_plan dp_ = (dcall);                                                       \
-        struct outcome d_ = outcome_of(dp_ != NULL);                                        \
-        CHECK(fp_ == NULL && dp_ == NULL);                                                  \
-        same_failure(__LINE__, (code), f_, d_, 1);                                          \
-        so3fftf_destroy_s2_plan(fp_);                                                       \
-        so3fft_destroy_s2_plan(dp_);                                                        \
-    } while (0)
-
-static int untouched_f(const float *a, size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++)
-        if (a[i] != 1234.5f) return 0;
-    return 1;
-}
-
-static void fill_sentinel_f(float *a, size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) a[i] = 1234.5f;
-}
+    SAME_NULL(code, so3fftf_s2_plan, fcall, so3fftf_destroy_s2_plan, so3fft_s2_plan, dcall, \
+              so3fft_destroy_s2_plan, 1)
 
 static void bad_arguments(void) {
     const int b = 8;
@@ -400,13 +335,13 @@ static void bad_arguments(void) {
     /* misaligned arrays (for their element type); nothing written */
     fill_sentinel_f(&cf[0][0], 2 * nc);
     SAME_CODE_ONLY(SO3FFT_EINVAL, so3fftf_s2_execute_forward(pf, sf, misf),
-                   so3fft_s2_execute_forward(pd, sd, misd));
+                   so3fft_s2_execute_forward(pd, sd, misd), "");
     SAME_CODE_ONLY(SO3FFT_EINVAL, so3fftf_s2_execute_inverse(pf, misf, sf),
-                   so3fft_s2_execute_inverse(pd, misd, sd));
+                   so3fft_s2_execute_inverse(pd, misd, sd), "");
     SAME_CODE_ONLY(SO3FFT_EINVAL, so3fftf_s2_execute_forward_real(pf, misrf, cf),
-                   so3fft_s2_execute_forward_real(pd, misrd, cd));
+                   so3fft_s2_execute_forward_real(pd, misrd, cd), "");
     SAME_CODE_ONLY(SO3FFT_EINVAL, so3fftf_s2_execute_inverse_real_many(pf, 1, cf, misrf),
-                   so3fft_s2_execute_inverse_real_many(pd, 1, cd, misrd));
+                   so3fft_s2_execute_inverse_real_many(pd, 1, cd, misrd), "");
     CHECK(untouched_f(&cf[0][0], 2 * nc));
     /* aligned to 4 bytes is enough for floats (not for doubles) */
     memset(sf, 0, ns * sizeof *sf);

@@ -14,6 +14,7 @@
  *    messages as the double-precision functions, nothing written;
  *  - nothing written behind the arrays (guard values; valgrind checks the rest). */
 #include "test_util.h"
+#include "f32_twins.h"
 
 /* Round trip of a single-precision transform, relative L2 (docs/precision.md). */
 static const double TOL = 1e-5;
@@ -21,7 +22,6 @@ static const double TOL = 1e-5;
 static const double AGREE = 5e-6;
 /* Guard values behind each array. */
 #define GUARD 8
-static const float SENTINEL_F = 1234.5f;
 
 static so3fftf_complex *alloc_cf(size_t n) {
     so3fftf_complex *p = (so3fftf_complex *)malloc((n + GUARD) * sizeof(so3fftf_complex));
@@ -43,18 +43,6 @@ static double *alloc_d(size_t n) {
     double *p = (double *)malloc(n * sizeof(double));
     if (!p) exit(EXIT_FAILURE);
     return p;
-}
-
-static int untouched_f(const float *a, size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++)
-        if (a[i] != SENTINEL_F) return 0;
-    return 1;
-}
-
-static void fill_sentinel_f(float *a, size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) a[i] = SENTINEL_F;
 }
 
 /* The guard values behind an array of n complex floats are intact. */
@@ -474,68 +462,6 @@ static void partial_betas(double *worst) {
 
 /* A call's outcome: its return value (or whether a planner returned NULL), the error code and
  * a copy of the message. */
-struct outcome {
-    long ret;
-    int code;
-    char msg[512];
-};
-
-static struct outcome outcome_of(long ret) {
-    struct outcome o;
-    o.ret = ret;
-    o.code = so3fft_last_error_code();
-    strncpy(o.msg, so3fft_last_error(), sizeof o.msg - 1);
-    o.msg[sizeof o.msg - 1] = '\0';
-    return o;
-}
-
-/* Both calls failed with `code` (returned, where the function returns one, and in the error
- * state), with a message, the same message when `same_msg`. */
-static void same_failure(int line, int code, struct outcome f, struct outcome d, int same_msg) {
-    if (f.code != code || d.code != code || f.ret != d.ret || f.msg[0] == '\0' ||
-        (same_msg && strcmp(f.msg, d.msg) != 0)) {
-        fprintf(stderr,
-                "test_f32_so3.c:%d: expected error %d from both; f32: %ld, %d \"%s\"; "
-                "f64: %ld, %d \"%s\"\n",
-                line, code, f.ret, f.code, f.msg, d.ret, d.code, d.msg);
-        g_failures++;
-    }
-}
-
-/* Compares an f32 call returning an error code (or a count) with its f64 twin. */
-#define SAME_CODE(code, fcall, dcall)                                                       \
-    do {                                                                                    \
-        struct outcome f_ = outcome_of((long)(fcall));                                      \
-        struct outcome d_ = outcome_of((long)(dcall));                                      \
-        CHECK(f_.ret == (code));                                                            \
-        same_failure(__LINE__, (code), f_, d_, 1);                                          \
-    } while (0)
-
-/* The same where the messages differ: an alignment (4 bytes against 8) and an address, or
- * a function name; `fmsg` must be part of the f32 message. */
-#define SAME_CODE_ONLY(code, fcall, dcall, fmsg)                                            \
-    do {                                                                                    \
-        struct outcome f_ = outcome_of((long)(fcall));                                      \
-        struct outcome d_ = outcome_of((long)(dcall));                                      \
-        CHECK(f_.ret == (code));                                                            \
-        same_failure(__LINE__, (code), f_, d_, 0);                                          \
-        CHECK(strstr(f_.msg, (fmsg)) != NULL);                                              \
-    } while (0)
-
-/* Compares an f32 planner with its f64 twin: both NULL, the same code and message; `ftype`
- * and `dtype` are the plan types, `fdestroy` and `ddestroy` their destroy functions. */
-#define SAME_NULL(code, ftype, fcall, fdestroy, dtype, dcall, ddestroy, same_msg)           \
-    do {                                                                                    \
-        ftype fp_ = (fcall);                                                                \
-        struct outcome f_ = outcome_of(fp_ != NULL);                                        \
-        dtype dp_ = (dcall);                                                                \
-        struct outcome d_ = outcome_of(dp_ != NULL);                                        \
-        CHECK(fp_ == NULL && dp_ == NULL);                                                  \
-        same_failure(__LINE__, (code), f_, d_, (same_msg));                                 \
-        fdestroy(fp_);                                                                      \
-        ddestroy(dp_);                                                                      \
-    } while (0)
-
 #define SAME_PLAN_FAILURE(code, fcall, dcall)                                               \
     SAME_NULL(code, so3fftf_plan, fcall, so3fftf_destroy_plan, so3fft_plan, dcall,          \
               so3fft_destroy_plan, 1)
