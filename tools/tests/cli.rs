@@ -83,6 +83,7 @@ fn stress_bad_usage_exits_2() {
         "--docs",
         "--from-csv",
         "--time-svg",
+        "--precision",
     ] {
         assert!(out.contains(needle), "{needle} missing from --help");
     }
@@ -92,6 +93,8 @@ fn stress_bad_usage_exits_2() {
         &["--only", "reference,nonsense"],
         &["--csv"],
         &["--from-csv", "x.csv", "--quick"],
+        &["--precision", "f16"],
+        &["--from-csv", "x.csv", "--precision", "f32"],
     ] {
         let (code, _, err) = run(STRESS, args);
         assert_eq!(code, 2, "{args:?}: {err}");

@@ -92,7 +92,7 @@ fn round_trips<T: Float>(limits: (f64, f64, f64)) {
         s2_max: 256,
         variants: true,
     };
-    roundtrip::run::<T>(ranges, 2, &mut report).unwrap();
+    roundtrip::run(ranges, 2, &[T::PRECISION], &mut report).unwrap();
     assert!(report.rows.iter().all(|r| r.precision == T::PRECISION));
     for (test, limit) in [
         ("roundtrip", limits.0),

@@ -39,7 +39,7 @@ use std::time::Instant;
 
 /// The numerical stress suite of so3fft: transforms against exact values, round trips over
 /// doubling bandwidths, adversarial inputs, determinism across threads, rotational matching
-/// and every instruction set. Prints a row per case as it is measured, the fitted growth
+/// and every instruction set, in double and single precision. Prints a row per case as it is measured, the fitted growth
 /// exponents and the accuracy targets. See docs/stability.md.
 #[derive(Parser, Debug)]
 #[command(
@@ -51,7 +51,7 @@ use std::time::Instant;
 )]
 struct Options {
     /// Small bandwidths only (SO(3) round trips to 64, partial to 128, S^2 to 256; about
-    /// 10 s); without it the full run (SO(3) to 256, partial and S^2 to 2048; a few
+    /// 5 s); without it the full run (SO(3) to 256, partial and S^2 to 2048; a few
     /// minutes, under 6 GB)
     #[arg(long)]
     quick: bool,
@@ -139,46 +139,79 @@ fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<String> {
     {
         let name = format!("{test:?}").to_lowercase();
         bar.message(name.clone());
-        for p in o.precisions() {
+        let precisions = o.precisions();
+        if matches!(test, Test::Roundtrip | Test::Matching) {
+            // Timed tests: the precisions alternate inside (one bandwidth at a time).
             let start = Instant::now();
-            match p {
-                Precision::F64 => run_test::<f64>(o, test, report)?,
-                Precision::F32 => run_test::<f32>(o, test, report)?,
+            run_timed(o, test, &precisions, report)?;
+            let list: Vec<&str> = precisions.iter().map(|p| p.name()).collect();
+            let seconds = start.elapsed().as_secs_f64();
+            times.push(format!("{name} {} {seconds:.1}", list.join("+")));
+        } else {
+            for p in precisions {
+                let start = Instant::now();
+                match p {
+                    Precision::F64 => run_test::<f64>(o, test, report)?,
+                    Precision::F32 => run_test::<f32>(o, test, report)?,
+                }
+                times.push(format!("{name} {p} {:.1}", start.elapsed().as_secs_f64()));
             }
-            times.push(format!("{name} {p} {:.1}", start.elapsed().as_secs_f64()));
         }
         bar.step();
     }
     Ok(times.join(", "))
 }
 
-/// Runs one test in `T`.
+/// Runs a test whose times the chart compares (round trips, matching) in every precision
+/// of `precisions`.
+fn run_timed(
+    o: &Options,
+    test: Test,
+    precisions: &[Precision],
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    let t = o.threads;
+    if test == Test::Matching {
+        let ls: &[usize] = if o.quick {
+            &[16, 32]
+        } else {
+            &[16, 32, 64, 128]
+        };
+        return matching::run(ls, t, precisions, report);
+    }
+    let ranges = if o.quick {
+        roundtrip::Ranges {
+            full_max: 64,
+            partial_max: 128,
+            s2_max: 256,
+            variants: true,
+        }
+    } else {
+        roundtrip::Ranges {
+            full_max: 256,
+            partial_max: 2048,
+            s2_max: 2048,
+            variants: true,
+        }
+    };
+    roundtrip::run(ranges, t, precisions, report)?;
+    if o.big {
+        for &p in precisions {
+            match p {
+                Precision::F64 => roundtrip::big::<f64>(t, report)?,
+                Precision::F32 => roundtrip::big::<f32>(t, report)?,
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Runs one test in `T` (the untimed ones: see [`run_timed`]).
 fn run_test<T: Float>(o: &Options, test: Test, report: &mut Report) -> so3fft::Result<()> {
     let t = o.threads;
     match test {
         Test::Reference => reference::run::<T>(&o.data_dir(), t, report),
-        Test::Roundtrip => {
-            let ranges = if o.quick {
-                roundtrip::Ranges {
-                    full_max: 64,
-                    partial_max: 128,
-                    s2_max: 256,
-                    variants: true,
-                }
-            } else {
-                roundtrip::Ranges {
-                    full_max: 256,
-                    partial_max: 2048,
-                    s2_max: 2048,
-                    variants: true,
-                }
-            };
-            roundtrip::run::<T>(ranges, t, report)?;
-            if o.big {
-                roundtrip::big::<T>(t, report)?;
-            }
-            Ok(())
-        }
+        Test::Roundtrip | Test::Matching => run_timed(o, test, &[T::PRECISION], report),
         Test::Adversarial => {
             let bw = if o.quick {
                 adversarial::Bandwidths {
@@ -196,14 +229,6 @@ fn run_test<T: Float>(o: &Options, test: Test, report: &mut Report) -> so3fft::R
             adversarial::run::<T>(&bw, t, report)
         }
         Test::Determinism => determinism::run::<T>(if o.quick { 32 } else { 64 }, report),
-        Test::Matching => {
-            let ls: &[usize] = if o.quick {
-                &[16, 32]
-            } else {
-                &[16, 32, 64, 128]
-            };
-            matching::run::<T>(ls, t, report)
-        }
         Test::Isa => {
             let bw = if o.quick {
                 reference::IsaBandwidths {

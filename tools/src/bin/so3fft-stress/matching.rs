@@ -89,10 +89,12 @@ fn against_f64(
     })
 }
 
-/// Matching at each `L` of `bandwidths` on `threads` workers, in `T`.
-pub fn run<T: Float>(
+/// Matching at each `L` of `bandwidths` on `threads` workers, in each of `precisions` (one
+/// after the other for each `L`, so that their times see the same load of a shared host).
+pub fn run(
     bandwidths: &[usize],
     threads: usize,
+    precisions: &[Precision],
     report: &mut Report,
 ) -> so3fft::Result<()> {
     let truth = Rotation::new(2.1234567, 1.2345678, 0.3456789);
@@ -107,33 +109,50 @@ pub fn run<T: Float>(
         );
         s2.inverse(&rotate_s2_coeffs(l, &hat, &truth)?, &mut sig)?;
         s2.inverse(&hat, &mut pat)?;
-        let (sig_t, pat_t) = (narrow::<T>(&sig), narrow::<T>(&pat));
-        for (variant, b_out) in [("match-grid", l), ("match-grid-2x", 2 * l)] {
-            let computed = pipeline::<T>(l, b_out, threads, (&sig_t, &pat_t), true)?;
-            let (plan, peak, t_grid) = (computed.plan, computed.peak, computed.time);
-            let err = peak.rotation().angle_to(&truth);
-            let mut note = format!("grid step pi/{b_out}");
-            if T::PRECISION != Precision::F64 {
-                let (sig64, pat64) = (widen(&sig_t), widen(&pat_t));
-                note += "; ";
-                note += &against_f64(l, b_out, threads, &sig64, &pat64, &peak)?;
+        for &p in precisions {
+            match p {
+                Precision::F64 => rows::<f64>(l, threads, (&sig, &pat), &truth, report)?,
+                Precision::F32 => rows::<f32>(l, threads, (&sig, &pat), &truth, report)?,
             }
-            report.push(row::<T>(l, variant, err, t_grid, &note));
-            if b_out == l {
-                let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
-                let start = Instant::now();
-                plan.coefficients(&sig_t, &pat_t, &mut coeffs)?;
-                let (refined, _) = plan.refine(&coeffs, &peak.rotation())?;
-                let t_refine = start.elapsed().as_secs_f64();
-                let err = refined.angle_to(&truth);
-                report.push(row::<T>(
-                    l,
-                    "match-refined",
-                    err,
-                    t_grid + t_refine,
-                    "grid + refinement",
-                ));
-            }
+        }
+    }
+    Ok(())
+}
+
+/// The rows of one `L` in `T`, from the `f64` samples `sig`, `pat` rounded to `T`.
+fn rows<T: Float>(
+    l: usize,
+    threads: usize,
+    (sig, pat): (&[Complex64], &[Complex64]),
+    truth: &Rotation,
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    let (sig_t, pat_t) = (narrow::<T>(sig), narrow::<T>(pat));
+    for (variant, b_out) in [("match-grid", l), ("match-grid-2x", 2 * l)] {
+        let computed = pipeline::<T>(l, b_out, threads, (&sig_t, &pat_t), true)?;
+        let (plan, peak, t_grid) = (computed.plan, computed.peak, computed.time);
+        let err = peak.rotation().angle_to(truth);
+        let mut note = format!("grid step pi/{b_out}");
+        if T::PRECISION != Precision::F64 {
+            let (sig64, pat64) = (widen(&sig_t), widen(&pat_t));
+            note += "; ";
+            note += &against_f64(l, b_out, threads, &sig64, &pat64, &peak)?;
+        }
+        report.push(row::<T>(l, variant, err, t_grid, &note));
+        if b_out == l {
+            let mut coeffs = vec![Complex64::default(); so3fft::num_coeffs(l)];
+            let start = Instant::now();
+            plan.coefficients(&sig_t, &pat_t, &mut coeffs)?;
+            let (refined, _) = plan.refine(&coeffs, &peak.rotation())?;
+            let t_refine = start.elapsed().as_secs_f64();
+            let err = refined.angle_to(truth);
+            report.push(row::<T>(
+                l,
+                "match-refined",
+                err,
+                t_grid + t_refine,
+                "grid + refinement",
+            ));
         }
     }
     Ok(())

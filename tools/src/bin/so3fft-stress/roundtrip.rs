@@ -455,32 +455,76 @@ pub struct Ranges {
     pub variants: bool,
 }
 
-/// Every round trip of (b) in `T`.
-pub fn run<T: Float>(ranges: Ranges, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+/// The round trips of one bandwidth and kind in `T`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Full plan: complex, the extra variants if asked, real.
+    Full,
+    /// Order-limited partial plan, complex and real.
+    Partial,
+    /// S^2, complex and real.
+    Sphere,
+}
+
+fn one<T: Float>(
+    kind: Kind,
+    b: usize,
+    ranges: Ranges,
+    run: RunOptions,
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    match kind {
+        Kind::Full => {
+            full_complex::<T>(b, FULL_VARIANTS[0], run, report)?;
+            if ranges.variants {
+                let quick = RunOptions {
+                    sample_checks: false,
+                    ..run
+                };
+                for v in &FULL_VARIANTS[1..] {
+                    full_complex::<T>(b, *v, quick, report)?;
+                }
+            }
+            full_real::<T>(b, run, report)
+        }
+        Kind::Partial => {
+            partial::<T>(b, false, run, report)?;
+            partial::<T>(b, true, run, report)
+        }
+        Kind::Sphere => {
+            sphere::<T>(b, false, run, report)?;
+            sphere::<T>(b, true, run, report)
+        }
+    }
+}
+
+/// Every round trip of (b) in each of `precisions`. The precisions of one bandwidth run
+/// one after the other, so that their times, compared in the time chart, see the same load
+/// of a shared host.
+pub fn run(
+    ranges: Ranges,
+    threads: usize,
+    precisions: &[Precision],
+    report: &mut Report,
+) -> so3fft::Result<()> {
     let run = RunOptions {
         threads,
         sample_checks: true,
     };
-    for b in doublings(8, ranges.full_max) {
-        full_complex::<T>(b, FULL_VARIANTS[0], run, report)?;
-        if ranges.variants {
-            let quick = RunOptions {
-                sample_checks: false,
-                ..run
-            };
-            for v in &FULL_VARIANTS[1..] {
-                full_complex::<T>(b, *v, quick, report)?;
+    let series = [
+        (Kind::Full, doublings(8, ranges.full_max)),
+        (Kind::Partial, doublings(16, ranges.partial_max)),
+        (Kind::Sphere, doublings(8, ranges.s2_max)),
+    ];
+    for (kind, bandwidths) in series {
+        for b in bandwidths {
+            for &p in precisions {
+                match p {
+                    Precision::F64 => one::<f64>(kind, b, ranges, run, report)?,
+                    Precision::F32 => one::<f32>(kind, b, ranges, run, report)?,
+                }
             }
         }
-        full_real::<T>(b, run, report)?;
-    }
-    for b in doublings(16, ranges.partial_max) {
-        partial::<T>(b, false, run, report)?;
-        partial::<T>(b, true, run, report)?;
-    }
-    for b in doublings(8, ranges.s2_max) {
-        sphere::<T>(b, false, run, report)?;
-        sphere::<T>(b, true, run, report)?;
     }
     Ok(())
 }
