@@ -1,8 +1,8 @@
 //! Log-log line charts as SVG, drawn with plotters: the benchmark's time and error panels
 //! (`bench.svg`) and the stress suite's error and time-against-error charts.
 //!
-//! A [`Figure`] is one or more [`Panel`]s side by side, each with its own legend (to the
-//! right of the plot or under it). Text is left to the SVG viewer's sans-serif font, so no
+//! A [`Figure`] is one or more [`Panel`]s in rows of `columns`, each with its own legend (to
+//! the right of the plot or under it). Text is left to the SVG viewer's sans-serif font, so no
 //! font files or system font libraries are needed.
 
 use plotters::coord::Shift;
@@ -137,13 +137,16 @@ pub struct Panel {
     pub y_rules: Vec<Rule>,
 }
 
-/// Panels side by side, each `panel_width` wide with a plot `plot_height` high.
+/// Panels in rows of `columns` (filled left to right, top to bottom), each `panel_width`
+/// wide with a plot `plot_height` high.
 #[derive(Clone, Debug)]
 pub struct Figure {
     pub panels: Vec<Panel>,
     pub panel_width: u32,
     pub plot_height: u32,
     pub legend: LegendPlace,
+    /// Panels per row (at least 1).
+    pub columns: usize,
 }
 
 impl Figure {
@@ -159,13 +162,16 @@ impl Figure {
             LegendPlace::Right => 0,
             LegendPlace::Below => legend_rows.div_ceil(2) as u32 * LEGEND_ROW + 12,
         };
-        let width = self.panel_width * self.panels.len().max(1) as u32;
-        let height = self.plot_height + legend_h;
+        let n = self.panels.len().max(1);
+        let columns = self.columns.clamp(1, n);
+        let rows = n.div_ceil(columns);
+        let width = self.panel_width * columns as u32;
+        let height = (self.plot_height + legend_h) * rows as u32;
         let mut out = String::new();
         {
             let root = SVGBackend::with_string(&mut out, (width, height)).into_drawing_area();
             root.fill(&WHITE).map_err(|e| e.to_string())?;
-            let areas = root.split_evenly((1, self.panels.len().max(1)));
+            let areas = root.split_evenly((rows, columns));
             for (panel, area) in self.panels.iter().zip(&areas) {
                 let (plot, legend) = match self.legend {
                     LegendPlace::Right => {
@@ -260,14 +266,24 @@ fn x_axis(panel: &Panel) -> (f64, f64, Vec<f64>) {
 }
 
 /// The y axis: range, labelled ticks (decades; also 2 and 5 times them when the range is
-/// two decades or less) and minor ticks (2..9 times each decade up to twelve decades).
+/// two decades or less) and minor ticks (2..9 times each decade up to twelve decades). A
+/// labelled point in the top quarter decade gets a decade of room above it for its label.
 fn y_axis(panel: &Panel) -> (f64, f64, Vec<f64>, Vec<f64>) {
     let ys = panel
         .series
         .iter()
         .flat_map(|s| s.points.iter().map(|p| p.1))
         .chain(panel.y_rules.iter().map(|r| r.at));
-    let (a, b) = decade_range(ys);
+    let (a, mut b) = decade_range(ys);
+    let top_label = panel
+        .series
+        .iter()
+        .filter(|s| !s.point_labels.is_empty())
+        .flat_map(|s| s.points.iter().map(|p| p.1.log10()))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if top_label > b - 0.25 {
+        b += 1.0;
+    }
     let decades = (b - a).round() as i32;
     let (a, b) = (a as i32, b as i32);
     let mut labelled = Vec::new();
@@ -522,6 +538,19 @@ mod tests {
         }
     }
 
+    /// A labelled point near the top decade line gets room for its label.
+    #[test]
+    fn labels_get_room_at_the_top() {
+        let mut s = Series::new("x", hex("#000000"), Line::Solid, Marker::Circle);
+        s.push(1.0, 7e-2);
+        let mut p = panel(vec![s.clone()], XTicks::Decades);
+        p.y_rules.clear();
+        assert_eq!(y_axis(&p).1, 1e-1);
+        s.push_labelled(2.0, 7e-2, "16");
+        p.series = vec![s];
+        assert_eq!(y_axis(&p).1, 1.0);
+    }
+
     /// Decade and octave ranges enclose the data, in whole steps.
     #[test]
     fn ranges_enclose_the_data() {
@@ -578,9 +607,19 @@ mod tests {
             panel_width: 600,
             plot_height: 400,
             legend: LegendPlace::Below,
+            columns: 2,
         };
         let svg = figure.svg().unwrap();
         assert!(svg.starts_with("<svg"), "{}", &svg[..100]);
+        // Side by side; one column stacks the panels.
+        assert!(svg.contains("width=\"1200\""), "{}", &svg[..200]);
+        let stacked = Figure {
+            columns: 1,
+            ..figure.clone()
+        }
+        .svg()
+        .unwrap();
+        assert!(stacked.contains("width=\"600\""), "{}", &stacked[..200]);
         for needle in [
             "complex (~B^0.73)",
             "SOFT",

@@ -18,6 +18,7 @@ pub fn svg(rows: &[Row]) -> Result<String, String> {
         panel_width: 560,
         plot_height: 440,
         legend: LegendPlace::Below,
+        columns: 2,
     }
     .svg()
 }

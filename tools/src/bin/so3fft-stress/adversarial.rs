@@ -1,29 +1,48 @@
 //! (c) Adversarial inputs: a single coefficient at the highest degree and orders (against
 //! the closed form of `d^l_{l,+-l}`), coefficients that decay or grow in the degree, exact
-//! scaling by `2^k`, subnormal inputs, NaN and infinite inputs.
+//! scaling by `2^k`, subnormal inputs, NaN and infinite inputs; each in `f64` and `f32`
+//! (the same inputs rounded to `f32`; the exponents of the scaling and subnormal tests
+//! follow the type's range, see [`crate::precision::Precision`]).
 
+use crate::precision::{narrow, narrow_one, pow2, random, widen, zero, Float};
 use crate::record::{bit_differences, errors, Case, Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::{compensated_sum, ORDER_LIMIT};
 use so3fft::s2::{s2_coef_index, s2_num_coeffs, s2_num_samples, S2Plan};
 use so3fft::{
-    coef_index, num_coeffs, num_samples, sample_index, Complex64, Options, PartialPlan, Plan, Shape,
+    coef_index, num_coeffs, num_samples, sample_index, Complex, Complex64, Options, PartialPlan,
+    Plan, Shape,
 };
 use std::f64::consts::PI;
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 const ZERO: Complex64 = Complex64::new(0.0, 0.0);
 
-fn plan(b: usize, threads: usize, real: bool) -> so3fft::Result<Plan> {
+fn plan<T: Float>(b: usize, threads: usize, real: bool) -> so3fft::Result<Plan<T>> {
     Plan::new(b, &Options::default().with_threads(threads).with_real(real))
 }
 
-/// `exp(-i pi t / B)` with `t` reduced mod `2B` first (accurate for large `M j`).
-fn phase(t: isize, b: usize) -> Complex64 {
-    let n = 2 * b as isize;
-    let angle = -PI * t.rem_euclid(n) as f64 / b as f64;
-    Complex64::new(angle.cos(), angle.sin())
+/// `exp(-i pi t / B)` for `t = 0 .. 2B-1`: [`Phases::at`] reduces `t` mod `2B` first
+/// (accurate for large `M j`) and looks the value up.
+struct Phases {
+    table: Vec<Complex64>,
+}
+
+impl Phases {
+    fn new(b: usize) -> Phases {
+        let table = (0..2 * b)
+            .map(|t| {
+                let angle = -PI * t as f64 / b as f64;
+                Complex64::new(angle.cos(), angle.sin())
+            })
+            .collect();
+        Phases { table }
+    }
+
+    fn at(&self, t: isize) -> Complex64 {
+        self.table[t.rem_euclid(self.table.len() as isize) as usize]
+    }
 }
 
 /// `cos^(2l)(x)` for `x = pi t / q` in `[0, pi/2]`, as `exp(l ln1p(-sin^2 x))`: accurate to
@@ -39,6 +58,7 @@ fn cos_power(l: usize, t: f64, q: f64) -> f64 {
 fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex64> {
     let l = m.unsigned_abs();
     let n = 2 * b;
+    let phases = Phases::new(b);
     let mut out = vec![ZERO; num_samples(b)];
     for k in 0..n {
         // beta / 2 = pi (2k+1) / (8B); sin(beta/2) = cos(pi (4B-2k-1) / (8B)).
@@ -51,7 +71,7 @@ fn top_order_samples(b: usize, m: isize, mp: isize, c: Complex64) -> Vec<Complex
         let dt = ((2 * l + 1) as f64 / 2.0).sqrt() * d / (2.0 * PI);
         for j1 in 0..n {
             for j2 in 0..n {
-                let e = phase(m * j1 as isize + mp * j2 as isize, b);
+                let e = phases.at(m * j1 as isize + mp * j2 as isize);
                 out[sample_index(b, j1, k, j2)] = c * dt * e;
             }
         }
@@ -69,6 +89,7 @@ fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
     let log_ratio = compensated_sum((1..=l).map(|i| (-1.0 / (2 * i) as f64).ln_1p()));
     let sign = if l.is_multiple_of(2) { 1.0 } else { -1.0 };
     let norm = sign * ((2 * l + 1) as f64 / 2.0).sqrt() / (2.0 * PI).sqrt();
+    let phases = Phases::new(b);
     let mut out = vec![ZERO; s2_num_samples(b)];
     for j in 0..n {
         // sin^l(theta) = cos^l(pi/2 - theta), pi/2 - theta_j = pi (2B-2j-1) / (4B); the
@@ -77,8 +98,8 @@ fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
         let s = x.sin();
         let p = (0.5 * log_ratio + 0.5 * l as f64 * (-s * s).ln_1p()).exp();
         for k in 0..n {
-            // e^{i m phi_k}, phi_k = pi k / B: phase() gives e^{-i pi t / B}.
-            let y = norm * p * phase(-m * k as isize, b);
+            // e^{i m phi_k}, phi_k = pi k / B: the table holds e^{-i pi t / B}.
+            let y = norm * p * phases.at(-m * k as isize);
             let y = if m < 0 { y * sign } else { y };
             out[j * n + k] = c * y;
         }
@@ -88,19 +109,25 @@ fn s2_top_order_samples(b: usize, m: isize, c: Complex64) -> Vec<Complex64> {
 
 /// S^2 single coefficients at `l = |m| = B-1`: the synthesis against the closed form
 /// (`s2-top-order-inverse`) and the round trip (`s2-top-order-roundtrip`).
-pub fn s2_top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    let plan = S2Plan::new(b, &Options::default().with_threads(threads))?;
+pub fn s2_top_order<T: Float>(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    let plan = S2Plan::<T>::new(b, &Options::default().with_threads(threads))?;
+    // Exact in both precisions.
     let c = Complex64::new(0.75, -0.5);
     let top = b as isize - 1;
     for (m, variant) in [(top, "m=B-1"), (-top, "m=-(B-1)")] {
-        let mut coeffs = vec![ZERO; s2_num_coeffs(b)];
-        coeffs[s2_coef_index(b, b - 1, m)] = c;
-        let mut samples = vec![ZERO; s2_num_samples(b)];
+        let mut coeffs = vec![zero::<T>(); s2_num_coeffs(b)];
+        coeffs[s2_coef_index(b, b - 1, m)] = narrow_one(c);
+        let mut samples = vec![zero::<T>(); s2_num_samples(b)];
         let start = Instant::now();
         plan.inverse(&coeffs, &mut samples)?;
         let t_inv = start.elapsed().as_secs_f64();
         let want = s2_top_order_samples(b, m, c);
-        let case = |test| Case { test, b, variant };
+        let case = |test| Case {
+            test,
+            b,
+            variant,
+            precision: T::PRECISION,
+        };
         let note = "vs closed form sin^l(theta)";
         report.push_errors(
             case("s2-top-order-inverse"),
@@ -108,7 +135,7 @@ pub fn s2_top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Re
             t_inv,
             note,
         );
-        let mut back = vec![ZERO; s2_num_coeffs(b)];
+        let mut back = vec![zero::<T>(); s2_num_coeffs(b)];
         let start = Instant::now();
         plan.forward(&samples, &mut back)?;
         let t_fwd = start.elapsed().as_secs_f64();
@@ -124,8 +151,8 @@ pub fn s2_top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Re
 
 /// Single coefficients at `l = B-1`, `|M| = |M'| = B-1`: the inverse against the closed
 /// form (`top-order-inverse`) and the round trip (`top-order-roundtrip`).
-pub fn top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    let plan = plan(b, threads, false)?;
+pub fn top_order<T: Float>(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    let plan = plan::<T>(b, threads, false)?;
     let top = b as isize - 1;
     let c = Complex64::new(0.75, -0.5);
     for (m, mp, variant) in [
@@ -133,14 +160,19 @@ pub fn top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Resul
         (-top, top, "M=-(B-1),M'=B-1"),
         (top, top, "M=M'=B-1"),
     ] {
-        let mut coeffs = vec![ZERO; num_coeffs(b)];
-        coeffs[coef_index(b, b - 1, m, mp)] = c;
-        let mut samples = vec![ZERO; num_samples(b)];
+        let mut coeffs = vec![zero::<T>(); num_coeffs(b)];
+        coeffs[coef_index(b, b - 1, m, mp)] = narrow_one(c);
+        let mut samples = vec![zero::<T>(); num_samples(b)];
         let start = Instant::now();
         plan.inverse(&coeffs, &mut samples)?;
         let t_inv = start.elapsed().as_secs_f64();
         let want = top_order_samples(b, m, mp, c);
-        let case = |test| Case { test, b, variant };
+        let case = |test| Case {
+            test,
+            b,
+            variant,
+            precision: T::PRECISION,
+        };
         let note = "vs closed form cos/sin^(2l)(beta/2)";
         report.push_errors(
             case("top-order-inverse"),
@@ -148,7 +180,7 @@ pub fn top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Resul
             t_inv,
             note,
         );
-        let mut back = vec![ZERO; num_coeffs(b)];
+        let mut back = vec![zero::<T>(); num_coeffs(b)];
         let start = Instant::now();
         plan.forward(&samples, &mut back)?;
         let t_fwd = start.elapsed().as_secs_f64();
@@ -164,8 +196,13 @@ pub fn top_order(b: usize, threads: usize, report: &mut Report) -> so3fft::Resul
 
 /// Coefficients `(l+1)^-p` times random values (p > 0 decays, p < 0 grows): the round
 /// trip, with the worst per-degree relative error in the note.
-pub fn power_law(b: usize, p: f64, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    let plan = plan(b, threads, false)?;
+pub fn power_law<T: Float>(
+    b: usize,
+    p: f64,
+    threads: usize,
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    let plan = plan::<T>(b, threads, false)?;
     let mut coeffs = SplitMix64::new(50 + b as u64).complex_vec(num_coeffs(b));
     for l in 0..b {
         let scale = ((l + 1) as f64).powf(-p);
@@ -176,12 +213,16 @@ pub fn power_law(b: usize, p: f64, threads: usize, report: &mut Report) -> so3ff
             }
         }
     }
-    let mut samples = vec![ZERO; num_samples(b)];
-    let mut back = vec![ZERO; num_coeffs(b)];
+    let input = narrow::<T>(&coeffs);
+    // The truth: the coefficients as the plan's type holds them.
+    let coeffs = widen(&input);
+    let mut samples = vec![zero::<T>(); num_samples(b)];
+    let mut out = vec![zero::<T>(); num_coeffs(b)];
     let start = Instant::now();
-    plan.inverse(&coeffs, &mut samples)?;
-    plan.forward(&samples, &mut back)?;
+    plan.inverse(&input, &mut samples)?;
+    plan.forward(&samples, &mut out)?;
     let time = start.elapsed().as_secs_f64();
+    let back = widen(&out);
     // Per degree: ||error|| / ||fhat|| over the degree's coefficients.
     let mut worst = (0.0f64, 0usize);
     for l in 0..b {
@@ -205,21 +246,23 @@ pub fn power_law(b: usize, p: f64, threads: usize, report: &mut Report) -> so3ff
         test: "power-law",
         b,
         variant: &variant,
+        precision: T::PRECISION,
     };
     report.push_errors(case, errors(&back, &coeffs), time, &note);
     Ok(())
 }
 
-/// A transform from one complex array to a new one.
-pub type TransformFn = Box<dyn Fn(&[Complex64]) -> so3fft::Result<Vec<Complex64>> + Send>;
+/// A transform from one complex array to a new one, in `T`.
+pub type TransformFn<T> =
+    Box<dyn Fn(&[Complex<T>]) -> so3fft::Result<Vec<Complex<T>>> + Send + Sync>;
 
 /// The transforms whose scaling and special values are checked, each as
-/// `f(input) -> output` on complex arrays.
-pub struct Transform {
+/// `f(input) -> output` on complex arrays of `T`.
+pub struct Transform<T: Float> {
     /// Row label.
     pub name: &'static str,
     /// Runs the transform.
-    pub run: TransformFn,
+    pub run: TransformFn<T>,
     /// Input length.
     pub input_len: usize,
     /// The input whose contributions are skipped most: the top-order coefficient
@@ -228,26 +271,31 @@ pub struct Transform {
     pub top: usize,
 }
 
-fn real_parts(x: &[Complex64]) -> Vec<f64> {
+fn real_parts<T: Float>(x: &[Complex<T>]) -> Vec<T> {
     x.iter().map(|z| z.re).collect()
 }
 
-fn as_complex(x: &[f64]) -> Vec<Complex64> {
-    x.iter().map(|&r| Complex64::new(r, 0.0)).collect()
+fn as_complex<T: Float>(x: &[T]) -> Vec<Complex<T>> {
+    x.iter()
+        .map(|&r| Complex::new(r, T::narrowed(0.0)))
+        .collect()
 }
 
 /// The ten transforms of the scaling and special-value tests: full plan with skipping
 /// off, full plan complex and real, partial order-limited, S^2 complex; inverse and forward
 /// of each. Real inverses read the
 /// representatives only; real forwards read the real parts.
-pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
-    let full = std::sync::Arc::new(plan(b, threads, true)?);
+pub fn transforms<T: Float>(b: usize, threads: usize) -> so3fft::Result<Vec<Transform<T>>> {
+    let full = std::sync::Arc::new(plan::<T>(b, threads, true)?);
     let shape = Shape::new(b).with_orders(ORDER_LIMIT.min(b - 1), ORDER_LIMIT.min(b - 1));
-    let part = std::sync::Arc::new(PartialPlan::new(
+    let part = std::sync::Arc::new(PartialPlan::<T>::new(
         &shape,
         &Options::default().with_threads(threads),
     )?);
-    let s2 = std::sync::Arc::new(S2Plan::new(b, &Options::default().with_threads(threads))?);
+    let s2 = std::sync::Arc::new(S2Plan::<T>::new(
+        b,
+        &Options::default().with_threads(threads),
+    )?);
     let (nc, ns) = (num_coeffs(b), num_samples(b));
     let (pc, ps) = (part.num_coeffs(), part.num_samples());
     let (sc, ss) = (s2_num_coeffs(b), s2_num_samples(b));
@@ -256,20 +304,20 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
     let top_so3 = coef_index(b, b - 1, -top, top);
     let top_partial = shape.coef_index(b - 1, -m, m).unwrap_or(0);
     let top_s2 = s2_coef_index(b, b - 1, top);
-    let noskip = std::sync::Arc::new(Plan::new(
+    let noskip = std::sync::Arc::new(Plan::<T>::new(
         b,
         &Options::default()
             .with_threads(threads)
             .with_skip_bits(Some(0)),
     )?);
-    let mut out: Vec<Transform> = Vec::new();
+    let mut out: Vec<Transform<T>> = Vec::new();
     let p = noskip.clone();
     out.push(Transform {
         name: "so3-inverse-noskip",
         input_len: nc,
         top: top_so3,
         run: Box::new(move |c| {
-            let mut f = vec![ZERO; ns];
+            let mut f = vec![zero(); ns];
             p.inverse(c, &mut f).map(|_| f)
         }),
     });
@@ -279,7 +327,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: ns,
         top: 0,
         run: Box::new(move |f| {
-            let mut c = vec![ZERO; nc];
+            let mut c = vec![zero(); nc];
             p.forward(f, &mut c).map(|_| c)
         }),
     });
@@ -289,7 +337,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: nc,
         top: top_so3,
         run: Box::new(move |c| {
-            let mut f = vec![ZERO; ns];
+            let mut f = vec![zero(); ns];
             p.inverse(c, &mut f).map(|_| f)
         }),
     });
@@ -299,7 +347,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: ns,
         top: 0,
         run: Box::new(move |f| {
-            let mut c = vec![ZERO; nc];
+            let mut c = vec![zero(); nc];
             p.forward(f, &mut c).map(|_| c)
         }),
     });
@@ -309,7 +357,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: nc,
         top: top_so3,
         run: Box::new(move |c| {
-            let mut f = vec![0.0; ns];
+            let mut f = vec![T::narrowed(0.0); ns];
             p.inverse_real(c, &mut f).map(|_| as_complex(&f))
         }),
     });
@@ -319,7 +367,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: ns,
         top: 0,
         run: Box::new(move |f| {
-            let mut c = vec![ZERO; nc];
+            let mut c = vec![zero(); nc];
             p.forward_real(&real_parts(f), &mut c).map(|_| c)
         }),
     });
@@ -329,7 +377,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: pc,
         top: top_partial,
         run: Box::new(move |c| {
-            let mut f = vec![ZERO; ps];
+            let mut f = vec![zero(); ps];
             p.inverse(c, &mut f).map(|_| f)
         }),
     });
@@ -339,7 +387,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: ps,
         top: 0,
         run: Box::new(move |f| {
-            let mut c = vec![ZERO; pc];
+            let mut c = vec![zero(); pc];
             p.forward(f, &mut c).map(|_| c)
         }),
     });
@@ -349,7 +397,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: sc,
         top: top_s2,
         run: Box::new(move |c| {
-            let mut f = vec![ZERO; ss];
+            let mut f = vec![zero(); ss];
             p.inverse(c, &mut f).map(|_| f)
         }),
     });
@@ -359,7 +407,7 @@ pub fn transforms(b: usize, threads: usize) -> so3fft::Result<Vec<Transform>> {
         input_len: ss,
         top: 0,
         run: Box::new(move |f| {
-            let mut c = vec![ZERO; sc];
+            let mut c = vec![zero(); sc];
             p.forward(f, &mut c).map(|_| c)
         }),
     });
@@ -373,48 +421,69 @@ pub struct Scaling {
     pub differing: usize,
     /// Values compared.
     pub total: usize,
+    /// Values of `2^k T(x)` that overflow the type (`k` out of range: they cannot differ
+    /// from an overflowing `T(2^k x)`, so they are not counted as exact).
+    pub overflowing: usize,
     /// `max |T(2^k x) - 2^k T(x)| / (2^k max |T(x)|)`.
     pub max_rel: f64,
 }
 
-/// `T(2^k x)` against `2^k T(x)` for one transform and a random `x`.
-pub fn scaling(t: &Transform, k: i32) -> so3fft::Result<Scaling> {
-    let x = SplitMix64::new(60).complex_vec(t.input_len);
-    let factor = 2f64.powi(k);
+impl Scaling {
+    /// The row's note: `bit-exact`, or what differs.
+    pub fn verdict(&self) -> String {
+        match (self.differing, self.overflowing) {
+            (0, 0) => "bit-exact".to_string(),
+            (d, 0) => format!("{d}/{} values differ", self.total),
+            (d, o) => format!("{d}/{} values differ, {o} overflow", self.total),
+        }
+    }
+}
+
+/// `v` times `2^k`, computed in `f64` (exact for every `k` of the tests) and rounded to
+/// `T`: exact where the product is a normal number of `T`.
+fn scaled<T: Float>(v: &[Complex<T>], k: i32) -> Vec<Complex<T>> {
+    let factor = pow2(k);
+    narrow(&widen(v).iter().map(|z| z * factor).collect::<Vec<_>>())
+}
+
+/// `T(2^k x)` against `2^k T(x)` for one transform and a random `x` (values of `T`).
+pub fn scaling<T: Float>(t: &Transform<T>, k: i32) -> so3fft::Result<Scaling> {
+    let x = random::<T>(&mut SplitMix64::new(60), t.input_len);
     let base = (t.run)(&x)?;
-    let scaled_input: Vec<Complex64> = x.iter().map(|z| z * factor).collect();
-    let got = (t.run)(&scaled_input)?;
-    let want: Vec<Complex64> = base.iter().map(|z| z * factor).collect();
-    let top = base.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    let max_rel = got
+    let got = (t.run)(&scaled(&x, k))?;
+    // 2^k T(x) rounded to T: where it is not normal, T(2^k x) cannot be exact either.
+    let want = scaled(&base, k);
+    let (got64, base64) = (widen(&got), widen(&base));
+    let top = base64.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    let overflowing = widen(&want)
         .iter()
-        .zip(&want)
-        .map(|(g, w)| (g * (1.0 / factor) - w * (1.0 / factor)).norm() / top)
+        .filter(|z| z.re.is_infinite() || z.im.is_infinite())
+        .count();
+    let unscale = pow2(-k);
+    let max_rel = got64
+        .iter()
+        .zip(&base64)
+        .map(|(g, w)| (g * unscale - w).norm() / top)
         .fold(0.0, f64::max);
     Ok(Scaling {
         differing: bit_differences(&got, &want),
         total: got.len(),
+        overflowing,
         max_rel,
     })
 }
 
-/// Powers of two of the scaling test.
-pub const SCALE_EXPONENTS: [i32; 8] = [1, -1, 100, -100, 900, -900, 1000, -1000];
-
-/// Rows `scale-2^k`: every transform, every exponent.
-pub fn scaling_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    for t in transforms(b, threads)? {
-        for k in SCALE_EXPONENTS {
+/// Rows `scale-2^k`: every transform, every exponent of `T`.
+pub fn scaling_rows<T: Float>(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    for t in transforms::<T>(b, threads)? {
+        for k in T::PRECISION.scale_exponents() {
             let s = scaling(&t, k)?;
-            let verdict = if s.differing == 0 {
-                "bit-exact".to_string()
-            } else {
-                format!("{}/{} values differ", s.differing, s.total)
-            };
+            let verdict = s.verdict();
             report.push(Row {
                 test: format!("scale-2^{k}"),
                 b,
                 variant: t.name.into(),
+                precision: T::PRECISION,
                 rel_l2: s.max_rel,
                 max_abs: f64::NAN,
                 time_s: 0.0,
@@ -425,30 +494,32 @@ pub fn scaling_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Re
     Ok(())
 }
 
-/// Exponent of the subnormal inputs: random values times `2^-1040` keep about 34 bits.
-pub const SUBNORMAL_EXPONENT: i32 = -1040;
-
-/// Subnormal inputs: `T(2^-1040 x) 2^1040` against `T(x)`, and the time against `T(x)`'s.
-pub fn subnormal_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    for t in transforms(b, threads)? {
-        let x = SplitMix64::new(70).complex_vec(t.input_len);
+/// Subnormal inputs: `T(2^e x) 2^-e` against `T(x)` (`e` of [`crate::precision::Precision::subnormal_exponent`]),
+/// and the time against `T(x)`'s.
+pub fn subnormal_rows<T: Float>(
+    b: usize,
+    threads: usize,
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    let e = T::PRECISION.subnormal_exponent();
+    for t in transforms::<T>(b, threads)? {
+        let x = random::<T>(&mut SplitMix64::new(70), t.input_len);
         let start = Instant::now();
         let base = (t.run)(&x)?;
         let t_normal = start.elapsed().as_secs_f64();
-        let tiny: Vec<Complex64> = x
-            .iter()
-            .map(|z| z * 2f64.powi(SUBNORMAL_EXPONENT))
-            .collect();
+        let tiny = scaled(&x, e);
         let start = Instant::now();
         let got = (t.run)(&tiny)?;
         let t_tiny = start.elapsed().as_secs_f64();
         // Two steps: 2^1040 itself is not a double.
-        let half = 2f64.powi(-SUBNORMAL_EXPONENT / 2);
-        let up: Vec<Complex64> = got.iter().map(|z| z * half * half).collect();
-        let finite = got.iter().all(|z| z.re.is_finite() && z.im.is_finite());
+        let half = pow2(-e / 2);
+        let up: Vec<Complex64> = widen(&got).iter().map(|z| z * half * half).collect();
+        let finite = got
+            .iter()
+            .all(|z| z.re.widened().is_finite() && z.im.widened().is_finite());
         let note = format!(
-            "inputs x 2^{SUBNORMAL_EXPONENT}, error of result x 2^{}; time {:.1}x normal; {}",
-            -SUBNORMAL_EXPONENT,
+            "inputs x 2^{e}, error of result x 2^{}; time {:.1}x normal; {}",
+            -e,
             t_tiny / t_normal.max(1e-9),
             if finite { "finite" } else { "NOT finite" }
         );
@@ -456,6 +527,7 @@ pub fn subnormal_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::
             test: "subnormal",
             b,
             variant: t.name,
+            precision: T::PRECISION,
         };
         report.push_errors(case, errors(&up, &base), t_tiny, &note);
     }
@@ -474,9 +546,10 @@ pub struct SpecialCounts {
 }
 
 /// Classifies every value.
-pub fn special_counts(values: &[Complex64]) -> SpecialCounts {
+pub fn special_counts<T: Float>(values: &[Complex<T>]) -> SpecialCounts {
     let mut c = SpecialCounts::default();
-    for z in values {
+    for &z in values {
+        let z = crate::precision::widen_one(z);
         if z.re.is_nan() || z.im.is_nan() {
             c.nan += 1;
         } else if z.re.is_infinite() || z.im.is_infinite() {
@@ -493,7 +566,7 @@ pub fn special_counts(values: &[Complex64]) -> SpecialCounts {
 pub struct Poison {
     /// Row label.
     pub name: &'static str,
-    /// The value.
+    /// The value (rounded to the plan's type: the same special value).
     pub value: Complex64,
     /// Where (index into the input).
     pub at: PoisonSite,
@@ -539,42 +612,39 @@ pub const POISONS: [Poison; 5] = [
     },
 ];
 
-/// Runs `T` on a random input with one poisoned value in a separate thread; `None` if it
-/// has not returned after `timeout` (it is left running).
-pub fn poisoned(
-    b: usize,
-    threads: usize,
-    which: usize,
+/// Runs transform `t` on a random input with one poisoned value in a separate thread;
+/// `None` if it has not returned after `timeout` (it is left running).
+pub fn poisoned<T: Float>(
+    t: Arc<Transform<T>>,
     poison: Poison,
     timeout: Duration,
 ) -> Option<so3fft::Result<(SpecialCounts, f64)>> {
     let (send, recv) = mpsc::channel();
     std::thread::spawn(move || {
-        let result = transforms(b, threads).and_then(|ts| {
-            let t = &ts[which];
-            let mut x = SplitMix64::new(80).complex_vec(t.input_len);
-            let i = match poison.at {
-                PoisonSite::Low => 1,
-                PoisonSite::Last => t.input_len - 1,
-                PoisonSite::Top => t.top,
-            };
-            x[i] = poison.value;
-            let start = Instant::now();
-            let y = (t.run)(&x)?;
-            Ok((special_counts(&y), start.elapsed().as_secs_f64()))
-        });
+        let mut x = random::<T>(&mut SplitMix64::new(80), t.input_len);
+        let i = match poison.at {
+            PoisonSite::Low => 1,
+            PoisonSite::Last => t.input_len - 1,
+            PoisonSite::Top => t.top,
+        };
+        x[i] = narrow_one(poison.value);
+        let start = Instant::now();
+        let result = (t.run)(&x).map(|y| (special_counts(&y), start.elapsed().as_secs_f64()));
         let _ = send.send(result);
     });
     recv.recv_timeout(timeout).ok()
 }
 
 /// Rows `nan-inf`: every transform, every poison; the note counts NaN / Inf / finite outputs.
-pub fn special_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
-    let names: Vec<&str> = transforms(b, threads)?.iter().map(|t| t.name).collect();
-    for (which, name) in names.iter().enumerate() {
+pub fn special_rows<T: Float>(b: usize, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+    for t in transforms::<T>(b, threads)? {
+        let name = t.name;
+        // One plan for every poison: NaN left behind in a plan's buffers would show in the
+        // rows that follow.
+        let t = Arc::new(t);
         for poison in POISONS {
             let timeout = Duration::from_secs(60);
-            let (note, time) = match poisoned(b, threads, which, poison, timeout) {
+            let (note, time) = match poisoned::<T>(t.clone(), poison, timeout) {
                 None => ("HANG: no result after 60 s".to_string(), f64::NAN),
                 Some(Err(e)) => (format!("error: {e}"), f64::NAN),
                 Some(Ok((c, t))) => (
@@ -593,6 +663,7 @@ pub fn special_rows(b: usize, threads: usize, report: &mut Report) -> so3fft::Re
                 test: "nan-inf".into(),
                 b,
                 variant: format!("{name}/{}", poison.name),
+                precision: T::PRECISION,
                 rel_l2: f64::NAN,
                 max_abs: f64::NAN,
                 time_s: time,
@@ -613,19 +684,23 @@ pub struct Bandwidths<'a> {
     pub small: usize,
 }
 
-/// Every adversarial test.
-pub fn run(bw: &Bandwidths<'_>, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+/// Every adversarial test in `T`.
+pub fn run<T: Float>(
+    bw: &Bandwidths<'_>,
+    threads: usize,
+    report: &mut Report,
+) -> so3fft::Result<()> {
     for &b in bw.top {
-        top_order(b, threads, report)?;
+        top_order::<T>(b, threads, report)?;
     }
     for &b in bw.s2_top {
-        s2_top_order(b, threads, report)?;
+        s2_top_order::<T>(b, threads, report)?;
     }
     for p in [2.0, 4.0, -2.0] {
-        power_law(bw.small, p, threads, report)?;
+        power_law::<T>(bw.small, p, threads, report)?;
     }
-    scaling_rows(bw.small, threads, report)?;
-    subnormal_rows(bw.small, threads, report)?;
-    special_rows(bw.small, threads, report)?;
+    scaling_rows::<T>(bw.small, threads, report)?;
+    subnormal_rows::<T>(bw.small, threads, report)?;
+    special_rows::<T>(bw.small, threads, report)?;
     Ok(())
 }

@@ -1,11 +1,13 @@
 //! (d) Determinism: every plan kind gives the same bits on 1, 2 and 4 threads (4 is
-//! oversubscribed on a two-core machine) and across repeated executions of one plan.
+//! oversubscribed on a two-core machine) and across repeated executions of one plan, in
+//! `f64` and `f32`.
 
+use crate::precision::{random, zero, Float};
 use crate::record::{Report, Row};
 use crate::rng::SplitMix64;
 use crate::roundtrip::ORDER_LIMIT;
-use so3fft::s2::{s2_num_coeffs, S2Plan};
-use so3fft::{num_coeffs, Complex64, Options, PartialPlan, Plan, Shape};
+use so3fft::s2::S2Plan;
+use so3fft::{Complex, Options, PartialPlan, Plan, Shape};
 use std::time::Instant;
 
 /// The plan kinds checked.
@@ -57,99 +59,98 @@ impl Kind {
 /// returns the bits of both outputs.
 pub type Runner = Box<dyn Fn() -> so3fft::Result<Vec<u64>>>;
 
-fn bits(values: &[Complex64], out: &mut Vec<u64>) {
-    out.extend(values.iter().flat_map(|z| [z.re.to_bits(), z.im.to_bits()]));
+fn bits<T: Float>(values: &[Complex<T>], out: &mut Vec<u64>) {
+    out.extend(
+        values
+            .iter()
+            .flat_map(|z| [z.re.bit_pattern(), z.im.bit_pattern()]),
+    );
 }
 
-fn bits_real(values: &[f64], out: &mut Vec<u64>) {
-    out.extend(values.iter().map(|x| x.to_bits()));
+fn bits_real<T: Float>(values: &[T], out: &mut Vec<u64>) {
+    out.extend(values.iter().map(|x| x.bit_pattern()));
 }
 
-fn plan_runner(b: usize, opts: Options) -> so3fft::Result<Runner> {
-    let real = opts.real;
-    let plan = Plan::new(b, &opts)?;
-    let coeffs = SplitMix64::new(100 + b as u64).complex_vec(num_coeffs(b));
-    Ok(Box::new(move || {
+/// The transforms a runner needs of a plan kind.
+trait RoundTrip<T: Float> {
+    fn sizes(&self) -> (usize, usize);
+    fn inverse(&self, c: &[Complex<T>], f: &mut [Complex<T>]) -> so3fft::Result<()>;
+    fn forward(&self, f: &[Complex<T>], c: &mut [Complex<T>]) -> so3fft::Result<()>;
+    fn inverse_real(&self, c: &[Complex<T>], f: &mut [T]) -> so3fft::Result<()>;
+    fn forward_real(&self, f: &[T], c: &mut [Complex<T>]) -> so3fft::Result<()>;
+}
+
+macro_rules! round_trip_of {
+    ($plan:ident) => {
+        impl<T: Float> RoundTrip<T> for $plan<T> {
+            fn sizes(&self) -> (usize, usize) {
+                (self.num_coeffs(), self.num_samples())
+            }
+            fn inverse(&self, c: &[Complex<T>], f: &mut [Complex<T>]) -> so3fft::Result<()> {
+                $plan::inverse(self, c, f).map(|_| ())
+            }
+            fn forward(&self, f: &[Complex<T>], c: &mut [Complex<T>]) -> so3fft::Result<()> {
+                $plan::forward(self, f, c).map(|_| ())
+            }
+            fn inverse_real(&self, c: &[Complex<T>], f: &mut [T]) -> so3fft::Result<()> {
+                $plan::inverse_real(self, c, f).map(|_| ())
+            }
+            fn forward_real(&self, f: &[T], c: &mut [Complex<T>]) -> so3fft::Result<()> {
+                $plan::forward_real(self, f, c).map(|_| ())
+            }
+        }
+    };
+}
+
+round_trip_of!(Plan);
+round_trip_of!(PartialPlan);
+round_trip_of!(S2Plan);
+
+/// The runner of `plan` on random coefficients of `seed` (complex, or the real transforms
+/// on the same coefficients: a real inverse reads one block of each conjugate pair).
+fn runner_of<T: Float, P: RoundTrip<T> + 'static>(plan: P, real: bool, seed: u64) -> Runner {
+    let (nc, ns) = plan.sizes();
+    let coeffs = random::<T>(&mut SplitMix64::new(seed), nc);
+    Box::new(move || {
         let mut out = Vec::new();
-        let mut back = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
+        let mut back = vec![zero::<T>(); nc];
         if real {
-            let mut f = vec![0.0; plan.num_samples()];
+            let mut f = vec![T::narrowed(0.0); ns];
             plan.inverse_real(&coeffs, &mut f)?;
             plan.forward_real(&f, &mut back)?;
             bits_real(&f, &mut out);
         } else {
-            let mut f = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
+            let mut f = vec![zero::<T>(); ns];
             plan.inverse(&coeffs, &mut f)?;
             plan.forward(&f, &mut back)?;
             bits(&f, &mut out);
         }
         bits(&back, &mut out);
         Ok(out)
-    }))
+    })
 }
 
-fn partial_runner(shape: Shape, opts: Options) -> so3fft::Result<Runner> {
-    let real = opts.real;
-    let plan = PartialPlan::new(&shape, &opts)?;
-    let coeffs = SplitMix64::new(200).complex_vec(plan.num_coeffs());
-    Ok(Box::new(move || {
-        let mut out = Vec::new();
-        let mut back = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
-        if real {
-            let mut f = vec![0.0; plan.num_samples()];
-            plan.inverse_real(&coeffs, &mut f)?;
-            plan.forward_real(&f, &mut back)?;
-            bits_real(&f, &mut out);
-        } else {
-            let mut f = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
-            plan.inverse(&coeffs, &mut f)?;
-            plan.forward(&f, &mut back)?;
-            bits(&f, &mut out);
-        }
-        bits(&back, &mut out);
-        Ok(out)
-    }))
-}
-
-fn s2_runner(b: usize, threads: usize, real: bool) -> so3fft::Result<Runner> {
-    let plan = S2Plan::new(b, &Options::default().with_threads(threads))?;
-    let coeffs = SplitMix64::new(300).complex_vec(s2_num_coeffs(b));
-    Ok(Box::new(move || {
-        let mut out = Vec::new();
-        let mut back = vec![Complex64::new(0.0, 0.0); plan.num_coeffs()];
-        if real {
-            let mut f = vec![0.0; plan.num_samples()];
-            plan.inverse_real(&coeffs, &mut f)?;
-            plan.forward_real(&f, &mut back)?;
-            bits_real(&f, &mut out);
-        } else {
-            let mut f = vec![Complex64::new(0.0, 0.0); plan.num_samples()];
-            plan.inverse(&coeffs, &mut f)?;
-            plan.forward(&f, &mut back)?;
-            bits(&f, &mut out);
-        }
-        bits(&back, &mut out);
-        Ok(out)
-    }))
-}
-
-/// The runner of `kind` at bandwidth `b` on `threads` threads.
-pub fn runner(kind: Kind, b: usize, threads: usize) -> so3fft::Result<Runner> {
-    let plan_opts = Options::default().with_threads(threads);
+/// The runner of `kind` at bandwidth `b` on `threads` threads, in `T`.
+pub fn runner<T: Float>(kind: Kind, b: usize, threads: usize) -> so3fft::Result<Runner> {
+    let opts = Options::default().with_threads(threads);
     let m = ORDER_LIMIT.min(b - 1);
-    let partial_opts = Options::default().with_threads(threads);
-    match kind {
-        Kind::PlanComplex => plan_runner(b, plan_opts),
-        Kind::PlanChunked => plan_runner(b, plan_opts.with_max_workspace_bytes(Some(1 << 20))),
-        Kind::PlanReal => plan_runner(b, plan_opts.with_real(true)),
-        Kind::PartialComplex => partial_runner(Shape::new(b).with_orders(m, m), partial_opts),
-        Kind::PartialReal => partial_runner(
-            Shape::new(b).with_orders(m, m),
-            partial_opts.with_real(true),
-        ),
-        Kind::S2Complex => s2_runner(b, threads, false),
-        Kind::S2Real => s2_runner(b, threads, true),
-    }
+    let shape = Shape::new(b).with_orders(m, m);
+    let seed = 100 + b as u64;
+    Ok(match kind {
+        Kind::PlanComplex => runner_of(Plan::<T>::new(b, &opts)?, false, seed),
+        Kind::PlanChunked => {
+            let opts = opts.with_max_workspace_bytes(Some(1 << 20));
+            runner_of(Plan::<T>::new(b, &opts)?, false, seed)
+        }
+        Kind::PlanReal => runner_of(Plan::<T>::new(b, &opts.with_real(true))?, true, seed),
+        Kind::PartialComplex => runner_of(PartialPlan::<T>::new(&shape, &opts)?, false, 200),
+        Kind::PartialReal => {
+            let plan = PartialPlan::<T>::new(&shape, &opts.with_real(true))?;
+            runner_of(plan, true, 200)
+        }
+        Kind::S2Complex => runner_of(S2Plan::<T>::new(b, &opts)?, false, 300),
+        Kind::S2Real => runner_of(S2Plan::<T>::new(b, &opts)?, true, 300),
+    })
 }
 
 /// Thread counts compared.
@@ -178,8 +179,8 @@ fn differing(a: &[u64], b: &[u64]) -> usize {
     a.iter().zip(b).filter(|(x, y)| x != y).count() + a.len().abs_diff(b.len())
 }
 
-/// Checks one kind: (outcome, seconds of one 1-thread run).
-pub fn check(kind: Kind, b: usize) -> so3fft::Result<(Outcome, f64)> {
+/// Checks one kind in `T`: (outcome, seconds of one 1-thread run).
+pub fn check<T: Float>(kind: Kind, b: usize) -> so3fft::Result<(Outcome, f64)> {
     let mut reference: Option<Vec<u64>> = None;
     let mut outcome = Outcome {
         across_threads: Vec::new(),
@@ -188,7 +189,7 @@ pub fn check(kind: Kind, b: usize) -> so3fft::Result<(Outcome, f64)> {
     };
     let mut time = 0.0;
     for threads in THREADS {
-        let run = runner(kind, b, threads)?;
+        let run = runner::<T>(kind, b, threads)?;
         let start = Instant::now();
         let first = run()?;
         if threads == 1 {
@@ -208,13 +209,13 @@ pub fn check(kind: Kind, b: usize) -> so3fft::Result<(Outcome, f64)> {
     Ok((outcome, time))
 }
 
-/// Rows `determinism`: one per kind.
-pub fn run(b: usize, report: &mut Report) -> so3fft::Result<()> {
+/// Rows `determinism`: one per kind, in `T`.
+pub fn run<T: Float>(b: usize, report: &mut Report) -> so3fft::Result<()> {
     for kind in KINDS {
-        let (o, time) = check(kind, b)?;
+        let (o, time) = check::<T>(kind, b)?;
         let note = if o.identical() {
             format!(
-                "bit-identical: threads 1/2/4, 3 executes each ({} doubles)",
+                "bit-identical: threads 1/2/4, 3 executes each ({} values)",
                 o.values
             )
         } else {
@@ -229,6 +230,7 @@ pub fn run(b: usize, report: &mut Report) -> so3fft::Result<()> {
             test: "determinism".into(),
             b,
             variant: kind.name().into(),
+            precision: T::PRECISION,
             rel_l2: f64::NAN,
             max_abs: f64::NAN,
             time_s: time,

@@ -4,12 +4,14 @@
 //! - (a) `reference`: transforms against exact values (40-digit sums in
 //!   `tests/data/stress/`), and (e) the same and round trips on every instruction set;
 //! - (b) `roundtrip`: `forward(inverse(c))`, `inverse(forward(f))` and Parseval over
-//!   doubling bandwidths, full plan complex and real, skipping variants, order-limited
+//!   doubling bandwidths, full plan complex and real (and with skipping off), order-limited
 //!   partial plans, S^2; growth exponents fitted by least squares;
 //! - (c) `adversarial`: top-order single coefficients, power-law spectra, exact scaling by
 //!   `2^k`, subnormal inputs, NaN and infinite inputs;
 //! - (d) `determinism`: bits across 1, 2, 4 threads and repeated executions;
 //! - `matching`: rotational matching's angle error and time (points of the time chart).
+//!
+//! Every test runs in `f64` and in `f32` (`--precision`); each row records its precision.
 //!
 //! Prints a table (a row per case as it is measured), the fitted exponents and the accuracy
 //! targets; `--csv`, `--svg`, `--time-svg` write the results, `--docs DIR` all of them plus
@@ -20,6 +22,7 @@ mod adversarial;
 mod determinism;
 mod matching;
 mod plot;
+mod precision;
 mod record;
 mod reference;
 mod rng;
@@ -27,6 +30,7 @@ mod roundtrip;
 mod targets;
 
 use clap::{Parser, ValueEnum};
+use precision::{Float, Precision};
 use record::{Report, Row};
 use so3fft_tools::progress::Steps;
 use std::path::{Path, PathBuf};
@@ -35,7 +39,7 @@ use std::time::Instant;
 
 /// The numerical stress suite of so3fft: transforms against exact values, round trips over
 /// doubling bandwidths, adversarial inputs, determinism across threads, rotational matching
-/// and every instruction set. Prints a row per case as it is measured, the fitted growth
+/// and every instruction set, in double and single precision. Prints a row per case as it is measured, the fitted growth
 /// exponents and the accuracy targets. See docs/stability.md.
 #[derive(Parser, Debug)]
 #[command(
@@ -47,13 +51,17 @@ use std::time::Instant;
 )]
 struct Options {
     /// Small bandwidths only (SO(3) round trips to 64, partial to 128, S^2 to 256; about
-    /// 5 s); without it the full run (SO(3) to 256, partial and S^2 to 2048; a few minutes,
-    /// under 6 GB)
+    /// 5 s); without it the full run (SO(3) to 256, partial and S^2 to 2048; a few
+    /// minutes, under 6 GB)
     #[arg(long)]
     quick: bool,
-    /// Also B = 512 full-grid SO(3) round trips (needs about 24 GB)
+    /// Also B = 512 full-grid SO(3) round trips (f64 complex: about 24 GB; f32 complex and
+    /// real: about 12 GB)
     #[arg(long)]
     big: bool,
+    /// Comma-separated precisions to run [default: f64,f32]
+    #[arg(long, value_name = "LIST", value_enum, value_delimiter = ',')]
+    precision: Option<Vec<Precision>>,
     /// Worker threads of the transforms (0 = all cores)
     #[arg(long, value_name = "N", default_value_t = 0)]
     threads: usize,
@@ -78,7 +86,11 @@ struct Options {
     docs: Option<PathBuf>,
     /// Run no test: read the rows of an earlier run's CSV (as written by --csv or --docs)
     /// and redraw the charts and tables from them (with --docs, the CSV is not rewritten)
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["quick", "big", "only", "threads"])]
+    #[arg(
+        long,
+        value_name = "FILE",
+        conflicts_with_all = ["quick", "big", "only", "threads", "precision"]
+    )]
     from_csv: Option<PathBuf>,
 }
 
@@ -89,13 +101,21 @@ enum Test {
     Roundtrip,
     Adversarial,
     Determinism,
-    Isa,
     Matching,
+    Isa,
 }
 
 impl Options {
     fn wants(&self, test: Test) -> bool {
         self.only.as_ref().is_none_or(|list| list.contains(&test))
+    }
+
+    /// The precisions to run, in [`Precision::ALL`] order.
+    fn precisions(&self) -> Vec<Precision> {
+        Precision::ALL
+            .into_iter()
+            .filter(|p| self.precision.as_ref().is_none_or(|list| list.contains(p)))
+            .collect()
     }
 
     /// Number of tests the run makes.
@@ -107,95 +127,125 @@ impl Options {
     }
 }
 
-/// Runs the selected tests into `report`.
-fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<()> {
-    let t = o.threads;
+/// Runs the selected tests into `report`, each in every selected precision; returns the
+/// wall time of each (test, precision) as text.
+fn run_tests(o: &Options, report: &mut Report) -> so3fft::Result<String> {
     let bar = Steps::new(o.test_count() as u64, "tests");
-    if o.wants(Test::Reference) {
-        bar.message("reference");
-        reference::run(&o.data_dir(), t, report)?;
-        bar.step();
-    }
-    if o.wants(Test::Roundtrip) {
-        bar.message("roundtrip");
-        let ranges = if o.quick {
-            roundtrip::Ranges {
-                full_max: 64,
-                partial_max: 128,
-                s2_max: 256,
-                variants: true,
-            }
+    let mut times = Vec::new();
+    for test in Test::value_variants()
+        .iter()
+        .copied()
+        .filter(|&t| o.wants(t))
+    {
+        let name = format!("{test:?}").to_lowercase();
+        bar.message(name.clone());
+        let precisions = o.precisions();
+        if matches!(test, Test::Roundtrip | Test::Matching) {
+            // Timed tests: the precisions alternate inside (one bandwidth at a time).
+            let start = Instant::now();
+            run_timed(o, test, &precisions, report)?;
+            let list: Vec<&str> = precisions.iter().map(|p| p.name()).collect();
+            let seconds = start.elapsed().as_secs_f64();
+            times.push(format!("{name} {} {seconds:.1}", list.join("+")));
         } else {
-            roundtrip::Ranges {
-                full_max: 256,
-                partial_max: 2048,
-                s2_max: 2048,
-                variants: true,
+            for p in precisions {
+                let start = Instant::now();
+                match p {
+                    Precision::F64 => run_test::<f64>(o, test, report)?,
+                    Precision::F32 => run_test::<f32>(o, test, report)?,
+                }
+                times.push(format!("{name} {p} {:.1}", start.elapsed().as_secs_f64()));
             }
-        };
-        roundtrip::run(ranges, t, report)?;
-        if o.big {
-            // Only the coefficient round trip: f (17 GB) and two coefficient arrays.
-            let run = roundtrip::RunOptions {
-                threads: t,
-                sample_checks: false,
-            };
-            roundtrip::full_complex(512, roundtrip::FULL_VARIANTS[0], run, report)?;
         }
         bar.step();
     }
-    if o.wants(Test::Adversarial) {
-        bar.message("adversarial");
-        let bw = if o.quick {
-            adversarial::Bandwidths {
-                top: &[16, 64],
-                s2_top: &[64, 256],
-                small: 16,
-            }
-        } else {
-            adversarial::Bandwidths {
-                top: &[16, 64, 256],
-                s2_top: &[64, 256, 1024, 2048],
-                small: 64,
-            }
-        };
-        adversarial::run(&bw, t, report)?;
-        bar.step();
-    }
-    if o.wants(Test::Determinism) {
-        bar.message("determinism");
-        determinism::run(if o.quick { 32 } else { 64 }, report)?;
-        bar.step();
-    }
-    if o.wants(Test::Matching) {
-        bar.message("matching");
+    Ok(times.join(", "))
+}
+
+/// Runs a test whose times the chart compares (round trips, matching) in every precision
+/// of `precisions`.
+fn run_timed(
+    o: &Options,
+    test: Test,
+    precisions: &[Precision],
+    report: &mut Report,
+) -> so3fft::Result<()> {
+    let t = o.threads;
+    if test == Test::Matching {
         let ls: &[usize] = if o.quick {
             &[16, 32]
         } else {
             &[16, 32, 64, 128]
         };
-        matching::run(ls, t, report)?;
-        bar.step();
+        return matching::run(ls, t, precisions, report);
     }
-    if o.wants(Test::Isa) {
-        bar.message("isa");
-        let bw = if o.quick {
-            reference::IsaBandwidths {
-                so3: 32,
-                partial: 64,
-                s2: 128,
+    let ranges = if o.quick {
+        roundtrip::Ranges {
+            full_max: 64,
+            partial_max: 128,
+            s2_max: 256,
+            variants: true,
+        }
+    } else {
+        roundtrip::Ranges {
+            full_max: 256,
+            partial_max: 2048,
+            s2_max: 2048,
+            variants: true,
+        }
+    };
+    roundtrip::run(ranges, t, precisions, report)?;
+    if o.big {
+        for &p in precisions {
+            match p {
+                Precision::F64 => roundtrip::big::<f64>(t, report)?,
+                Precision::F32 => roundtrip::big::<f32>(t, report)?,
             }
-        } else {
-            reference::IsaBandwidths {
-                so3: 128,
-                partial: 1024,
-                s2: 1024,
-            }
-        };
-        reference::isa_roundtrips(bw, t, report)?;
-        bar.step();
+        }
     }
     Ok(())
+}
+
+/// Runs one test in `T` (the untimed ones: see [`run_timed`]).
+fn run_test<T: Float>(o: &Options, test: Test, report: &mut Report) -> so3fft::Result<()> {
+    let t = o.threads;
+    match test {
+        Test::Reference => reference::run::<T>(&o.data_dir(), t, report),
+        Test::Roundtrip | Test::Matching => run_timed(o, test, &[T::PRECISION], report),
+        Test::Adversarial => {
+            let bw = if o.quick {
+                adversarial::Bandwidths {
+                    top: &[16, 64],
+                    s2_top: &[64, 256],
+                    small: 16,
+                }
+            } else {
+                adversarial::Bandwidths {
+                    top: &[16, 64, 256],
+                    s2_top: &[64, 256, 1024, 2048],
+                    small: 64,
+                }
+            };
+            adversarial::run::<T>(&bw, t, report)
+        }
+        Test::Determinism => determinism::run::<T>(if o.quick { 32 } else { 64 }, report),
+        Test::Isa => {
+            let bw = if o.quick {
+                reference::IsaBandwidths {
+                    so3: 32,
+                    partial: 64,
+                    s2: 128,
+                }
+            } else {
+                reference::IsaBandwidths {
+                    so3: 128,
+                    partial: 1024,
+                    s2: 1024,
+                }
+            };
+            reference::isa_roundtrips::<T>(bw, t, report)
+        }
+    }
 }
 
 impl Options {
@@ -250,7 +300,8 @@ fn collect_rows(o: &Options) -> Result<Vec<Row>, String> {
         ..Default::default()
     };
     println!("{}", Report::header());
-    run_tests(o, &mut report).map_err(|e| e.to_string())?;
+    let times = run_tests(o, &mut report).map_err(|e| e.to_string())?;
+    println!("\nseconds per test: {times}");
     Ok(report.rows)
 }
 
@@ -271,15 +322,16 @@ fn main() -> ExitCode {
         "growth of the error with B (least squares on log-log):\n{}",
         record::growth_table(&growths)
     );
-    // Read back, the rows tell whether the full-grid B = 512 round trips were run.
-    let big = o.big
-        || (o.from_csv.is_some()
-            && rows.iter().any(|r| {
-                r.test == "roundtrip"
-                    && r.b == 512
-                    && (r.variant == "complex" || r.variant == "real")
-            }));
-    let summary = targets::evaluate(&rows, big);
+    // The rows tell whether the full-grid B = 512 round trips were run, per precision.
+    let big = |p: Precision| {
+        rows.iter().any(|r| {
+            r.precision == p
+                && r.test == "roundtrip"
+                && r.b == 512
+                && (r.variant == "complex" || r.variant == "real")
+        })
+    };
+    let summary = targets::evaluate(&rows, big(Precision::F64), big(Precision::F32));
     println!("accuracy targets:\n{}", summary.text());
     if o.from_csv.is_none() {
         println!("total {:.1} s", start.elapsed().as_secs_f64());

@@ -1,7 +1,9 @@
 //! (a) Errors against exact values: inverse and forward transforms compared with 40-digit
 //! sums from `tests/data/stress/gen_stress_reference.py`, on every instruction set the CPU
-//! has (e).
+//! has (e). In `f32` the inputs are rounded to `f32` first and the truth stays that of the
+//! `f64` inputs: the error includes the inputs' rounding (about `3e-8` relative).
 
+use crate::precision::{narrow, random, zero, Float};
 use crate::record::{errors, Case, Report};
 use crate::rng::SplitMix64;
 use so3fft::{coef_index, num_samples, sample_index, Complex64, Isa, Options, Plan};
@@ -128,7 +130,7 @@ impl ForwardKind {
     }
 }
 
-fn plan_on(b: usize, isa: Isa, threads: usize) -> so3fft::Result<Plan> {
+fn plan_on<T: Float>(b: usize, isa: Isa, threads: usize) -> so3fft::Result<Plan<T>> {
     Plan::new(
         b,
         &Options::default().with_isa(Some(isa)).with_threads(threads),
@@ -139,21 +141,21 @@ fn io_error(e: std::io::Error) -> so3fft::Error {
     so3fft::Error::InvalidArgument(e.to_string())
 }
 
-/// The inverse at the reference points: (errors, seconds of the transform).
-pub fn check_inverse(
+/// The inverse at the reference points in `T`: (errors, seconds of the transform).
+pub fn check_inverse<T: Float>(
     dir: &Path,
     b: usize,
     isa: Isa,
     threads: usize,
 ) -> so3fft::Result<(crate::record::Errors, f64)> {
     let refs = read_reference(&dir.join(format!("inverse_B{b}.txt"))).map_err(io_error)?;
-    let plan = plan_on(b, isa, threads)?;
-    let coeffs = inverse_input(b);
-    let mut samples = vec![Complex64::new(0.0, 0.0); num_samples(b)];
+    let plan = plan_on::<T>(b, isa, threads)?;
+    let coeffs = narrow::<T>(&inverse_input(b));
+    let mut samples = vec![zero::<T>(); num_samples(b)];
     let start = Instant::now();
     plan.inverse(&coeffs, &mut samples)?;
     let time = start.elapsed().as_secs_f64();
-    let got: Vec<Complex64> = refs
+    let got: Vec<_> = refs
         .iter()
         .map(|([k, j1, j2], _)| samples[sample_index(b, *j1 as usize, *k as usize, *j2 as usize)])
         .collect();
@@ -161,8 +163,8 @@ pub fn check_inverse(
     Ok((errors(&got, &want), time))
 }
 
-/// The forward at the reference coefficients: (errors, seconds of the transform).
-pub fn check_forward(
+/// The forward at the reference coefficients in `T`: (errors, seconds of the transform).
+pub fn check_forward<T: Float>(
     dir: &Path,
     b: usize,
     kind: ForwardKind,
@@ -171,13 +173,13 @@ pub fn check_forward(
 ) -> so3fft::Result<(crate::record::Errors, f64)> {
     let path = dir.join(format!("{}_B{b}.txt", kind.file_stem()));
     let refs = read_reference(&path).map_err(io_error)?;
-    let plan = plan_on(b, isa, threads)?;
-    let samples = forward_input(b, kind.seed(b), &kind.slices(b));
-    let mut coeffs = vec![Complex64::new(0.0, 0.0); so3fft::num_coeffs(b)];
+    let plan = plan_on::<T>(b, isa, threads)?;
+    let samples = narrow::<T>(&forward_input(b, kind.seed(b), &kind.slices(b)));
+    let mut coeffs = vec![zero::<T>(); so3fft::num_coeffs(b)];
     let start = Instant::now();
     plan.forward(&samples, &mut coeffs)?;
     let time = start.elapsed().as_secs_f64();
-    let got: Vec<Complex64> = refs
+    let got: Vec<_> = refs
         .iter()
         .map(|([l, m, mp], _)| coeffs[coef_index(b, *l as usize, *m as isize, *mp as isize)])
         .collect();
@@ -185,35 +187,38 @@ pub fn check_forward(
     Ok((errors(&got, &want), time))
 }
 
-/// Every reference file on every instruction set: rows `reference-inverse`,
+/// Every reference file on every instruction set, in `T`: rows `reference-inverse`,
 /// `reference-forward`, `reference-poles` with the ISA as variant.
-pub fn run(dir: &Path, threads: usize, report: &mut Report) -> so3fft::Result<()> {
+pub fn run<T: Float>(dir: &Path, threads: usize, report: &mut Report) -> so3fft::Result<()> {
     for isa in supported_isas() {
         let variant = isa_name(isa);
         for b in INVERSE_BANDWIDTHS {
-            let (e, t) = check_inverse(dir, b, isa, threads)?;
+            let (e, t) = check_inverse::<T>(dir, b, isa, threads)?;
             let case = Case {
                 test: "reference-inverse",
                 b,
                 variant,
+                precision: T::PRECISION,
             };
             report.push_errors(case, e, t, "vs 40-digit direct sum, 7-8 betas x 8 points");
         }
         for b in FORWARD_BANDWIDTHS {
-            let (e, t) = check_forward(dir, b, ForwardKind::Everywhere, isa, threads)?;
+            let (e, t) = check_forward::<T>(dir, b, ForwardKind::Everywhere, isa, threads)?;
             let case = Case {
                 test: "reference-forward",
                 b,
                 variant,
+                precision: T::PRECISION,
             };
             report.push_errors(case, e, t, "random samples, vs 40-digit quadrature");
         }
         for b in POLES_BANDWIDTHS {
-            let (e, t) = check_forward(dir, b, ForwardKind::Poles, isa, threads)?;
+            let (e, t) = check_forward::<T>(dir, b, ForwardKind::Poles, isa, threads)?;
             let case = Case {
                 test: "reference-poles",
                 b,
                 variant,
+                precision: T::PRECISION,
             };
             report.push_errors(case, e, t, "mass on beta_0, beta_2B-1 only");
         }
@@ -232,65 +237,61 @@ pub struct IsaBandwidths {
     pub s2: usize,
 }
 
-/// Round trips on every instruction set: rows `isa-roundtrip` with variants
+/// Round trips on every instruction set, in `T`: rows `isa-roundtrip` with variants
 /// `so3-<isa>`, `partial-m8-<isa>`, `s2-<isa>`.
-pub fn isa_roundtrips(
+pub fn isa_roundtrips<T: Float>(
     bw: IsaBandwidths,
     threads: usize,
     report: &mut Report,
 ) -> so3fft::Result<()> {
     use so3fft::s2::{s2_num_coeffs, s2_num_samples, S2Plan};
     use so3fft::{PartialPlan, Shape};
-    let zero = Complex64::new(0.0, 0.0);
     for isa in supported_isas() {
         let name = isa_name(isa);
+        let mut push = |b: usize, kind: &str, e, time| {
+            let variant = format!("{kind}-{name}");
+            let case = Case {
+                test: "isa-roundtrip",
+                b,
+                variant: &variant,
+                precision: T::PRECISION,
+            };
+            report.push_errors(case, e, time, "");
+        };
         let b = bw.so3;
-        let plan = plan_on(b, isa, threads)?;
-        let c = SplitMix64::new(10 + b as u64).complex_vec(so3fft::num_coeffs(b));
-        let (mut f, mut back) = (vec![zero; num_samples(b)], vec![zero; c.len()]);
+        let plan = plan_on::<T>(b, isa, threads)?;
+        let c = random::<T>(&mut SplitMix64::new(10 + b as u64), so3fft::num_coeffs(b));
+        let (mut f, mut back) = (vec![zero::<T>(); num_samples(b)], vec![zero(); c.len()]);
         let start = Instant::now();
         plan.inverse(&c, &mut f)?;
         plan.forward(&f, &mut back)?;
-        let variant = format!("so3-{name}");
-        let case = Case {
-            test: "isa-roundtrip",
-            b,
-            variant: &variant,
-        };
-        report.push_errors(case, errors(&back, &c), start.elapsed().as_secs_f64(), "");
+        push(b, "so3", errors(&back, &c), start.elapsed().as_secs_f64());
 
         let b = bw.partial;
         let m = crate::roundtrip::ORDER_LIMIT;
         let opts = Options::default().with_isa(Some(isa)).with_threads(threads);
-        let plan = PartialPlan::new(&Shape::new(b).with_orders(m, m), &opts)?;
-        let c = SplitMix64::new(30 + b as u64).complex_vec(plan.num_coeffs());
-        let (mut f, mut back) = (vec![zero; plan.num_samples()], vec![zero; c.len()]);
+        let plan = PartialPlan::<T>::new(&Shape::new(b).with_orders(m, m), &opts)?;
+        let c = random::<T>(&mut SplitMix64::new(30 + b as u64), plan.num_coeffs());
+        let (mut f, mut back) = (vec![zero::<T>(); plan.num_samples()], vec![zero(); c.len()]);
         let start = Instant::now();
         plan.inverse(&c, &mut f)?;
         plan.forward(&f, &mut back)?;
-        let variant = format!("partial-m8-{name}");
-        let case = Case {
-            test: "isa-roundtrip",
+        push(
             b,
-            variant: &variant,
-        };
-        report.push_errors(case, errors(&back, &c), start.elapsed().as_secs_f64(), "");
+            "partial-m8",
+            errors(&back, &c),
+            start.elapsed().as_secs_f64(),
+        );
 
         let b = bw.s2;
         let opts = Options::default().with_isa(Some(isa)).with_threads(threads);
-        let plan = S2Plan::new(b, &opts)?;
-        let c = SplitMix64::new(40 + b as u64).complex_vec(s2_num_coeffs(b));
-        let (mut f, mut back) = (vec![zero; s2_num_samples(b)], vec![zero; c.len()]);
+        let plan = S2Plan::<T>::new(b, &opts)?;
+        let c = random::<T>(&mut SplitMix64::new(40 + b as u64), s2_num_coeffs(b));
+        let (mut f, mut back) = (vec![zero::<T>(); s2_num_samples(b)], vec![zero(); c.len()]);
         let start = Instant::now();
         plan.inverse(&c, &mut f)?;
         plan.forward(&f, &mut back)?;
-        let variant = format!("s2-{name}");
-        let case = Case {
-            test: "isa-roundtrip",
-            b,
-            variant: &variant,
-        };
-        report.push_errors(case, errors(&back, &c), start.elapsed().as_secs_f64(), "");
+        push(b, "s2", errors(&back, &c), start.elapsed().as_secs_f64());
     }
     Ok(())
 }

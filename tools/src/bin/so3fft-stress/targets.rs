@@ -1,6 +1,7 @@
 //! The stress suite's accuracy targets, checked against the rows of a run, and the Markdown
 //! tables of `docs/stability.md`.
 
+use crate::precision::Precision;
 use crate::record::{Growth, Row};
 use std::fmt::Write as _;
 
@@ -25,7 +26,7 @@ pub struct Target {
     /// The measured figure(s).
     pub detail: String,
     /// Kinds (see [`kind`]) of the rows it covers.
-    pub covers: Vec<String>,
+    pub covers: Vec<Kind>,
 }
 
 /// Every target of a run.
@@ -64,23 +65,36 @@ fn status_word(s: Status) -> &'static str {
     }
 }
 
-/// What a row is summarised under: its test, and for the round trips (whose variants have
-/// different targets and tolerances) the variant too.
-fn kind(r: &Row) -> String {
-    if r.test == "roundtrip" {
+/// What a row is summarised under: its test, for the round trips (whose variants have
+/// different targets and tolerances) the variant too, and its precision.
+type Kind = (String, Precision);
+
+fn kind(r: &Row) -> Kind {
+    let name = if r.test == "roundtrip" {
         format!("roundtrip {}", r.variant)
     } else {
         r.test.clone()
-    }
+    };
+    (name, r.precision)
 }
 
-/// Distinct kinds of `rows`, in order.
-fn kinds_of(rows: &[&Row]) -> Vec<String> {
-    let mut kinds: Vec<String> = Vec::new();
+/// Distinct kinds of `rows`, in the order their names first appear, each name's `f64`
+/// kind before its `f32` kind.
+fn kinds_of(rows: &[&Row]) -> Vec<Kind> {
+    let mut names: Vec<String> = Vec::new();
     for r in rows {
-        let k = kind(r);
-        if !kinds.contains(&k) {
-            kinds.push(k);
+        let (name, _) = kind(r);
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    let mut kinds = Vec::new();
+    for name in names {
+        for p in Precision::ALL {
+            let k = (name.clone(), p);
+            if rows.iter().any(|r| kind(r) == k) {
+                kinds.push(k);
+            }
         }
     }
     kinds
@@ -175,26 +189,53 @@ fn max_abs(r: &Row) -> f64 {
     r.max_abs
 }
 
-/// Scaling exponents that keep every value of these tests in the normal range (see
-/// docs/stability.md): the target covers them; `2^+-1000` rows are reported only.
-fn scale_in_range(test: &str) -> bool {
-    [
-        "scale-2^1",
-        "scale-2^-1",
-        "scale-2^100",
-        "scale-2^-100",
-        "scale-2^900",
-    ]
-    .contains(&test)
+/// Whether a `scale-2^k` row's exponent keeps every value of its transforms in the normal
+/// range of its precision (see docs/stability.md): the target covers these; the others are
+/// reported only.
+fn scale_in_range(r: &Row) -> bool {
+    r.test
+        .strip_prefix("scale-2^")
+        .and_then(|k| k.parse::<i32>().ok())
+        .is_some_and(|k| r.precision.scale_in_range(k))
 }
 
-/// Checks the targets against the rows (`big`: the run included B = 512).
-pub fn evaluate(rows: &[Row], big: bool) -> Summary {
-    let so3 = |r: &Row| r.test == "roundtrip" && (r.variant == "complex" || r.variant == "real");
+/// The exponents a precision's scaling target covers, as the target names them.
+fn scale_target_exponents(p: Precision) -> String {
+    let ks = p.scale_exponents();
+    let covered: Vec<i32> = ks.into_iter().filter(|&k| p.scale_in_range(k)).collect();
+    let mut parts: Vec<String> = Vec::new();
+    for &k in &covered {
+        if k < 0 && covered.contains(&-k) {
+            continue;
+        }
+        if k > 0 && covered.contains(&-k) {
+            parts.push(format!("+-{k}"));
+        } else {
+            parts.push(k.to_string());
+        }
+    }
+    parts.join(", ")
+}
+
+/// The f32 round trips' bound on the relative L2 error, up to B = 512.
+pub const F32_ROUND_TRIP: f64 = 1e-5;
+
+/// Checks the targets against the rows (`big`: the run included the f64 full-grid round
+/// trip at B = 512; `big_f32`: the f32 ones).
+pub fn evaluate(rows: &[Row], big: bool, big_f32: bool) -> Summary {
+    let f64_rows = |r: &Row| r.precision == Precision::F64;
+    let f32_rows = |r: &Row| r.precision == Precision::F32;
+    let full = |r: &Row| r.test == "roundtrip" && (r.variant == "complex" || r.variant == "real");
+    let so3 = |r: &Row| f64_rows(r) && full(r);
     let partial = |b: usize| {
-        move |r: &Row| r.test == "roundtrip" && r.variant.starts_with("partial-m8") && r.b == b
+        move |r: &Row| {
+            f64_rows(r) && r.test == "roundtrip" && r.variant.starts_with("partial-m8") && r.b == b
+        }
     };
-    let s2 = |r: &Row| r.test == "roundtrip" && r.variant.starts_with("s2-") && r.b == 2048;
+    let s2 = |r: &Row| {
+        f64_rows(r) && r.test == "roundtrip" && r.variant.starts_with("s2-") && r.b == 2048
+    };
+    let every = |test: &'static str| move |r: &Row| r.test == test;
     let mut targets = vec![
         bound(
             rows,
@@ -225,33 +266,60 @@ pub fn evaluate(rows: &[Row], big: bool) -> Summary {
             1e-13,
         ),
         bound(rows, "S^2 B = 2048 rel L2 <= 1e-12", s2, rel, 1e-12),
+        bound(
+            rows,
+            "f32 round trip rel L2 <= 1e-5 up to B = 512 (SO(3) complex, real, order-limited; S^2)",
+            |r: &Row| f32_rows(r) && r.test == "roundtrip" && r.b <= 512,
+            rel,
+            F32_ROUND_TRIP,
+        ),
+        bound(
+            rows,
+            "f32 SO(3) round trip rel L2 <= 1e-5 at B = 512 (complex, real)",
+            |r: &Row| f32_rows(r) && full(r) && r.b == 512,
+            rel,
+            F32_ROUND_TRIP,
+        ),
         every_note(
             rows,
-            "scaling by 2^k bit-exact (k = +-1, +-100, 900)",
-            |r: &Row| scale_in_range(&r.test),
+            &format!(
+                "scaling by 2^k bit-exact (f64: k = {}; f32: k = {})",
+                scale_target_exponents(Precision::F64),
+                scale_target_exponents(Precision::F32)
+            ),
+            scale_in_range,
             |n| n == "bit-exact",
         ),
         every_note(
             rows,
             "NaN / Inf inputs: a result, no hang, no error",
-            |r: &Row| r.test == "nan-inf",
+            every("nan-inf"),
             |n| !n.starts_with("HANG") && !n.starts_with("error"),
         ),
         every_note(
             rows,
             "subnormal inputs: finite results",
-            |r: &Row| r.test == "subnormal",
+            every("subnormal"),
             |n| n.ends_with("; finite"),
         ),
         every_note(
             rows,
             "determinism: bit-identical on 1, 2, 4 threads and repeats",
-            |r: &Row| r.test == "determinism",
+            every("determinism"),
             |n| n.starts_with("bit-identical"),
+        ),
+        every_note(
+            rows,
+            "f32 matching: the grid peak is f64's, or a tie within f32 rounding",
+            |r: &Row| f32_rows(r) && r.test == "matching" && r.variant != "match-refined",
+            |n| n.contains("peak = f64's") || n.contains("peak: a tie"),
         ),
     ];
     if !big {
         targets[1].detail = "needs --big (B = 512 full grid, about 24 GB)".into();
+    }
+    if !big_f32 {
+        targets[6].detail = "needs --big (B = 512 full grid in f32, about 12 GB)".into();
     }
     Summary { targets }
 }
@@ -279,39 +347,52 @@ pub fn markdown(rows: &[Row], growths: &[Growth], summary: &Summary) -> String {
         );
     }
     out.push_str("\n### Growth of the error with the bandwidth\n\n");
-    out.push_str("Least-squares slope of log(error) against log(B): error ~ C B^p.\n\n");
     out.push_str(
-        "| test | variant | p (rel L2) | p (max abs) | bandwidths |\n|---|---|---|---|---|\n",
+        "Least-squares slope of log(error) against log(B): error ~ C B^p; r^2 of the relative \
+         error's fit (well below 1: no power law).\n\n",
+    );
+    out.push_str(
+        "| test | variant | precision | p (rel L2) | r^2 | p (max abs) | bandwidths |\n\
+         |---|---|---|---|---|---|---|\n",
     );
     let show = |e: Option<f64>| e.map_or("-".to_string(), |v| format!("{v:.2}"));
     for g in growths {
         let bs: Vec<String> = g.bandwidths.iter().map(|b| b.to_string()).collect();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} |",
             g.test,
             g.variant,
+            g.precision,
             show(g.rel_exponent),
+            show(g.rel_r2),
             show(g.max_exponent),
             bs.join(", ")
         );
     }
     out.push_str("\n### Summary per test\n\n");
     out.push_str(
-        "Worst errors over each test's rows (round trips: each variant's), with the variant \
-         and B where they occur (\"-\" where the rows carry no such error: bit checks, NaN \
+        "Worst errors over each test's rows (round trips: each variant's) per precision, with \
+         the variant and B where they occur (\"-\" where the rows carry no such error: bit checks, NaN \
          counts), and the accuracy targets that cover them. Every row (test, B, variant, \
-         errors, time, note) is in [stability.csv](stability.csv).\n\n",
+         precision, errors, time, note) is in [stability.csv](stability.csv).\n\n",
     );
     out.push_str(
-        "| test | rows | variants | B | worst rel L2 | worst max abs | targets |\n\
-         |---|---|---|---|---|---|---|\n",
+        "| test | precision | rows | variants | B | worst rel L2 | worst max abs | targets |\n\
+         |---|---|---|---|---|---|---|---|\n",
     );
     for k in kind_summaries(rows, summary) {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} | {} |",
-            k.kind, k.rows, k.variants, k.bandwidths, k.worst_rel, k.worst_max, k.targets
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            k.kind.0,
+            k.kind.1,
+            k.rows,
+            k.variants,
+            k.bandwidths,
+            k.worst_rel,
+            k.worst_max,
+            k.targets
         );
     }
     out
@@ -319,7 +400,7 @@ pub fn markdown(rows: &[Row], growths: &[Growth], summary: &Summary) -> String {
 
 /// One line of the per-test summary, formatted.
 struct KindSummary {
-    kind: String,
+    kind: Kind,
     rows: usize,
     variants: usize,
     /// `lo..hi`, or the one bandwidth.
