@@ -1,13 +1,37 @@
-/* Comparisons of the single-precision C API with its double-precision twin, shared by the
- * f32 tests: both calls of a pair fail with the same code (and message), nothing written.
- * Include after test_util.h. */
+/* Helpers of the single-precision C tests: float arrays against double ones, and the
+ * comparison of an so3fftf_ call with its so3fft_ twin (both fail with the same code and
+ * message, nothing written). Include after test_util.h. */
 #ifndef SO3FFT_C_TESTS_F32_TWINS_H
 #define SO3FFT_C_TESTS_F32_TWINS_H
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #define SENTINEL_F 1234.5f
+
+/* ||a - b|| / ||b|| over n values of a float array and a double array (NaN propagates). */
+static inline double rel_f_d(const float *a, const double *b, size_t n) {
+    double num = 0.0, den = 0.0;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        double d = (double)a[i] - b[i];
+        num += d * d;
+        den += b[i] * b[i];
+    }
+    return sqrt(num / den);
+}
+
+/* The same for complex arrays. */
+static inline double rel_cf_cd(so3fftf_complex *a, so3fft_complex *b, size_t n) {
+    return rel_f_d(&a[0][0], &b[0][0], 2 * n);
+}
+
+/* A float array widened to double. */
+static inline void widen(const float *a, double *b, size_t n) {
+    size_t i;
+    for (i = 0; i < n; i++) b[i] = a[i];
+}
 
 static inline int untouched_f(const float *a, size_t n) {
     size_t i;

@@ -48,29 +48,6 @@ static double *alloc_d(size_t n) {
 /* The guard values behind an array of n complex floats are intact. */
 static int guard_cf(so3fftf_complex *a, size_t n) { return untouched_f(&a[n][0], 2 * GUARD); }
 
-/* ||a - b|| / ||b|| over n values of a float array and a double array (NaN propagates). */
-static double rel_f_d(const float *a, const double *b, size_t n) {
-    double num = 0.0, den = 0.0;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        double d = (double)a[i] - b[i];
-        num += d * d;
-        den += b[i] * b[i];
-    }
-    return sqrt(num / den);
-}
-
-/* The same for complex arrays. */
-static double rel_cf_cd(so3fftf_complex *a, so3fft_complex *b, size_t n) {
-    return rel_f_d(&a[0][0], &b[0][0], 2 * n);
-}
-
-/* A float array widened to double. */
-static void widen(const float *a, double *b, size_t n) {
-    size_t i;
-    for (i = 0; i < n; i++) b[i] = a[i];
-}
-
 /* Random values in float, and the same values in double (d may be NULL). */
 static void random_cf(so3fftf_complex *c, so3fft_complex *d, size_t n, unsigned long long seed) {
     size_t i;

@@ -4,6 +4,7 @@
 
 mod common;
 
+use common::narrow;
 use num_complex::{Complex32, Complex64};
 use so3fft::matching::{
     grid_argmax, grid_argmax_real, rotate_s2_coeffs, top_peaks, Correlation, CorrelationOptions,
@@ -11,12 +12,6 @@ use so3fft::matching::{
 };
 use so3fft::s2::{s2_coef_index, S2Plan};
 use so3fft::Options;
-
-fn narrow(v: &[Complex64]) -> Vec<Complex32> {
-    v.iter()
-        .map(|z| Complex32::new(z.re as f32, z.im as f32))
-        .collect()
-}
 
 fn reals(v: &[Complex64]) -> Vec<f32> {
     v.iter().map(|z| z.re as f32).collect()

@@ -3,28 +3,10 @@
 
 mod common;
 
-use common::Rng;
+use common::{narrow, relative_l2, widen, Rng};
 use num_complex::{Complex32, Complex64};
 use so3fft::s2::{s2_coef_index, S2Plan};
 use so3fft::{Isa, Options};
-
-fn narrow(v: &[Complex64]) -> Vec<Complex32> {
-    v.iter()
-        .map(|z| Complex32::new(z.re as f32, z.im as f32))
-        .collect()
-}
-
-fn widen(v: &[Complex32]) -> Vec<Complex64> {
-    v.iter()
-        .map(|z| Complex64::new(z.re as f64, z.im as f64))
-        .collect()
-}
-
-fn relative_l2(a: &[Complex64], b: &[Complex64]) -> f64 {
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y).norm_sqr()).sum();
-    let den: f64 = b.iter().map(|y| y.norm_sqr()).sum();
-    (num / den).sqrt()
-}
 
 fn plan32(b: usize, isa: Option<Isa>) -> S2Plan<f32> {
     let mut options = Options::default().with_threads(2);

@@ -4,28 +4,9 @@
 
 mod common;
 
-use common::{parse_transform, random_real_signal_coefs, Rng};
+use common::{narrow, parse_transform, random_real_signal_coefs, relative_l2, widen, Rng};
 use num_complex::{Complex32, Complex64};
 use so3fft::{Batch, Betas, Isa, Options, PartialPlan, Plan, Shape};
-
-fn narrow(v: &[Complex64]) -> Vec<Complex32> {
-    v.iter()
-        .map(|z| Complex32::new(z.re as f32, z.im as f32))
-        .collect()
-}
-
-fn widen(v: &[Complex32]) -> Vec<Complex64> {
-    v.iter()
-        .map(|z| Complex64::new(z.re as f64, z.im as f64))
-        .collect()
-}
-
-fn relative_l2(a: &[Complex64], b: &[Complex64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y).norm_sqr()).sum();
-    let den: f64 = b.iter().map(|y| y.norm_sqr()).sum();
-    (num / den).sqrt()
-}
 
 fn relative_l2_real(a: &[f32], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());

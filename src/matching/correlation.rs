@@ -16,8 +16,20 @@ use crate::transform::StageTimes;
 use crate::workers::WorkerPool;
 use crate::Real;
 use num_complex::{Complex, Complex64};
-use std::any::Any;
+use std::any::{Any, TypeId};
+use std::borrow::Cow;
 use std::sync::{Arc, Mutex, OnceLock};
+
+/// `x` as values of `W`: the slice itself where `U` is `W` (a plan in `f64`), else each
+/// value widened by `widen`.
+fn widened<U: Copy + 'static, W: Copy + 'static>(x: &[U], widen: impl Fn(U) -> W) -> Cow<'_, [W]> {
+    if TypeId::of::<U>() == TypeId::of::<W>() {
+        // SAFETY: `U` and `W` are the same type, so the slice's values are `W`s.
+        Cow::Borrowed(unsafe { std::slice::from_raw_parts(x.as_ptr().cast::<W>(), x.len()) })
+    } else {
+        Cow::Owned(x.iter().map(|&u| widen(u)).collect())
+    }
+}
 
 /// What a [`Correlation`] computes, and the [`Options`] of its plans. Made with
 /// [`CorrelationOptions::default`] and the `with_*` setters (the type is
@@ -241,8 +253,18 @@ impl<T: Real> Correlation<T> {
 
     /// [`Correlation::with_buffers`] on the calling thread.
     fn with_buffers_here<R>(&self, f: impl FnOnce(&mut Buffers<T>) -> Result<R>) -> Result<R> {
+        self.with_buffers_in(&self.buffers, f)
+    }
+
+    /// Runs `f` with the buffers kept in `slot` (made on first use; new ones when they are
+    /// in use).
+    fn with_buffers_in<C: Real, R>(
+        &self,
+        slot: &Mutex<Option<Buffers<C>>>,
+        f: impl FnOnce(&mut Buffers<C>) -> Result<R>,
+    ) -> Result<R> {
         let fresh = || Buffers::new(self.b_in, self.deg_lim);
-        match self.buffers.try_lock() {
+        match slot.try_lock() {
             Ok(mut guard) => {
                 if guard.is_none() {
                     *guard = Some(fresh()?);
@@ -349,12 +371,8 @@ impl<T: Real> Correlation<T> {
         out: &mut [Complex64],
     ) -> Result<()> {
         let s2 = self.s2_f64()?;
-        let wide = |x: &[Complex<T>]| -> Vec<Complex64> {
-            x.iter()
-                .map(|z| Complex64::new(z.re.to_f64(), z.im.to_f64()))
-                .collect()
-        };
-        let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&wide(x), c);
+        let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
+        let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&widened(x, wide), c);
         self.coefficients_in((signal, pattern), &fwd, out)
     }
 
@@ -366,8 +384,7 @@ impl<T: Real> Correlation<T> {
         out: &mut [Complex64],
     ) -> Result<()> {
         let s2 = self.s2_f64()?;
-        let wide = |x: &[T]| -> Vec<f64> { x.iter().map(|v| v.to_f64()).collect() };
-        let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&wide(x), c);
+        let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&widened(x, T::to_f64), c);
         self.coefficients_in((signal, pattern), &fwd, out)
     }
 
@@ -378,10 +395,16 @@ impl<T: Real> Correlation<T> {
         fwd: S2Forward<X, f64>,
         out: &mut [Complex64],
     ) -> Result<()> {
-        self.s2.install(|| {
-            let mut buf = Buffers::<f64>::new(self.b_in, self.deg_lim)?;
-            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), &mut buf)?;
+        let mut run = |buf: &mut Buffers<f64>| {
+            self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
             self.widen(&buf.so3, out)
+        };
+        self.s2.install(|| {
+            // A plan in f64 uses its own buffers; one in f32 makes f64 ones for the call.
+            match (&self.buffers as &dyn Any).downcast_ref::<Mutex<Option<Buffers<f64>>>>() {
+                Some(own) => self.with_buffers_in(own, run),
+                None => run(&mut Buffers::new(self.b_in, self.deg_lim)?),
+            }
         })
     }
 

@@ -6,7 +6,7 @@
 //! direct (naive, FFT-free) summations of the inverse and forward transforms.
 #![allow(dead_code)]
 
-use so3fft::Complex64;
+use so3fft::{Complex32, Complex64};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -592,4 +592,29 @@ pub fn s2_samples_and_coefs(name: &str, b: usize) -> (Vec<Complex64>, Vec<Comple
         coefs[row[0] as usize] = Complex64::new(row[3], row[4]);
     }
     (samples, coefs)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Single precision: values rounded to f32 and back, and the relative L2 error.
+// ---------------------------------------------------------------------------------------------
+/// `v` rounded to single precision.
+pub fn narrow(v: &[Complex64]) -> Vec<Complex32> {
+    v.iter()
+        .map(|z| Complex32::new(z.re as f32, z.im as f32))
+        .collect()
+}
+
+/// `v` in double precision (exact).
+pub fn widen(v: &[Complex32]) -> Vec<Complex64> {
+    v.iter()
+        .map(|z| Complex64::new(z.re as f64, z.im as f64))
+        .collect()
+}
+
+/// `||a - b|| / ||b||`.
+pub fn relative_l2(a: &[Complex64], b: &[Complex64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y).norm_sqr()).sum();
+    let den: f64 = b.iter().map(|y| y.norm_sqr()).sum();
+    (num / den).sqrt()
 }

@@ -10,22 +10,9 @@ use crate::cli::{rigor_name, Options};
 use crate::floor::{self, SliceFloor};
 use crate::workload::{dwt_flops_exact, dwt_flops_real, median, random_coeffs};
 use so3fft::matching::{rotate_s2_coeffs, top_peaks, Correlation, CorrelationOptions, Rotation};
-use so3fft::s2::{s2_coef_index, S2Plan};
+use so3fft::s2::S2Plan;
 use so3fft::Complex64;
 use std::time::Instant;
-
-/// Coefficients of a real function (Hermitian in `m`).
-fn real_function(l: usize, seed: u64) -> Vec<Complex64> {
-    let mut c = random_coeffs(l * l, seed);
-    for deg in 0..l {
-        c[s2_coef_index(l, deg, 0)].im = 0.0;
-        for m in 1..=deg as isize {
-            let v = c[s2_coef_index(l, deg, m)];
-            c[s2_coef_index(l, deg, -m)] = if m % 2 == 0 { v.conj() } else { -v.conj() };
-        }
-    }
-    c
-}
 
 /// One line of the floor table: a bandwidth and thread count.
 struct FloorRow {
@@ -98,7 +85,7 @@ pub fn run(opts: &Options) -> so3fft::Result<()> {
             let fft_times: Vec<f64> = (0..runs).map(|_| slice_floor.complex()).collect();
             let (t_complex, fft_complex) = (median(&times), median(&fft_times));
             // Real inputs.
-            let rhat = real_function(l, 5);
+            let rhat = crate::s2::hermitian(l, 5);
             let (mut rsig, mut rpat) = (vec![0.0; ns], vec![0.0; ns]);
             s2.inverse_real(&rotate_s2_coeffs(l, &rhat, &truth)?, &mut rsig)?;
             s2.inverse_real(&rhat, &mut rpat)?;

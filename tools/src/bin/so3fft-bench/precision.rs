@@ -7,7 +7,7 @@
 use crate::cli::Options;
 use crate::workload::{median, random_coeffs};
 use so3fft::matching::{rotate_s2_coeffs, Correlation, CorrelationOptions, Peak, Rotation};
-use so3fft::s2::{s2_coef_index, S2Plan};
+use so3fft::s2::S2Plan;
 use so3fft::{Complex, Complex64, Plan, Real};
 use std::time::Instant;
 
@@ -27,30 +27,6 @@ fn rel_l2<T: Real>(got: &[Complex<T>], want: &[Complex<T>]) -> f64 {
     let num: f64 = got.iter().zip(want).map(|(&a, &b)| d(a, b)).sum();
     let den: f64 = want.iter().map(|&b| d(b, zero)).sum();
     (num / den).sqrt()
-}
-
-/// Coefficients of a real signal: `fhat(l,-M,-M') = (-1)^(M-M') conj(fhat(l,M,M'))`.
-fn real_signal(b: usize, c: &[Complex64]) -> Vec<Complex64> {
-    let mut c = c.to_vec();
-    for l in 0..b {
-        let top = l as isize;
-        for m in -top..=top {
-            for mp in -top..=top {
-                if (m, mp) < (-m, -mp) {
-                    let v = c[so3fft::coef_index(b, l, m, mp)];
-                    let w = if (m - mp) % 2 == 0 {
-                        v.conj()
-                    } else {
-                        -v.conj()
-                    };
-                    c[so3fft::coef_index(b, l, -m, -mp)] = w;
-                } else if m == 0 && mp == 0 {
-                    c[so3fft::coef_index(b, l, 0, 0)].im = 0.0;
-                }
-            }
-        }
-    }
-    c
 }
 
 /// One precision's plan and arrays at one bandwidth.
@@ -77,7 +53,11 @@ impl<T: Real> Case<T> {
             reals: vec![T::ZERO; plan.num_samples()],
             back: vec![zero; plan.num_coeffs()],
             coefs: narrow(coefs),
-            real_coefs: narrow(&real_signal(b, coefs)),
+            real_coefs: {
+                let mut real = vec![Complex64::default(); coefs.len()];
+                crate::seeded::fill_real(0x5EED, b, &mut real);
+                narrow(&real)
+            },
             plan,
             times: Default::default(),
             stages: Default::default(),
@@ -286,7 +266,7 @@ pub fn run_matching(opts: &Options) -> so3fft::Result<()> {
                 .with_rigor(opts.rigor);
             let truth = Rotation::new(2.1234567, 1.2345678, 0.3456789);
             let s2 = S2Plan::<f64>::new(l, &options)?;
-            let hat = real_signal_s2(l, &random_coeffs(l * l, 3));
+            let hat = crate::s2::hermitian(l, 3);
             let (mut sig, mut pat) = (
                 vec![Complex64::default(); s2.num_samples()],
                 vec![Complex64::default(); s2.num_samples()],
@@ -330,17 +310,4 @@ pub fn run_matching(opts: &Options) -> so3fft::Result<()> {
         }
     }
     Ok(())
-}
-
-/// S^2 coefficients of a real function (Hermitian in `m`) from any `c`.
-fn real_signal_s2(l: usize, c: &[Complex64]) -> Vec<Complex64> {
-    let mut c = c.to_vec();
-    for deg in 0..l {
-        c[s2_coef_index(l, deg, 0)].im = 0.0;
-        for m in 1..=deg as isize {
-            let v = c[s2_coef_index(l, deg, m)];
-            c[s2_coef_index(l, deg, -m)] = if m % 2 == 0 { v.conj() } else { -v.conj() };
-        }
-    }
-    c
 }

@@ -16,7 +16,7 @@ fn legendre_flops(b: usize) -> f64 {
 }
 
 /// Coefficients of a real function (Hermitian in `m`, real at `m = 0`).
-fn hermitian(b: usize, seed: u64) -> Vec<Complex64> {
+pub fn hermitian(b: usize, seed: u64) -> Vec<Complex64> {
     let mut c = random_coeffs(b * b, seed);
     for l in 0..b {
         c[s2_coef_index(b, l, 0)].im = 0.0;
