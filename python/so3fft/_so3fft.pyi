@@ -4,10 +4,14 @@ The extension is the package's low level: every function takes exactly-typed, C-
 arrays of the right length (the package ``so3fft`` checks and converts arguments, allocates
 outputs and documents the API), releases the GIL while it computes, and turns every library
 error into a Python exception (``ValueError`` for bad arguments, ``MemoryError`` when memory
-runs out, ``RuntimeError`` otherwise).
+runs out, ``RuntimeError`` otherwise; ``TypeError`` for an array of the wrong dtype).
+
+The plans are made in double (``dtype="float64"``) or single (``"float32"``) precision and
+then take arrays of that precision only: ``float64`` and ``complex128``, or ``float32`` and
+``complex64``. A correlation's SO(3) coefficients and refinement are double in either.
 """
 
-from typing import Optional, Sequence, Tuple
+from typing import Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -15,6 +19,11 @@ import numpy.typing as npt
 _ComplexArray = npt.NDArray[np.complex128]
 _RealArray = npt.NDArray[np.float64]
 _IntArray = npt.NDArray[np.int64]
+# Arrays of a plan's precision: double or single.
+_ComplexArrayP = Union[npt.NDArray[np.complex128], npt.NDArray[np.complex64]]
+_RealArrayP = Union[npt.NDArray[np.float64], npt.NDArray[np.float32]]
+# A plan's precision, by the name of its real dtype.
+_DType = Literal["float64", "float32"]
 
 # A peak of a correlation grid: (flat index, alpha, beta, gamma, |C|^2).
 _PeakTuple = Tuple[int, float, float, float, float]
@@ -35,8 +44,11 @@ S2_MAX_BANDWIDTH: int
 class Plan:
     """An SO(3) transform plan of one bandwidth (exact arrays, no allocation)."""
 
-    def __init__(self, bandwidth: int, real: bool, threads: int, rigor: str) -> None:
-        """Plan the transforms at ``bandwidth`` (``threads`` 0: all cores; ``rigor`` FFTW's)."""
+    def __init__(
+        self, bandwidth: int, real: bool, threads: int, rigor: str, dtype: str = "float64"
+    ) -> None:
+        """Plan the transforms at ``bandwidth`` (``threads`` 0: all cores; ``rigor`` FFTW's) in
+        the precision ``dtype`` (``"float64"`` or ``"float32"``)."""
         ...
 
     @property
@@ -47,6 +59,11 @@ class Plan:
     @property
     def real(self) -> bool:
         """Whether the plan was made for real samples."""
+        ...
+
+    @property
+    def dtype(self) -> _DType:
+        """The precision: ``"float64"`` or ``"float32"``."""
         ...
 
     @property
@@ -75,25 +92,25 @@ class Plan:
         ...
 
     def forward(
-        self, samples: _ComplexArray, coeffs: _ComplexArray, check_finite: bool
+        self, samples: _ComplexArrayP, coeffs: _ComplexArrayP, check_finite: bool
     ) -> float:
         """Complex samples to coefficients, written into ``coeffs``; the seconds the library spent."""
         ...
 
     def forward_real(
-        self, samples: _RealArray, coeffs: _ComplexArray, check_finite: bool
+        self, samples: _RealArrayP, coeffs: _ComplexArrayP, check_finite: bool
     ) -> float:
         """Real samples to coefficients, written into ``coeffs``; the seconds the library spent."""
         ...
 
     def inverse(
-        self, coeffs: _ComplexArray, samples: _ComplexArray, check_finite: bool
+        self, coeffs: _ComplexArrayP, samples: _ComplexArrayP, check_finite: bool
     ) -> float:
         """Coefficients to complex samples, written into ``samples``; the seconds the library spent."""
         ...
 
     def inverse_real(
-        self, coeffs: _ComplexArray, samples: _RealArray, check_finite: bool
+        self, coeffs: _ComplexArrayP, samples: _RealArrayP, check_finite: bool
     ) -> float:
         """Coefficients of a real function to real samples, written into ``samples``; the seconds the library spent."""
         ...
@@ -102,13 +119,20 @@ class Plan:
 class S2Plan:
     """An S^2 transform plan of one bandwidth; each call takes ``howmany`` fields in a row."""
 
-    def __init__(self, bandwidth: int, threads: int, rigor: str) -> None:
-        """Plan the S^2 transforms at ``bandwidth``."""
+    def __init__(
+        self, bandwidth: int, threads: int, rigor: str, dtype: str = "float64"
+    ) -> None:
+        """Plan the S^2 transforms at ``bandwidth`` in the precision ``dtype``."""
         ...
 
     @property
     def bandwidth(self) -> int:
         """The bandwidth ``B``."""
+        ...
+
+    @property
+    def dtype(self) -> _DType:
+        """The precision: ``"float64"`` or ``"float32"``."""
         ...
 
     @property
@@ -128,8 +152,8 @@ class S2Plan:
 
     def forward(
         self,
-        samples: _ComplexArray,
-        coeffs: _ComplexArray,
+        samples: _ComplexArrayP,
+        coeffs: _ComplexArrayP,
         howmany: int,
         check_finite: bool,
     ) -> float:
@@ -138,8 +162,8 @@ class S2Plan:
 
     def forward_real(
         self,
-        samples: _RealArray,
-        coeffs: _ComplexArray,
+        samples: _RealArrayP,
+        coeffs: _ComplexArrayP,
         howmany: int,
         check_finite: bool,
     ) -> float:
@@ -148,8 +172,8 @@ class S2Plan:
 
     def inverse(
         self,
-        coeffs: _ComplexArray,
-        samples: _ComplexArray,
+        coeffs: _ComplexArrayP,
+        samples: _ComplexArrayP,
         howmany: int,
         check_finite: bool,
     ) -> float:
@@ -158,8 +182,8 @@ class S2Plan:
 
     def inverse_real(
         self,
-        coeffs: _ComplexArray,
-        samples: _RealArray,
+        coeffs: _ComplexArrayP,
+        samples: _RealArrayP,
         howmany: int,
         check_finite: bool,
     ) -> float:
@@ -237,8 +261,10 @@ class Correlation:
         normalized: bool,
         threads: int,
         rigor: str,
+        dtype: str = "float64",
     ) -> None:
-        """Plan the correlation of S^2 functions of bandwidth ``b_in`` on the grid of ``b_out``."""
+        """Plan the correlation of S^2 functions of bandwidth ``b_in`` on the grid of ``b_out``,
+        in the precision ``dtype`` (``"float64"`` or ``"float32"``)."""
         ...
 
     @property
@@ -262,15 +288,20 @@ class Correlation:
         ...
 
     @property
+    def dtype(self) -> _DType:
+        """The precision of inputs and grid: ``"float64"`` or ``"float32"``."""
+        ...
+
+    @property
     def num_grid(self) -> int:
         """Number of grid values, ``(2 b_out)^3``."""
         ...
 
     def correlate(
         self,
-        signal: _ComplexArray,
-        pattern: _ComplexArray,
-        out: _ComplexArray,
+        signal: _ComplexArrayP,
+        pattern: _ComplexArrayP,
+        out: _ComplexArrayP,
         argmax: bool,
     ) -> Optional[_PeakTuple]:
         """The correlation grid of complex inputs into ``out``; with ``argmax`` its largest ``|C|^2``."""
@@ -278,9 +309,9 @@ class Correlation:
 
     def correlate_real(
         self,
-        signal: _RealArray,
-        pattern: _RealArray,
-        out: _RealArray,
+        signal: _RealArrayP,
+        pattern: _RealArrayP,
+        out: _RealArrayP,
         argmax: bool,
     ) -> Optional[_PeakTuple]:
         """The correlation grid of real inputs into ``out``; with ``argmax`` its largest ``|C|^2``."""
@@ -288,28 +319,28 @@ class Correlation:
 
     def correlate_shells(
         self,
-        shells: Sequence[Tuple[_ComplexArray, _ComplexArray, float]],
-        out: _ComplexArray,
+        shells: Sequence[Tuple[_ComplexArrayP, _ComplexArrayP, float]],
+        out: _ComplexArrayP,
     ) -> None:
         """The weighted sum of the correlations of ``(signal, pattern, weight)`` shells into ``out``."""
         ...
 
     def correlate_shells_real(
         self,
-        shells: Sequence[Tuple[_RealArray, _RealArray, float]],
-        out: _RealArray,
+        shells: Sequence[Tuple[_RealArrayP, _RealArrayP, float]],
+        out: _RealArrayP,
     ) -> None:
         """:meth:`correlate_shells` of real shells."""
         ...
 
     def coefficients(
-        self, signal: _ComplexArray, pattern: _ComplexArray, out: _ComplexArray
+        self, signal: _ComplexArrayP, pattern: _ComplexArrayP, out: _ComplexArray
     ) -> None:
         """The correlation's SO(3) coefficients (bandwidth ``b_out``) of complex inputs into ``out``."""
         ...
 
     def coefficients_real(
-        self, signal: _RealArray, pattern: _RealArray, out: _ComplexArray
+        self, signal: _RealArrayP, pattern: _RealArrayP, out: _ComplexArray
     ) -> None:
         """The correlation's SO(3) coefficients of real inputs into ``out``."""
         ...
@@ -321,12 +352,13 @@ class Correlation:
         ...
 
 
-def top_peaks(grid: _ComplexArray, k: int, min_angle: float) -> list[_PeakTuple]:
-    """The ``k`` largest local maxima of ``|C|^2`` on a complex grid, ``min_angle`` apart."""
+def top_peaks(grid: _ComplexArrayP, k: int, min_angle: float) -> list[_PeakTuple]:
+    """The ``k`` largest local maxima of ``|C|^2`` on a complex grid (``complex128`` or
+    ``complex64``), ``min_angle`` apart."""
     ...
 
 
-def top_peaks_real(grid: _RealArray, k: int, min_angle: float) -> list[_PeakTuple]:
+def top_peaks_real(grid: _RealArrayP, k: int, min_angle: float) -> list[_PeakTuple]:
     """:func:`top_peaks` of a real grid."""
     ...
 

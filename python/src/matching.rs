@@ -1,8 +1,9 @@
-//! Rotational matching: the correlation plan, peaks of a correlation grid, refinement off the
-//! grid, rotations.
+//! Rotational matching: the correlation plan (double or single precision), peaks of a
+//! correlation grid, refinement off the grid, rotations.
 
 use crate::arrays::{
-    all_finite, all_finite_real, input, not_finite_always, output, readonly, readwrite,
+    all_finite, all_finite_real, build, each, input, not_finite_always, output, readonly,
+    readwrite, typed, ByPrecision, Float, Precision,
 };
 use crate::errors::{to_py, value_error};
 use crate::layout::checked;
@@ -13,7 +14,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 use so3fft::matching::{self, CorrelationOptions, Peak, Rotation};
-use so3fft::Complex64;
+use so3fft::{Complex, Complex32, Complex64};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Correlation>()?;
@@ -34,66 +35,102 @@ fn peak_tuple(p: &Peak) -> PeakTuple {
     (p.index, p.alpha, p.beta, p.gamma, p.value)
 }
 
-/// A correlation plan (low level: exact arrays, no allocation).
+/// A correlation plan in double or single precision (low level: exact arrays, no
+/// allocation). The SO(3) coefficients and the refinement are `f64` in either.
 #[pyclass(frozen, module = "so3fft._so3fft")]
 pub struct Correlation {
-    plan: matching::Correlation,
+    plan: ByPrecision<matching::Correlation<f64>, matching::Correlation<f32>>,
 }
 
 /// A shell as the caller gives it: signal, pattern, weight.
-type ShellArrays<'py, T> = (Bound<'py, PyArrayDyn<T>>, Bound<'py, PyArrayDyn<T>>, f64);
+type ShellArrays<'py> = (Bound<'py, PyAny>, Bound<'py, PyAny>, f64);
 
 /// Shells as the library takes them, from `(signal, pattern, weight)` arrays.
 type Shells<'a, T> = Vec<(&'a [T], &'a [T], f64)>;
 
-impl Correlation {
-    fn s2_samples(&self) -> usize {
-        so3fft::s2::s2_num_samples(self.plan.b_in())
-    }
+/// A library call on a signal, a pattern and an output.
+type PairRun<'a, I, O, R> = &'a (dyn Fn(&[I], &[I], &mut [O]) -> so3fft::Result<R> + Sync);
 
-    /// Borrows `signal`, `pattern` (S^2 samples) and `out` (`out_len` values), checks the
-    /// inputs with `finite`, and runs `run` with the GIL released.
-    #[allow(clippy::type_complexity)]
-    fn run_pair<I: Element + Sync, O: Element + Send, R: Send>(
-        &self,
-        py: Python<'_>,
-        (signal, pattern, out): (
-            &Bound<'_, PyArrayDyn<I>>,
-            &Bound<'_, PyArrayDyn<I>>,
-            &Bound<'_, PyArrayDyn<O>>,
-        ),
-        (out_len, finite): (usize, fn(&[I]) -> bool),
-        run: &(dyn Fn(&[I], &[I], &mut [O]) -> so3fft::Result<R> + Sync),
-    ) -> PyResult<R> {
-        let signal = readonly(signal)?;
-        let pattern = readonly(pattern)?;
-        let mut out = readwrite(out)?;
-        let n = self.s2_samples();
-        let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
-        self.check_inputs(py, &[s, p], finite)?;
-        let o = output(&mut out, out_len, "out")?;
-        py.detach(|| run(s, p, o)).map_err(to_py)
-    }
+/// A library call on shells and an output.
+type ShellsRun<'a, I> = &'a (dyn Fn(&[(&[I], &[I], f64)], &mut [I]) -> so3fft::Result<()> + Sync);
 
-    /// Checks, with the GIL released, that the inputs are finite.
-    fn check_inputs<T: Sync>(
-        &self,
-        py: Python<'_>,
-        values: &[&[T]],
-        finite: impl Fn(&[T]) -> bool + Send + Sync,
-    ) -> PyResult<()> {
-        if py.detach(|| values.iter().all(|v| finite(v))) {
-            Ok(())
-        } else {
-            Err(not_finite_always("signal or pattern samples"))
-        }
+/// A finiteness check of values of `T`.
+type Finite<T> = fn(&[T]) -> bool;
+
+/// The number of S^2 samples of the inputs of a plan of bandwidth `b_in`.
+fn s2_samples(b_in: usize) -> usize {
+    so3fft::s2::s2_num_samples(b_in)
+}
+
+/// Borrows `signal`, `pattern` (S^2 samples of bandwidth `b_in`) and `out` (`out_len`
+/// values) as arrays of `I` and `O`, checks the inputs with `finite`, and runs `run` with the
+/// GIL released.
+#[allow(clippy::type_complexity)]
+fn run_pair<I: Element + Sync, O: Element + Send, R: Send>(
+    py: Python<'_>,
+    (signal, pattern, out): (&Bound<'_, PyAny>, &Bound<'_, PyAny>, &Bound<'_, PyAny>),
+    (b_in, out_len, finite): (usize, usize, Finite<I>),
+    run: PairRun<'_, I, O, R>,
+) -> PyResult<R> {
+    let signal = readonly(typed::<I>(signal, "signal")?)?;
+    let pattern = readonly(typed::<I>(pattern, "pattern")?)?;
+    let mut out = readwrite(typed::<O>(out, "out")?)?;
+    let n = s2_samples(b_in);
+    let (s, p) = (input(&signal, n, "signal")?, input(&pattern, n, "pattern")?);
+    check_inputs(py, &[s, p], finite)?;
+    let o = output(&mut out, out_len, "out")?;
+    py.detach(|| run(s, p, o)).map_err(to_py)
+}
+
+/// Borrows the shells' arrays (S^2 samples of bandwidth `b_in`) and `out` (`out_len` values)
+/// as arrays of `I`, checks the inputs with `finite`, and runs `run` with the GIL released.
+fn run_shells<I: Element + Sync + Send>(
+    py: Python<'_>,
+    (shells, out): (&[ShellArrays<'_>], &Bound<'_, PyAny>),
+    (b_in, out_len, finite): (usize, usize, Finite<I>),
+    run: ShellsRun<'_, I>,
+) -> PyResult<()> {
+    let borrowed = shells
+        .iter()
+        .map(|(s, p, w)| {
+            let s = readonly(typed::<I>(s, "signal")?)?;
+            Ok((s, readonly(typed::<I>(p, "pattern")?)?, *w))
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let mut out = readwrite(typed::<I>(out, "out")?)?;
+    let n = s2_samples(b_in);
+    let mut views: Shells<'_, I> = Vec::with_capacity(shells.len());
+    for (s, p, w) in &borrowed {
+        let (s, p) = (input(s, n, "signal")?, input(p, n, "pattern")?);
+        check_inputs(py, &[s, p], finite)?;
+        views.push((s, p, *w));
     }
+    let g = output(&mut out, out_len, "out")?;
+    py.detach(|| run(&views, g)).map_err(to_py)
+}
+
+/// Checks, with the GIL released, that the inputs are finite.
+fn check_inputs<T: Sync>(
+    py: Python<'_>,
+    values: &[&[T]],
+    finite: impl Fn(&[T]) -> bool + Send + Sync,
+) -> PyResult<()> {
+    if py.detach(|| values.iter().all(|v| finite(v))) {
+        Ok(())
+    } else {
+        Err(not_finite_always("signal or pattern samples"))
+    }
+}
+
+/// The complex and real finiteness checks of one precision, as function pointers.
+fn finite<T: Float>() -> (Finite<Complex<T>>, Finite<T>) {
+    (all_finite::<T>, all_finite_real::<T>)
 }
 
 #[pymethods]
 impl Correlation {
     #[new]
-    #[pyo3(signature = (b_in, b_out, deg_lim, real, normalized, threads, rigor))]
+    #[pyo3(signature = (b_in, b_out, deg_lim, real, normalized, threads, rigor, dtype = "float64"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -104,6 +141,7 @@ impl Correlation {
         normalized: bool,
         threads: usize,
         rigor: &str,
+        dtype: &str,
     ) -> PyResult<Self> {
         let o = CorrelationOptions::default()
             .with_b_out(b_out)
@@ -111,55 +149,61 @@ impl Correlation {
             .with_real(real)
             .with_normalized(normalized)
             .with_plans(options(threads, rigor, real)?);
-        let plan = py
-            .detach(|| matching::Correlation::new(b_in, &o))
-            .map_err(to_py)?;
+        let plan = build!(Precision::from_name(dtype)?, T => py
+            .detach(|| matching::Correlation::<T>::new(b_in, &o))
+            .map_err(to_py)?);
         Ok(Correlation { plan })
     }
 
     #[getter]
     fn b_in(&self) -> usize {
-        self.plan.b_in()
+        each!(&self.plan, p => p.b_in())
     }
 
     #[getter]
     fn b_out(&self) -> usize {
-        self.plan.b_out()
+        each!(&self.plan, p => p.b_out())
     }
 
     #[getter]
     fn deg_lim(&self) -> usize {
-        self.plan.deg_lim()
+        each!(&self.plan, p => p.deg_lim())
     }
 
     #[getter]
     fn real(&self) -> bool {
-        self.plan.is_real()
+        each!(&self.plan, p => p.is_real())
+    }
+
+    /// The real dtype's name of inputs and grid: `"float64"` or `"float32"`.
+    #[getter]
+    fn dtype(&self) -> &'static str {
+        self.plan.precision().name()
     }
 
     #[getter]
     fn num_grid(&self) -> usize {
-        self.plan.num_grid()
+        each!(&self.plan, p => p.num_grid())
     }
 
     /// The correlation grid of complex inputs; with `argmax`, also its largest `|C|^2`.
     fn correlate(
         &self,
         py: Python<'_>,
-        signal: Bound<'_, PyArrayDyn<Complex64>>,
-        pattern: Bound<'_, PyArrayDyn<Complex64>>,
-        out: Bound<'_, PyArrayDyn<Complex64>>,
+        signal: Bound<'_, PyAny>,
+        pattern: Bound<'_, PyAny>,
+        out: Bound<'_, PyAny>,
         argmax: bool,
     ) -> PyResult<Option<PeakTuple>> {
-        let grid = (self.plan.num_grid(), all_finite as fn(&[_]) -> bool);
-        self.run_pair(py, (&signal, &pattern, &out), grid, &|s, p, g| {
-            if argmax {
-                self.plan
-                    .correlate_argmax(s, p, g)
-                    .map(|k| Some(peak_tuple(&k)))
-            } else {
-                self.plan.correlate(s, p, g).map(|_| None)
-            }
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), p.num_grid(), finite().0);
+            run_pair(py, (&signal, &pattern, &out), sizes, &|s, q, g| {
+                if argmax {
+                    p.correlate_argmax(s, q, g).map(|k| Some(peak_tuple(&k)))
+                } else {
+                    p.correlate(s, q, g).map(|_| None)
+                }
+            })
         })
     }
 
@@ -167,20 +211,20 @@ impl Correlation {
     fn correlate_real(
         &self,
         py: Python<'_>,
-        signal: Bound<'_, PyArrayDyn<f64>>,
-        pattern: Bound<'_, PyArrayDyn<f64>>,
-        out: Bound<'_, PyArrayDyn<f64>>,
+        signal: Bound<'_, PyAny>,
+        pattern: Bound<'_, PyAny>,
+        out: Bound<'_, PyAny>,
         argmax: bool,
     ) -> PyResult<Option<PeakTuple>> {
-        let grid = (self.plan.num_grid(), all_finite_real as fn(&[_]) -> bool);
-        self.run_pair(py, (&signal, &pattern, &out), grid, &|s, p, g| {
-            if argmax {
-                self.plan
-                    .correlate_real_argmax(s, p, g)
-                    .map(|k| Some(peak_tuple(&k)))
-            } else {
-                self.plan.correlate_real(s, p, g).map(|_| None)
-            }
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), p.num_grid(), finite().1);
+            run_pair(py, (&signal, &pattern, &out), sizes, &|s, q, g| {
+                if argmax {
+                    p.correlate_real_argmax(s, q, g).map(|k| Some(peak_tuple(&k)))
+                } else {
+                    p.correlate_real(s, q, g).map(|_| None)
+                }
+            })
         })
     }
 
@@ -188,64 +232,42 @@ impl Correlation {
     fn correlate_shells(
         &self,
         py: Python<'_>,
-        shells: Vec<ShellArrays<'_, Complex64>>,
-        out: Bound<'_, PyArrayDyn<Complex64>>,
+        shells: Vec<ShellArrays<'_>>,
+        out: Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        let borrowed = shells
-            .iter()
-            .map(|(s, p, w)| Ok((readonly(s)?, readonly(p)?, *w)))
-            .collect::<PyResult<Vec<_>>>()?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let mut views: Shells<'_, Complex64> = Vec::with_capacity(shells.len());
-        for (s, p, w) in &borrowed {
-            let (s, p) = (input(s, n, "signal")?, input(p, n, "pattern")?);
-            self.check_inputs(py, &[s, p], all_finite)?;
-            views.push((s, p, *w));
-        }
-        let g = output(&mut out, self.plan.num_grid(), "out")?;
-        py.detach(|| self.plan.correlate_shells(&views, g))
-            .map_err(to_py)
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), p.num_grid(), finite().0);
+            run_shells(py, (&shells, &out), sizes, &|v, g| p.correlate_shells(v, g))
+        })
     }
 
     /// [`Correlation::correlate_shells`] of real shells.
     fn correlate_shells_real(
         &self,
         py: Python<'_>,
-        shells: Vec<ShellArrays<'_, f64>>,
-        out: Bound<'_, PyArrayDyn<f64>>,
+        shells: Vec<ShellArrays<'_>>,
+        out: Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        let borrowed = shells
-            .iter()
-            .map(|(s, p, w)| Ok((readonly(s)?, readonly(p)?, *w)))
-            .collect::<PyResult<Vec<_>>>()?;
-        let mut out = readwrite(&out)?;
-        let n = self.s2_samples();
-        let mut views: Shells<'_, f64> = Vec::with_capacity(shells.len());
-        for (s, p, w) in &borrowed {
-            let (s, p) = (input(s, n, "signal")?, input(p, n, "pattern")?);
-            self.check_inputs(py, &[s, p], all_finite_real)?;
-            views.push((s, p, *w));
-        }
-        let g = output(&mut out, self.plan.num_grid(), "out")?;
-        py.detach(|| self.plan.correlate_shells_real(&views, g))
-            .map_err(to_py)
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), p.num_grid(), finite().1);
+            run_shells(py, (&shells, &out), sizes, &|v, g| p.correlate_shells_real(v, g))
+        })
     }
 
-    /// The SO(3) coefficients of the correlation (bandwidth `b_out`), for refinement.
+    /// The SO(3) coefficients of the correlation (bandwidth `b_out`, `complex128` in either
+    /// precision), for refinement.
     fn coefficients(
         &self,
         py: Python<'_>,
-        signal: Bound<'_, PyArrayDyn<Complex64>>,
-        pattern: Bound<'_, PyArrayDyn<Complex64>>,
-        out: Bound<'_, PyArrayDyn<Complex64>>,
+        signal: Bound<'_, PyAny>,
+        pattern: Bound<'_, PyAny>,
+        out: Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        let coeffs = (
-            so3fft::num_coeffs(self.plan.b_out()),
-            all_finite as fn(&[_]) -> bool,
-        );
-        self.run_pair(py, (&signal, &pattern, &out), coeffs, &|s, p, c| {
-            self.plan.coefficients(s, p, c)
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), so3fft::num_coeffs(p.b_out()), finite().0);
+            run_pair(py, (&signal, &pattern, &out), sizes, &|s, q, c: &mut [Complex64]| {
+                p.coefficients(s, q, c)
+            })
         })
     }
 
@@ -253,22 +275,21 @@ impl Correlation {
     fn coefficients_real(
         &self,
         py: Python<'_>,
-        signal: Bound<'_, PyArrayDyn<f64>>,
-        pattern: Bound<'_, PyArrayDyn<f64>>,
-        out: Bound<'_, PyArrayDyn<Complex64>>,
+        signal: Bound<'_, PyAny>,
+        pattern: Bound<'_, PyAny>,
+        out: Bound<'_, PyAny>,
     ) -> PyResult<()> {
-        let coeffs = (
-            so3fft::num_coeffs(self.plan.b_out()),
-            all_finite_real as fn(&[_]) -> bool,
-        );
-        self.run_pair(py, (&signal, &pattern, &out), coeffs, &|s, p, c| {
-            self.plan.coefficients_real(s, p, c)
+        each!(&self.plan, p => {
+            let sizes = (p.b_in(), so3fft::num_coeffs(p.b_out()), finite().1);
+            run_pair(py, (&signal, &pattern, &out), sizes, &|s, q, c: &mut [Complex64]| {
+                p.coefficients_real(s, q, c)
+            })
         })
     }
 
     /// Refines each start rotation (rows of Euler angles) to the nearest maximum of `|C|^2`
-    /// of the band-limited correlation with coefficients `coeffs`; the rotations (rows) and
-    /// the values there.
+    /// of the band-limited correlation with coefficients `coeffs` (`complex128` in either
+    /// precision); the rotations (rows) and the values there, in `f64`.
     #[allow(clippy::type_complexity)]
     fn refine<'py>(
         &self,
@@ -277,16 +298,14 @@ impl Correlation {
         starts: PyReadonlyArray2<'_, f64>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
         let coeffs = readonly(&coeffs)?;
-        let c = input(
-            &coeffs,
-            so3fft::num_coeffs(self.plan.b_out()),
-            "coefficients",
-        )?;
+        let c = input(&coeffs, so3fft::num_coeffs(self.b_out()), "coefficients")?;
         if !all_finite(c) {
             return Err(not_finite_always("coefficients"));
         }
         let gs = rotations(&starts)?;
-        let found = py.detach(|| self.plan.refine_many(c, &gs)).map_err(to_py)?;
+        let found = py
+            .detach(|| each!(&self.plan, p => p.refine_many(c, &gs)))
+            .map_err(to_py)?;
         found_arrays(py, &found)
     }
 }
@@ -402,43 +421,83 @@ fn peak_args(len: usize, min_angle: f64) -> PyResult<usize> {
     Ok(b)
 }
 
-/// The `k` largest local maxima of `|C|^2` on a complex grid, each at least `min_angle`
-/// radians from every larger one taken.
-#[pyfunction]
-fn top_peaks(
+/// The peaks of a grid of `X` values (`what` the library's peak search of its precision).
+fn peaks<X: Element + Sync>(
     py: Python<'_>,
-    grid: PyReadonlyArrayDyn<'_, Complex64>,
-    k: usize,
-    min_angle: f64,
+    grid: &Bound<'_, PyArrayDyn<X>>,
+    (k, min_angle): (usize, f64),
+    finite: Finite<X>,
+    search: fn(usize, &[X], usize, f64) -> Vec<Peak>,
 ) -> PyResult<Vec<PeakTuple>> {
+    let grid = readonly(grid)?;
     let g = grid
         .as_slice()
         .map_err(|_| value_error("the grid must be C-contiguous"))?;
     let b = peak_args(g.len(), min_angle)?;
-    if !py.detach(|| all_finite(g)) {
+    if !py.detach(|| finite(g)) {
         return Err(not_finite_always("the grid"));
     }
-    let peaks = py.detach(|| matching::top_peaks(b, g, k, min_angle));
+    let peaks = py.detach(|| search(b, g, k, min_angle));
     Ok(peaks.iter().map(peak_tuple).collect())
 }
 
-/// [`top_peaks`] of a real grid.
+/// The `k` largest local maxima of `|C|^2` on a complex grid (`complex128` or `complex64`),
+/// each at least `min_angle` radians from every larger one taken.
 #[pyfunction]
-fn top_peaks_real(
+fn top_peaks(
     py: Python<'_>,
-    grid: PyReadonlyArrayDyn<'_, f64>,
+    grid: Bound<'_, PyAny>,
     k: usize,
     min_angle: f64,
 ) -> PyResult<Vec<PeakTuple>> {
-    let g = grid
-        .as_slice()
-        .map_err(|_| value_error("the grid must be C-contiguous"))?;
-    let b = peak_args(g.len(), min_angle)?;
-    if !py.detach(|| all_finite_real(g)) {
-        return Err(not_finite_always("the grid"));
+    match grid.cast::<PyArrayDyn<Complex32>>() {
+        Ok(g) => peaks(
+            py,
+            g,
+            (k, min_angle),
+            all_finite,
+            matching::top_peaks::<f32>,
+        ),
+        Err(_) => {
+            let g = typed::<Complex64>(&grid, "the grid")?;
+            peaks(
+                py,
+                g,
+                (k, min_angle),
+                all_finite,
+                matching::top_peaks::<f64>,
+            )
+        }
     }
-    let peaks = py.detach(|| matching::top_peaks_real(b, g, k, min_angle));
-    Ok(peaks.iter().map(peak_tuple).collect())
+}
+
+/// [`top_peaks`] of a real grid (`float64` or `float32`).
+#[pyfunction]
+fn top_peaks_real(
+    py: Python<'_>,
+    grid: Bound<'_, PyAny>,
+    k: usize,
+    min_angle: f64,
+) -> PyResult<Vec<PeakTuple>> {
+    match grid.cast::<PyArrayDyn<f32>>() {
+        Ok(g) => peaks(
+            py,
+            g,
+            (k, min_angle),
+            all_finite_real,
+            matching::top_peaks_real::<f32>,
+        ),
+        Err(_) => {
+            let g = typed::<f64>(&grid, "the grid")?;
+            peaks(
+                py,
+                g,
+                (k, min_angle),
+                all_finite_real,
+                matching::top_peaks_real::<f64>,
+            )
+        }
+    }
 }
 
 /// The unit quaternion `(w, x, y, z)` (`w >= 0`) of `Rz(alpha) Ry(beta) Rz(gamma)`.
