@@ -10,6 +10,9 @@ Main objects:
 - :class:`Rotation` -- z-y-z Euler angles, matrices, quaternions, SciPy's rotations;
 - :mod:`so3fft.interop` -- conversions to ducc0's and SciPy's conventions.
 
+Precision: every plan takes ``dtype=numpy.float64`` (the default) or ``numpy.float32``
+(``float32`` and ``complex64`` arrays; see ``help(so3fft.Plan)``).
+
 Layouts (see ``help(so3fft.Plan)``): SO(3) samples ``(2B, 2B, 2B)`` indexed
 ``[beta, alpha, gamma]``, coefficients flat in SOFT's order (:func:`coef_index`,
 :func:`to_dense`); S^2 samples ``(2B, 2B)`` indexed ``[theta, phi]``, coefficients flat

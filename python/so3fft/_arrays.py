@@ -1,15 +1,46 @@
 """Argument checks shared by the plans: inputs used in place when they already have the
 right dtype, layout and shape, copied when a safe conversion exists, rejected otherwise;
-outputs checked, never converted."""
+outputs checked, never converted; the plans' precision (``dtype``)."""
 
 from __future__ import annotations
 
+from typing import Any, Dict, Tuple
+
 import numpy as np
+
+#: The precisions of the plans: their real dtype and its complex counterpart.
+_PRECISIONS: Dict[np.dtype, Tuple[np.dtype, np.dtype]] = {
+    np.dtype(np.float64): (np.dtype(np.float64), np.dtype(np.complex128)),
+    np.dtype(np.complex128): (np.dtype(np.float64), np.dtype(np.complex128)),
+    np.dtype(np.float32): (np.dtype(np.float32), np.dtype(np.complex64)),
+    np.dtype(np.complex64): (np.dtype(np.float32), np.dtype(np.complex64)),
+}
+
+
+def dtype_arg(dtype: Any) -> Tuple[np.dtype, np.dtype]:
+    """The real and complex dtypes of the precision ``dtype`` names: ``float64`` or
+    ``float32``, as a NumPy type, a ``numpy.dtype`` or a name; ``complex128`` and
+    ``complex64`` name the same precisions, and ``None`` is ``float64`` (as for NumPy).
+    Anything else is a ``TypeError``."""
+    try:
+        d = np.dtype(dtype)
+    except TypeError as e:
+        raise TypeError(f"dtype must be float64 or float32, not {dtype!r} ({e})") from None
+    if d not in _PRECISIONS:
+        raise TypeError(
+            f"dtype must be float64 or float32 (or complex128, complex64), not {d}"
+        )
+    return _PRECISIONS[d]
 
 
 def as_input(x, dtype, shapes, what) -> np.ndarray:
     """`x` as a C-contiguous array of `dtype` with one of `shapes` (tuples; `None` in a
-    shape matches any length). Arrays that already fit are returned as they are."""
+    shape matches any length). Arrays that already fit are returned as they are.
+
+    For a single-precision `dtype` (``float32``, ``complex64``), an input with a dtype of
+    more precision (``float64``, ``complex128``, ...) is a ``TypeError``: rounding it would
+    lose information. Python lists and numbers have no dtype and are rounded, as NumPy
+    rounds Python floats mixed with ``float32`` arrays."""
     if (
         type(x) is np.ndarray
         and x.dtype == dtype
@@ -28,10 +59,27 @@ def as_input(x, dtype, shapes, what) -> np.ndarray:
             f"{what}: cannot convert {a.dtype} to {np.dtype(dtype)} without losing "
             "information (complex data for a real plan?)"
         )
+    if _narrows(x, a.dtype, np.dtype(dtype)):
+        raise TypeError(
+            f"{what}: a single-precision plan takes {np.dtype(dtype)}, not {a.dtype} "
+            f"(convert explicitly, e.g. x.astype(numpy.{np.dtype(dtype)}), to round it, "
+            "or use a plan with dtype=numpy.float64)"
+        )
     if not any(_fits(a.shape, s) for s in shapes):
         expected = " or ".join(str(s) for s in shapes)
         raise ValueError(f"{what}: shape {a.shape}, expected {expected}")
     return np.require(a, dtype=dtype, requirements=["C", "A"])
+
+
+def _narrows(x, have: np.dtype, want: np.dtype) -> bool:
+    """Whether converting `x` (of dtype `have`, if it has one) to the single-precision
+    `want` would round a more precise floating-point dtype."""
+    return (
+        want in (np.float32, np.complex64)
+        and hasattr(x, "dtype")
+        and np.issubdtype(have, np.inexact)
+        and np.finfo(have).precision > np.finfo(want).precision
+    )
 
 
 def _fits(shape, pattern):

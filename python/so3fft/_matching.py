@@ -7,10 +7,18 @@ import math
 from typing import Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, DTypeLike
 
 from . import _so3fft
-from ._arrays import apart, as_input, bandwidth_arg, check_output, int_arg, threads_arg
+from ._arrays import (
+    apart,
+    as_input,
+    bandwidth_arg,
+    check_output,
+    dtype_arg,
+    int_arg,
+    threads_arg,
+)
 
 
 #: A rotation: a :class:`Rotation` or Euler angles ``(alpha, beta, gamma)``.
@@ -171,6 +179,13 @@ class Correlation:
     normalized : bool
         Normalised cross-correlation: the means left out and the result divided by the
         norms, so ``|C| <= 1`` with 1 for an exact rotated, scaled and shifted copy.
+    dtype : numpy dtype or name
+        Precision of the inputs and the grid: ``numpy.float64`` (the default) or
+        ``numpy.float32`` (inputs and grid ``float32``, or ``complex64`` for a complex
+        plan; ``float64`` or ``complex128`` inputs are a ``TypeError``, as for
+        :class:`Plan`). A single-precision plan finds the same grid peaks in less time;
+        :meth:`coefficients` are ``complex128`` and :meth:`refine` computes in double
+        precision whatever ``dtype`` is, so refined rotations are as accurate as in double.
     threads, rigor
         As for :class:`Plan`.
     """
@@ -183,17 +198,26 @@ class Correlation:
         deg_lim: Optional[int] = None,
         real: bool = False,
         normalized: bool = False,
+        dtype: DTypeLike = np.float64,
         threads: int = 0,
         rigor: str = "estimate",
     ) -> None:
         B = bandwidth_arg(B)
         b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
         deg_lim = None if deg_lim is None else int_arg(deg_lim, "deg_lim", 0, 1 << 31)
+        self._dtype, complex_dtype = dtype_arg(dtype)
         self._plan = _so3fft.Correlation(
-            B, b_out, deg_lim, bool(real), bool(normalized), threads_arg(threads), rigor
+            B,
+            b_out,
+            deg_lim,
+            bool(real),
+            bool(normalized),
+            threads_arg(threads),
+            rigor,
+            self._dtype.name,
         )
         self._normalized = bool(normalized)
-        self._in_dtype = np.float64 if self.real else np.complex128
+        self._in_dtype = self._dtype if self.real else complex_dtype
         self._s2_shapes = ((2 * B, 2 * B),)
 
     @property
@@ -222,6 +246,12 @@ class Correlation:
         return self._normalized
 
     @property
+    def dtype(self) -> np.dtype:
+        """The precision of inputs and grid: ``float64`` or ``float32`` (complex inputs and
+        grids ``complex128`` or ``complex64``)."""
+        return self._dtype
+
+    @property
     def grid_shape(self) -> Tuple[int, int, int]:
         """Shape of the correlation grid, ``(2 b_out,) * 3``."""
         return (2 * self.b_out,) * 3
@@ -229,7 +259,9 @@ class Correlation:
     def __repr__(self):
         return (
             f"so3fft.Correlation({self.B}, b_out={self.b_out}, deg_lim={self.deg_lim}, "
-            f"real={self.real}, normalized={self.normalized})"
+            f"real={self.real}, normalized={self.normalized}"
+            + ("" if self._dtype == np.float64 else f", dtype='{self._dtype}'")
+            + ")"
         )
 
     def _inputs(self, signal, pattern, out):
@@ -247,8 +279,8 @@ class Correlation:
     def correlate(
         self, signal: ArrayLike, pattern: ArrayLike, out: Optional[np.ndarray] = None
     ) -> np.ndarray:
-        """The correlation grid (``(2 b_out)^3``; real for a real plan), into ``out`` if
-        given."""
+        """The correlation grid (``(2 b_out)^3``; real for a real plan; of the plan's
+        precision), into ``out`` if given."""
         out = self._grid(out)
         s, p = self._inputs(signal, pattern, out)
         run = self._plan.correlate_real if self.real else self._plan.correlate
@@ -284,7 +316,8 @@ class Correlation:
         self, signal: ArrayLike, pattern: ArrayLike, out: Optional[np.ndarray] = None
     ) -> np.ndarray:
         """The correlation's SO(3) coefficients (bandwidth ``b_out``; zero above
-        ``deg_lim``), the input of :meth:`refine`."""
+        ``deg_lim``), the input of :meth:`refine`: ``complex128`` in either precision
+        (a single-precision plan computes them in double from its inputs, widened exactly)."""
         n = _so3fft.num_coeffs(self.b_out)
         if out is None:
             out = np.empty(n, np.complex128)
@@ -298,7 +331,8 @@ class Correlation:
     def refine(self, coeffs: ArrayLike, starts: Rotations) -> List[Tuple[Rotation, float]]:
         """From each start rotation, the nearest maximum of ``|C|^2`` of the band-limited
         correlation with coefficients ``coeffs`` (from :meth:`coefficients`), off the grid:
-        a list of ``(Rotation, value)``."""
+        a list of ``(Rotation, value)``, computed in double precision whatever the plan's
+        ``dtype``."""
         c = as_input(coeffs, np.complex128, ((_so3fft.num_coeffs(self.b_out),),), "coefficients")
         angles, values = self._plan.refine(c, _rows(starts))
         return [(Rotation(*a), float(v)) for a, v in zip(angles, values)]
@@ -323,9 +357,15 @@ class Correlation:
 
 
 @functools.lru_cache(maxsize=4)
-def _cached_correlation(B, b_out, deg_lim, real, normalized, threads):
+def _cached_correlation(B, b_out, deg_lim, real, normalized, threads, dtype):
     return Correlation(
-        B, b_out=b_out, deg_lim=deg_lim, real=real, normalized=normalized, threads=threads
+        B,
+        b_out=b_out,
+        deg_lim=deg_lim,
+        real=real,
+        normalized=normalized,
+        dtype=dtype,
+        threads=threads,
     )
 
 
@@ -336,12 +376,14 @@ def correlate(
     deg_lim: Optional[int] = None,
     *,
     normalized: bool = False,
+    dtype: DTypeLike = np.float64,
     threads: int = 0,
 ) -> np.ndarray:
     """The correlation grid of ``signal`` and ``pattern`` (S^2 samples, ``(2B, 2B)``): see
-    :class:`Correlation`. Real inputs (both ``float``) give a real grid. The plan is kept
-    for the next call with the same arguments (a :class:`Correlation` made once is faster
-    for many calls with different ones)."""
+    :class:`Correlation`. Real inputs (both ``float``) give a real grid; ``dtype`` is the
+    precision (``numpy.float32`` for ``float32`` or ``complex64`` inputs and grid). The
+    plan is kept for the next call with the same arguments (a :class:`Correlation` made once
+    is faster for many calls with different ones)."""
     s, p = np.asarray(signal), np.asarray(pattern)
     if s.ndim != 2 or s.shape[0] != s.shape[1] or s.shape[0] % 2:
         raise ValueError(f"signal: shape {s.shape}, expected (2B, 2B)")
@@ -349,22 +391,31 @@ def correlate(
     b_out = None if b_out is None else bandwidth_arg(b_out, "b_out")
     deg_lim = None if deg_lim is None else int_arg(deg_lim, "deg_lim", 0, 1 << 31)
     plan = _cached_correlation(
-        s.shape[0] // 2, b_out, deg_lim, real, bool(normalized), threads_arg(threads)
+        s.shape[0] // 2,
+        b_out,
+        deg_lim,
+        real,
+        bool(normalized),
+        threads_arg(threads),
+        dtype_arg(dtype)[0],
     )
-    return plan.correlate(s, p)
+    return plan.correlate(signal, pattern)  # lists keep their rounding rule (as_input)
 
 
 def top_peaks(grid: ArrayLike, k: int = 1, min_angle: float = 0.0) -> List[Peak]:
     """The ``k`` largest local maxima of ``|C|^2`` on a correlation grid (``(2B)^3``, complex
     or real), each at least ``min_angle`` radians (geodesic) from every larger one taken: a
-    list of :class:`Peak`, largest first."""
+    list of :class:`Peak`, largest first. ``complex64`` and ``float32`` grids (of
+    single-precision plans) are searched as they are, other grids in double precision."""
     g = np.asarray(grid)
     k = int_arg(k, "k", 0, 1 << 31)
     if np.iscomplexobj(g):
-        g = as_input(g, np.complex128, (g.shape,), "grid")
+        c = np.complex64 if g.dtype == np.complex64 else np.complex128
+        g = as_input(g, c, (g.shape,), "grid")
         found = _so3fft.top_peaks(g, k, float(min_angle))
     else:
-        g = as_input(g, np.float64, (g.shape,), "grid")
+        r = np.float32 if g.dtype == np.float32 else np.float64
+        g = as_input(g, r, (g.shape,), "grid")
         found = _so3fft.top_peaks_real(g, k, float(min_angle))
     return [Peak(*p) for p in found]
 
