@@ -83,6 +83,16 @@ static inline void same_failure(const char *file, int line, int code, struct out
         same_failure(__FILE__, __LINE__, (code), f_, d_, 1);                                          \
     } while (0)
 
+/* Compares an f32 call returning `fail` on failure (-1 for those returning an index or a
+ * count) with its f64 twin: `fail` from both, error `code`, the same message. */
+#define SAME_FAILURE(fail, code, fcall, dcall)                                              \
+    do {                                                                                    \
+        struct outcome f_ = outcome_of((long)(fcall));                                      \
+        struct outcome d_ = outcome_of((long)(dcall));                                      \
+        CHECK(f_.ret == (fail));                                                            \
+        same_failure(__FILE__, __LINE__, (code), f_, d_, 1);                                \
+    } while (0)
+
 /* The same where the messages differ: an alignment (4 bytes against 8) and an address, or
  * a function name; `fmsg` must be part of the f32 message. */
 #define SAME_CODE_ONLY(code, fcall, dcall, fmsg)                                            \

@@ -115,6 +115,9 @@ typedef struct so3fft_plan_s so3fft_plan_s;
 // Opaque S^2 plan object (made by `so3fft_plan_s2`, released by `so3fft_destroy_s2_plan`).
 typedef struct so3fft_s2_plan_s so3fft_s2_plan_s;
 
+// Opaque single-precision correlation plan (made by `so3fftf_plan_correlation`).
+typedef struct so3fftf_correlation_s so3fftf_correlation_s;
+
 // Opaque single-precision partial plan object (made by `so3fftf_plan_partial`).
 typedef struct so3fftf_partial_s so3fftf_partial_s;
 
@@ -189,6 +192,9 @@ typedef struct so3fftf_partial_s *so3fftf_partial;
 
 // A single-precision S^2 plan: a pointer to an opaque object.
 typedef struct so3fftf_s2_plan_s *so3fftf_s2_plan;
+
+// A single-precision correlation plan: a pointer to an opaque object.
+typedef struct so3fftf_correlation_s *so3fftf_correlation;
 
 #ifdef __cplusplus
 extern "C" {
@@ -638,6 +644,48 @@ int so3fftf_import_wisdom_from_string(const char *wisdom);
 
 // Forgets single-precision FFTW's wisdom (plans already made are not affected).
 void so3fftf_forget_wisdom(void);
+
+// As `so3fft_plan_correlation`, in single precision: float samples and grids (same
+// arguments and flags). NULL on error.
+so3fftf_correlation so3fftf_plan_correlation(int L, int B_out, int deg_lim, unsigned int flags, int nthreads);
+
+// Destroys a single-precision correlation plan; NULL is a no-op.
+void so3fftf_destroy_correlation(so3fftf_correlation p);
+
+// Number of values `(2 B_out)^3` of the plan's grid (`SO3FFT_ENULL` for NULL).
+ptrdiff_t so3fftf_correlation_grid_size(so3fftf_correlation p);
+
+// As `so3fft_correlate`: complex float samples (`(2L)^2` each) into the grid `out`.
+int so3fftf_correlate(so3fftf_correlation p, so3fftf_complex *signal, so3fftf_complex *pattern, so3fftf_complex *out);
+
+// As `so3fft_correlate_real`: real float samples into the real grid `out`.
+int so3fftf_correlate_real(so3fftf_correlation p, const float *signal, const float *pattern, float *out);
+
+// As `so3fft_correlate_argmax`: the grid, and the index of its largest `|C|^2` (angles
+// into `angles`, 3 doubles, or NULL). -1 on error.
+ptrdiff_t so3fftf_correlate_argmax(so3fftf_correlation p, so3fftf_complex *signal, so3fftf_complex *pattern, so3fftf_complex *out, double *angles);
+
+// As `so3fft_correlate_real_argmax`, on real float samples.
+ptrdiff_t so3fftf_correlate_real_argmax(so3fftf_correlation p, const float *signal, const float *pattern, float *out, double *angles);
+
+// As `so3fft_grid_argmax`, on a complex float grid (angles in double).
+ptrdiff_t so3fftf_grid_argmax(int B, so3fftf_complex *grid, double *angles);
+
+// As `so3fft_grid_argmax_real`, on a real float grid.
+ptrdiff_t so3fftf_grid_argmax_real(int B, const float *grid, double *angles);
+
+// As `so3fft_grid_top_peaks`, on a complex float grid (angles and values in double).
+ptrdiff_t so3fftf_grid_top_peaks(int B, so3fftf_complex *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
+
+// As `so3fft_grid_top_peaks_real`, on a real float grid.
+ptrdiff_t so3fftf_grid_top_peaks_real(int B, const float *grid, size_t k, double min_angle, double *angles, double *values, ptrdiff_t *indices);
+
+// As `so3fft_correlation_refine`: float samples (complex ones as interleaved floats),
+// `angles` and `value` in double; the refinement computes in double.
+int so3fftf_correlation_refine(so3fftf_correlation p, const float *signal, const float *pattern, double *angles, double *value);
+
+// As `so3fft_correlation_refine_many`: float samples, `npeaks` peaks in double.
+int so3fftf_correlation_refine_many(so3fftf_correlation p, const float *signal, const float *pattern, size_t npeaks, double *angles, double *values);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -1,15 +1,17 @@
 //! Rotational matching: correlation plans, the grid peak and its refinement off the grid.
+//!
+//! The bodies are generic over the plan's handle ([`CorrelationHandle`], whose element type
+//! is the precision) or over the grid's element type: the `so3fft_*` functions here and the
+//! `so3fftf_*` ones of `single_matching.rs` are one-line wrappers over them. Peaks, angles
+//! and refinement are `f64` in both precisions.
 
 use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_REAL};
 use super::{SO3FFT_DESTROY_INPUT, SO3FFT_ENULL};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::matching::{
-    grid_argmax, grid_argmax_real, top_peaks, top_peaks_real, Correlation, CorrelationOptions,
-    Peak, Rotation,
-};
+use crate::matching::{self, Correlation, CorrelationOptions, Peak, Rotation};
 use crate::options::Options;
-use crate::Complex64;
+use crate::{Complex, Complex64, Real};
 use std::ffi::{c_double, c_int, c_uint};
 
 /// Correlation planner flag: normalised cross-correlation (means left out, divided by the
@@ -18,25 +20,49 @@ pub const SO3FFT_NORMALIZED: c_uint = 64;
 
 /// Opaque correlation plan (made by `so3fft_plan_correlation`).
 pub struct so3fft_correlation_s {
-    plan: Correlation,
+    plan: Correlation<f64>,
 }
 
 /// A correlation plan: a pointer to an opaque object.
 pub type so3fft_correlation = *mut so3fft_correlation_s;
 
-/// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
-/// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
-/// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
-/// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
-/// NULL on error.
-#[no_mangle]
-pub extern "C" fn so3fft_plan_correlation(
+/// The opaque object behind the correlation plan handles of one precision
+/// (`so3fft_correlation_s`, `so3fftf_correlation_s`): it owns a `Correlation` of its
+/// element type.
+pub(super) trait CorrelationHandle: Sized + 'static {
+    /// The element type of the samples and the grid (`f64` or `f32`).
+    type T: Real;
+    /// The object owning `plan`.
+    fn wrap(plan: Correlation<Self::T>) -> Self;
+    /// The plan it owns.
+    fn plan(&self) -> &Correlation<Self::T>;
+}
+
+impl CorrelationHandle for so3fft_correlation_s {
+    type T = f64;
+    fn wrap(plan: Correlation<f64>) -> Self {
+        so3fft_correlation_s { plan }
+    }
+    fn plan(&self) -> &Correlation<f64> {
+        &self.plan
+    }
+}
+
+/// An array of interleaved complex values `{re, im}` as `Complex<T>` (`#[repr(C)]`, the
+/// same layout and alignment).
+fn complex<T>(a: *mut [T; 2]) -> *mut Complex<T> {
+    a.cast()
+}
+
+/// The body of `so3fft_plan_correlation` for the handle type `H`: a new plan, or NULL on
+/// error.
+pub(super) fn plan_correlation<H: CorrelationHandle>(
     L: c_int,
     B_out: c_int,
     deg_lim: c_int,
     flags: c_uint,
     nthreads: c_int,
-) -> so3fft_correlation {
+) -> *mut H {
     guarded(std::ptr::null_mut(), || {
         let l = checks::bandwidth(L)?;
         let b_out = match B_out {
@@ -65,42 +91,82 @@ pub extern "C" fn so3fft_plan_correlation(
                 ..Options::default()
             },
         };
-        let plan = Correlation::new(l, &options)?;
-        Ok(Box::into_raw(Box::new(so3fft_correlation_s { plan })))
+        let plan = Correlation::<H::T>::new(l, &options)?;
+        Ok(Box::into_raw(Box::new(H::wrap(plan))))
     })
 }
 
-/// Destroys a correlation plan; NULL is a no-op.
-#[no_mangle]
-pub unsafe extern "C" fn so3fft_destroy_correlation(p: so3fft_correlation) {
+/// The body of `so3fft_destroy_correlation` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a plan made by [`plan_correlation`] with the same `H`, not destroyed yet
+/// and used by no other thread.
+pub(super) unsafe fn destroy_correlation<H: CorrelationHandle>(p: *mut H) {
     guarded((), || {
         if !p.is_null() {
-            // SAFETY: a non-NULL `p` came from Box::into_raw in `so3fft_plan_correlation` and
-            // is destroyed once, while no other thread uses it (the caller's contract).
+            // SAFETY: a non-NULL `p` came from Box::into_raw of a `Box<H>` in
+            // `plan_correlation` and is destroyed once, while no other thread uses it (this
+            // function's contract).
             drop(unsafe { Box::from_raw(p) });
         }
         Ok(())
     })
 }
 
+/// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
+/// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
+/// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
+/// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
+/// NULL on error.
+#[no_mangle]
+pub extern "C" fn so3fft_plan_correlation(
+    L: c_int,
+    B_out: c_int,
+    deg_lim: c_int,
+    flags: c_uint,
+    nthreads: c_int,
+) -> so3fft_correlation {
+    plan_correlation(L, B_out, deg_lim, flags, nthreads)
+}
+
+/// Destroys a correlation plan; NULL is a no-op.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_destroy_correlation(p: so3fft_correlation) {
+    // SAFETY: `p` is NULL or a live plan of this type, used by no other thread (the API's
+    // contract).
+    unsafe { destroy_correlation(p) }
+}
+
 /// The plan behind a handle; an error for NULL.
 ///
 /// # Safety
-/// `p` is NULL or a live correlation plan.
-unsafe fn plan_ref<'a>(p: so3fft_correlation) -> Result<&'a Correlation, CallError> {
+/// `p` is NULL or a live correlation plan, not destroyed during the returned reference's
+/// use.
+unsafe fn plan_ref<'a, H: CorrelationHandle>(
+    p: *mut H,
+) -> Result<&'a Correlation<H::T>, CallError> {
     // SAFETY: non-NULL handles are live plans (this function's contract), only read.
     unsafe { p.as_ref() }
-        .map(|s| &s.plan)
+        .map(H::plan)
         .ok_or_else(|| CallError::new(ErrorKind::Null, "the correlation plan is NULL"))
+}
+
+/// The body of `so3fft_correlation_grid_size` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`.
+pub(super) unsafe fn correlation_grid_size<H: CorrelationHandle>(p: *mut H) -> isize {
+    guarded(SO3FFT_ENULL as isize, || {
+        // SAFETY: `p` is NULL or a live plan (this function's contract).
+        Ok(unsafe { plan_ref(p) }?.num_grid() as isize)
+    })
 }
 
 /// Number of values `(2 B_out)^3` of a plan's correlation grid (`SO3FFT_ENULL` for NULL).
 #[no_mangle]
 pub unsafe extern "C" fn so3fft_correlation_grid_size(p: so3fft_correlation) -> isize {
-    guarded(SO3FFT_ENULL as isize, || {
-        // SAFETY: `p` is NULL or a live plan (the API's contract).
-        Ok(unsafe { plan_ref(p) }?.num_grid() as isize)
-    })
+    // SAFETY: `p` is NULL or a live plan (the API's contract).
+    unsafe { correlation_grid_size(p) }
 }
 
 /// Input slices of a correlation call, checked (non-NULL, aligned, and disjoint from `out`
@@ -108,12 +174,12 @@ pub unsafe extern "C" fn so3fft_correlation_grid_size(p: so3fft_correlation) -> 
 ///
 /// # Safety
 /// Non-NULL pointers hold `n` values each, only read during the call.
-unsafe fn inputs<'a, T>(
-    signal: *const T,
-    pattern: *const T,
+unsafe fn inputs<'a, X, G>(
+    signal: *const X,
+    pattern: *const X,
     n: usize,
-    out: Option<&Array<u8>>,
-) -> Result<(&'a [T], &'a [T]), CallError> {
+    out: Option<&Array<G>>,
+) -> Result<(&'a [X], &'a [X]), CallError> {
     for input in [
         Array::new(signal, n, "signal"),
         Array::new(pattern, n, "pattern"),
@@ -132,8 +198,8 @@ unsafe fn inputs<'a, T>(
     })
 }
 
-/// The plan and arrays of a correlation call, checked: samples of `T`, a grid of `G`.
-type CallArgs<'a, T, G> = (&'a Correlation, (&'a [T], &'a [T]), &'a mut [G]);
+/// The plan and arrays of a correlation call, checked: samples of `X`, a grid of `G`.
+type CallArgs<'a, T, X, G> = (&'a Correlation<T>, (&'a [X], &'a [X]), &'a mut [G]);
 
 /// [`CallArgs`] of a call on `p` with `signal`, `pattern` (`(2L)^2` values each) and the
 /// grid `out` (`(2 B_out)^3` values).
@@ -141,19 +207,106 @@ type CallArgs<'a, T, G> = (&'a Correlation, (&'a [T], &'a [T]), &'a mut [G]);
 /// # Safety
 /// `p` is NULL or a live plan; the arrays are NULL or hold those sizes (the API's
 /// contract).
-unsafe fn call_args<'a, T, G>(
-    p: so3fft_correlation,
-    (signal, pattern): (*const T, *const T),
+unsafe fn call_args<'a, H: CorrelationHandle, X, G>(
+    p: *mut H,
+    (signal, pattern): (*const X, *const X),
     out: *mut G,
-) -> Result<CallArgs<'a, T, G>, CallError> {
+) -> Result<CallArgs<'a, H::T, X, G>, CallError> {
     // SAFETY: this function's contract.
     unsafe {
         let plan = plan_ref(p)?;
         let (ns, ng) = (4 * plan.b_in() * plan.b_in(), plan.num_grid());
-        let grid = Array::new(out.cast_const().cast::<u8>(), ng * size_of::<G>(), "out");
+        let grid = Array::new(out.cast_const(), ng, "out");
         let inputs = inputs(signal, pattern, ns, Some(&grid))?;
         Ok((plan, inputs, std::slice::from_raw_parts_mut(out, ng)))
     }
+}
+
+/// The body of `so3fft_correlate` for the handle type `H` (element `H::T`).
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`; non-NULL arrays hold the plan's sizes (the API's
+/// contract).
+pub(super) unsafe fn correlate<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *mut [H::T; 2],
+    pattern: *mut [H::T; 2],
+    out: *mut [H::T; 2],
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: this function's contract.
+        let (plan, (s, h), out) = unsafe {
+            call_args(
+                p,
+                (complex(signal).cast_const(), complex(pattern).cast_const()),
+                complex(out),
+            )
+        }?;
+        Ok(plan.correlate(s, h, out)?)
+    })
+}
+
+/// The body of `so3fft_correlate_real` for the handle type `H`.
+///
+/// # Safety
+/// As [`correlate`].
+pub(super) unsafe fn correlate_real<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *const H::T,
+    pattern: *const H::T,
+    out: *mut H::T,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: this function's contract.
+        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
+        Ok(plan.correlate_real(s, h, out)?)
+    })
+}
+
+/// The body of `so3fft_correlate_argmax` for the handle type `H`.
+///
+/// # Safety
+/// As [`correlate`]; `angles` is NULL or holds 3 doubles.
+pub(super) unsafe fn correlate_argmax<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *mut [H::T; 2],
+    pattern: *mut [H::T; 2],
+    out: *mut [H::T; 2],
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract.
+        let (plan, (s, h), out) = unsafe {
+            call_args(
+                p,
+                (complex(signal).cast_const(), complex(pattern).cast_const()),
+                complex(out),
+            )
+        }?;
+        let peak = plan.correlate_argmax(s, h, out)?;
+        // SAFETY: `angles` NULL or 3 doubles (this function's contract).
+        Ok(unsafe { put_angles(peak, angles) })
+    })
+}
+
+/// The body of `so3fft_correlate_real_argmax` for the handle type `H`.
+///
+/// # Safety
+/// As [`correlate_argmax`].
+pub(super) unsafe fn correlate_real_argmax<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *const H::T,
+    pattern: *const H::T,
+    out: *mut H::T,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract.
+        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
+        let peak = plan.correlate_real_argmax(s, h, out)?;
+        // SAFETY: `angles` NULL or 3 doubles (this function's contract).
+        Ok(unsafe { put_angles(peak, angles) })
+    })
 }
 
 /// The correlation of complex S^2 samples (`(2L)^2` each) into the grid `out`
@@ -165,14 +318,9 @@ pub unsafe extern "C" fn so3fft_correlate(
     pattern: *mut so3fft_complex,
     out: *mut so3fft_complex,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: `p` NULL or live; arrays of the documented sizes (the API's contract);
-        // `so3fft_complex` is layout-identical to `Complex64`.
-        let (plan, (s, h), out) = unsafe {
-            call_args::<Complex64, Complex64>(p, (signal.cast(), pattern.cast()), out.cast())
-        }?;
-        Ok(plan.correlate(s, h, out)?)
-    })
+    // SAFETY: `p` is NULL or a live plan; non-NULL arrays hold the plan's sizes (the API's
+    // contract).
+    unsafe { correlate(p, signal, pattern, out) }
 }
 
 /// The correlation of real S^2 samples into the real grid `out` (plan made with
@@ -184,11 +332,8 @@ pub unsafe extern "C" fn so3fft_correlate_real(
     pattern: *const c_double,
     out: *mut c_double,
 ) -> c_int {
-    guarded_code(|| {
-        // SAFETY: as in `so3fft_correlate`.
-        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
-        Ok(plan.correlate_real(s, h, out)?)
-    })
+    // SAFETY: as in `so3fft_correlate`.
+    unsafe { correlate_real(p, signal, pattern, out) }
 }
 
 /// [`so3fft_correlate`] and the index of the grid's largest `|C|^2` (the point
@@ -202,15 +347,8 @@ pub unsafe extern "C" fn so3fft_correlate_argmax(
     out: *mut so3fft_complex,
     angles: *mut c_double,
 ) -> isize {
-    guarded(-1, || {
-        // SAFETY: as in `so3fft_correlate`.
-        let (plan, (s, h), out) = unsafe {
-            call_args::<Complex64, Complex64>(p, (signal.cast(), pattern.cast()), out.cast())
-        }?;
-        let peak = plan.correlate_argmax(s, h, out)?;
-        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
-        Ok(unsafe { put_angles(peak, angles) })
-    })
+    // SAFETY: as in `so3fft_correlate`; `angles` NULL or 3 doubles (the API's contract).
+    unsafe { correlate_argmax(p, signal, pattern, out, angles) }
 }
 
 /// [`so3fft_correlate_real`] and the index of the grid's largest `C^2`, as
@@ -223,13 +361,8 @@ pub unsafe extern "C" fn so3fft_correlate_real_argmax(
     out: *mut c_double,
     angles: *mut c_double,
 ) -> isize {
-    guarded(-1, || {
-        // SAFETY: as in `so3fft_correlate`.
-        let (plan, (s, h), out) = unsafe { call_args(p, (signal, pattern), out) }?;
-        let peak = plan.correlate_real_argmax(s, h, out)?;
-        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
-        Ok(unsafe { put_angles(peak, angles) })
-    })
+    // SAFETY: as in `so3fft_correlate_argmax`.
+    unsafe { correlate_real_argmax(p, signal, pattern, out, angles) }
 }
 
 /// Writes a peak's angles and returns its index.
@@ -248,6 +381,53 @@ unsafe fn put_angles(peak: Peak, angles: *mut c_double) -> isize {
     peak.index as isize
 }
 
+/// The `(2B)^3` values of a grid of bandwidth `B`, checked (non-NULL, aligned).
+///
+/// # Safety
+/// `grid` is NULL or holds `(2B)^3` values, only read during the call.
+unsafe fn grid_values<'a, G>(B: c_int, grid: *const G) -> Result<(usize, &'a [G]), CallError> {
+    let b = checks::bandwidth(B)?;
+    let n = crate::num_samples(b);
+    Array::new(grid, n, "grid").check()?;
+    // SAFETY: checked non-NULL and aligned; (2B)^3 values (this function's contract).
+    Ok((b, unsafe { std::slice::from_raw_parts(grid, n) }))
+}
+
+/// The body of `so3fft_grid_argmax` for complex grids of `T`.
+///
+/// # Safety
+/// `grid` is NULL or holds `(2B)^3` values; `angles` is NULL or holds 3 doubles.
+pub(super) unsafe fn grid_argmax<T: Real>(
+    B: c_int,
+    grid: *mut [T; 2],
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract; the grid is only read (non-const in the
+        // prototype like every complex array of this API).
+        let (b, values) = unsafe { grid_values(B, complex(grid).cast_const()) }?;
+        // SAFETY: `angles` NULL or 3 doubles (this function's contract).
+        Ok(unsafe { put_angles(matching::grid_argmax(b, values), angles) })
+    })
+}
+
+/// The body of `so3fft_grid_argmax_real` for real grids of `T`.
+///
+/// # Safety
+/// As [`grid_argmax`].
+pub(super) unsafe fn grid_argmax_real<T: Real>(
+    B: c_int,
+    grid: *const T,
+    angles: *mut c_double,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract.
+        let (b, values) = unsafe { grid_values(B, grid) }?;
+        // SAFETY: `angles` NULL or 3 doubles (this function's contract).
+        Ok(unsafe { put_angles(matching::grid_argmax_real(b, values), angles) })
+    })
+}
+
 /// Index of the largest `|C|^2` of a complex grid of bandwidth `B` (ties: the lowest index;
 /// SOFT's rule), its Euler angles `(alpha, beta, gamma)` into `angles` (3 doubles, or NULL);
 /// -1 on error.
@@ -257,16 +437,8 @@ pub unsafe extern "C" fn so3fft_grid_argmax(
     grid: *mut so3fft_complex,
     angles: *mut c_double,
 ) -> isize {
-    guarded(-1, || {
-        let b = checks::bandwidth(B)?;
-        let n = crate::num_samples(b);
-        Array::new(grid.cast_const(), n, "grid").check()?;
-        // SAFETY: checked non-NULL and aligned; (2B)^3 values (the API's contract).
-        let values =
-            unsafe { std::slice::from_raw_parts(grid.cast_const().cast::<Complex64>(), n) };
-        // SAFETY: `angles` NULL or 3 doubles (the API's contract).
-        Ok(unsafe { put_angles(grid_argmax(b, values), angles) })
-    })
+    // SAFETY: `grid` NULL or (2B)^3 values, `angles` NULL or 3 doubles (the API's contract).
+    unsafe { grid_argmax(B, grid, angles) }
 }
 
 /// [`so3fft_grid_argmax`] of a real grid.
@@ -276,15 +448,8 @@ pub unsafe extern "C" fn so3fft_grid_argmax_real(
     grid: *const c_double,
     angles: *mut c_double,
 ) -> isize {
-    guarded(-1, || {
-        let b = checks::bandwidth(B)?;
-        let n = crate::num_samples(b);
-        Array::new(grid, n, "grid").check()?;
-        // SAFETY: as in `so3fft_grid_argmax`.
-        let values = unsafe { std::slice::from_raw_parts(grid, n) };
-        // SAFETY: as in `so3fft_grid_argmax`.
-        Ok(unsafe { put_angles(grid_argmax_real(b, values), angles) })
-    })
+    // SAFETY: as in `so3fft_grid_argmax`.
+    unsafe { grid_argmax_real(B, grid, angles) }
 }
 
 /// The rotation matrix (row-major, acting on column vectors) of the rotation with Euler
@@ -389,6 +554,54 @@ fn check_peak_arrays(
     Ok(())
 }
 
+/// The body of `so3fft_grid_top_peaks` for complex grids of `T`.
+///
+/// # Safety
+/// `grid` is NULL or holds `(2B)^3` values; `angles` is NULL or holds `3 k` doubles,
+/// `values` and `indices` NULL or `k` entries each.
+pub(super) unsafe fn grid_top_peaks<T: Real>(
+    B: c_int,
+    grid: *mut [T; 2],
+    k: usize,
+    min_angle: c_double,
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract; the grid is only read (non-const in the
+        // prototype like every complex array of this API).
+        let (b, grid) = unsafe { grid_values(B, complex(grid).cast_const()) }?;
+        check_peak_arrays(k, min_angle, angles, values, indices)?;
+        let peaks = matching::top_peaks(b, grid, k, min_angle);
+        // SAFETY: the arrays' sizes were checked for `k >= peaks.len()` peaks.
+        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
+    })
+}
+
+/// The body of `so3fft_grid_top_peaks_real` for real grids of `T`.
+///
+/// # Safety
+/// As [`grid_top_peaks`].
+pub(super) unsafe fn grid_top_peaks_real<T: Real>(
+    B: c_int,
+    grid: *const T,
+    k: usize,
+    min_angle: c_double,
+    angles: *mut c_double,
+    values: *mut c_double,
+    indices: *mut isize,
+) -> isize {
+    guarded(-1, || {
+        // SAFETY: this function's contract.
+        let (b, grid) = unsafe { grid_values(B, grid) }?;
+        check_peak_arrays(k, min_angle, angles, values, indices)?;
+        let peaks = matching::top_peaks_real(b, grid, k, min_angle);
+        // SAFETY: the arrays' sizes were checked for `k >= peaks.len()` peaks.
+        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
+    })
+}
+
 /// The (up to) `k` largest local maxima of `|C|^2` on a complex grid of bandwidth `B`, at
 /// least `min_angle` radians (geodesic) apart, largest first: Euler angles into `angles`
 /// (`3 k` doubles), `|C|^2` into `values` and flat indices into `indices` (each NULL or `k`
@@ -404,18 +617,9 @@ pub unsafe extern "C" fn so3fft_grid_top_peaks(
     values: *mut c_double,
     indices: *mut isize,
 ) -> isize {
-    guarded(-1, || {
-        let b = checks::bandwidth(B)?;
-        let n = crate::num_samples(b);
-        Array::new(grid.cast_const(), n, "grid").check()?;
-        check_peak_arrays(k, min_angle, angles, values, indices)?;
-        // SAFETY: checked non-NULL and aligned; (2B)^3 values (the API's contract), only
-        // read (non-const in the prototype like every complex array of this API).
-        let grid = unsafe { std::slice::from_raw_parts(grid.cast_const().cast::<Complex64>(), n) };
-        let peaks = top_peaks(b, grid, k, min_angle);
-        // SAFETY: the arrays' sizes were checked for `k >= peaks.len()` peaks.
-        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
-    })
+    // SAFETY: `grid` NULL or (2B)^3 values, the peak arrays NULL or of `k` peaks (the API's
+    // contract).
+    unsafe { grid_top_peaks(B, grid, k, min_angle, angles, values, indices) }
 }
 
 /// `so3fft_grid_top_peaks` of a real grid (`C^2`).
@@ -429,45 +633,21 @@ pub unsafe extern "C" fn so3fft_grid_top_peaks_real(
     values: *mut c_double,
     indices: *mut isize,
 ) -> isize {
-    guarded(-1, || {
-        let b = checks::bandwidth(B)?;
-        let n = crate::num_samples(b);
-        Array::new(grid, n, "grid").check()?;
-        check_peak_arrays(k, min_angle, angles, values, indices)?;
-        // SAFETY: as in `so3fft_grid_top_peaks`.
-        let grid = unsafe { std::slice::from_raw_parts(grid, n) };
-        let peaks = top_peaks_real(b, grid, k, min_angle);
-        // SAFETY: as in `so3fft_grid_top_peaks`.
-        Ok(unsafe { put_peaks(&peaks, angles, values, indices) })
-    })
+    // SAFETY: as in `so3fft_grid_top_peaks`.
+    unsafe { grid_top_peaks_real(B, grid, k, min_angle, angles, values, indices) }
 }
 
-/// Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from
-/// `so3fft_grid_argmax`), the nearby maximum of the band-limited `|C|^2` of `signal` and
-/// `pattern` (complex samples as interleaved doubles, or real ones for a plan made with
-/// `SO3FFT_REAL`), written
-/// back to `angles`; `|C|^2` there into `value` (or NULL). `SO3FFT_OK` or an error code.
-#[no_mangle]
-pub unsafe extern "C" fn so3fft_correlation_refine(
-    p: so3fft_correlation,
-    signal: *const c_double,
-    pattern: *const c_double,
-    angles: *mut c_double,
-    value: *mut c_double,
-) -> c_int {
-    // SAFETY: the caller's contract is `so3fft_correlation_refine_many`'s with one peak.
-    unsafe { so3fft_correlation_refine_many(p, signal, pattern, 1, angles, value) }
-}
-
-/// `so3fft_correlation_refine` for `npeaks` peaks at once (one correlation, one pass over
-/// its coefficients per step for all peaks): `angles` holds `3 npeaks` doubles (alpha,
-/// beta, gamma per peak), each triple replaced by its refined peak; `values` (NULL or
-/// `npeaks` doubles) receives `|C|^2` there. `SO3FFT_OK` or an error code.
-#[no_mangle]
-pub unsafe extern "C" fn so3fft_correlation_refine_many(
-    p: so3fft_correlation,
-    signal: *const c_double,
-    pattern: *const c_double,
+/// The body of `so3fft_correlation_refine_many` for the handle type `H`: samples of
+/// `H::T` (complex ones interleaved), angles and values in `f64`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`; `signal` and `pattern` NULL or `(2L)^2` samples
+/// each; `angles` NULL or `3 npeaks` doubles, `values` NULL or `npeaks` doubles (the API's
+/// contract).
+pub(super) unsafe fn correlation_refine_many<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *const H::T,
+    pattern: *const H::T,
     npeaks: usize,
     angles: *mut c_double,
     values: *mut c_double,
@@ -486,7 +666,7 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
         if !values.is_null() {
             Array::new(values.cast_const(), npeaks, "values").check()?;
         }
-        // SAFETY: as in `so3fft_correlate`; `angles` holds `3 npeaks` doubles (checked for
+        // SAFETY: this function's contract; `angles` holds `3 npeaks` doubles (checked for
         // NULL, alignment and range above), `values` NULL or `npeaks`; both are read and
         // written through raw pointers (they may overlap).
         unsafe {
@@ -509,10 +689,10 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
             let mut coeffs = vec![Complex64::default(); crate::num_coeffs(b_out)];
             let ns = 4 * plan.b_in() * plan.b_in();
             if plan.is_real() {
-                let (s, h) = inputs(signal, pattern, ns, None)?;
+                let (s, h) = inputs::<_, u8>(signal, pattern, ns, None)?;
                 plan.coefficients_real(s, h, &mut coeffs)?;
             } else {
-                let (s, h) = inputs(signal.cast::<Complex64>(), pattern.cast(), ns, None)?;
+                let (s, h) = inputs::<Complex<H::T>, u8>(signal.cast(), pattern.cast(), ns, None)?;
                 plan.coefficients(s, h, &mut coeffs)?;
             }
             let refined = plan.refine_many(&coeffs, &starts)?;
@@ -526,4 +706,39 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
             Ok(())
         }
     })
+}
+
+/// Refines a peak off the grid: from the Euler angles in `angles` (3 doubles, e.g. from
+/// `so3fft_grid_argmax`), the nearby maximum of the band-limited `|C|^2` of `signal` and
+/// `pattern` (complex samples as interleaved doubles, or real ones for a plan made with
+/// `SO3FFT_REAL`), written
+/// back to `angles`; `|C|^2` there into `value` (or NULL). `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_refine(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    angles: *mut c_double,
+    value: *mut c_double,
+) -> c_int {
+    // SAFETY: the caller's contract is `so3fft_correlation_refine_many`'s with one peak.
+    unsafe { correlation_refine_many(p, signal, pattern, 1, angles, value) }
+}
+
+/// `so3fft_correlation_refine` for `npeaks` peaks at once (one correlation, one pass over
+/// its coefficients per step for all peaks): `angles` holds `3 npeaks` doubles (alpha,
+/// beta, gamma per peak), each triple replaced by its refined peak; `values` (NULL or
+/// `npeaks` doubles) receives `|C|^2` there. `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_refine_many(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    npeaks: usize,
+    angles: *mut c_double,
+    values: *mut c_double,
+) -> c_int {
+    // SAFETY: `p` is NULL or a live plan; the arrays hold the documented sizes (the API's
+    // contract).
+    unsafe { correlation_refine_many(p, signal, pattern, npeaks, angles, values) }
 }

@@ -52,6 +52,8 @@ mod wisdom;
 mod errors;
 // Single precision (so3fftf_*): last, so that its section follows the double API.
 mod single;
+// Single-precision rotational matching (so3fftf_correlation ...).
+mod single_matching;
 
 use crate::ffi::last_error::LastErrorSink;
 use crate::ffi::{boundary, CallError, ErrorKind};

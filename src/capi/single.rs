@@ -1,5 +1,6 @@
 //! The single-precision C API, `so3fftf_*` on `float` data (as FFTW's `fftwf_*`): the SO(3)
-//! plans, the partial plans, the S^2 transforms and single-precision FFTW's wisdom. Each
+//! plans, the partial plans, the S^2 transforms and single-precision FFTW's wisdom (the
+//! correlation plans are in `single_matching.rs`). Each
 //! function is a thin wrapper over the body its `so3fft_*` twin runs (`planner.rs`,
 //! `execute.rs`, `query.rs`, `grid.rs`, `partial.rs`, `s2.rs`, `wisdom.rs`), instantiated
 //! for `f32`, so the checks and error messages are the same in both precisions. Sizes,
