@@ -90,6 +90,7 @@ pub(super) fn plan_correlation<H: CorrelationHandle>(
                 rigor: rigor_of(flags & !(SO3FFT_REAL | SO3FFT_NORMALIZED))?,
                 ..Options::default()
             },
+            weights: Default::default(),
         };
         let plan = Correlation::<H::T>::new(l, &options)?;
         Ok(Box::into_raw(Box::new(H::wrap(plan))))

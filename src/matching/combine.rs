@@ -207,7 +207,7 @@ pub(super) enum Combine {
     Assign,
 }
 
-/// Adds `scale` times the combination of degrees `from..=to` to `out` (lengths checked by
+/// Adds the combination of degrees `from..=to`, degree `l` times `factors[l]`, to `out` (lengths checked by
 /// the caller with [`check`]), or writes it (`mode`); with `half`, only the order pairs a
 /// real-signal inverse reads (`M' > 0`, or `M' = 0` and `M >= 0`; the others are left as
 /// they are). For each order pair the degrees are consecutive in all three arrays, so the
@@ -218,7 +218,7 @@ pub(super) fn add_combined<T: Real>(
     b_in: usize,
     (from, to): (usize, usize),
     b_out: usize,
-    (scale, out): (f64, &mut [Complex<T>]),
+    (factors, out): (&[f64], &mut [Complex<T>]),
     (half, mode): (bool, Combine),
 ) {
     let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
@@ -227,7 +227,7 @@ pub(super) fn add_combined<T: Real>(
         return;
     }
     let norms: Vec<f64> = (0..=to)
-        .map(|l| scale * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt())
+        .map(|l| factors[l] * 2.0 * PI * (2.0 / (2 * l + 1) as f64).sqrt())
         .collect();
     let top = to as isize;
     let len = out.len();

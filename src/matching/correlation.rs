@@ -5,6 +5,8 @@
 use super::combine::{add_combined, Combine};
 use super::peaks::{Peak, SliceArgmax};
 use super::series::SeriesTables;
+use super::uncertainty::{uncertainty, NoiseModel, Uncertainty};
+use super::weights::{degree_powers, DegreeWeights, Spectra};
 use crate::engine::SliceRef;
 use crate::error::{check_length, Error, Result};
 use crate::grid::{coef_index, num_coeffs};
@@ -52,6 +54,9 @@ pub struct CorrelationOptions {
     /// Options of the correlation's S^2 and SO(3) plans (threads, rigour, instruction set,
     /// skip threshold); their direction and real form follow from the correlation.
     pub plans: Options,
+    /// Weights of the degrees (`w_0..=w_deg_lim`): uniform, given, or estimated from the
+    /// inputs' noise at each call. With `normalized`, the norms are weighted too.
+    pub weights: DegreeWeights,
 }
 
 impl CorrelationOptions {
@@ -82,6 +87,12 @@ impl CorrelationOptions {
     /// With [`CorrelationOptions::plans`].
     pub fn with_plans(mut self, plans: Options) -> CorrelationOptions {
         self.plans = plans;
+        self
+    }
+
+    /// With [`CorrelationOptions::weights`].
+    pub fn with_weights(mut self, weights: DegreeWeights) -> CorrelationOptions {
+        self.weights = weights;
         self
     }
 
@@ -139,6 +150,7 @@ pub struct Correlation<T: Real = f64> {
     deg_lim: usize,
     real: bool,
     normalized: bool,
+    weights: DegreeWeights,
     s2: S2Plan<T>,
     /// The inverse onto the grid: degrees `l <= deg_lim` (bandwidth `deg_lim + 1`).
     so3: PartialPlan<T>,
@@ -147,6 +159,9 @@ pub struct Correlation<T: Real = f64> {
     series: OnceLock<Arc<SeriesTables>>,
     /// An `f64` S^2 plan for the coefficients of an `f32` correlation, made on first use.
     s2_wide: OnceLock<S2Plan<f64>>,
+    /// An `f64` S^2 plan of every degree for [`Correlation::spectra`] where neither plan
+    /// is one, made on first use.
+    s2_full: OnceLock<S2Plan<f64>>,
     /// The options the plans were made with (for `s2_wide`).
     plans: Options,
     workers: WorkerPool,
@@ -163,6 +178,7 @@ impl<T: Real> Correlation<T> {
                  limit {deg_lim}: need 1 <= bandwidths and degree limit < both"
             )));
         }
+        options.weights.check(deg_lim, options.normalized)?;
         // One pool for both plans: an execution enters it once, and each stage of the
         // pipeline runs on its workers directly (at small bandwidths waking the workers
         // for every stage cost as much as the stages).
@@ -170,7 +186,7 @@ impl<T: Real> Correlation<T> {
         let workers = WorkerPool::process(threads)?;
         let s2 = S2Plan::new_on(
             b_in,
-            Self::s2_limits(deg_lim),
+            Self::s2_limits(deg_lim, &options.weights),
             &options.plans,
             Some(&workers),
         )?;
@@ -192,22 +208,47 @@ impl<T: Real> Correlation<T> {
             deg_lim,
             real: options.real,
             normalized: options.normalized,
+            weights: options.weights.clone(),
             s2,
             so3,
             buffers: Mutex::new(None),
             series: OnceLock::new(),
             s2_wide: OnceLock::new(),
+            s2_full: OnceLock::new(),
             plans: options.plans.clone(),
             workers,
         })
     }
 
-    /// The S^2 plans' limits: only the combined degrees are needed.
-    fn s2_limits(deg_lim: usize) -> S2Limits {
+    /// The S^2 plans' limits: only the combined degrees are needed, unless the weights
+    /// are estimated from the noise at the high degrees.
+    fn s2_limits(deg_lim: usize, weights: &DegreeWeights) -> S2Limits {
         S2Limits {
-            degree_limit: Some(deg_lim + 1),
+            degree_limit: (*weights != DegreeWeights::Automatic).then_some(deg_lim + 1),
             order_limit: None,
         }
+    }
+
+    /// Whether the S^2 plans compute every degree of the input.
+    fn s2_complete(&self) -> bool {
+        self.weights == DegreeWeights::Automatic || self.deg_lim + 1 == self.b_in
+    }
+
+    /// An `f64` S^2 plan of every degree: the plan's own where it is one.
+    fn s2_every_degree(&self) -> Result<&S2Plan<f64>> {
+        if self.s2_complete() {
+            return self.s2_f64();
+        }
+        if let Some(p) = self.s2_full.get() {
+            return Ok(p);
+        }
+        let made = S2Plan::new_on(
+            self.b_in,
+            S2Limits::default(),
+            &self.plans,
+            Some(&self.workers),
+        )?;
+        Ok(self.s2_full.get_or_init(|| made))
     }
 
     /// The plan's S^2 plan in `f64`: its own for `T = f64`, else one made on first use.
@@ -220,7 +261,7 @@ impl<T: Real> Correlation<T> {
         }
         let made = S2Plan::new_on(
             self.b_in,
-            Self::s2_limits(self.deg_lim),
+            Self::s2_limits(self.deg_lim, &self.weights),
             &self.plans,
             Some(&self.workers),
         )?;
@@ -294,22 +335,24 @@ impl<T: Real> Correlation<T> {
         forward(signal, &mut buf.sig)?;
         forward(pattern, &mut buf.pat)?;
         let from = usize::from(self.normalized);
+        let degree_weights = match &self.weights {
+            DegreeWeights::Uniform => vec![1.0; self.deg_lim + 1],
+            DegreeWeights::Given(w) => w.clone(),
+            DegreeWeights::Automatic => {
+                Spectra::estimate((&buf.sig, &buf.pat), self.b_in, self.deg_lim, &self.weights)
+                    .weights
+            }
+        };
         if self.normalized {
             for (norm, c) in norms.iter_mut().zip([&buf.sig, &buf.pat]) {
-                let norm_sqr = |z: &Complex<C>| z.re.to_f64().powi(2) + z.im.to_f64().powi(2);
-                let sq: f64 = c.iter().map(norm_sqr).sum::<f64>()
-                    - (0..self.b_in)
-                        .filter(|&l| l > self.deg_lim || l == 0)
-                        .map(|l| {
-                            let li = l as isize;
-                            (-li..=li)
-                                .map(|m| norm_sqr(&c[crate::s2::s2_coef_index(self.b_in, l, m)]))
-                                .sum::<f64>()
-                        })
-                        .sum::<f64>();
-                *norm += weight.abs() * sq.max(0.0);
+                let powers = degree_powers(c, self.b_in);
+                let sq: f64 = (from..=self.deg_lim)
+                    .map(|l| degree_weights[l] * powers[l])
+                    .sum();
+                *norm += weight.abs() * sq;
             }
         }
+        let factors: Vec<f64> = degree_weights.iter().map(|w| w * weight).collect();
         let (sig, pat, so3) = (&buf.sig, &buf.pat, &mut buf.so3);
         // On the plan's workers (the orders spread over them).
         self.s2.install(|| {
@@ -318,7 +361,7 @@ impl<T: Real> Correlation<T> {
                 self.b_in,
                 (from, self.deg_lim),
                 self.deg_lim + 1,
-                (weight, so3),
+                (&factors, so3),
                 (half, mode),
             )
         });
@@ -373,7 +416,8 @@ impl<T: Real> Correlation<T> {
         let s2 = self.s2_f64()?;
         let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
         let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&widened(x, wide), c);
-        self.coefficients_in((signal, pattern), &fwd, out)
+        self.coefficients_in((signal, pattern), &fwd, out, false)
+            .map(|_| ())
     }
 
     /// [`Correlation::coefficients`] of real samples.
@@ -385,19 +429,55 @@ impl<T: Real> Correlation<T> {
     ) -> Result<()> {
         let s2 = self.s2_f64()?;
         let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&widened(x, T::to_f64), c);
-        self.coefficients_in((signal, pattern), &fwd, out)
+        self.coefficients_in((signal, pattern), &fwd, out, false)
+            .map(|_| ())
     }
 
-    /// The body of the `coefficients` functions, with the `f64` S^2 forward `fwd`.
+    /// [`Correlation::coefficients`] and [`Correlation::spectra`] of complex samples, the
+    /// S^2 transforms shared where the plan's cover every degree.
+    pub(crate) fn coefficients_spectra(
+        &self,
+        (signal, pattern): (&[Complex<T>], &[Complex<T>]),
+        out: &mut [Complex64],
+    ) -> Result<Spectra> {
+        let s2 = self.s2_f64()?;
+        let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
+        let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&widened(x, wide), c);
+        match self.coefficients_in((signal, pattern), &fwd, out, true)? {
+            Some(spectra) => Ok(spectra),
+            None => self.spectra(signal, pattern),
+        }
+    }
+
+    /// [`Correlation::coefficients_spectra`] of real samples.
+    pub(crate) fn coefficients_spectra_real(
+        &self,
+        (signal, pattern): (&[T], &[T]),
+        out: &mut [Complex64],
+    ) -> Result<Spectra> {
+        let s2 = self.s2_f64()?;
+        let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&widened(x, T::to_f64), c);
+        match self.coefficients_in((signal, pattern), &fwd, out, true)? {
+            Some(spectra) => Ok(spectra),
+            None => self.spectra_real(signal, pattern),
+        }
+    }
+
+    /// The body of the `coefficients` functions, with the `f64` S^2 forward `fwd`; with
+    /// `spectra`, also the inputs' [`Spectra`] where the S^2 plans cover every degree.
     fn coefficients_in<X: Sync>(
         &self,
         (signal, pattern): (&[X], &[X]),
         fwd: S2Forward<X, f64>,
         out: &mut [Complex64],
-    ) -> Result<()> {
+        spectra: bool,
+    ) -> Result<Option<Spectra>> {
         let mut run = |buf: &mut Buffers<f64>| {
             self.combine_shells(&[(signal, pattern, 1.0)], (fwd, false), buf)?;
-            self.widen(&buf.so3, out)
+            self.widen(&buf.so3, out)?;
+            Ok((spectra && self.s2_complete()).then(|| {
+                Spectra::estimate((&buf.sig, &buf.pat), self.b_in, self.deg_lim, &self.weights)
+            }))
         };
         self.s2.install(|| {
             // A plan in f64 uses its own buffers; one in f32 makes f64 ones for the call.
@@ -440,6 +520,89 @@ impl<T: Real> Correlation<T> {
                 .clone();
             super::So3Series::with_tables(tables, coeffs).maximise_many(starts)
         }))
+    }
+
+    /// The power spectra of complex samples `signal` and `pattern`, their noise floors and
+    /// the degree weights the plan applies to them (computed in `f64`, as for
+    /// [`Correlation::coefficients`]).
+    pub fn spectra(&self, signal: &[Complex<T>], pattern: &[Complex<T>]) -> Result<Spectra> {
+        self.need(false)?;
+        let s2 = self.s2_every_degree()?;
+        let wide = |z: Complex<T>| Complex64::new(z.re.to_f64(), z.im.to_f64());
+        let fwd = |x: &[Complex<T>], c: &mut [Complex64]| s2.forward(&widened(x, wide), c);
+        self.spectra_in((signal, pattern), &fwd)
+    }
+
+    /// [`Correlation::spectra`] of real samples.
+    pub fn spectra_real(&self, signal: &[T], pattern: &[T]) -> Result<Spectra> {
+        self.need(true)?;
+        let s2 = self.s2_every_degree()?;
+        let fwd = |x: &[T], c: &mut [Complex64]| s2.forward_real(&widened(x, T::to_f64), c);
+        self.spectra_in((signal, pattern), &fwd)
+    }
+
+    fn spectra_in<X: Sync>(
+        &self,
+        (signal, pattern): (&[X], &[X]),
+        fwd: S2Forward<X, f64>,
+    ) -> Result<Spectra> {
+        let n = self.b_in * self.b_in;
+        let (mut sig, mut pat) = (vec![Complex64::default(); n], vec![Complex64::default(); n]);
+        self.s2.install(|| -> Result<()> {
+            fwd(signal, &mut sig)?;
+            fwd(pattern, &mut pat)?;
+            Ok(())
+        })?;
+        Ok(Spectra::estimate(
+            (&sig, &pat),
+            self.b_in,
+            self.deg_lim,
+            &self.weights,
+        ))
+    }
+
+    /// How sure the peak `at` (refined with [`Correlation::refine`] from `coeffs`) is, with
+    /// the noise of the inputs `spectra` ([`Correlation::spectra`] of the same samples):
+    /// the covariance of its error from the curvature of `|C|` at `at` and the noise's
+    /// share of each degree (`docs/matching-noise.md`). A linear estimate: it holds while
+    /// the error is small against the peak's width and the peak is the right one (see
+    /// the peak ratio of [`Correlation::find`](Correlation::find)).
+    pub fn uncertainty(
+        &self,
+        coeffs: &[Complex64],
+        at: &super::Rotation,
+        spectra: &Spectra,
+    ) -> Result<Uncertainty> {
+        check_length("SO(3) coefficients", num_coeffs(self.b_out), coeffs.len())?;
+        check_length("degree weights", self.deg_lim + 1, spectra.weights.len())?;
+        for (what, p) in [
+            ("signal power", &spectra.signal_power),
+            ("pattern power", &spectra.pattern_power),
+        ] {
+            check_length(what, self.b_in, p.len())?;
+        }
+        if !at.is_finite() {
+            return Err(Error::InvalidArgument(format!(
+                "rotation {at:?} is not finite"
+            )));
+        }
+        let model = NoiseModel {
+            spectra,
+            real: self.real,
+            normalized: self.normalized,
+        };
+        Ok(self.s2.install(|| {
+            let tables = self
+                .series
+                .get_or_init(|| Arc::new(SeriesTables::new(self.b_out, self.deg_lim)))
+                .clone();
+            uncertainty(&super::So3Series::with_tables(tables, coeffs), at, &model)
+        }))
+    }
+
+    /// The plan's degree weights.
+    pub fn weights(&self) -> &DegreeWeights {
+        &self.weights
     }
 
     /// Whether the plan takes real inputs.

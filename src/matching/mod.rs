@@ -10,14 +10,21 @@
 
 mod combine;
 mod correlation;
+mod find;
 mod peaks;
 mod refine;
 mod rotation;
+pub mod scene;
 mod series;
+mod uncertainty;
+mod weights;
 
 pub use combine::combine;
 pub use correlation::{Correlation, CorrelationOptions};
+pub use find::Match;
 pub(crate) use peaks::SliceArgmax;
 pub use peaks::{grid_argmax, grid_argmax_real, top_peaks, top_peaks_real, Peak};
 pub use refine::So3Series;
 pub use rotation::{rotate_s2_coeffs, rotate_s2_coeffs_to, Rotation};
+pub use uncertainty::Uncertainty;
+pub use weights::{degree_powers, noise_floor, noise_weights, DegreeWeights, Spectra};

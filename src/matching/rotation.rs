@@ -18,7 +18,7 @@ pub struct Rotation {
 }
 
 /// Hamilton product of quaternions `(w, x, y, z)`.
-fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+pub(crate) fn qmul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     [
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
@@ -45,6 +45,27 @@ impl Rotation {
             alpha += PI;
             gamma -= PI;
         }
+        Rotation::new(alpha.rem_euclid(TAU), beta, gamma.rem_euclid(TAU))
+    }
+
+    /// The rotation of unit quaternion `q = (w, x, y, z)` (`q` and `-q` are the same), its
+    /// angles as [`Rotation::normalized`] gives them; at `beta = 0` or `pi`, where only
+    /// `alpha + gamma` or `alpha - gamma` is defined, `gamma = 0`.
+    pub fn from_quaternion(q: [f64; 4]) -> Rotation {
+        use std::f64::consts::TAU;
+        let [w, x, y, z] = q;
+        // q = (cos(b/2) cos(s), -sin(b/2) sin(d), sin(b/2) cos(d), cos(b/2) sin(s)) with
+        // s = (alpha + gamma) / 2, d = (alpha - gamma) / 2.
+        let (c, s) = ((w * w + z * z).sqrt(), (x * x + y * y).sqrt());
+        let beta = 2.0 * s.atan2(c);
+        let (sum, diff) = (2.0 * z.atan2(w), 2.0 * (-x).atan2(y));
+        let (alpha, gamma) = if s == 0.0 {
+            (sum, 0.0)
+        } else if c == 0.0 {
+            (diff, 0.0)
+        } else {
+            (0.5 * (sum + diff), 0.5 * (sum - diff))
+        };
         Rotation::new(alpha.rem_euclid(TAU), beta, gamma.rem_euclid(TAU))
     }
 

@@ -26,6 +26,7 @@ mod matching;
 mod memory;
 mod mpi_model;
 mod naive;
+mod noise;
 mod partial;
 mod peak;
 mod plot;
@@ -74,6 +75,7 @@ fn run_tool(opts: &Options) -> ExitCode {
         Tool::S2 => report_failure("s2", s2::run(opts)),
         Tool::Precision => report_failure("precision", precision::run(opts)),
         Tool::Match => report_failure("match", matching::run(opts)),
+        Tool::Noise => report_failure("noise", noise::run(opts)),
         Tool::Partial => report_failure("partial", partial::run(opts)),
         Tool::MpiModel => report_failure("mpi-model", mpi_model::run(opts)),
     }
