@@ -77,8 +77,9 @@ impl Spectra {
     /// The spectra of S^2 coefficients `sig` and `pat` (bandwidth `b`), and the weights of
     /// `mode` for degrees `0..=deg_lim`: for [`DegreeWeights::Automatic`],
     /// `w_l = sqrt(s_f s_h) / (s_f n_h + s_h n_f + n_f n_h)` scaled to a largest weight of 1,
-    /// with `n` the noise floors and `s = max(P(l)/(2l+1) - n, 0)` the signal powers per
-    /// coefficient. That `w_l` minimises the variance of the peak's position when the
+    /// with `n` the noise floors and `s` the signal powers per coefficient net of the noise
+    /// (three-degree means, 0 where they do not stand out of it: [`noise_weights`]). That
+    /// `w_l` minimises the variance of the peak's position when the
     /// noise is white and independent in the two inputs (`docs/matching-noise.md`); with
     /// noise-free inputs it is uniform.
     pub fn estimate<C: Real>(

@@ -1,6 +1,7 @@
 //! The command lines of so3fft-bench and so3fft-stress as a user meets them: help, exit
 //! status 2 on bad usage, and the stress suite's redraw from a CSV file (exit status from
-//! the accuracy targets, charts and tables written). Nothing here runs a transform.
+//! the accuracy targets, charts and tables written), and the noise tool end to end at B = 8
+//! (the only test here that runs transforms, in well under a second).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -32,6 +33,7 @@ fn bench_help_lists_tools_and_options() {
         "real",
         "--s2",
         "--match",
+        "noise",
         "--mpi-model",
         "--partial",
         "--bandwidths",
@@ -50,6 +52,36 @@ fn bench_help_lists_tools_and_options() {
     ] {
         assert!(out.contains(needle), "{needle} missing from --help");
     }
+}
+
+/// The noise tool runs end to end at a small bandwidth: a row per scene in the CSV, the
+/// chart, and the cost table.
+#[test]
+fn bench_noise_smoke() {
+    let (csv, svg) = (temp("noise.csv"), temp("noise.svg"));
+    let (code, out, err) = run(
+        BENCH,
+        &[
+            "noise",
+            "--bandwidths",
+            "8",
+            "--runs",
+            "2",
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            svg.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("automatic") && out.contains("coverage"),
+        "{out}"
+    );
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    // Header, then 4 noise levels x 2 scenes.
+    assert_eq!(rows.lines().count(), 1 + 4 * 2, "{rows}");
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
 }
 
 /// Bad usage exits with status 2 before anything is measured.

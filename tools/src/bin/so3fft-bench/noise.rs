@@ -317,9 +317,14 @@ fn costs(opts: &Options, threads: usize) -> so3fft::Result<()> {
         let mut grid = vec![0.0; uniform.num_grid()];
         let mut coeffs = vec![so3fft::Complex64::default(); so3fft::num_coeffs(b)];
         let (mut tu, mut ta, mut tr, mut tc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        let runs = opts.runs_for(b).max(5);
-        for _ in 0..runs {
-            for (p, t) in [(&uniform, &mut tu), (&auto, &mut ta)] {
+        let runs = opts.runs_for(b).max(6);
+        for run in 0..runs {
+            // Each plan goes first in every other run.
+            let mut pair = [(&uniform, &mut tu), (&auto, &mut ta)];
+            if run % 2 == 1 {
+                pair.reverse();
+            }
+            for (p, t) in pair {
                 let start = Instant::now();
                 p.correlate_real_argmax(&scene.signal, &scene.pattern, &mut grid)?;
                 t.push(start.elapsed().as_secs_f64());
