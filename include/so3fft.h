@@ -103,6 +103,10 @@
 // norms; `|C| <= 1`).
 #define SO3FFT_NORMALIZED 64
 
+// Correlation planner flag: degree weights estimated from the inputs' noise at each call
+// (`so3fft_correlation_weights` shows them).
+#define SO3FFT_NOISE_WEIGHTS 128
+
 // Opaque correlation plan (made by `so3fft_plan_correlation`).
 typedef struct so3fft_correlation_s so3fft_correlation_s;
 
@@ -180,6 +184,47 @@ typedef struct so3fft_s2_plan_s *so3fft_s2_plan;
 
 // A correlation plan: a pointer to an opaque object.
 typedef struct so3fft_correlation_s *so3fft_correlation;
+
+// The result of `so3fft_correlation_find`: the peak refined off the grid, the grid peak it
+// started from, and how sure it is. Angles in radians; shared by both precisions.
+typedef struct so3fft_match {
+    // Euler angles of the refined peak: the rotation `g` with `f(x) ~ h(g^-1 x)`.
+    double alpha;
+    // Beta of the refined peak.
+    double beta;
+    // Gamma of the refined peak.
+    double gamma;
+    // `|C|^2` at the refined peak.
+    double value;
+    // Euler angles of the grid's largest `|C|^2` (the point `so3fft_correlate_argmax`
+    // gives), where the refinement started.
+    double grid_alpha;
+    // Beta of the grid peak.
+    double grid_beta;
+    // Gamma of the grid peak.
+    double grid_gamma;
+    // `|C|^2` at the grid peak.
+    double grid_value;
+    // Flat index of the grid peak.
+    ptrdiff_t grid_index;
+    // `sqrt(trace(covariance))`: the rms angle of the refined peak's error from the noise
+    // in the inputs; infinite when the peak is not a maximum.
+    double sigma;
+    // Covariance (rad^2, row-major 3x3) of the error `xi`, a rotation vector in the
+    // refined rotation's frame: the true rotation is `g exp(xi)`.
+    double covariance[9];
+    // `|C|` at the peak over `|C|` at the next peak at least `separation` away (both
+    // refined): near 1, the inputs cannot tell them apart; infinite if there is none.
+    double peak_ratio;
+    // The angle beyond which another peak counts as separate: `2 pi / (L + 1)`, `L` the
+    // highest degree weighted at least a tenth of the largest weight.
+    double separation;
+    // White-noise power per S^2 coefficient of the signal, fitted at the high degrees (0
+    // for exactly band-limited inputs).
+    double signal_noise;
+    // The same for the pattern.
+    double pattern_noise;
+} so3fft_match;
 
 // A single-precision plan: a pointer to an opaque object (like `fftwf_plan`).
 typedef struct so3fftf_plan_s *so3fftf_plan;
@@ -409,9 +454,16 @@ ptrdiff_t so3fft_s2_coef_index(int B, int l, int m);
 // Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
 // on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
 // `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
-// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
+// `SO3FFT_NORMALIZED` for the normalised cross-correlation, `SO3FFT_NOISE_WEIGHTS` for
+// degree weights estimated from the inputs' noise.
 // NULL on error.
 so3fft_correlation so3fft_plan_correlation(int L, int B_out, int deg_lim, unsigned int flags, int nthreads);
+
+// `so3fft_plan_correlation` with the caller's degree weights: `C(g) = sum_l w_l
+// <f_l, (g h)_l>`, `weights` = `w_0 .. w_D` (`D + 1` doubles, copied; finite, >= 0, not all
+// 0), `D` = `deg_lim`, or `min(L, B_out) - 1` for -1 (`so3fft_correlation_degree_limit`).
+// Not with `SO3FFT_NOISE_WEIGHTS`. NULL on error.
+so3fft_correlation so3fft_plan_correlation_weighted(int L, int B_out, int deg_lim, unsigned int flags, int nthreads, const double *weights);
 
 // Destroys a correlation plan; NULL is a no-op.
 void so3fft_destroy_correlation(so3fft_correlation p);
@@ -476,6 +528,27 @@ int so3fft_correlation_refine(so3fft_correlation p, const double *signal, const 
 // beta, gamma per peak), each triple replaced by its refined peak; `values` (NULL or
 // `npeaks` doubles) receives `|C|^2` there. `SO3FFT_OK` or an error code.
 int so3fft_correlation_refine_many(so3fft_correlation p, const double *signal, const double *pattern, size_t npeaks, double *angles, double *values);
+
+// The highest degree `D` the plan combines (its weights are `w_0 .. w_D`);
+// `SO3FFT_ENULL` for NULL.
+int so3fft_correlation_degree_limit(so3fft_correlation p);
+
+// The whole matching of complex samples: the grid into `grid` (as `so3fft_correlate`), its
+// peak refined off the grid, its uncertainty from the inputs' noise and its ratio to the
+// next separate peak, into `*out`. `SO3FFT_OK` or an error code.
+int so3fft_correlation_find(so3fft_correlation p, so3fft_complex *signal, so3fft_complex *pattern, so3fft_complex *grid, struct so3fft_match *out);
+
+// `so3fft_correlation_find` of real samples into the real grid `grid` (plan made with
+// `SO3FFT_REAL`).
+int so3fft_correlation_find_real(so3fft_correlation p, const double *signal, const double *pattern, double *grid, struct so3fft_match *out);
+
+// The degree weights `w_0 .. w_D` the plan applies to these complex inputs, into `w`
+// (`D + 1` doubles): 1, the given ones, or (`SO3FFT_NOISE_WEIGHTS`) those estimated from
+// them, largest 1. `SO3FFT_OK` or an error code.
+int so3fft_correlation_weights(so3fft_correlation p, so3fft_complex *signal, so3fft_complex *pattern, double *w);
+
+// `so3fft_correlation_weights` of real inputs (plan made with `SO3FFT_REAL`).
+int so3fft_correlation_weights_real(so3fft_correlation p, const double *signal, const double *pattern, double *w);
 
 // Writes FFTW's wisdom to the file `filename` (replaced atomically). `SO3FFT_OK` or an
 // error code.
@@ -649,6 +722,10 @@ void so3fftf_forget_wisdom(void);
 // arguments and flags). NULL on error.
 so3fftf_correlation so3fftf_plan_correlation(int L, int B_out, int deg_lim, unsigned int flags, int nthreads);
 
+// As `so3fft_plan_correlation_weighted`, in single precision (the weights stay double).
+// NULL on error.
+so3fftf_correlation so3fftf_plan_correlation_weighted(int L, int B_out, int deg_lim, unsigned int flags, int nthreads, const double *weights);
+
 // Destroys a single-precision correlation plan; NULL is a no-op.
 void so3fftf_destroy_correlation(so3fftf_correlation p);
 
@@ -686,6 +763,22 @@ int so3fftf_correlation_refine(so3fftf_correlation p, const float *signal, const
 
 // As `so3fft_correlation_refine_many`: float samples, `npeaks` peaks in double.
 int so3fftf_correlation_refine_many(so3fftf_correlation p, const float *signal, const float *pattern, size_t npeaks, double *angles, double *values);
+
+// As `so3fft_correlation_degree_limit`.
+int so3fftf_correlation_degree_limit(so3fftf_correlation p);
+
+// As `so3fft_correlation_find`: complex float samples and grid, the result in double (the
+// refinement and the uncertainty computed in double).
+int so3fftf_correlation_find(so3fftf_correlation p, so3fftf_complex *signal, so3fftf_complex *pattern, so3fftf_complex *grid, struct so3fft_match *out);
+
+// As `so3fft_correlation_find_real`: real float samples and grid.
+int so3fftf_correlation_find_real(so3fftf_correlation p, const float *signal, const float *pattern, float *grid, struct so3fft_match *out);
+
+// As `so3fft_correlation_weights`: complex float samples, double weights.
+int so3fftf_correlation_weights(so3fftf_correlation p, so3fftf_complex *signal, so3fftf_complex *pattern, double *w);
+
+// As `so3fft_correlation_weights_real`: real float samples.
+int so3fftf_correlation_weights_real(so3fftf_correlation p, const float *signal, const float *pattern, double *w);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -9,7 +9,9 @@ use super::{guarded, guarded_code, rigor_of, so3fft_complex, threads_of, SO3FFT_
 use super::{SO3FFT_DESTROY_INPUT, SO3FFT_ENULL};
 use crate::ffi::checks::{self, input_output, Array};
 use crate::ffi::{CallError, ErrorKind};
-use crate::matching::{self, Correlation, CorrelationOptions, Peak, Rotation};
+use crate::matching::{
+    self, Correlation, CorrelationOptions, DegreeWeights, Match, Peak, Rotation, Spectra,
+};
 use crate::options::Options;
 use crate::{Complex, Complex64, Real};
 use std::ffi::{c_double, c_int, c_uint};
@@ -17,6 +19,13 @@ use std::ffi::{c_double, c_int, c_uint};
 /// Correlation planner flag: normalised cross-correlation (means left out, divided by the
 /// norms; `|C| <= 1`).
 pub const SO3FFT_NORMALIZED: c_uint = 64;
+
+/// Correlation planner flag: degree weights estimated from the inputs' noise at each call
+/// (`so3fft_correlation_weights` shows them).
+pub const SO3FFT_NOISE_WEIGHTS: c_uint = 128;
+
+/// The flags of a correlation plan besides a planner rigour.
+const CORRELATION_FLAGS: c_uint = SO3FFT_REAL | SO3FFT_NORMALIZED | SO3FFT_NOISE_WEIGHTS;
 
 /// Opaque correlation plan (made by `so3fft_plan_correlation`).
 pub struct so3fft_correlation_s {
@@ -54,14 +63,20 @@ fn complex<T>(a: *mut [T; 2]) -> *mut Complex<T> {
     a.cast()
 }
 
-/// The body of `so3fft_plan_correlation` for the handle type `H`: a new plan, or NULL on
-/// error.
-pub(super) fn plan_correlation<H: CorrelationHandle>(
+/// The body of `so3fft_plan_correlation` (`weights` None) and of
+/// `so3fft_plan_correlation_weighted` (`weights` the caller's pointer) for the handle type
+/// `H`: a new plan, or NULL on error.
+///
+/// # Safety
+/// A non-NULL `weights` holds `D + 1` doubles, `D` the resolved degree limit (the API's
+/// contract).
+pub(super) unsafe fn plan_correlation<H: CorrelationHandle>(
     L: c_int,
     B_out: c_int,
     deg_lim: c_int,
     flags: c_uint,
     nthreads: c_int,
+    weights: Option<*const c_double>,
 ) -> *mut H {
     guarded(std::ptr::null_mut(), || {
         let l = checks::bandwidth(L)?;
@@ -80,6 +95,30 @@ pub(super) fn plan_correlation<H: CorrelationHandle>(
                 "SO3FFT_DESTROY_INPUT does not apply to correlation plans",
             ));
         }
+        let automatic = flags & SO3FFT_NOISE_WEIGHTS != 0;
+        let weights = match weights {
+            None if automatic => DegreeWeights::Automatic,
+            None => DegreeWeights::Uniform,
+            Some(_) if automatic => {
+                return Err(CallError::invalid(
+                    "SO3FFT_NOISE_WEIGHTS with given weights: the plan takes one or the other",
+                ))
+            }
+            Some(w) => {
+                // The degree limit the plan resolves; one it refuses is reported by the
+                // planner below, without reading the weights.
+                let m = l.min(b_out.unwrap_or(l));
+                let d = deg_lim.unwrap_or(m - 1);
+                if d < m {
+                    Array::new(w, d + 1, "weights").check()?;
+                    // SAFETY: checked non-NULL and aligned; `d + 1` doubles (this
+                    // function's contract).
+                    DegreeWeights::Given(unsafe { std::slice::from_raw_parts(w, d + 1) }.to_vec())
+                } else {
+                    DegreeWeights::Uniform
+                }
+            }
+        };
         let options = CorrelationOptions {
             b_out,
             deg_lim,
@@ -87,10 +126,10 @@ pub(super) fn plan_correlation<H: CorrelationHandle>(
             normalized: flags & SO3FFT_NORMALIZED != 0,
             plans: Options {
                 threads: threads_of(nthreads)?,
-                rigor: rigor_of(flags & !(SO3FFT_REAL | SO3FFT_NORMALIZED))?,
+                rigor: rigor_of(flags & !CORRELATION_FLAGS)?,
                 ..Options::default()
             },
-            weights: Default::default(),
+            weights,
         };
         let plan = Correlation::<H::T>::new(l, &options)?;
         Ok(Box::into_raw(Box::new(H::wrap(plan))))
@@ -117,7 +156,8 @@ pub(super) unsafe fn destroy_correlation<H: CorrelationHandle>(p: *mut H) {
 /// Plans the correlation `C(g) = int f(x) conj(h(g^-1 x)) dx` of functions of bandwidth `L`
 /// on the SO(3) grid of bandwidth `B_out` (0 = `L`), degrees up to `deg_lim` (-1 =
 /// `min(L, B_out) - 1`). `flags`: a planner rigour, `SO3FFT_REAL` for real inputs,
-/// `SO3FFT_NORMALIZED` for the normalised cross-correlation.
+/// `SO3FFT_NORMALIZED` for the normalised cross-correlation, `SO3FFT_NOISE_WEIGHTS` for
+/// degree weights estimated from the inputs' noise.
 /// NULL on error.
 #[no_mangle]
 pub extern "C" fn so3fft_plan_correlation(
@@ -127,7 +167,25 @@ pub extern "C" fn so3fft_plan_correlation(
     flags: c_uint,
     nthreads: c_int,
 ) -> so3fft_correlation {
-    plan_correlation(L, B_out, deg_lim, flags, nthreads)
+    // SAFETY: no weights array.
+    unsafe { plan_correlation(L, B_out, deg_lim, flags, nthreads, None) }
+}
+
+/// `so3fft_plan_correlation` with the caller's degree weights: `C(g) = sum_l w_l
+/// <f_l, (g h)_l>`, `weights` = `w_0 .. w_D` (`D + 1` doubles, copied; finite, >= 0, not all
+/// 0), `D` = `deg_lim`, or `min(L, B_out) - 1` for -1 (`so3fft_correlation_degree_limit`).
+/// Not with `SO3FFT_NOISE_WEIGHTS`. NULL on error.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_plan_correlation_weighted(
+    L: c_int,
+    B_out: c_int,
+    deg_lim: c_int,
+    flags: c_uint,
+    nthreads: c_int,
+    weights: *const c_double,
+) -> so3fft_correlation {
+    // SAFETY: `weights` NULL or `D + 1` doubles (the API's contract).
+    unsafe { plan_correlation(L, B_out, deg_lim, flags, nthreads, Some(weights)) }
 }
 
 /// Destroys a correlation plan; NULL is a no-op.
@@ -742,4 +800,297 @@ pub unsafe extern "C" fn so3fft_correlation_refine_many(
     // SAFETY: `p` is NULL or a live plan; the arrays hold the documented sizes (the API's
     // contract).
     unsafe { correlation_refine_many(p, signal, pattern, npeaks, angles, values) }
+}
+
+/// The result of `so3fft_correlation_find`: the peak refined off the grid, the grid peak it
+/// started from, and how sure it is. Angles in radians; shared by both precisions.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct so3fft_match {
+    /// Euler angles of the refined peak: the rotation `g` with `f(x) ~ h(g^-1 x)`.
+    pub alpha: c_double,
+    /// Beta of the refined peak.
+    pub beta: c_double,
+    /// Gamma of the refined peak.
+    pub gamma: c_double,
+    /// `|C|^2` at the refined peak.
+    pub value: c_double,
+    /// Euler angles of the grid's largest `|C|^2` (the point `so3fft_correlate_argmax`
+    /// gives), where the refinement started.
+    pub grid_alpha: c_double,
+    /// Beta of the grid peak.
+    pub grid_beta: c_double,
+    /// Gamma of the grid peak.
+    pub grid_gamma: c_double,
+    /// `|C|^2` at the grid peak.
+    pub grid_value: c_double,
+    /// Flat index of the grid peak.
+    pub grid_index: isize,
+    /// `sqrt(trace(covariance))`: the rms angle of the refined peak's error from the noise
+    /// in the inputs; infinite when the peak is not a maximum.
+    pub sigma: c_double,
+    /// Covariance (rad^2, row-major 3x3) of the error `xi`, a rotation vector in the
+    /// refined rotation's frame: the true rotation is `g exp(xi)`.
+    pub covariance: [c_double; 9],
+    /// `|C|` at the peak over `|C|` at the next peak at least `separation` away (both
+    /// refined): near 1, the inputs cannot tell them apart; infinite if there is none.
+    pub peak_ratio: c_double,
+    /// The angle beyond which another peak counts as separate: `2 pi / (L + 1)`, `L` the
+    /// highest degree weighted at least a tenth of the largest weight.
+    pub separation: c_double,
+    /// White-noise power per S^2 coefficient of the signal, fitted at the high degrees (0
+    /// for exactly band-limited inputs).
+    pub signal_noise: c_double,
+    /// The same for the pattern.
+    pub pattern_noise: c_double,
+}
+
+impl From<&Match> for so3fft_match {
+    fn from(m: &Match) -> so3fft_match {
+        let (g, p) = (&m.rotation, &m.grid_peak);
+        so3fft_match {
+            alpha: g.alpha,
+            beta: g.beta,
+            gamma: g.gamma,
+            value: m.value,
+            grid_alpha: p.alpha,
+            grid_beta: p.beta,
+            grid_gamma: p.gamma,
+            grid_value: p.value,
+            grid_index: p.index as isize,
+            sigma: m.uncertainty.sigma,
+            covariance: *m
+                .uncertainty
+                .covariance
+                .as_flattened()
+                .first_chunk()
+                .expect("9"),
+            peak_ratio: m.peak_ratio,
+            separation: m.separation,
+            signal_noise: m.spectra.signal_noise,
+            pattern_noise: m.spectra.pattern_noise,
+        }
+    }
+}
+
+/// The byte range of a checked array and its name.
+fn extent<T>(a: &Array<T>) -> Result<(usize, usize, &'static str), CallError> {
+    a.byte_range().map(|(s, e)| (s, e, a.what))
+}
+
+/// The body of the `find` functions: `find` of the plan on the checked arrays, written to
+/// `out`.
+///
+/// # Safety
+/// As [`correlate`], for samples of `X` and a grid of `G`; `out` is NULL or one
+/// `so3fft_match`.
+unsafe fn find_into<H: CorrelationHandle, X, G>(
+    p: *mut H,
+    (signal, pattern): (*const X, *const X),
+    grid: *mut G,
+    out: *mut so3fft_match,
+    find: impl FnOnce(&Correlation<H::T>, (&[X], &[X]), &mut [G]) -> crate::Result<Match>,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: this function's contract.
+        let (plan, inputs, values) = unsafe { call_args(p, (signal, pattern), grid) }?;
+        let result = Array::new(out.cast_const(), 1, "match");
+        result.check()?;
+        let (r0, r1, _) = extent(&result)?;
+        let n = inputs.0.len();
+        for (s, e, what) in [
+            extent(&Array::new(signal, n, "signal"))?,
+            extent(&Array::new(pattern, n, "pattern"))?,
+            extent(&Array::new(grid.cast_const(), values.len(), "out"))?,
+        ] {
+            if s < r1 && r0 < e {
+                return Err(CallError::invalid(format!(
+                    "the match result and the {what} array overlap"
+                )));
+            }
+        }
+        let m = find(plan, inputs, values)?;
+        // SAFETY: checked non-NULL, aligned and apart from the other arrays.
+        unsafe { out.write(so3fft_match::from(&m)) };
+        Ok(())
+    })
+}
+
+/// The body of `so3fft_correlation_find` for the handle type `H`.
+///
+/// # Safety
+/// As [`correlate`]; `out` is NULL or one `so3fft_match`.
+pub(super) unsafe fn correlation_find<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *mut [H::T; 2],
+    pattern: *mut [H::T; 2],
+    grid: *mut [H::T; 2],
+    out: *mut so3fft_match,
+) -> c_int {
+    let inputs = (complex(signal).cast_const(), complex(pattern).cast_const());
+    // SAFETY: this function's contract.
+    unsafe {
+        find_into(p, inputs, complex(grid), out, |plan, (s, h), g| {
+            plan.find(s, h, g)
+        })
+    }
+}
+
+/// The body of `so3fft_correlation_find_real` for the handle type `H`.
+///
+/// # Safety
+/// As [`correlation_find`].
+pub(super) unsafe fn correlation_find_real<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *const H::T,
+    pattern: *const H::T,
+    grid: *mut H::T,
+    out: *mut so3fft_match,
+) -> c_int {
+    // SAFETY: this function's contract.
+    unsafe {
+        find_into(p, (signal, pattern), grid, out, |plan, (s, h), g| {
+            plan.find_real(s, h, g)
+        })
+    }
+}
+
+/// The body of the `weights` functions: the weights the plan applies to the checked
+/// inputs (`spectra` for estimated ones), written to `w`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`; `signal` and `pattern` NULL or `(2L)^2` samples
+/// of `X` each; `w` NULL or `D + 1` doubles.
+unsafe fn weights_into<H: CorrelationHandle, X>(
+    p: *mut H,
+    (signal, pattern, real): (*const X, *const X, bool),
+    w: *mut c_double,
+    spectra: impl FnOnce(&Correlation<H::T>, (&[X], &[X])) -> crate::Result<Spectra>,
+) -> c_int {
+    guarded_code(|| {
+        // SAFETY: this function's contract.
+        let plan = unsafe { plan_ref(p) }?;
+        let n = plan.deg_lim() + 1;
+        let out = Array::new(w.cast_const(), n, "weights");
+        let ns = 4 * plan.b_in() * plan.b_in();
+        // SAFETY: this function's contract.
+        let inputs = unsafe { inputs(signal, pattern, ns, Some(&out)) }?;
+        plan.need(real)?;
+        let weights = match plan.weights() {
+            DegreeWeights::Uniform => vec![1.0; n],
+            DegreeWeights::Given(w) => w.clone(),
+            DegreeWeights::Automatic => spectra(plan, inputs)?.weights,
+        };
+        // SAFETY: checked non-NULL, aligned, `n` doubles apart from the inputs.
+        unsafe { std::slice::from_raw_parts_mut(w, n) }.copy_from_slice(&weights);
+        Ok(())
+    })
+}
+
+/// The body of `so3fft_correlation_weights` for the handle type `H`.
+///
+/// # Safety
+/// As [`weights_into`], complex samples.
+pub(super) unsafe fn correlation_weights<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *mut [H::T; 2],
+    pattern: *mut [H::T; 2],
+    w: *mut c_double,
+) -> c_int {
+    let (s, h) = (complex(signal).cast_const(), complex(pattern).cast_const());
+    // SAFETY: this function's contract.
+    unsafe { weights_into(p, (s, h, false), w, |plan, (s, h)| plan.spectra(s, h)) }
+}
+
+/// The body of `so3fft_correlation_weights_real` for the handle type `H`.
+///
+/// # Safety
+/// As [`weights_into`], real samples.
+pub(super) unsafe fn correlation_weights_real<H: CorrelationHandle>(
+    p: *mut H,
+    signal: *const H::T,
+    pattern: *const H::T,
+    w: *mut c_double,
+) -> c_int {
+    // SAFETY: this function's contract.
+    unsafe {
+        weights_into(p, (signal, pattern, true), w, |plan, (s, h)| {
+            plan.spectra_real(s, h)
+        })
+    }
+}
+
+/// The body of `so3fft_correlation_degree_limit` for the handle type `H`.
+///
+/// # Safety
+/// `p` is NULL or a live plan of type `H`.
+pub(super) unsafe fn correlation_degree_limit<H: CorrelationHandle>(p: *mut H) -> c_int {
+    guarded(SO3FFT_ENULL, || {
+        // SAFETY: `p` is NULL or a live plan (this function's contract).
+        Ok(unsafe { plan_ref(p) }?.deg_lim() as c_int)
+    })
+}
+
+/// The highest degree `D` the plan combines (its weights are `w_0 .. w_D`);
+/// `SO3FFT_ENULL` for NULL.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_degree_limit(p: so3fft_correlation) -> c_int {
+    // SAFETY: `p` is NULL or a live plan (the API's contract).
+    unsafe { correlation_degree_limit(p) }
+}
+
+/// The whole matching of complex samples: the grid into `grid` (as `so3fft_correlate`), its
+/// peak refined off the grid, its uncertainty from the inputs' noise and its ratio to the
+/// next separate peak, into `*out`. `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_find(
+    p: so3fft_correlation,
+    signal: *mut so3fft_complex,
+    pattern: *mut so3fft_complex,
+    grid: *mut so3fft_complex,
+    out: *mut so3fft_match,
+) -> c_int {
+    // SAFETY: as in `so3fft_correlate`; `out` NULL or one so3fft_match (the API's contract).
+    unsafe { correlation_find(p, signal, pattern, grid, out) }
+}
+
+/// `so3fft_correlation_find` of real samples into the real grid `grid` (plan made with
+/// `SO3FFT_REAL`).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_find_real(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    grid: *mut c_double,
+    out: *mut so3fft_match,
+) -> c_int {
+    // SAFETY: as in `so3fft_correlation_find`.
+    unsafe { correlation_find_real(p, signal, pattern, grid, out) }
+}
+
+/// The degree weights `w_0 .. w_D` the plan applies to these complex inputs, into `w`
+/// (`D + 1` doubles): 1, the given ones, or (`SO3FFT_NOISE_WEIGHTS`) those estimated from
+/// them, largest 1. `SO3FFT_OK` or an error code.
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_weights(
+    p: so3fft_correlation,
+    signal: *mut so3fft_complex,
+    pattern: *mut so3fft_complex,
+    w: *mut c_double,
+) -> c_int {
+    // SAFETY: `p` NULL or a live plan, the inputs NULL or `(2L)^2` samples, `w` NULL or
+    // `D + 1` doubles (the API's contract).
+    unsafe { correlation_weights(p, signal, pattern, w) }
+}
+
+/// `so3fft_correlation_weights` of real inputs (plan made with `SO3FFT_REAL`).
+#[no_mangle]
+pub unsafe extern "C" fn so3fft_correlation_weights_real(
+    p: so3fft_correlation,
+    signal: *const c_double,
+    pattern: *const c_double,
+    w: *mut c_double,
+) -> c_int {
+    // SAFETY: as in `so3fft_correlation_weights`.
+    unsafe { correlation_weights_real(p, signal, pattern, w) }
 }

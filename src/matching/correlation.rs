@@ -637,7 +637,8 @@ impl<T: Real> Correlation<T> {
         Ok(())
     }
 
-    fn need(&self, real: bool) -> Result<()> {
+    /// An error unless the plan takes inputs of this kind (`real` or complex).
+    pub(crate) fn need(&self, real: bool) -> Result<()> {
         if real != self.real {
             return Err(Error::InvalidArgument(format!(
                 "{} correlation asked of a plan made for {} inputs",

@@ -1,5 +1,6 @@
-//! The `so3fft-match` tool: a reference correlation recovered from sample files, and bad
-//! files rejected with the file and line named and exit status 2.
+//! The `so3fft-match` tool: a reference correlation recovered from sample files, a noisy
+//! scene matched with estimated weights (the uncertainty and the peak ratio reported), and
+//! bad sample or weight files rejected with the file and line named and exit status 2.
 
 #[path = "../../tests/common/mod.rs"]
 mod common;
@@ -93,4 +94,141 @@ fn bad_files_are_named_with_their_line() {
     for f in [good, short, text, nan] {
         std::fs::remove_file(f).unwrap();
     }
+}
+
+/// The number after `key` on the output line starting with `line`.
+fn number_after(out: &str, line: &str, key: &str) -> f64 {
+    let l = out
+        .lines()
+        .find(|l| l.starts_with(line))
+        .unwrap_or_else(|| panic!("no line '{line}' in: {out}"));
+    let rest = &l[l.find(key).unwrap_or_else(|| panic!("no '{key}' in: {l}")) + key.len()..];
+    let word = rest.split_whitespace().next().unwrap();
+    word.trim_end_matches(',').parse().unwrap()
+}
+
+/// A noisy scene with a known rotation, matched with estimated weights: the refined
+/// rotation within a few sigma of the truth, and the uncertainty, peak ratio, noise floors
+/// and weighted degrees reported; uniform and file weights too.
+#[test]
+fn noisy_scene_with_weights() {
+    let b = 16;
+    let scene = so3fft::matching::scene::vmf_scene(b, 7, 0.3);
+    let sig = write("scene.sig", &scene.signal);
+    let pat = write("scene.pat", &scene.pattern);
+    let (code, out, err) = run(&[
+        sig.as_os_str(),
+        pat.as_os_str(),
+        "--weights".as_ref(),
+        "auto".as_ref(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for needle in [
+        "grid peak:",
+        "refined peak:",
+        "sigma = ",
+        "peak ratio:",
+        "noise floor:",
+        "weights:      auto; highest degree weighted",
+    ] {
+        assert!(out.contains(needle), "expected '{needle}' in: {out}");
+    }
+    let angle = |name: &str| number_after(&out, "refined peak:", name);
+    let found = so3fft::matching::Rotation::new(angle("alpha "), angle("beta "), angle("gamma "));
+    let sigma = number_after(&out, "uncertainty:", "(");
+    let error = found.angle_to(&scene.rotation);
+    assert!(
+        sigma > 0.0 && error < 5.0 * sigma,
+        "error {error} rad, sigma {sigma}: {out}"
+    );
+    assert!(
+        number_after(&out, "peak ratio:", "peak ratio:") > 1.0,
+        "{out}"
+    );
+    assert!(number_after(&out, "noise floor:", "signal ") > 0.0, "{out}");
+
+    // Uniform weights, and a file of weights for degrees 0..=9.
+    let (code, out, err) = run(&[sig.as_os_str(), pat.as_os_str()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("weights:      uniform") && out.contains("sigma = "),
+        "{out}"
+    );
+    let weights: Vec<f64> = (0..10).map(|l| 1.0 / (1.0 + l as f64)).collect();
+    let wfile = write("weights", &weights);
+    let (code, out, err) = run(&[
+        sig.as_os_str(),
+        pat.as_os_str(),
+        "--weights".as_ref(),
+        wfile.as_os_str(),
+        "--degree-limit".as_ref(),
+        "9".as_ref(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("degrees 0..=9"), "{out}");
+    assert!(
+        out.contains("highest degree weighted >= 0.1 of the largest: 9 (of 9)"),
+        "{out}"
+    );
+    for f in [sig, pat, wfile] {
+        std::fs::remove_file(f).unwrap();
+    }
+}
+
+#[test]
+fn bad_weight_files_exit_with_status_2() {
+    let good = write("wgood", &[0.5; 64]);
+    let path = |name: &str| {
+        let file = format!("so3fft-match-{}-weights-{name}", std::process::id());
+        std::env::temp_dir().join(file)
+    };
+    // B = 4: weights w_0 .. w_3 by default.
+    let cases = [
+        ("count", "1\n1\n1\n", "3 weights, need 4".to_string()),
+        (
+            "negative",
+            "1\n-0.5\n1\n1\n",
+            ":2: weight '-0.5'".to_string(),
+        ),
+        ("nan", "1\n1\nNaN\n1\n", ":3: weight 'NaN'".to_string()),
+        (
+            "text",
+            "1\nheavy\n1\n1\n",
+            ":2: not a number: 'heavy'".to_string(),
+        ),
+        ("zero", "0\n0\n0\n0\n", "every weight is 0".to_string()),
+    ];
+    for (name, text, needle) in &cases {
+        let file = path(name);
+        std::fs::write(&file, text).unwrap();
+        let (code, _, err) = run(&[
+            good.as_os_str(),
+            good.as_os_str(),
+            "--weights".as_ref(),
+            file.as_os_str(),
+        ]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(needle.as_str()),
+            "{name}: expected '{needle}' in: {err}"
+        );
+        std::fs::remove_file(file).unwrap();
+    }
+    // A missing file, and a degree limit the bandwidth does not have.
+    let (code, _, err) = run(&[
+        good.as_os_str(),
+        good.as_os_str(),
+        "--weights".as_ref(),
+        path("missing").as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run(&[
+        good.as_os_str(),
+        good.as_os_str(),
+        "--degree-limit".as_ref(),
+        "4".as_ref(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("degree limit 4"), "{err}");
+    std::fs::remove_file(good).unwrap();
 }
