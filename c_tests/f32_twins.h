@@ -5,10 +5,38 @@
 #define SO3FFT_C_TESTS_F32_TWINS_H
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
 #define SENTINEL_F 1234.5f
+/* Guard values behind each array the allocators below return. */
+#define GUARD 8
+
+/* n complex floats and GUARD guard values behind them (exit on failure). */
+static inline so3fftf_complex *alloc_cf(size_t n) {
+    so3fftf_complex *p = (so3fftf_complex *)malloc((n + GUARD) * sizeof(so3fftf_complex));
+    size_t i;
+    if (!p) exit(EXIT_FAILURE);
+    for (i = n; i < n + GUARD; i++) p[i][0] = p[i][1] = SENTINEL_F;
+    return p;
+}
+
+/* n floats and GUARD guard values behind them. */
+static inline float *alloc_f(size_t n) {
+    float *p = (float *)malloc((n + GUARD) * sizeof(float));
+    size_t i;
+    if (!p) exit(EXIT_FAILURE);
+    for (i = n; i < n + GUARD; i++) p[i] = SENTINEL_F;
+    return p;
+}
+
+/* n doubles. */
+static inline double *alloc_d(size_t n) {
+    double *p = (double *)malloc(n * sizeof(double));
+    if (!p) exit(EXIT_FAILURE);
+    return p;
+}
 
 /* ||a - b|| / ||b|| over n values of a float array and a double array (NaN propagates). */
 static inline double rel_f_d(const float *a, const double *b, size_t n) {

@@ -16,24 +16,6 @@
 /* Tolerance of a single-precision result, relative L2 (docs/precision.md). */
 static const double TOL = 1e-5;
 
-static so3fftf_complex *alloc_cf(size_t n) {
-    so3fftf_complex *p = (so3fftf_complex *)malloc(n * sizeof(so3fftf_complex));
-    if (!p) exit(EXIT_FAILURE);
-    return p;
-}
-
-static float *alloc_f(size_t n) {
-    float *p = (float *)malloc(n * sizeof(float));
-    if (!p) exit(EXIT_FAILURE);
-    return p;
-}
-
-static double *alloc_d(size_t n) {
-    double *p = (double *)malloc(n * sizeof(double));
-    if (!p) exit(EXIT_FAILURE);
-    return p;
-}
-
 /* Random coefficients in float, and the same values in double. */
 static void random_coeffs(so3fftf_complex *c, so3fft_complex *d, size_t n, unsigned long long seed) {
     size_t i;

@@ -18,22 +18,6 @@
 static const double AGREE = 1e-6;
 /* A refined rotation from the float plan against the double plan's, per angle (radians). */
 static const double REFINE = 1e-8;
-/* Guard values behind each float array. */
-#define GUARD 8
-
-static float *alloc_f(size_t n) {
-    float *p = (float *)malloc((n + GUARD) * sizeof(float));
-    size_t i;
-    if (!p) exit(EXIT_FAILURE);
-    for (i = n; i < n + GUARD; i++) p[i] = SENTINEL_F;
-    return p;
-}
-
-static double *alloc_d(size_t n) {
-    double *p = (double *)malloc(n * sizeof(double));
-    if (!p) exit(EXIT_FAILURE);
-    return p;
-}
 
 /* Largest |a - b| over n doubles. */
 static double max_diff(const double *a, const double *b, size_t n) {

@@ -20,30 +20,6 @@
 static const double TOL = 1e-5;
 /* Single against double precision on the same data, relative L2. */
 static const double AGREE = 5e-6;
-/* Guard values behind each array. */
-#define GUARD 8
-
-static so3fftf_complex *alloc_cf(size_t n) {
-    so3fftf_complex *p = (so3fftf_complex *)malloc((n + GUARD) * sizeof(so3fftf_complex));
-    size_t i;
-    if (!p) exit(EXIT_FAILURE);
-    for (i = n; i < n + GUARD; i++) p[i][0] = p[i][1] = SENTINEL_F;
-    return p;
-}
-
-static float *alloc_f(size_t n) {
-    float *p = (float *)malloc((n + GUARD) * sizeof(float));
-    size_t i;
-    if (!p) exit(EXIT_FAILURE);
-    for (i = n; i < n + GUARD; i++) p[i] = SENTINEL_F;
-    return p;
-}
-
-static double *alloc_d(size_t n) {
-    double *p = (double *)malloc(n * sizeof(double));
-    if (!p) exit(EXIT_FAILURE);
-    return p;
-}
 
 /* The guard values behind an array of n complex floats are intact. */
 static int guard_cf(so3fftf_complex *a, size_t n) { return untouched_f(&a[n][0], 2 * GUARD); }

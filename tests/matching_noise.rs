@@ -130,9 +130,9 @@ fn noise_floor_of_white_noise() {
             "floor {floor:e}, expected {expected:e}"
         );
     }
-    // Noise alone: the weights find no degree worth more than the noise (all uniform by
-    // convention, or none standing out).
-    assert_eq!(sp.weights.len(), b);
+    // Noise alone: no degree stands out of the noise, and weights without signal are
+    // uniform by convention.
+    assert_eq!(sp.weights, vec![1.0; b]);
     // A smooth scene under the same noise: the low degrees keep their clean power.
     let noisy = vmf_scene(b, 3, 1.0);
     let clean = vmf_scene(b, 3, 0.0);

@@ -335,17 +335,20 @@ impl<T: Real> Correlation<T> {
         forward(signal, &mut buf.sig)?;
         forward(pattern, &mut buf.pat)?;
         let from = usize::from(self.normalized);
-        let degree_weights = match &self.weights {
-            DegreeWeights::Uniform => vec![1.0; self.deg_lim + 1],
-            DegreeWeights::Given(w) => w.clone(),
+        // The automatic weights' estimate has the degree powers the norms need.
+        let (degree_weights, powers) = match &self.weights {
+            DegreeWeights::Uniform => (vec![1.0; self.deg_lim + 1], None),
+            DegreeWeights::Given(w) => (w.clone(), None),
             DegreeWeights::Automatic => {
-                Spectra::estimate((&buf.sig, &buf.pat), self.b_in, self.deg_lim, &self.weights)
-                    .weights
+                let s =
+                    Spectra::estimate((&buf.sig, &buf.pat), self.b_in, self.deg_lim, &self.weights);
+                (s.weights, Some([s.signal_power, s.pattern_power]))
             }
         };
         if self.normalized {
-            for (norm, c) in norms.iter_mut().zip([&buf.sig, &buf.pat]) {
-                let powers = degree_powers(c, self.b_in);
+            let powers =
+                powers.unwrap_or_else(|| [&buf.sig, &buf.pat].map(|c| degree_powers(c, self.b_in)));
+            for (norm, powers) in norms.iter_mut().zip(powers) {
                 let sq: f64 = (from..=self.deg_lim)
                     .map(|l| degree_weights[l] * powers[l])
                     .sum();

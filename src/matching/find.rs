@@ -49,7 +49,7 @@ impl<T: Real> Correlation<T> {
         let spectra = self.coefficients_spectra((signal, pattern), &mut coeffs)?;
         let separation = separation(&spectra.weights);
         let others = top_peaks(self.b_out(), grid, 2, separation);
-        self.finish(best, &others, (&coeffs, spectra))
+        self.finish((best, &others, separation), (&coeffs, spectra))
     }
 
     /// [`Correlation::find`] of real samples.
@@ -59,18 +59,16 @@ impl<T: Real> Correlation<T> {
         let spectra = self.coefficients_spectra_real((signal, pattern), &mut coeffs)?;
         let separation = separation(&spectra.weights);
         let others = top_peaks_real(self.b_out(), grid, 2, separation);
-        self.finish(best, &others, (&coeffs, spectra))
+        self.finish((best, &others, separation), (&coeffs, spectra))
     }
 
-    /// Refines the best grid peak and the next separate one of `peaks`, and assesses the
-    /// best.
+    /// Refines the best grid peak and the next one of `peaks` at least `separation` from
+    /// it, and assesses the best.
     fn finish(
         &self,
-        best: Peak,
-        peaks: &[Peak],
+        (best, peaks, separation): (Peak, &[Peak], f64),
         (coeffs, spectra): (&[Complex64], Spectra),
     ) -> Result<Match> {
-        let separation = separation(&spectra.weights);
         let start = best.rotation();
         // The next peak: the first of the top two not within the separation of the best.
         let next = peaks

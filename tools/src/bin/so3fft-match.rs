@@ -14,8 +14,9 @@ use so3fft::Complex64;
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Reads a sample file: the numbers, or a message naming the file and the line.
-fn read_samples(path: &str) -> Result<Vec<f64>, String> {
+/// The numbers of a file, one per non-empty line, each with its line number and text; a
+/// message naming the file and the line for text that is not a number.
+fn read_numbers(path: &str) -> Result<Vec<(usize, f64, String)>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -26,35 +27,40 @@ fn read_samples(path: &str) -> Result<Vec<f64>, String> {
         let v: f64 = t
             .parse()
             .map_err(|_| format!("{path}:{}: not a number: '{t}'", i + 1))?;
-        if !v.is_finite() {
-            return Err(format!("{path}:{}: not a finite number: '{t}'", i + 1));
-        }
-        out.push(v);
+        out.push((i + 1, v, t.to_string()));
     }
     Ok(out)
+}
+
+/// Reads a sample file: the numbers, or a message naming the file and the line.
+fn read_samples(path: &str) -> Result<Vec<f64>, String> {
+    read_numbers(path)?
+        .into_iter()
+        .map(|(line, v, t)| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!("{path}:{line}: not a finite number: '{t}'"))
+            }
+        })
+        .collect()
 }
 
 /// Reads a weight file: `count` weights `w_0 ..` one per line, finite, `>= 0` and not all
 /// 0, or a message naming the file (and the line).
 fn read_weights(path: &str, count: usize) -> Result<Vec<f64>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
-    let mut out = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.is_empty() {
-            continue;
-        }
-        let v: f64 = t
-            .parse()
-            .map_err(|_| format!("{path}:{}: not a number: '{t}'", i + 1))?;
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(format!(
-                "{path}:{}: weight '{t}': weights must be finite and >= 0",
-                i + 1
-            ));
-        }
-        out.push(v);
-    }
+    let out: Vec<f64> = read_numbers(path)?
+        .into_iter()
+        .map(|(line, v, t)| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(format!(
+                    "{path}:{line}: weight '{t}': weights must be finite and >= 0"
+                ))
+            }
+        })
+        .collect::<Result<_, _>>()?;
     if out.len() != count {
         return Err(format!(
             "{path}: {} weights, need {count} (w_0 .. w_{}, one per line; see --degree-limit)",
